@@ -1,0 +1,138 @@
+"""The ``mindgrasp`` command line: ``mindgrasp <command> [<verb>] ...``, in the manner of ``ros2``.
+
+Each command lives in a module that defines ``add_arguments(parser)`` and ``main(args) -> int``.
+Commands with verbs (``bag record``, ``train classifier``) map each verb to such a module, possibly
+in another package (``train classifier`` is :mod:`mindgrasp_classifier.train_cli`). Modules are
+imported only when their command runs, so ``mindgrasp --help`` stays fast and one broken package
+does not break the others.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import importlib.util
+import sys
+from collections.abc import Sequence
+
+#: command -> module, or command -> {verb: module}
+COMMANDS: dict[str, str | dict[str, str]] = {
+    'launch': 'mindgrasp_bringup.commands.launch',
+    'bag': {
+        'record': 'mindgrasp_bringup.commands.bag_record',
+        'play': 'mindgrasp_bringup.commands.bag_play',
+        'info': 'mindgrasp_bringup.commands.bag_info',
+    },
+    'topic': {
+        'list': 'mindgrasp_bringup.commands.topic_list',
+        'echo': 'mindgrasp_bringup.commands.topic_echo',
+        'hz': 'mindgrasp_bringup.commands.topic_hz',
+        'info': 'mindgrasp_bringup.commands.topic_info',
+        'pub': 'mindgrasp_bringup.commands.topic_pub',
+    },
+    'node': {
+        'list': 'mindgrasp_bringup.commands.node_list',
+        'info': 'mindgrasp_bringup.commands.node_info',
+    },
+    'param': {
+        'list': 'mindgrasp_bringup.commands.param_list',
+        'get': 'mindgrasp_bringup.commands.param_get',
+        'set': 'mindgrasp_bringup.commands.param_set',
+    },
+    'eeg': {
+        'virtual-amp': 'mindgrasp_eeg.virtual_amp_cli',
+        'play': 'mindgrasp_eeg.player_cli',
+    },
+    'train': {
+        'classifier': 'mindgrasp_classifier.train_cli',
+        'vision': 'mindgrasp_vision.train_cli',
+    },
+    'evaluate': {
+        'classifier': 'mindgrasp_classifier.evaluate_cli',
+    },
+    'experiment': {
+        'random-locations': 'mindgrasp_bringup.commands.experiment_random_locations',
+    },
+    'export': {
+        'eeg': 'mindgrasp_eeg.export_cli',
+    },
+}
+
+
+def _module_doc(module_name: str) -> str:
+    """First docstring line of a command module, without importing heavy packages on --help."""
+    try:
+        spec = importlib.util.find_spec(module_name)
+    except (ImportError, ValueError):
+        spec = None
+    if spec is None or spec.origin is None:
+        return '(not installed)'
+    import ast
+
+    try:
+        with open(spec.origin, encoding='utf-8') as f:
+            doc = ast.get_docstring(ast.parse(f.read())) or ''
+    except (OSError, SyntaxError):
+        return ''
+    return doc.strip().splitlines()[0] if doc.strip() else ''
+
+
+def _add_command(subparsers: argparse._SubParsersAction, name: str, module_name: str) -> None:
+    parser = subparsers.add_parser(name, help=_module_doc(module_name),
+                                   description=_module_doc(module_name))
+    parser.set_defaults(_module=module_name)
+    module = _import(module_name)
+    if module is not None:
+        module.add_arguments(parser)
+
+
+def _import(module_name: str):  # noqa: ANN202 - returns a module
+    try:
+        return importlib.import_module(module_name)
+    except ModuleNotFoundError as exc:
+        if exc.name and module_name.startswith(exc.name):
+            return None
+        raise
+
+
+def build_parser(argv: Sequence[str]) -> argparse.ArgumentParser:
+    """Build the parser; only the command named in ``argv`` imports its module."""
+    parser = argparse.ArgumentParser(
+        prog='mindgrasp',
+        description='MIndGrasp-ROS: motor-imagery EEG control of an assistive arm on ROS 2.')
+    sub = parser.add_subparsers(dest='command', metavar='<command>')
+    chosen = argv[0] if argv else None
+    for command, target in COMMANDS.items():
+        if isinstance(target, str):
+            if command == chosen:
+                _add_command(sub, command, target)
+            else:
+                sub.add_parser(command, help=_module_doc(target))
+            continue
+        cmd_parser = sub.add_parser(command, help=f'{command} verbs: ' + ', '.join(target))
+        verbs = cmd_parser.add_subparsers(dest='verb', metavar='<verb>')
+        for verb, module_name in target.items():
+            if command == chosen and len(argv) > 1 and argv[1] == verb:
+                _add_command(verbs, verb, module_name)
+            else:
+                verbs.add_parser(verb, help=_module_doc(module_name))
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of the ``mindgrasp`` console script."""
+    argv = list(sys.argv[1:] if argv is None else argv)
+    parser = build_parser(argv)
+    args = parser.parse_args(argv)
+    module_name = getattr(args, '_module', None)
+    if module_name is None:
+        parser.print_help()
+        return 0 if not argv else 2
+    module = _import(module_name)
+    if module is None:
+        print(f'mindgrasp: the command module {module_name!r} is not installed.', file=sys.stderr)
+        return 2
+    try:
+        return int(module.main(args) or 0)
+    except KeyboardInterrupt:
+        return 130

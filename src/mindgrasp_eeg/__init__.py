@@ -1,0 +1,1 @@
+"""mindgrasp_eeg."""
