@@ -1,0 +1,430 @@
+"""Type support: the message/service registry, rclpy-like message classes and CDR (de)serialisation.
+
+One typestore holds every type the runtime knows: ROS 2 Jazzy's common_interfaces (from the
+``rosbags`` Jazzy store), the service types the runtime serves (rcl_interfaces parameter services,
+std_srvs), and ``mindgrasp_msgs`` registered from its own ``msg/*.msg`` and ``srv/*.srv`` files, so
+the interface package is the one source of truth.
+
+Message classes behave like rclpy's generated classes: keyword construction with ROS defaults,
+numeric sequences as numpy arrays, ``get_fields_and_field_types()``. Serialisation uses ``rosbags``'
+generated numpy CDR code (XCDR1, little endian), which reads attributes by name, so our classes
+are passed to it directly and it constructs our classes when deserialising.
+"""
+
+from __future__ import annotations
+
+import functools
+import hashlib
+import json
+import keyword
+import threading
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from rosbags.typesys import Stores, get_typestore
+from rosbags.typesys.base import Nodetype
+from rosbags.typesys.msg import get_types_from_msg
+from rosbags.typesys.store import Typestore
+
+from mindgrasp_ros.errors import RosError
+
+__all__ = [
+    'MessageTypeError',
+    'deserialize',
+    'get_message_class',
+    'get_service_class',
+    'rihs01',
+    'serialize',
+    'type_name_of',
+    'typestore',
+]
+
+
+class MessageTypeError(RosError):
+    """An unknown message type, or a message of the wrong class."""
+
+
+_DATA_DIR = Path(__file__).resolve().parent / 'interface_data'
+
+_NUMPY_DTYPES = {
+    'bool': np.bool_, 'byte': np.uint8, 'char': np.uint8, 'int8': np.int8, 'uint8': np.uint8,
+    'int16': np.int16, 'uint16': np.uint16, 'int32': np.int32, 'uint32': np.uint32,
+    'int64': np.int64, 'uint64': np.uint64, 'float32': np.float32, 'float64': np.float64,
+}
+_PY_DEFAULTS = {'bool': False, 'float32': 0.0, 'float64': 0.0, 'string': ''}
+
+#: Field defaults that ROS .msg files declare but rosbags' field definitions do not carry.
+_FIELD_DEFAULTS: dict[str, dict[str, Any]] = {
+    'geometry_msgs/msg/Quaternion': {'w': 1.0},
+}
+
+#: Service types the runtime needs beyond the rosbags store (which has no srv types).
+_EXTRA_SERVICE_FILES = ('rcl_interfaces', 'std_srvs')
+
+_lock = threading.RLock()
+
+
+def _split_srv(text: str) -> tuple[str, str]:
+    lines = text.splitlines()
+    for i, line in enumerate(lines):
+        if line.strip() == '---':
+            return '\n'.join(lines[:i]), '\n'.join(lines[i + 1:])
+    msg = 'A .srv definition needs a line "---" between request and response.'
+    raise MessageTypeError(msg)
+
+
+def _register_srv(store: Typestore, package: str, name: str, text: str) -> None:
+    request, response = _split_srv(text)
+    for part, body in (('Request', request), ('Response', response)):
+        # Parse under a msg name (the parser resolves relative names against the package),
+        # then register under the srv name.
+        parsed = get_types_from_msg(body, f'{package}/msg/{name}_{part}')
+        store.register({f'{package}/srv/{name}_{part}': v for v in parsed.values()})
+
+
+def _register_interface_dir(store: Typestore, package: str, folder: Path) -> None:
+    msg_dir = folder / 'msg'
+    pending: dict[str, str] = {}
+    if msg_dir.is_dir():
+        for path in sorted(msg_dir.glob('*.msg')):
+            pending[f'{package}/msg/{path.stem}'] = path.read_text(encoding='utf-8')
+    types: dict[str, Any] = {}
+    for name, text in pending.items():
+        types.update(get_types_from_msg(text, name))
+    if types:
+        store.register(types)
+    srv_dir = folder / 'srv'
+    if srv_dir.is_dir():
+        for path in sorted(srv_dir.glob('*.srv')):
+            _register_srv(store, package, path.stem, path.read_text(encoding='utf-8'))
+
+
+@functools.cache
+def typestore() -> Typestore:
+    """The process-wide typestore: Jazzy common_interfaces, service types and mindgrasp_msgs.
+
+    Message classes of this store are this module's rclpy-like classes, so
+    ``typestore().deserialize_cdr(raw, 'sensor_msgs/msg/JointState')`` returns one of them.
+    Bag tools use the same store to read and write rosbag2 files.
+    """
+    import mindgrasp_msgs
+
+    store = get_typestore(Stores.ROS2_JAZZY)
+    # A copy of the types table: we replace the classes below, never the shared store's.
+    store.types = dict(store.types)
+    store.cache = {}
+    for package in _EXTRA_SERVICE_FILES:
+        _register_interface_dir(store, package, _DATA_DIR / package)
+    _register_interface_dir(store, 'mindgrasp_msgs', mindgrasp_msgs.INTERFACE_DIR)
+    for name in list(store.fielddefs):
+        store.types[name] = _make_message_class(store, name)
+    return store
+
+
+# --------------------------------------------------------------------------- message classes
+
+
+def _field_default_factory(store: Typestore, desc: tuple) -> Any:  # noqa: ANN401
+    kind, detail = desc
+    if kind == Nodetype.BASE:
+        base, _bound = detail
+        if base in _PY_DEFAULTS:
+            return lambda: _PY_DEFAULTS[base]
+        return lambda: 0
+    if kind == Nodetype.NAME:
+        return lambda: get_message_class(detail)()
+    (sub_kind, sub_detail), count = detail
+    if sub_kind == Nodetype.BASE and sub_detail[0] in _NUMPY_DTYPES:
+        dtype = _NUMPY_DTYPES[sub_detail[0]]
+        n = count if kind == Nodetype.ARRAY else 0
+        return lambda: np.zeros(n, dtype=dtype)
+    if kind == Nodetype.ARRAY:
+        if sub_kind == Nodetype.BASE:
+            return lambda: [''] * count
+        return lambda: [get_message_class(sub_detail)() for _ in range(count)]
+    return list
+
+
+def _numeric_dtype(desc: tuple) -> tuple[Any, int | None] | None:
+    """(dtype, fixed length or None) for numeric array/sequence fields, else None."""
+    kind, detail = desc
+    if kind not in (Nodetype.ARRAY, Nodetype.SEQUENCE):
+        return None
+    (sub_kind, sub_detail), count = detail
+    if sub_kind != Nodetype.BASE or sub_detail[0] not in _NUMPY_DTYPES:
+        return None
+    return _NUMPY_DTYPES[sub_detail[0]], (count if kind == Nodetype.ARRAY else None)
+
+
+def _ros_type_string(desc: tuple) -> str:
+    kind, detail = desc
+    if kind == Nodetype.BASE:
+        base, bound = detail
+        return f'{base}<={bound}' if bound else base
+    if kind == Nodetype.NAME:
+        return detail.replace('/msg/', '/')
+    (sub, count) = detail
+    inner = _ros_type_string(sub)
+    if kind == Nodetype.ARRAY:
+        return f'{inner}[{count}]'
+    return f'sequence<{inner}, {count}>' if count else f'sequence<{inner}>'
+
+
+class Message:
+    """Base class of runtime message classes (rclpy-like, see module docstring)."""
+
+    __slots__ = ()
+    __msgtype__: str = ''
+    _fields: tuple[str, ...] = ()
+    _defaults: tuple = ()
+    _numeric: dict[str, tuple[Any, int | None]] = {}
+    _fields_and_field_types: dict[str, str] = {}
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:  # noqa: ANN401
+        if len(args) > len(self._fields):
+            msg = f'{self.__msgtype__} takes at most {len(self._fields)} positional fields.'
+            raise TypeError(msg)
+        if args and not kwargs and len(args) == len(self._fields):
+            # Fast path used by the deserialiser: values arrive complete and typed.
+            for name, value in zip(self._fields, args, strict=True):
+                object.__setattr__(self, name, value)
+            return
+        values = dict(zip(self._fields, args, strict=False))
+        for key, value in kwargs.items():
+            if key not in self._fields_and_field_types:
+                msg = (f'{self.__msgtype__} has no field {key!r}; its fields are: '
+                       f'{", ".join(self._fields)}.')
+                raise TypeError(msg)
+            values[key] = value
+        for name, factory in zip(self._fields, self._defaults, strict=True):
+            if name in values:
+                setattr(self, name, values[name])
+            else:
+                object.__setattr__(self, name, factory())
+
+    def __setattr__(self, name: str, value: Any) -> None:  # noqa: ANN401
+        spec = self._numeric.get(name)
+        if spec is not None:
+            value = _as_array(self.__msgtype__, name, value, *spec)
+        object.__setattr__(self, name, value)
+
+    @classmethod
+    def get_fields_and_field_types(cls) -> dict[str, str]:
+        """Field names and ROS IDL types, like rclpy's generated classes."""
+        return dict(cls._fields_and_field_types)
+
+    def __eq__(self, other: object) -> bool:
+        if type(other) is not type(self):
+            return NotImplemented
+        for name in self._fields:
+            a, b = getattr(self, name), getattr(other, name)
+            if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
+                if not np.array_equal(np.asarray(a), np.asarray(b)):
+                    return False
+            elif a != b:
+                return False
+        return True
+
+    __hash__ = None  # mutable, like rclpy messages
+
+    def __repr__(self) -> str:
+        parts = []
+        for name in self._fields:
+            value = getattr(self, name)
+            if isinstance(value, np.ndarray) and value.size > 16:
+                text = f'array(shape={value.shape}, dtype={value.dtype})'
+            else:
+                text = repr(value)
+            parts.append(f'{name}={text}')
+        return f'{type(self).__module__}.{type(self).__qualname__}({", ".join(parts)})'
+
+
+def _as_array(typename: str, field: str, value: Any, dtype: Any,  # noqa: ANN401
+              length: int | None) -> np.ndarray:
+    if isinstance(value, np.ndarray) and value.dtype == dtype and value.ndim == 1:
+        arr = value
+    elif isinstance(value, (bytes, bytearray, memoryview)) and dtype == np.uint8:
+        arr = np.frombuffer(value, dtype=np.uint8)
+    else:
+        try:
+            arr = np.asarray(value, dtype=dtype)
+        except (TypeError, ValueError) as exc:
+            msg = f'{typename}.{field} must be a sequence of {np.dtype(dtype).name}: {exc}'
+            raise TypeError(msg) from None
+        if arr.ndim != 1:
+            arr = arr.reshape(-1)
+    if length is not None and arr.shape[0] != length:
+        msg = f'{typename}.{field} must have exactly {length} elements, not {arr.shape[0]}.'
+        raise ValueError(msg)
+    return arr
+
+
+def _make_message_class(store: Typestore, typename: str) -> type[Message]:
+    consts, fields = store.fielddefs[typename]
+    package, kind, name = typename.split('/')
+    field_names = tuple(_normalize(f) for f, _ in fields)
+    defaults = []
+    extra = _FIELD_DEFAULTS.get(typename, {})
+    for fname, desc in fields:
+        if fname in extra:
+            defaults.append(functools.partial(lambda v: v, extra[fname]))
+        else:
+            defaults.append(_field_default_factory(store, desc))
+    namespace: dict[str, Any] = {
+        '__slots__': field_names,
+        '__msgtype__': typename,
+        '__module__': f'{package}.{kind}',
+        '__qualname__': name,
+        '_fields': field_names,
+        '_defaults': tuple(defaults),
+        '_numeric': {_normalize(f): spec for f, d in fields if (spec := _numeric_dtype(d))},
+        '_fields_and_field_types': {_normalize(f): _ros_type_string(d) for f, d in fields},
+    }
+    for cname, _ctype, value in consts:
+        namespace[cname] = value
+    return type(name, (Message,), namespace)
+
+
+def _normalize(name: str) -> str:
+    return f'{name}_' if keyword.iskeyword(name) else name
+
+
+class Service:
+    """Base class of runtime service classes: ``Srv.Request`` and ``Srv.Response``."""
+
+    __srvtype__: str = ''
+    Request: type[Message]
+    Response: type[Message]
+
+
+@functools.cache
+def get_service_class(srvtype: str) -> type[Service]:
+    """The service class of ``'pkg/srv/Name'`` (``Request`` and ``Response`` attributes)."""
+    store = typestore()
+    req, res = f'{srvtype}_Request', f'{srvtype}_Response'
+    if req not in store.types or res not in store.types:
+        raise MessageTypeError(_unknown_type_message(srvtype, 'srv'))
+    package, _, name = srvtype.split('/')
+    return type(name, (Service,), {
+        '__srvtype__': srvtype, '__module__': f'{package}.srv', '__qualname__': name,
+        'Request': store.types[req], 'Response': store.types[res],
+    })
+
+
+def _unknown_type_message(typename: str, kind: str) -> str:
+    store = typestore()
+    package = typename.split('/')[0]
+    known = sorted({n.split('/')[0] for n in store.fielddefs})
+    same = sorted(n.rsplit('/', 1)[-1] for n in store.fielddefs
+                  if n.startswith(f'{package}/{kind}/'))
+    hint = (f' Known {package} {kind} types: {", ".join(same)}.' if same
+            else f' Known packages: {", ".join(known)}.')
+    return (f'Unknown {kind} type {typename!r}.{hint} Custom types belong in '
+            f'src/mindgrasp_msgs/{kind}/ (registered at start-up).')
+
+
+def get_message_class(typename: str) -> type[Message]:
+    """The message class of ``'pkg/msg/Name'`` (``'pkg/Name'`` is accepted too)."""
+    typename = normalize_type_name(typename)
+    store = typestore()
+    try:
+        return store.types[typename]  # type: ignore[return-value]
+    except KeyError:
+        raise MessageTypeError(_unknown_type_message(typename, 'msg')) from None
+
+
+def normalize_type_name(typename: str) -> str:
+    """``'pkg/Name'`` -> ``'pkg/msg/Name'``; ``'pkg/msg/Name'`` unchanged."""
+    parts = typename.split('/')
+    if len(parts) == 2:
+        return f'{parts[0]}/msg/{parts[1]}'
+    if len(parts) != 3 or not all(parts):
+        msg = f'{typename!r} is not a ROS type name; write it as "package/msg/Name".'
+        raise MessageTypeError(msg)
+    return typename
+
+
+def type_name_of(msg_type: type | object) -> str:
+    """ROS type name (``'pkg/msg/Name'``) of a message class or instance, ours or rclpy's."""
+    cls = msg_type if isinstance(msg_type, type) else type(msg_type)
+    name = getattr(cls, '__msgtype__', None)
+    if name:
+        return name
+    # rclpy generated classes: module 'sensor_msgs.msg._joint_state', class 'JointState'
+    module = cls.__module__.split('.')
+    if len(module) >= 2 and module[1] in ('msg', 'srv'):
+        return f'{module[0]}/{module[1]}/{cls.__name__}'
+    msg = f'{cls!r} is not a ROS message class.'
+    raise MessageTypeError(msg)
+
+
+def serialize(msg: object, typename: str | None = None) -> bytes:
+    """CDR bytes (4-byte encapsulation header, little endian) of a message."""
+    name = typename or type_name_of(msg)
+    return bytes(typestore().serialize_cdr(msg, name, little_endian=True))
+
+
+def deserialize(data: bytes | memoryview, typename: str) -> Message:
+    """Message from CDR bytes (with the encapsulation header)."""
+    return typestore().deserialize_cdr(data, typename)  # type: ignore[return-value]
+
+
+# --------------------------------------------------------------------------- RIHS01 type hashes
+
+_TYPE_IDS = {
+    'int8': 2, 'uint8': 3, 'int16': 4, 'uint16': 5, 'int32': 6, 'uint32': 7, 'int64': 8,
+    'uint64': 9, 'float32': 10, 'float64': 11, 'float128': 12,
+    # rosidl maps .msg "char" to uint8 in type descriptions (rosbags says 13, which is wrong).
+    'char': 3, 'bool': 15, 'byte': 16, 'string': 17, 'bounded_string': 21,
+}
+
+
+@functools.cache
+def rihs01(typename: str) -> str:
+    """REP-2011 type hash ``RIHS01_<sha256>`` of a message type, as rosidl computes it."""
+    store = typestore()
+    structs: dict[str, dict] = {}
+
+    def field(name: str, desc: tuple) -> dict:
+        increment = capacity = string_capacity = 0
+        nested = ''
+        kind, detail = desc
+        if kind == Nodetype.ARRAY:
+            increment, capacity = 48, detail[1]
+            kind, detail = detail[0]
+        elif kind == Nodetype.SEQUENCE:
+            bound = detail[1]
+            increment, capacity = (96, bound) if bound else (144, 0)
+            kind, detail = detail[0]
+        if kind == Nodetype.NAME:
+            tid = increment + 1
+            nested = detail
+            struct(detail)
+        elif detail[0] == 'string' and detail[1]:
+            string_capacity = detail[1]
+            tid = increment + _TYPE_IDS['bounded_string']
+        else:
+            tid = increment + _TYPE_IDS[detail[0]]
+        return {'name': name, 'type': {'type_id': tid, 'capacity': capacity,
+                                       'string_capacity': string_capacity,
+                                       'nested_type_name': nested}}
+
+    def struct(name: str) -> dict:
+        if name not in structs:
+            fields = store.fielddefs[name][1] or [
+                ('structure_needs_at_least_one_member', (Nodetype.BASE, ('uint8', 0)))]
+            structs[name] = {'type_name': name, 'fields': [field(n, d) for n, d in fields]}
+        return structs[name]
+
+    top = struct(normalize_type_name(typename))
+    desc = {'type_description': top,
+            'referenced_type_descriptions': [v for k, v in sorted(structs.items())
+                                             if k != typename]}
+    return 'RIHS01_' + hashlib.sha256(json.dumps(desc).encode()).hexdigest()
+
+
+def message_definition(typename: str) -> str:
+    """Full ros2msg definition text with dependencies, as rosbag2 stores it in MCAP schemas."""
+    text, _digest = typestore().generate_msgdef(typename, ros_version=2)
+    return text
