@@ -1,1 +1,24 @@
-"""mindgrasp_eeg."""
+"""mindgrasp_eeg: EEG acquisition over LSL, a virtual amplifier with a virtual subject, a dataset
+player and an exporter.
+
+Layers (ROS-free unless the module name ends in ``_node``):
+
+- :mod:`~mindgrasp_eeg.montage`: the 32-channel g.Nautilus-like 10-20 montage and MI class names.
+- :mod:`~mindgrasp_eeg.synthetic`: synthetic EEG (1/f background, alpha/mu/beta rhythms, artefacts,
+  motor-imagery ERD mixed through a fixed head model), in volts.
+- :mod:`~mindgrasp_eeg.subject`: the virtual subject (modes ``noise``, ``follow``, ``pursue``).
+- :mod:`~mindgrasp_eeg.lsl`: LSL outlet (virtual amplifier) and inlet (acquisition) wrappers.
+- :mod:`~mindgrasp_eeg.quality`: NaN/flat/railed detection, drop and out-of-order counting.
+- :mod:`~mindgrasp_eeg.acquisition`: the acquisition core used by the acquisition node.
+- :mod:`~mindgrasp_eeg.virtual_amp`: synthetic generator + subject + outlet, paced by a clock.
+- :mod:`~mindgrasp_eeg.player`: streams EDF/GDF/BDF/FIF/XDF files over LSL with a marker stream.
+- :mod:`~mindgrasp_eeg.export`: rosbag2 (``/eeg/raw``, prompts, targets) -> FIF/EDF.
+- Nodes: :mod:`~mindgrasp_eeg.acquisition_node`, :mod:`~mindgrasp_eeg.virtual_amp_node`.
+"""
+
+
+class EEGError(Exception):
+    """Any problem of the EEG package; the message names the problem and the fix."""
+
+
+__all__ = ['EEGError']

@@ -1,0 +1,231 @@
+"""The virtual subject: decides which motor-imagery class is imagined at each moment.
+
+Modes (all seeded: same seed and same inputs, same decisions):
+
+``noise``
+    Never imagines anything, like the paper's unworn cap: the EEG carries no class information.
+``follow``
+    Imagines the class of each trainer prompt (``/trainer/prompt``) during the active phases
+    (default ``cue`` and ``move``), starting ``reaction_delay`` seconds after the prompt. Per
+    prompted trial it lapses (imagines nothing) with probability ``lapse_rate``; otherwise it
+    imagines the prompted class with probability ``accuracy`` and one of the three other classes
+    (uniformly) otherwise.
+``pursue``
+    Acts as a competent user of the MIndGrasp controller (see :func:`pursue_class`), from the task
+    target, the scene objects, the base joint angle and the controller state. Every
+    ``decision_period`` seconds it re-decides; the decision is right with probability ``accuracy``.
+
+Times are seconds on any monotonic clock the caller chooses (ROS time in the node).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import EEGError
+from .montage import BOTH_FEET, BOTH_HANDS, LEFT_HAND, NO_CLASS, RIGHT_HAND
+
+MODES = ('noise', 'follow', 'pursue')
+
+# FsmState constants (mindgrasp_msgs/FsmState)
+OBJECT_SEARCH, CENTER_OBJECT, INITIAL_APPROACH = 1, 2, 3
+FINAL_APPROACH, GRASP_OBJECT, RETURN_TO_START = 4, 5, 6
+
+
+@dataclass(frozen=True)
+class SceneObject:
+    """One object of the scene, in the robot base frame (x forward at joint 1 = 0, y left; m)."""
+
+    object_id: int
+    colour: str
+    shape: str
+    x: float
+    y: float
+    z: float = 0.0
+
+    @property
+    def label(self) -> str:
+        """``"<colour> <shape>"`` as in ``FsmState.object_of_interest``."""
+        return f'{self.colour} {self.shape}'
+
+
+def wrap_angle(a: float) -> float:
+    """Wrap an angle (rad) to [-pi, pi)."""
+    return (a + math.pi) % (2.0 * math.pi) - math.pi
+
+
+def find_target(objects: Sequence[SceneObject], object_id: int = -1, colour: str = '',
+                shape: str = '') -> SceneObject | None:
+    """The target object: by id when ``object_id >= 0`` and present, else by colour and shape."""
+    if object_id >= 0:
+        for obj in objects:
+            if obj.object_id == object_id:
+                return obj
+    for obj in objects:
+        if obj.colour == colour and obj.shape == shape and colour:
+            return obj
+    return None
+
+
+def pursue_class(target: SceneObject | None, base_yaw: float, fsm_state: int,
+                 object_of_interest: str = '', *, heading_tolerance: float = 0.1) -> int | None:
+    """What a competent user imagines to reach ``target`` (pure function).
+
+    Parameters
+    ----------
+    target : SceneObject or None
+        The desired object in the base frame; None (unknown target) -> rest.
+    base_yaw : float
+        Heading of the arm (rad): the base joint angle plus the arm's heading at zero; positive
+        is to the left (counter-clockwise seen from above), as the controller turns left with
+        positive joint-1 velocity.
+    fsm_state : int
+        ``FsmState.state`` (1 search, 2 centre, 3 initial approach, 4 final approach, 5 grasp,
+        6 return); 0 = unknown, treated as search.
+    object_of_interest : str
+        ``"<colour> <shape>"`` the controller is working on, empty when none.
+    heading_tolerance : float
+        Heading error (rad) under which the user considers the target centred.
+
+    Returns
+    -------
+    int or None
+        0 left hand (turn left), 1 right hand (turn right), 2 both hands (stop the search /
+        approach), 3 both feet (back away from a wrong object), None (rest: the controller is
+        autonomous or there is nothing to do).
+    """
+    if target is None or fsm_state in (FINAL_APPROACH, GRASP_OBJECT, RETURN_TO_START):
+        return None
+    wrong = bool(object_of_interest) and object_of_interest != target.label
+    if fsm_state == CENTER_OBJECT:
+        return BOTH_FEET if wrong else None
+    if fsm_state == INITIAL_APPROACH and wrong:
+        return BOTH_FEET
+    error = wrap_angle(math.atan2(target.y, target.x) - base_yaw)
+    if error > heading_tolerance:
+        return LEFT_HAND
+    if error < -heading_tolerance:
+        return RIGHT_HAND
+    return BOTH_HANDS
+
+
+class VirtualSubject:
+    """Seeded virtual BCI user (see module docstring for the modes).
+
+    Parameters
+    ----------
+    mode : {'noise', 'follow', 'pursue'}
+    accuracy : float
+        Probability (0..1) that a (non-lapsed) decision is the right class.
+    reaction_delay : float
+        Seconds from a prompt (or a pursue decision) to the start of imagery.
+    lapse_rate : float
+        Probability (0..1) that a prompted trial is not imagined at all (follow mode).
+    seed : int
+    active_phases : sequence of str
+        Prompt phases during which the prompted class is imagined (follow mode).
+    decision_period : float
+        Seconds between decisions in pursue mode.
+    heading_tolerance : float
+        See :func:`pursue_class` (rad).
+    """
+
+    def __init__(self, mode: str = 'noise', *, accuracy: float = 1.0, reaction_delay: float = 0.5,
+                 lapse_rate: float = 0.0, seed: int = 0,
+                 active_phases: Sequence[str] = ('cue', 'move'), decision_period: float = 0.5,
+                 heading_tolerance: float = 0.1) -> None:
+        if mode not in MODES:
+            msg = f'The virtual subject mode must be one of {MODES}; {mode!r} is unknown.'
+            raise EEGError(msg)
+        for name, value in (('accuracy', accuracy), ('lapse_rate', lapse_rate)):
+            if not 0.0 <= value <= 1.0:
+                msg = f'The virtual subject {name} must be within 0..1; {value} is invalid.'
+                raise EEGError(msg)
+        if reaction_delay < 0 or decision_period <= 0:
+            msg = (f'reaction_delay must be >= 0 s and decision_period > 0 s; got '
+                   f'{reaction_delay} s and {decision_period} s.')
+            raise EEGError(msg)
+        self.mode, self.accuracy, self.reaction_delay = mode, accuracy, reaction_delay
+        self.lapse_rate, self.active_phases = lapse_rate, tuple(active_phases)
+        self.decision_period, self.heading_tolerance = decision_period, heading_tolerance
+        self._rng = np.random.default_rng(seed)
+        self._schedule: list[tuple[float, int | None]] = []   # (effective time, class), sorted
+        self._current: int | None = None
+        self._trial_key: tuple[int, int] | None = None
+        self._trial_choice: int | None = None
+        self._next_decision = -math.inf
+        # pursue inputs
+        self.objects: list[SceneObject] = []
+        self.target_id, self.target_colour, self.target_shape = -1, '', ''
+        self.base_yaw, self.fsm_state, self.object_of_interest = 0.0, 0, ''
+        #: (time, asked class or None, imagined class or None) for every decision taken
+        self.decisions: list[tuple[float, int | None, int | None]] = []
+
+    # -- follow --------------------------------------------------------------------------------
+    def on_prompt(self, t: float, class_index: int, phase: str, trial: int = 0) -> None:
+        """A trainer prompt arrived at time ``t`` (s); only used in follow mode."""
+        if self.mode != 'follow':
+            return
+        asked = None if class_index == NO_CLASS or class_index > BOTH_FEET else int(class_index)
+        if asked is None or phase not in self.active_phases:
+            self._schedule_at(t + self.reaction_delay, None)
+            return
+        key = (trial, asked)
+        if key != self._trial_key:        # one decision per prompted trial (cue then move = same)
+            self._trial_key = key
+            self._trial_choice = self._choose(asked, lapse=True)
+            self.decisions.append((t, asked, self._trial_choice))
+        self._schedule_at(t + self.reaction_delay, self._trial_choice)
+
+    # -- pursue --------------------------------------------------------------------------------
+    def set_target(self, object_id: int, colour: str, shape: str) -> None:
+        """The desired object (``/task/target``)."""
+        self.target_id, self.target_colour, self.target_shape = object_id, colour, shape
+
+    def set_objects(self, objects: Sequence[SceneObject]) -> None:
+        """Scene objects in the base frame (``/sim/objects``)."""
+        self.objects = list(objects)
+
+    def set_base_yaw(self, yaw: float) -> None:
+        """Arm heading (rad), from ``/joint_states``."""
+        self.base_yaw = float(yaw)
+
+    def set_fsm(self, state: int, object_of_interest: str = '') -> None:
+        """Controller state (``/fsm/state``)."""
+        self.fsm_state, self.object_of_interest = int(state), object_of_interest
+
+    def competent_class(self) -> int | None:
+        """What a competent user would imagine now (pursue mode inputs, no errors)."""
+        target = find_target(self.objects, self.target_id, self.target_colour, self.target_shape)
+        return pursue_class(target, self.base_yaw, self.fsm_state, self.object_of_interest,
+                            heading_tolerance=self.heading_tolerance)
+
+    # -- output --------------------------------------------------------------------------------
+    def intent(self, t: float) -> int | None:
+        """Class imagined at time ``t`` (s), None for rest. Call with non-decreasing ``t``."""
+        if self.mode == 'pursue' and t >= self._next_decision:
+            self._next_decision = t + self.decision_period
+            right = self.competent_class()
+            chosen = self._choose(right, lapse=False)
+            self.decisions.append((t, right, chosen))
+            self._schedule_at(t + self.reaction_delay, chosen)
+        while self._schedule and self._schedule[0][0] <= t:
+            self._current = self._schedule.pop(0)[1]
+        return self._current
+
+    def _choose(self, right: int | None, *, lapse: bool) -> int | None:
+        if lapse and self._rng.random() < self.lapse_rate:
+            return None
+        if self._rng.random() < self.accuracy:
+            return right
+        others = [c for c in (LEFT_HAND, RIGHT_HAND, BOTH_HANDS, BOTH_FEET) if c != right]
+        return int(self._rng.choice(others))
+
+    def _schedule_at(self, t_eff: float, cls: int | None) -> None:
+        # a newer decision replaces everything scheduled after it
+        self._schedule = [(te, c) for te, c in self._schedule if te < t_eff]
+        self._schedule.append((t_eff, cls))
