@@ -74,6 +74,8 @@ class ObjectOfInterestRanker:
         self._track: _Track | None = None
         self._challenger: _Track | None = None
         self._challenger_frames = 0
+        #: counts the objects of interest chosen so far; changes whenever the choice changes
+        self.track_id = getattr(self, 'track_id', 0) + 1
 
     @staticmethod
     def focus(width: int, height: int, mi_class: int | None = None) -> tuple[float, float]:
@@ -151,5 +153,7 @@ class ObjectOfInterestRanker:
                 chosen = current
         det = detections[chosen]
         det.is_object_of_interest = True
+        if chosen != current:
+            self.track_id += 1
         self._track = _Track(det.colour, det.centre)
         return chosen
