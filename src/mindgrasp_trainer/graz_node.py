@@ -1,0 +1,167 @@
+"""Graz-BCI prompter node: publishes the cue schedule on /trainer/prompt and draws the screen.
+
+Run::
+
+    python -m mindgrasp_trainer.graz_node --ros-args -p n_trials:=40 -p seed:=1 \
+        --params-file config/params/trainer.yaml
+
+Publishes ``/trainer/prompt`` (mindgrasp_msgs/Prompt, reliable, transient local, depth 1: a late
+joiner gets the current phase) and ``/trainer/display`` (sensor_msgs/Image rgb8, when
+``display_rate`` > 0); subscribes ``/bci/prediction`` for the feedback bar. Ends by itself after
+the last trial, or after ``duration`` seconds when that is > 0.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+
+from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import MIPrediction, Prompt
+from mindgrasp_ros.interfaces.sensor_msgs.msg import Image
+
+from mindgrasp_ros import rclpy
+from mindgrasp_trainer.display import render_display
+from mindgrasp_trainer.graz import GrazProtocol, PromptSequencer
+from mindgrasp_trainer.protocol import PromptEvent, TrainerError
+
+
+def prompt_qos() -> rclpy.qos.QoSProfile:
+    """QoS of /trainer/prompt: reliable, transient local, keep last 1 (DESIGN.md topic table)."""
+    return rclpy.qos.QoSProfile(
+        depth=1,
+        history=rclpy.qos.HistoryPolicy.KEEP_LAST,
+        reliability=rclpy.qos.ReliabilityPolicy.RELIABLE,
+        durability=rclpy.qos.DurabilityPolicy.TRANSIENT_LOCAL,
+    )
+
+
+def to_msg(event: PromptEvent, stamp) -> Prompt:
+    """A mindgrasp_msgs/Prompt for ``event``, stamped with the phase onset ``stamp``."""
+    msg = Prompt(
+        paradigm=event.paradigm,
+        class_index=event.class_index,
+        class_name=event.class_name,
+        phase=event.phase,
+        trial=event.trial,
+        duration=event.duration,
+    )
+    msg.header.stamp = stamp
+    return msg
+
+
+class GrazNode(rclpy.node.Node):
+    """Publishes the Graz-BCI schedule of :class:`GrazProtocol` as it unfolds in ROS time."""
+
+    def __init__(self, **kwargs) -> None:
+        super().__init__('graz_prompter', **kwargs)
+        self.declare_parameters('', [
+            ('n_trials', 40), ('classes', [0, 1, 2, 3]), ('seed', 0),
+            ('fixation', 2.0), ('cue', 1.25), ('imagery', 2.75),
+            ('rest_min', 1.5), ('rest_max', 2.5), ('max_repeat', 0),
+            ('start_delay', 1.0), ('duration', 0.0), ('rate', 200.0),
+            ('display_rate', 10.0), ('display_width', 480), ('display_height', 360),
+            ('feedback', 'move'), ('max_certainty', 1.0),
+        ])  # fmt: skip
+        p = {name: self.get_parameter(name).value for name in (
+            'n_trials', 'classes', 'seed', 'fixation', 'cue', 'imagery', 'rest_min', 'rest_max',
+            'max_repeat', 'start_delay')}  # fmt: skip
+        self.duration = float(self.get_parameter('duration').value)
+        self.display = {
+            'width': int(self.get_parameter('display_width').value),
+            'height': int(self.get_parameter('display_height').value),
+            'feedback': str(self.get_parameter('feedback').value),
+            'max_certainty': float(self.get_parameter('max_certainty').value),
+        }
+        try:
+            self.protocol = GrazProtocol(**p)
+            self.sequencer = PromptSequencer(self.protocol.schedule())
+            render_display(None, **self.display)  # validates the display parameters
+        except TrainerError as err:
+            self.get_logger().error(str(err))
+            raise
+        self.n_trials = len(self.protocol.class_order())
+        self.prediction: tuple[int, float] | None = None
+        self.t0_ns: int | None = None
+        self.finished = False
+
+        self.prompt_pub = self.create_publisher(Prompt, '/trainer/prompt', prompt_qos())
+        self.create_subscription(MIPrediction, '/bci/prediction', self.prediction_callback, 10)
+        self.create_timer(1.0 / float(self.get_parameter('rate').value), self.tick_callback)
+        display_rate = float(self.get_parameter('display_rate').value)
+        if display_rate > 0:
+            self.display_pub = self.create_publisher(
+                Image, '/trainer/display', rclpy.qos.qos_profile_sensor_data
+            )
+            self.create_timer(1.0 / display_rate, self.display_callback)
+        self.get_logger().info(
+            f'Graz-BCI session: {self.n_trials} trials, classes {list(self.protocol.classes)}, '
+            f'seed {self.protocol.seed}, {self.protocol.total_duration():.1f} s planned.'
+        )
+
+    def prediction_callback(self, msg: MIPrediction) -> None:
+        self.prediction = (int(msg.class_index), float(msg.certainty))
+
+    def tick_callback(self) -> None:
+        if self.finished:
+            return
+        now = self.get_clock().now()
+        if now.nanoseconds == 0:  # use_sim_time and no /clock yet
+            return
+        if self.t0_ns is None:
+            self.t0_ns = now.nanoseconds
+        elapsed = (now.nanoseconds - self.t0_ns) * 1e-9
+        events = self.sequencer.due(elapsed)
+        if self.duration > 0 and elapsed >= self.duration and not self.sequencer.done:
+            events.append(self.sequencer.stop(elapsed))
+        for event in events:
+            self.prompt_pub.publish(to_msg(event, now.to_msg()))
+            late_ms = (elapsed - event.onset) * 1e3
+            if event.phase == 'cue':
+                self.get_logger().info(
+                    f'Trial {event.trial}/{self.n_trials}: cue {event.class_name} '
+                    f'(published {late_ms:.1f} ms after the planned onset).'
+                )
+            elif event.phase == 'end':
+                self.get_logger().info(f'Graz-BCI session ended after {elapsed:.1f} s.')
+                self.finished = True
+
+    def display_callback(self) -> None:
+        frame = render_display(self.sequencer.current, self.prediction, **self.display)
+        msg = Image(
+            height=frame.shape[0], width=frame.shape[1], encoding='rgb8',
+            is_bigendian=0, step=frame.shape[1] * 3, data=frame.reshape(-1),
+        )  # fmt: skip
+        msg.header.stamp = self.get_clock().now().to_msg()
+        msg.header.frame_id = 'trainer_display'
+        self.display_pub.publish(msg)
+
+
+def spin_until_finished(node: rclpy.node.Node, linger: float = 0.5) -> None:
+    """Spin until ``node.finished``, then ``linger`` s more so reliable readers get the end."""
+    while rclpy.ok() and not node.finished:
+        rclpy.spin_once(node, timeout_sec=0.1)
+    deadline = time.monotonic() + linger  # wall time: /clock may have stopped
+    while rclpy.ok() and time.monotonic() < deadline:
+        rclpy.spin_once(node, timeout_sec=0.05)
+
+
+def main(args: list[str] | None = None) -> int:
+    rclpy.init(args=args)
+    try:
+        node = GrazNode()
+    except TrainerError:
+        rclpy.shutdown()
+        return 2
+    try:
+        spin_until_finished(node)
+    except KeyboardInterrupt:
+        pass
+    finally:
+        node.destroy_node()
+        if rclpy.ok():
+            rclpy.shutdown()
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())

@@ -1,0 +1,280 @@
+"""MIndGrasp Trainer node: the training robot prompts by moving; resets; end-effector distance.
+
+Run (with the simulator's training robot up, e.g. ``mindgrasp launch trainer``)::
+
+    python -m mindgrasp_trainer.trainer_node --ros-args -p n_trials:=40 -p seed:=1
+
+Publishes ``/trainer/prompt`` (mindgrasp_msgs/Prompt, reliable, transient local, depth 1),
+``/trainer_robot/arm_controller/commands`` (std_msgs/Float64MultiArray, joint velocities, rad/s)
+and ``/trainer/ee_distance`` (std_msgs/Float64, m). Subscribes ``/trainer_robot/joint_states``,
+``/trainer_robot/ee_pose``, ``/ee_pose`` and ``/fsm/state``; calls ``/sim/reset``
+(mindgrasp_msgs/ResetSim) when the training end-effector goes below ``reset_height`` or the
+user's controller enters the grasp state. Ends by itself after ``n_trials`` or ``duration`` s.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+import sys
+import time
+
+import numpy as np
+from mindgrasp_ros.interfaces.geometry_msgs.msg import PoseStamped
+from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import FsmState, Prompt
+from mindgrasp_ros.interfaces.mindgrasp_msgs.srv import ResetSim
+from mindgrasp_ros.interfaces.sensor_msgs.msg import JointState
+from mindgrasp_ros.interfaces.std_msgs.msg import Float64, Float64MultiArray
+
+from mindgrasp_ros import rclpy
+from mindgrasp_trainer.graz_node import prompt_qos, spin_until_finished, to_msg
+from mindgrasp_trainer.protocol import CLASS_NAMES, TrainerError
+from mindgrasp_trainer.trainer import TrainerProtocol, ee_distance
+
+_PROTOCOL_PARAMS = (
+    ('n_trials', 40), ('classes', [0, 1, 2, 3]), ('seed', 0), ('balanced', True),
+    ('move_duration', 2.0), ('wait_duration', 2.0), ('turn_speed', 0.2), ('approach_speed', 0.05),
+    ('turn_joint', 0), ('approach_joint', 1), ('n_joints', 6), ('reset_height', 0.1),
+    ('grasp_state', 5), ('settle_time', 1.0), ('start_delay', 1.0), ('duration', 0.0),
+)  # fmt: skip
+
+
+def _position(msg: PoseStamped) -> np.ndarray:
+    p = msg.pose.position
+    return np.array([p.x, p.y, p.z], dtype=float)
+
+
+class TrainerNode(rclpy.node.Node):
+    """Runs :class:`TrainerProtocol` against the simulated training robot."""
+
+    def __init__(self, **kwargs) -> None:
+        super().__init__('trainer', **kwargs)
+        self.declare_parameters('', [
+            *_PROTOCOL_PARAMS, ('rate', 50.0), ('robot_timeout', 10.0), ('reset_timeout', 5.0),
+            ('reset_new_random_draw', False), ('log_file', ''),
+        ])  # fmt: skip
+        params = {name: self.get_parameter(name).value for name, _ in _PROTOCOL_PARAMS}
+        try:
+            self.protocol = TrainerProtocol(**params)
+        except TrainerError as err:
+            self.get_logger().error(str(err))
+            raise
+        self.robot_timeout = float(self.get_parameter('robot_timeout').value)
+        self.reset_timeout = float(self.get_parameter('reset_timeout').value)
+        self.log_file = str(self.get_parameter('log_file').value)
+        self.trainer_pos: np.ndarray | None = None
+        self.user_pos: np.ndarray | None = None
+        self.fsm_state: int | None = None
+        self.joint_count: int | None = None
+        self.reset_deadline: float | None = None  # wall time by which /sim/reset must answer
+        self.reset_future = None
+        self.created = time.monotonic()
+        self.finished = False
+        self.exit_code = 0
+
+        self.prompt_pub = self.create_publisher(Prompt, '/trainer/prompt', prompt_qos())
+        self.command_pub = self.create_publisher(
+            Float64MultiArray, '/trainer_robot/arm_controller/commands', 10
+        )
+        self.distance_pub = self.create_publisher(Float64, '/trainer/ee_distance', 10)
+        self.create_subscription(
+            JointState, '/trainer_robot/joint_states', self.joint_states_callback, 10
+        )
+        self.create_subscription(
+            PoseStamped, '/trainer_robot/ee_pose', self.trainer_pose_callback, 10
+        )
+        self.create_subscription(PoseStamped, '/ee_pose', self.user_pose_callback, 10)
+        fsm_qos = rclpy.qos.QoSProfile(
+            depth=1,
+            reliability=rclpy.qos.ReliabilityPolicy.RELIABLE,
+            durability=rclpy.qos.DurabilityPolicy.TRANSIENT_LOCAL,
+        )
+        self.create_subscription(FsmState, '/fsm/state', self.fsm_callback, fsm_qos)
+        self.reset_client = self.create_client(ResetSim, '/sim/reset')
+        self.create_timer(1.0 / float(self.get_parameter('rate').value), self.tick_callback)
+        self.get_logger().info(
+            f'MIndGrasp Trainer: {self.protocol.n_trials} trials of '
+            f'{self.protocol.move_duration} s move + {self.protocol.wait_duration} s wait, '
+            f'seed {self.protocol.seed}; waiting for '
+            '/trainer_robot/joint_states and /trainer_robot/ee_pose.'
+        )
+
+    # ------------------------------------------------------------------ inputs
+    def joint_states_callback(self, msg: JointState) -> None:
+        self.joint_count = len(msg.position)
+
+    def trainer_pose_callback(self, msg: PoseStamped) -> None:
+        self.trainer_pos = _position(msg)
+
+    def user_pose_callback(self, msg: PoseStamped) -> None:
+        self.user_pos = _position(msg)
+
+    def fsm_callback(self, msg: FsmState) -> None:
+        self.fsm_state = int(msg.state)
+
+    # ------------------------------------------------------------------ loop
+    def _now(self) -> float:
+        return self.get_clock().now().nanoseconds * 1e-9
+
+    def _ready(self) -> bool:
+        """True once the training robot is heard from; ends the node if it never is."""
+        if self.joint_count is not None and self.trainer_pos is not None:
+            if self.joint_count != self.protocol.n_joints:
+                self.get_logger().error(
+                    f'/trainer_robot/joint_states has {self.joint_count} joints but the trainer '
+                    f"commands {self.protocol.n_joints}; set the parameter 'n_joints' to "
+                    f'{self.joint_count} or check the remapping.'
+                )
+                self._finish(1)
+                return False
+            return True
+        if self.robot_timeout > 0 and time.monotonic() - self.created > self.robot_timeout:
+            missing = [
+                topic for topic, value in (
+                    ('/trainer_robot/joint_states', self.joint_count),
+                    ('/trainer_robot/ee_pose', self.trainer_pos),
+                ) if value is None
+            ]  # fmt: skip
+            self.get_logger().error(
+                f'No message on {" and ".join(missing)} within {self.robot_timeout:.1f} s: start '
+                'the simulator with the training robot (mindgrasp launch trainer) or remap the '
+                "topics; 'robot_timeout' sets the wait."
+            )
+            self._finish(1)
+        return False
+
+    def tick_callback(self) -> None:
+        if self.finished:
+            return
+        now = self.get_clock().now()
+        if now.nanoseconds == 0:  # use_sim_time and no /clock yet
+            return
+        t = now.nanoseconds * 1e-9
+        if self.protocol.state == 'idle':
+            if not self._ready():
+                return
+            events = self.protocol.start(t)
+            step = self.protocol.update(t, self.trainer_pos[2], self.fsm_state)
+            step.events[:0] = events
+        else:
+            z = self.trainer_pos[2] if self.trainer_pos is not None else None
+            step = self.protocol.update(t, z, self.fsm_state)
+        self._check_reset_timeout(t)
+        if self.trainer_pos is not None and self.user_pos is not None:
+            d = ee_distance(self.trainer_pos, self.user_pos)
+            self.protocol.record_distance(d)
+            self.distance_pub.publish(Float64(data=d))
+        self.command_pub.publish(Float64MultiArray(data=step.command))
+        for event in step.events:
+            self.prompt_pub.publish(to_msg(event, now.to_msg()))
+            if event.phase == 'move':
+                self.get_logger().info(
+                    f'Trial {event.trial}/{self.protocol.n_trials}: training robot shows '
+                    f'{event.class_name}.'
+                )
+            elif event.phase == 'wait':
+                tr = self.protocol.trial
+                self.get_logger().info(
+                    f'Trial {event.trial}: end-effector distance {tr.final_distance:.3f} m '
+                    f'after the move (mean {tr.mean_distance:.3f} m).'
+                )
+        if step.reset:
+            self._request_reset(step.reset, t)
+        if step.done:
+            self._finish(0)
+
+    def _request_reset(self, reason: str, t: float) -> None:
+        self.get_logger().info(f'Resetting both robots: {reason}.')
+        if not self.reset_client.service_is_ready():
+            self.get_logger().error(
+                'The reset service /sim/reset is not available, so the robots stay where they '
+                'are: start the simulator (mindgrasp launch trainer) or remap /sim/reset.'
+            )
+            self.protocol.reset_finished(t, success=False)
+            return
+        request = ResetSim.Request(
+            new_random_draw=bool(self.get_parameter('reset_new_random_draw').value), seed=-1
+        )
+        self.reset_deadline = time.monotonic() + self.reset_timeout
+        self.reset_future = self.reset_client.call_async(request)
+        self.reset_future.add_done_callback(self.reset_done_callback)
+
+    def reset_done_callback(self, future) -> None:
+        if future is not self.reset_future:
+            return  # an answer after its timeout
+        self.reset_future = None
+        self.reset_deadline = None
+        try:
+            response = future.result()
+        except Exception as err:
+            response = ResetSim.Response(success=False, message=repr(err))
+        if not response.success:
+            self.get_logger().error(f'/sim/reset failed: {response.message}')
+        self.protocol.reset_finished(self._now(), success=bool(response.success))
+
+    def _check_reset_timeout(self, t: float) -> None:
+        if self.reset_deadline is not None and time.monotonic() > self.reset_deadline:
+            self.get_logger().error(
+                f'/sim/reset did not answer within {self.reset_timeout:.1f} s; the session goes '
+                "on. Check the simulator's log, or raise 'reset_timeout'."
+            )
+            self.reset_future = None
+            self.reset_deadline = None
+            self.protocol.reset_finished(t, success=False)
+
+    def _finish(self, code: int) -> None:
+        self.finished = True
+        self.exit_code = code
+        self.command_pub.publish(Float64MultiArray(data=np.zeros(self.protocol.n_joints)))
+        if code != 0 or not self.protocol.trials:
+            return
+        summary = self.protocol.summary()
+        self.get_logger().info('Trainer session summary: ' + json.dumps(summary))
+        if self.log_file:
+            self._write_log(self.log_file)
+
+    def _write_log(self, path: str) -> None:
+        """Per-trial CSV: trial, class, onset (s), mean and final end-effector distance (m)."""
+        try:
+            with open(path, 'w', newline='', encoding='utf-8') as f:
+                w = csv.writer(f)
+                w.writerow(['trial', 'class_index', 'class_name', 'onset_s',
+                            'mean_ee_distance_m', 'final_ee_distance_m', 'aborted'])  # fmt: skip
+                for tr in self.protocol.trials:
+                    w.writerow([tr.trial, tr.class_index, CLASS_NAMES[tr.class_index],
+                                f'{tr.onset:.3f}', _fmt(tr.mean_distance),
+                                _fmt(tr.final_distance), tr.aborted])  # fmt: skip
+        except OSError as err:
+            self.get_logger().error(
+                f"Could not write the trial log 'log_file' = {path!r}: {err}. Give a writable path."
+            )
+            return
+        self.get_logger().info(f'Trial log written to {path}.')
+
+
+def _fmt(x: float) -> str:
+    return f'{x:.4f}' if math.isfinite(x) else ''
+
+
+def main(args: list[str] | None = None) -> int:
+    rclpy.init(args=args)
+    try:
+        node = TrainerNode()
+    except TrainerError:
+        rclpy.shutdown()
+        return 2
+    try:
+        spin_until_finished(node)
+    except KeyboardInterrupt:
+        node.command_pub.publish(Float64MultiArray(data=np.zeros(node.protocol.n_joints)))
+    finally:
+        code = node.exit_code
+        node.destroy_node()
+        if rclpy.ok():
+            rclpy.shutdown()
+    return code
+
+
+if __name__ == '__main__':
+    sys.exit(main())
