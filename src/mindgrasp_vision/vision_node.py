@@ -1,0 +1,249 @@
+"""Vision node: colour detections, object of interest, AR overlay and depth shape of each frame.
+
+Run::
+
+    python -m mindgrasp_vision.vision_node --ros-args --params-file config/params/vision.yaml
+
+Subscribes /camera/color/image_raw (rgb8), /camera/depth/image_raw (32FC1 m), /camera/color/
+camera_info, /bci/prediction (a left/right hand prediction shifts the ranking focus) and /fsm/state
+(shapes are classified in ``classify_states``); publishes /vision/detections and /vision/overlay.
+Service ``~/classify_shape`` (std_srvs/Trigger) classifies the current object of interest now.
+The algorithms are :class:`mindgrasp_vision.pipeline.VisionPipeline`.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+
+from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import (
+    Detection,
+    DetectionArray,
+    FsmState,
+    MIPrediction,
+)
+from mindgrasp_ros.interfaces.rcl_interfaces.msg import SetParametersResult
+from mindgrasp_ros.interfaces.sensor_msgs.msg import CameraInfo, Image, RegionOfInterest
+from mindgrasp_ros.interfaces.std_srvs.srv import Trigger
+
+from mindgrasp_ros import rclpy
+from mindgrasp_vision._checks import VisionError
+from mindgrasp_vision.config import VisionConfig
+from mindgrasp_vision.detector import CameraIntrinsics
+from mindgrasp_vision.ros_conversions import (
+    depth_from_image,
+    detection_to_msg,
+    image_from_rgb,
+    rgb_from_image,
+)
+
+_RELIABLE = 10
+
+
+def _stamp_ns(header: object) -> int:
+    return int(header.stamp.sec) * 1_000_000_000 + int(header.stamp.nanosec)
+
+
+class VisionNode(rclpy.node.Node):
+    """Thin ROS wrapper round :class:`VisionPipeline` (parameters: config/params/vision.yaml)."""
+
+    def __init__(self, **kwargs: object) -> None:
+        super().__init__('vision', **kwargs)
+        defaults = VisionConfig().flat()
+        self.declare_parameters('', list(defaults.items()))
+        self.cfg = VisionConfig.from_mapping(
+            {name: self.get_parameter(name).value for name in defaults})
+        classifier = None
+        try:
+            classifier = self.cfg.load_classifier()
+        except VisionError as exc:
+            self.get_logger().error(f'{exc} Running without shape classification.')
+        self.pipeline = self.cfg.build_pipeline(classifier)
+        sensor = rclpy.qos.qos_profile_sensor_data
+        self.detections_pub = self.create_publisher(DetectionArray, '/vision/detections', _RELIABLE)
+        self.overlay_pub = self.create_publisher(Image, '/vision/overlay', sensor)
+        self.create_subscription(Image, '/camera/color/image_raw', self.color_callback, sensor)
+        self.create_subscription(Image, '/camera/depth/image_raw', self.depth_callback, sensor)
+        self.create_subscription(CameraInfo, '/camera/color/camera_info', self.info_callback,
+                                 sensor)
+        self.create_subscription(MIPrediction, '/bci/prediction', self.prediction_callback,
+                                 _RELIABLE)
+        state_qos = rclpy.qos.QoSProfile(
+            depth=1, reliability=rclpy.qos.ReliabilityPolicy.RELIABLE,
+            durability=rclpy.qos.DurabilityPolicy.TRANSIENT_LOCAL)
+        self.create_subscription(FsmState, '/fsm/state', self.state_callback, state_qos)
+        self.create_service(Trigger, '~/classify_shape', self.classify_callback)
+        self.add_on_set_parameters_callback(self.parameters_callback)
+        self._pending = None      # (stamp ns, rgb, header) waiting for its depth image
+        self._depth = None        # (stamp ns, depth)
+        self._seen_depth = False
+        self._mi = None           # (class index, receipt time s)
+        self._fsm_state = 0
+        self._classify_next = False
+        self._last = None         # (rgb, depth, header) of the last processed frame
+        self._errors: dict[str, float] = {}
+        self.frames = 0
+        self._start = time.monotonic()
+        self.done = False
+        if self.cfg.duration > 0:
+            self.create_timer(0.1, self.duration_callback)
+        self.get_logger().info(
+            f'Vision ready: colours {self.cfg.colour_names}, shape model '
+            f'{"none" if classifier is None else self.cfg.shape_model}.')
+
+    # ------------------------------------------------------------------ callbacks
+    def color_callback(self, msg: Image) -> None:
+        try:
+            rgb = rgb_from_image(msg)
+            self._check_size(rgb.shape[1], rgb.shape[0], '/camera/color/image_raw')
+        except VisionError as exc:
+            self._error('color', str(exc))
+            return
+        if self._pending is not None:
+            # its depth image never came: process the older frame without depth
+            self._process(*self._pending[1:], None)
+        self._pending = (_stamp_ns(msg.header), rgb, msg.header)
+        self._try_process()
+
+    def depth_callback(self, msg: Image) -> None:
+        try:
+            depth = depth_from_image(msg)
+            self._check_size(depth.shape[1], depth.shape[0], '/camera/depth/image_raw')
+        except VisionError as exc:
+            self._error('depth', str(exc))
+            return
+        self._seen_depth = True
+        self._depth = (_stamp_ns(msg.header), depth)
+        self._try_process()
+
+    def info_callback(self, msg: CameraInfo) -> None:
+        try:
+            self.pipeline.detector.intrinsics = CameraIntrinsics.from_k(msg.k)
+        except VisionError as exc:
+            self._error('camera_info', str(exc))
+
+    def prediction_callback(self, msg: MIPrediction) -> None:
+        self._mi = (int(msg.class_index), time.monotonic())
+
+    def state_callback(self, msg: FsmState) -> None:
+        if msg.state == FsmState.RETURN_TO_START and self._fsm_state != msg.state:
+            self.pipeline.reset()  # a new trial: forget the object of interest and its shape
+        self._fsm_state = int(msg.state)
+
+    def classify_callback(self, request: Trigger.Request, response: Trigger.Response
+                          ) -> Trigger.Response:
+        if self._last is None:
+            response.success, response.message = False, 'No camera frame received yet.'
+            return response
+        if self.pipeline.classifier is None:
+            response.success = False
+            response.message = 'No shape model loaded; set the shape_model parameter.'
+            return response
+        result = self._process(*self._last, classify=True)
+        target = None if result is None else result.target
+        if target is None or target.shape == 'unknown':
+            response.success, response.message = False, 'No object of interest to classify.'
+        else:
+            response.success = True
+            response.message = f'{target.label} {target.shape_confidence:.3f}'
+        return response
+
+    def parameters_callback(self, params: list) -> SetParametersResult:
+        values = {p.name: p.value for p in params}
+        if 'shape_model' in values:
+            return SetParametersResult(successful=False,
+                                       reason='shape_model is read at start; restart the node.')
+        try:
+            cfg = VisionConfig.from_mapping({**self.cfg.flat(), **values})
+            detector, ranker = cfg.build_detector(), cfg.build_ranker()
+        except (VisionError, TypeError, ValueError) as exc:
+            return SetParametersResult(successful=False, reason=str(exc))
+        detector.intrinsics = self.pipeline.detector.intrinsics
+        self.cfg = cfg
+        self.pipeline.detector, self.pipeline.ranker = detector, ranker
+        self.pipeline.shape_min_fraction = float(cfg.shape_min_fraction)
+        return SetParametersResult(successful=True)
+
+    def duration_callback(self) -> None:
+        if time.monotonic() - self._start >= self.cfg.duration:
+            self.done = True
+
+    # ------------------------------------------------------------------ work
+    def _check_size(self, width: int, height: int, topic: str) -> None:
+        ew, eh = int(self.cfg.expected_width), int(self.cfg.expected_height)
+        if (ew and width != ew) or (eh and height != eh):
+            msg = (f'The image on {topic} is {width}x{height} px, expected {ew or width}x'
+                   f'{eh or height} px (parameters expected_width/expected_height); fix the '
+                   'camera resolution or the parameters.')
+            raise VisionError(msg)
+
+    def _try_process(self) -> None:
+        if self._pending is None:
+            return
+        stamp, rgb, header = self._pending
+        tol = int(self.cfg.sync_tolerance * 1e9)
+        if self._depth is not None and abs(self._depth[0] - stamp) <= tol:
+            depth = self._depth[1]
+        elif self._seen_depth and (self._depth is None or self._depth[0] < stamp - tol):
+            return  # the matching depth image is still on its way
+        else:
+            depth = None
+        self._pending = None
+        self._process(rgb, header, depth)
+
+    def _process(self, rgb: object, header: object, depth: object, classify: bool = False):
+        if depth is not None and depth.shape != rgb.shape[:2]:
+            self._error('size', f'The depth image is {depth.shape[1]}x{depth.shape[0]} px but '
+                        f'the colour image is {rgb.shape[1]}x{rgb.shape[0]} px; publish the '
+                        'depth registered to the colour camera.')
+            depth = None
+        mi = None
+        if self._mi is not None and time.monotonic() - self._mi[1] <= self.cfg.prediction_timeout:
+            mi = self._mi[0]
+        classify = (classify or self._classify_next
+                    or self._fsm_state in list(self.cfg.classify_states))
+        try:
+            result = self.pipeline.process(rgb, depth, mi, classify=classify)
+        except VisionError as exc:
+            self._error('process', str(exc))
+            return None
+        self._last = (rgb, header, depth)
+        self.frames += 1
+        out = DetectionArray(
+            header=header, image_width=result.width, image_height=result.height,
+            object_of_interest=-1 if result.object_of_interest is None
+            else result.object_of_interest,
+            detections=[detection_to_msg(Detection, RegionOfInterest, d)
+                        for d in result.detections])
+        self.detections_pub.publish(out)
+        if self.cfg.publish_overlay:
+            self.overlay_pub.publish(image_from_rgb(Image, self.pipeline.overlay(rgb, result),
+                                                    header))
+        return result
+
+    def _error(self, key: str, text: str) -> None:
+        now = time.monotonic()
+        if now - self._errors.get(key, -1e9) >= 5.0:  # the same problem at most every 5 s
+            self._errors[key] = now
+            self.get_logger().error(text)
+
+
+def main(args: list[str] | None = None) -> int:
+    """Run the vision node until Ctrl-C or the ``duration`` parameter."""
+    rclpy.init(args=args if args is not None else sys.argv)
+    node = VisionNode()
+    try:
+        while rclpy.ok() and not node.done:
+            rclpy.spin_once(node, timeout_sec=0.1)
+    except KeyboardInterrupt:
+        pass
+    finally:
+        node.get_logger().info(f'Vision processed {node.frames} frames.')
+        node.destroy_node()
+        if rclpy.ok():
+            rclpy.shutdown()
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())
