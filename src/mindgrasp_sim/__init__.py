@@ -1,1 +1,12 @@
-"""mindgrasp_sim."""
+"""mindgrasp_sim: PyBullet simulation of the MIndGrasp assistive arm.
+
+Layers: :mod:`~mindgrasp_sim.robot_model` (URDF of the arm and three-finger gripper),
+:mod:`~mindgrasp_sim.scene` (scene files), :mod:`~mindgrasp_sim.simulation` (the ROS-free
+``Simulation``), :mod:`~mindgrasp_sim.scripted` (scripted motions and grasps),
+:mod:`~mindgrasp_sim.task` (grasp success / drop detection) and the ROS node
+:mod:`~mindgrasp_sim.sim_node`.
+"""
+
+from mindgrasp_sim.errors import SimError
+
+__all__ = ['SimError']

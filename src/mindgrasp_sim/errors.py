@@ -1,0 +1,5 @@
+"""The one exception class of mindgrasp_sim."""
+
+
+class SimError(Exception):
+    """Bad input to the simulation (scene file, parameter, command): the message says the fix."""

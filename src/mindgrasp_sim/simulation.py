@@ -1,0 +1,648 @@
+"""The PyBullet simulation of the MIndGrasp arm, gripper, eye-in-hand RGB-D camera and scene
+(ROS-free; the node :mod:`mindgrasp_sim.sim_node` is a thin layer on top).
+
+Typical use::
+
+    from mindgrasp_sim.simulation import Simulation, CameraConfig
+    sim = Simulation(scene='set_locations', seed=0, camera=CameraConfig(128, 128, 10.0))
+    sim.set_joint_velocities(np.array([0.1, 0, 0, 0, 0, 0]))   # rad/s
+    sim.step(240)                                              # one simulated second
+    rgb, depth = sim.render_camera()                           # uint8 (H, W, 3), float32 (H, W) m
+    sim.close()
+
+Joint control follows a ros2_control forward velocity controller on a position-controlled arm:
+each physics step integrates the commanded (clipped) velocity into a joint reference that a stiff,
+torque-limited PD motor tracks, so the arm holds still without drift when the command is zero and
+stops at its position limits. Two simulations with the same seed and command sequence produce
+identical states and images (DIRECT mode, deterministic overlapping pairs).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pybullet as pb
+from pybullet_utils.bullet_client import BulletClient
+
+from mindgrasp_sim.errors import SimError
+from mindgrasp_sim.robot_model import ARM_JOINTS, FINGER_JOINTS
+from mindgrasp_sim.scene import ObjectSpec, SceneSpec, config_dir, load_scene
+
+#: home pose (rad): long arm up, short arm forward, wrist pitched so the camera looks down at the
+#: objects 0.5 m in front of the base (the paper: "all joints straight except joint 5")
+HOME_POSE = (0.0, 0.0, 0.0, math.pi / 2, 1.2, 0.0)
+#: finger joint angles (rad) for closure 0 (open) and 1 (closed)
+FINGER_OPEN, FINGER_CLOSED = -0.55, 1.25
+GROUND_RGBA = (0.78, 0.77, 0.74, 1.0)
+TRAINER_RGBA = (0.1, 0.85, 0.1, 0.35)
+ROBOTS = ('user', 'trainer')
+
+
+@dataclass
+class CameraConfig:
+    """Eye-in-hand RGB-D camera settings.
+
+    width, height: image size (px); rate_hz: publishing rate (Hz, used by the node);
+    fov_deg: vertical field of view (deg); near, far: clipping planes (m).
+    """
+
+    width: int = 128
+    height: int = 128
+    rate_hz: float = 10.0
+    fov_deg: float = 60.0
+    near: float = 0.01
+    far: float = 3.0
+
+    def __post_init__(self) -> None:
+        for name in ('width', 'height'):
+            value = getattr(self, name)
+            if not isinstance(value, (int, np.integer)) or not 8 <= value <= 4096:
+                msg = f'Camera {name} must be an integer number of pixels in 8..4096, got ' \
+                      f'{value!r}; use e.g. 128 or 640.'
+                raise SimError(msg)
+        if not (math.isfinite(self.rate_hz) and self.rate_hz > 0):
+            msg = f'Camera rate_hz must be a positive number of Hz, got {self.rate_hz!r}; use ' \
+                  'e.g. 10.0.'
+            raise SimError(msg)
+        if not 5.0 <= self.fov_deg <= 150.0:
+            msg = f'Camera fov_deg must be in 5..150 degrees, got {self.fov_deg!r}.'
+            raise SimError(msg)
+        if not 0 < self.near < self.far:
+            msg = f'Camera clipping planes must satisfy 0 < near < far, got near={self.near!r}, ' \
+                  f'far={self.far!r}.'
+            raise SimError(msg)
+
+
+@dataclass
+class SceneObject:
+    """State of one scene object. position (3,) m and orientation (4,) quaternion xyzw, world."""
+
+    id: int
+    shape: str
+    colour: str
+    size: float
+    mass: float
+    position: np.ndarray
+    orientation: np.ndarray
+    body: int = field(default=-1, repr=False)
+
+    @property
+    def label(self) -> str:
+        """``"<colour> <shape>"`` as used in GraspResult and TaskTarget."""
+        return f'{self.colour} {self.shape}'
+
+
+@dataclass
+class _Robot:
+    body: int
+    q_ref: np.ndarray
+    v_cmd: np.ndarray
+    closure: float = 0.0
+    gripper_dirty: bool = True
+
+
+def _quat_to_matrix(quat: np.ndarray) -> np.ndarray:
+    return np.array(pb.getMatrixFromQuaternion(quat), dtype=float).reshape(3, 3)
+
+
+def top_down_quat(yaw: float = 0.0) -> np.ndarray:
+    """Quaternion (xyzw) of a gripper pointing straight down whose thumb points along ``yaw``
+    (rad, world frame) rotated by pi, i.e. the thumb is on the side facing the base when ``yaw`` is
+    the object's bearing from the base."""
+    # gripper z = world -z; gripper x = -(cos yaw, sin yaw, 0) (towards the base)
+    x = -np.array([math.cos(yaw), math.sin(yaw), 0.0])
+    z = np.array([0.0, 0.0, -1.0])
+    y = np.cross(z, x)
+    m = np.column_stack([x, y, z])
+    return _matrix_to_quat(m)
+
+
+def _matrix_to_quat(m: np.ndarray) -> np.ndarray:
+    tr = m[0, 0] + m[1, 1] + m[2, 2]
+    if tr > 0:
+        s = math.sqrt(tr + 1.0) * 2
+        q = [(m[2, 1] - m[1, 2]) / s, (m[0, 2] - m[2, 0]) / s, (m[1, 0] - m[0, 1]) / s, 0.25 * s]
+    elif m[0, 0] > m[1, 1] and m[0, 0] > m[2, 2]:
+        s = math.sqrt(1.0 + m[0, 0] - m[1, 1] - m[2, 2]) * 2
+        q = [0.25 * s, (m[0, 1] + m[1, 0]) / s, (m[0, 2] + m[2, 0]) / s, (m[2, 1] - m[1, 2]) / s]
+    elif m[1, 1] > m[2, 2]:
+        s = math.sqrt(1.0 + m[1, 1] - m[0, 0] - m[2, 2]) * 2
+        q = [(m[0, 1] + m[1, 0]) / s, 0.25 * s, (m[1, 2] + m[2, 1]) / s, (m[0, 2] - m[2, 0]) / s]
+    else:
+        s = math.sqrt(1.0 + m[2, 2] - m[0, 0] - m[1, 1]) * 2
+        q = [(m[0, 2] + m[2, 0]) / s, (m[1, 2] + m[2, 1]) / s, 0.25 * s, (m[1, 0] - m[0, 1]) / s]
+    q = np.array(q)
+    return q / np.linalg.norm(q)
+
+
+class Simulation:
+    """PyBullet world: the user's arm (and optionally the trainer's ghost arm), objects, camera.
+
+    Parameters
+    ----------
+    scene : str | Path
+        ``'set_locations'``, ``'random_locations'`` (names in ``config/scenes``) or a YAML path.
+    seed : int
+        Seed of the random object layout (random scenes); same seed, same layout.
+    camera : CameraConfig | None
+        Eye-in-hand camera (default 128 x 128 px, 10 Hz, 60 deg vertical field of view).
+    physics_hz : float
+        Physics rate (Hz); each :meth:`step` advances ``1 / physics_hz`` s.
+    trainer_robot : bool
+        Also load the green, semi-transparent, non-colliding training robot.
+    gui : bool
+        Open the PyBullet window (needs a display); DIRECT (headless) otherwise.
+    n_objects : int | None
+        Number of random objects (random scenes); None: the scene file's number.
+    urdf : str | Path | None
+        Robot description (default ``config/robots/mindgrasp_arm.urdf``).
+    """
+
+    joint_names: tuple[str, ...] = ARM_JOINTS
+    finger_names: tuple[str, ...] = FINGER_JOINTS
+
+    def __init__(self, scene: str | Path = 'set_locations', seed: int = 0,
+                 camera: CameraConfig | None = None, physics_hz: float = 240.0,
+                 trainer_robot: bool = False, gui: bool = False, n_objects: int | None = None,
+                 urdf: str | Path | None = None, solver_iterations: int = 50) -> None:
+        if not (isinstance(physics_hz, (int, float)) and math.isfinite(physics_hz)
+                and 30.0 <= physics_hz <= 10000.0):
+            msg = f'physics_hz must be a rate in 30..10000 Hz, got {physics_hz!r}; the ' \
+                  'default 240.0 suits contacts.'
+            raise SimError(msg)
+        if n_objects is not None and (not isinstance(n_objects, (int, np.integer))
+                                      or n_objects < 0):
+            msg = f'n_objects must be None or an integer >= 0, got {n_objects!r}.'
+            raise SimError(msg)
+        self.camera = camera or CameraConfig()
+        self.physics_hz = float(physics_hz)
+        self.dt = 1.0 / self.physics_hz
+        self.gui = bool(gui)
+        self.n_objects = n_objects
+        self.home_pose = np.array(HOME_POSE, dtype=float)
+        self.urdf = Path(urdf) if urdf else config_dir() / 'robots' / 'mindgrasp_arm.urdf'
+        if not self.urdf.is_file():
+            msg = f'Robot description {str(self.urdf)!r} does not exist; give an existing URDF.'
+            raise SimError(msg)
+        self._p = BulletClient(connection_mode=pb.GUI if self.gui else pb.DIRECT)
+        self._kin = BulletClient(connection_mode=pb.DIRECT)   # kinematic twin for IK / FK
+        p = self._p
+        p.setPhysicsEngineParameter(fixedTimeStep=self.dt, numSolverIterations=solver_iterations,
+                                    deterministicOverlappingPairs=1, numSubSteps=0)
+        p.setGravity(0, 0, -9.81)
+        if self.gui:
+            p.configureDebugVisualizer(pb.COV_ENABLE_GUI, 0)
+            p.resetDebugVisualizerCamera(1.4, 30, -35, [0.2, 0, 0.2])
+        self._ground = self._make_ground()
+        self._robots: dict[str, _Robot] = {}
+        self._robots['user'] = self._load_robot(p, ghost=False)
+        if trainer_robot:
+            self._robots['trainer'] = self._load_robot(p, ghost=True)
+        self._kin_body = self._kin.loadURDF(str(self.urdf), useFixedBase=True)
+        names = {p.getJointInfo(self._robots['user'].body, j)[1].decode():
+                 j for j in range(p.getNumJoints(self._robots['user'].body))}
+        self._names = names
+        self._arm_idx = [names[n] for n in ARM_JOINTS]
+        self._finger_idx = [names[n] for n in FINGER_JOINTS]
+        self._tcp_idx = names['tcp_joint']
+        self._cam_idx = names['camera_joint']
+        infos = [p.getJointInfo(self._robots['user'].body, j) for j in self._arm_idx]
+        self.lower = np.array([i[8] for i in infos])
+        self.upper = np.array([i[9] for i in infos])
+        self.max_velocity = np.array([i[11] for i in infos])
+        self.max_effort = np.array([i[10] for i in infos])
+        finfo = [p.getJointInfo(self._robots['user'].body, j) for j in self._finger_idx]
+        self._finger_effort = [i[10] for i in finfo]
+        self._finger_velocity = [i[11] for i in finfo]
+        self._finger_links = {j: n for j, n in zip(self._finger_idx, FINGER_JOINTS, strict=True)}
+        self._objects: list[tuple[ObjectSpec, int]] = []
+        self._step_count = 0
+        self._proj = None
+        self._scene: SceneSpec | None = None
+        self.seed = int(seed)
+        self.load_scene(scene, seed=seed)
+
+    # ------------------------------------------------------------------ world building
+    def _make_ground(self) -> int:
+        p = self._p
+        col = p.createCollisionShape(pb.GEOM_PLANE)
+        vis = p.createVisualShape(pb.GEOM_BOX, halfExtents=[2.0, 2.0, 0.005],
+                                  visualFramePosition=[0, 0, -0.005], rgbaColor=GROUND_RGBA)
+        body = p.createMultiBody(0, col, vis, [0, 0, 0])
+        p.changeDynamics(body, -1, lateralFriction=0.6, restitution=0.0)
+        return body
+
+    def _load_robot(self, p: BulletClient, ghost: bool) -> _Robot:
+        flags = pb.URDF_USE_INERTIA_FROM_FILE
+        if not ghost:
+            flags |= pb.URDF_USE_SELF_COLLISION | pb.URDF_USE_SELF_COLLISION_EXCLUDE_PARENT
+        body = p.loadURDF(str(self.urdf), useFixedBase=True, flags=flags)
+        n = p.getNumJoints(body)
+        for link in range(-1, n):
+            if ghost:
+                # the trainer's arm is a prompt, not a body: it touches nothing
+                p.setCollisionFilterGroupMask(body, link, 0, 0)
+                p.changeVisualShape(body, link, rgbaColor=TRAINER_RGBA)
+            name = p.getJointInfo(body, link)[1].decode() if link >= 0 else ''
+            if name.startswith('finger_'):
+                p.changeDynamics(body, link, lateralFriction=1.2, spinningFriction=0.003,
+                                 rollingFriction=0.0, frictionAnchor=1)
+            else:
+                p.changeDynamics(body, link, lateralFriction=0.8)
+            if link >= 0:
+                p.changeDynamics(body, link, linearDamping=0.0, angularDamping=0.0,
+                                 jointDamping=0.05)
+        # velocity motors off: joints are driven by the PD reference in step()
+        return _Robot(body=body, q_ref=np.array(HOME_POSE, dtype=float), v_cmd=np.zeros(6))
+
+    def _spawn(self, spec: ObjectSpec) -> int:
+        p = self._p
+        s = spec.size
+        if spec.shape == 'cube':
+            col = p.createCollisionShape(pb.GEOM_BOX, halfExtents=[s / 2] * 3)
+            vis = p.createVisualShape(pb.GEOM_BOX, halfExtents=[s / 2] * 3, rgbaColor=spec.rgba)
+        elif spec.shape == 'cylinder':
+            col = p.createCollisionShape(pb.GEOM_CYLINDER, radius=s / 2, height=s)
+            vis = p.createVisualShape(pb.GEOM_CYLINDER, radius=s / 2, length=s,
+                                      rgbaColor=spec.rgba)
+        elif spec.shape == 'sphere':
+            col = p.createCollisionShape(pb.GEOM_SPHERE, radius=s / 2)
+            vis = p.createVisualShape(pb.GEOM_SPHERE, radius=s / 2, rgbaColor=spec.rgba)
+        else:
+            scale = [spec.scale] * 3
+            col = p.createCollisionShape(pb.GEOM_MESH, fileName=spec.mesh, meshScale=scale)
+            vis = p.createVisualShape(pb.GEOM_MESH, fileName=spec.mesh, meshScale=scale,
+                                      rgbaColor=spec.rgba)
+        orn = p.getQuaternionFromEuler([0, 0, spec.yaw])
+        body = p.createMultiBody(spec.mass, col, vis, spec.position, orn)
+        p.changeDynamics(body, -1, lateralFriction=spec.friction,
+                         rollingFriction=spec.rolling_friction,
+                         spinningFriction=spec.spinning_friction, restitution=0.0,
+                         linearDamping=0.04, angularDamping=0.04)
+        return body
+
+    # ------------------------------------------------------------------ scene and reset
+    def load_scene(self, scene: str | Path | dict, seed: int | None = None) -> None:
+        """Load a scene (name, YAML path or mapping) and reset; ``seed`` None: the scene's own."""
+        spec = load_scene(scene)
+        self._scene = spec
+        self.seed = int(spec.seed if seed is None else seed)
+        self._layout_seed = self.seed
+        self._layout = spec.draw(self._layout_seed, self.n_objects)
+        self.reset()
+
+    @property
+    def scene(self) -> SceneSpec:
+        """The loaded :class:`~mindgrasp_sim.scene.SceneSpec`."""
+        assert self._scene is not None
+        return self._scene
+
+    def reset(self, new_random_draw: bool = False, seed: int | None = None) -> None:
+        """Robots home, grippers open, time 0; objects back to the layout.
+
+        new_random_draw: draw a new layout (random scenes): from ``seed`` if given, else the next
+        seed of the sequence (previous layout seed + 1).
+        """
+        if new_random_draw or seed is not None:
+            if self.scene.random is None and new_random_draw:
+                msg = f'Scene {self.scene.name!r} has no random section, so a new random draw is ' \
+                      'not possible; load a random scene (e.g. random_locations) first.'
+                raise SimError(msg)
+            self._layout_seed = int(seed) if seed is not None else self._layout_seed + 1
+            self._layout = self.scene.draw(self._layout_seed, self.n_objects)
+        p = self._p
+        for _, body in self._objects:
+            p.removeBody(body)
+        self._objects = [(spec, self._spawn(spec)) for spec in self._layout]
+        for robot in self._robots.values():
+            for i, j in enumerate(self._arm_idx):
+                p.resetJointState(robot.body, j, self.home_pose[i], 0.0)
+            for j in self._finger_idx:
+                p.resetJointState(robot.body, j, FINGER_OPEN, 0.0)
+            robot.q_ref = self.home_pose.copy()
+            robot.v_cmd = np.zeros(6)
+            robot.closure = 0.0
+            robot.gripper_dirty = True
+        self._step_count = 0
+
+    # ------------------------------------------------------------------ time and commands
+    @property
+    def time(self) -> float:
+        """Simulated time since the last reset (s)."""
+        return self._step_count * self.dt
+
+    @property
+    def step_count(self) -> int:
+        """Physics steps since the last reset."""
+        return self._step_count
+
+    def _robot(self, robot: str) -> _Robot:
+        try:
+            return self._robots[robot]
+        except KeyError:
+            hint = (' (start the simulation with trainer_robot=True)' if robot == 'trainer'
+                    else '')
+            msg = f'Unknown robot {robot!r}; use one of {sorted(self._robots)}{hint}.'
+            raise SimError(msg) from None
+
+    def set_joint_velocities(self, velocities: np.ndarray, robot: str = 'user') -> None:
+        """Command joint velocities (6,) rad/s, clipped to the joint velocity limits.
+
+        Raises SimError for a wrong length or NaN/inf (the previous command stays in force).
+        """
+        v = np.asarray(velocities, dtype=float).reshape(-1)
+        if v.shape != (6,):
+            msg = f'Joint velocity command must have 6 values (one per joint, rad/s), got ' \
+                  f'{v.size}; send [v1, ..., v6].'
+            raise SimError(msg)
+        if not np.all(np.isfinite(v)):
+            msg = f'Joint velocity command contains NaN or inf ({v.tolist()}); send finite ' \
+                  'velocities in rad/s.'
+            raise SimError(msg)
+        self._robot(robot).v_cmd = np.clip(v, -self.max_velocity, self.max_velocity)
+
+    def stop(self, robot: str = 'user') -> None:
+        """Zero velocity command (the arm holds its current reference)."""
+        self._robot(robot).v_cmd = np.zeros(6)
+
+    def set_gripper(self, closure: float, robot: str = 'user') -> None:
+        """Gripper target: 0 open .. 1 closed; fingers close with limited torque (they stop on
+        the object and squeeze it with the joint effort limit)."""
+        c = float(closure)
+        if not math.isfinite(c):
+            msg = f'Gripper closure must be a finite number in [0, 1], got {closure!r}.'
+            raise SimError(msg)
+        r = self._robot(robot)
+        r.closure = min(max(c, 0.0), 1.0)
+        r.gripper_dirty = True
+
+    def set_joint_positions(self, positions: np.ndarray, robot: str = 'user') -> None:
+        """Teleport the arm to joint positions (6,) rad (tests, scripted set-ups; not physical)."""
+        q = np.clip(np.asarray(positions, dtype=float).reshape(6), self.lower, self.upper)
+        r = self._robot(robot)
+        for i, j in enumerate(self._arm_idx):
+            self._p.resetJointState(r.body, j, q[i], 0.0)
+        r.q_ref = q.copy()
+        r.v_cmd = np.zeros(6)
+
+    def step(self, n: int = 1) -> None:
+        """Advance the physics by ``n`` steps of ``1 / physics_hz`` s."""
+        p = self._p
+        dt = self.dt
+        for _ in range(int(n)):
+            for r in self._robots.values():
+                q = np.array([s[0] for s in p.getJointStates(r.body, self._arm_idx)])
+                # keep the reference near the real joints (a blocked arm does not wind up)
+                q_ref = np.clip(r.q_ref, q - 0.05, q + 0.05)
+                new_ref = np.clip(q_ref + r.v_cmd * dt, self.lower, self.upper)
+                v_ff = (new_ref - q_ref) / dt
+                r.q_ref = new_ref
+                p.setJointMotorControlArray(
+                    r.body, self._arm_idx, pb.POSITION_CONTROL, targetPositions=new_ref,
+                    targetVelocities=v_ff, forces=self.max_effort, positionGains=[0.2] * 6,
+                    velocityGains=[1.0] * 6)
+                if r.gripper_dirty:
+                    target = FINGER_OPEN + (FINGER_CLOSED - FINGER_OPEN) * r.closure
+                    for k, j in enumerate(self._finger_idx):
+                        p.setJointMotorControl2(
+                            r.body, j, pb.POSITION_CONTROL, targetPosition=target,
+                            force=self._finger_effort[k], maxVelocity=self._finger_velocity[k],
+                            positionGain=0.05, velocityGain=1.0)
+                    r.gripper_dirty = False
+            p.stepSimulation()
+            self._step_count += 1
+
+    # ------------------------------------------------------------------ state
+    def joint_positions(self, robot: str = 'user') -> np.ndarray:
+        """Arm joint positions (6,) rad."""
+        r = self._robot(robot)
+        return np.array([s[0] for s in self._p.getJointStates(r.body, self._arm_idx)])
+
+    def joint_velocities(self, robot: str = 'user') -> np.ndarray:
+        """Arm joint velocities (6,) rad/s."""
+        r = self._robot(robot)
+        return np.array([s[1] for s in self._p.getJointStates(r.body, self._arm_idx)])
+
+    def joint_efforts(self, robot: str = 'user') -> np.ndarray:
+        """Arm joint motor torques (6,) N m applied in the last step."""
+        r = self._robot(robot)
+        return np.array([s[3] for s in self._p.getJointStates(r.body, self._arm_idx)])
+
+    def finger_positions(self, robot: str = 'user') -> np.ndarray:
+        """Finger joint angles (3,) rad (thumb, left, right); larger is more closed."""
+        r = self._robot(robot)
+        return np.array([s[0] for s in self._p.getJointStates(r.body, self._finger_idx)])
+
+    def commanded_velocities(self, robot: str = 'user') -> np.ndarray:
+        """The velocity command in force (6,) rad/s, after clipping."""
+        return self._robot(robot).v_cmd.copy()
+
+    def _link_pose(self, body: int, link: int) -> tuple[np.ndarray, np.ndarray]:
+        st = self._p.getLinkState(body, link, computeForwardKinematics=True)
+        return np.array(st[4]), np.array(st[5])
+
+    def ee_pose(self, robot: str = 'user') -> tuple[np.ndarray, np.ndarray]:
+        """Tool centre point (between the fingertips) pose: position (3,) m, quaternion (4,)
+        xyzw, world frame."""
+        return self._link_pose(self._robot(robot).body, self._tcp_idx)
+
+    def camera_pose(self, robot: str = 'user') -> tuple[np.ndarray, np.ndarray]:
+        """Camera optical frame pose (z forward, x right, y down): position (3,) m, quat xyzw."""
+        return self._link_pose(self._robot(robot).body, self._cam_idx)
+
+    def link_pose(self, link: str, robot: str = 'user') -> tuple[np.ndarray, np.ndarray]:
+        """Pose of a named link of the robot (the child link of joint ``link`` or link name)."""
+        body = self._robot(robot).body
+        for j in range(self._p.getNumJoints(body)):
+            info = self._p.getJointInfo(body, j)
+            if link in (info[1].decode(), info[12].decode()):
+                return self._link_pose(body, j)
+        msg = f'Unknown link {link!r}; the robot has {sorted(self._names)}.'
+        raise SimError(msg)
+
+    def gripper_state(self, robot: str = 'user') -> dict:
+        """Gripper state: ``closure`` (commanded, 0..1), ``positions`` (3,) rad, ``contacts`` (3,)
+        bool (finger touches any object), ``names`` (thumb, left, right)."""
+        r = self._robot(robot)
+        contacts = []
+        bodies = [b for _, b in self._objects]
+        for j in self._finger_idx:
+            touching = False
+            for b in bodies:
+                if self._p.getContactPoints(r.body, b, j, -1):
+                    touching = True
+                    break
+            contacts.append(touching)
+        return {'closure': r.closure, 'positions': self.finger_positions(robot),
+                'contacts': np.array(contacts, dtype=bool), 'names': FINGER_JOINTS}
+
+    def objects(self) -> list[SceneObject]:
+        """Current state of all scene objects (id = index in the scene layout)."""
+        out = []
+        for i, (spec, body) in enumerate(self._objects):
+            pos, orn = self._p.getBasePositionAndOrientation(body)
+            out.append(SceneObject(id=i, shape=spec.shape, colour=spec.colour, size=spec.size,
+                                   mass=spec.mass, position=np.array(pos),
+                                   orientation=np.array(orn), body=body))
+        return out
+
+    def object_velocity(self, obj: SceneObject | int) -> np.ndarray:
+        """Linear velocity (3,) m/s of an object."""
+        body = self._objects[obj if isinstance(obj, int) else obj.id][1]
+        return np.array(self._p.getBaseVelocity(body)[0])
+
+    def held_object(self, robot: str = 'user') -> SceneObject | None:
+        """The object touched by >= 2 fingers and not touching the ground, else None."""
+        r = self._robot(robot)
+        for obj in self.objects():
+            fingers = sum(bool(self._p.getContactPoints(r.body, obj.body, j, -1))
+                          for j in self._finger_idx)
+            if fingers >= 2 and not self._p.getContactPoints(obj.body, self._ground):
+                return obj
+        return None
+
+    def collisions(self, robot: str = 'user') -> list[str]:
+        """Unwanted contacts of the arm: with the ground (any link but the fingertips) and with
+        itself, as ``'<link> - <link|ground>'`` strings."""
+        r = self._robot(robot)
+        names = {j: self._p.getJointInfo(r.body, j)[12].decode()
+                 for j in range(self._p.getNumJoints(r.body))}
+        names[-1] = 'base_link'
+        out = set()
+        for c in self._p.getContactPoints(r.body, self._ground):
+            if c[3] not in self._finger_links and c[3] != -1:
+                out.add(f'{names[c[3]]} - ground')
+        for c in self._p.getContactPoints(r.body, r.body):
+            a, b = sorted((names[c[3]], names[c[4]]))
+            out.add(f'{a} - {b}')
+        return sorted(out)
+
+    # ------------------------------------------------------------------ camera
+    def camera_intrinsics(self) -> tuple[np.ndarray, int, int]:
+        """Pinhole matrix K (3, 3) in pixels (ROS convention: pixel centres at integers), width,
+        height."""
+        c = self.camera
+        fy = c.height / 2.0 / math.tan(math.radians(c.fov_deg) / 2.0)
+        k = np.array([[fy, 0.0, (c.width - 1) / 2.0], [0.0, fy, (c.height - 1) / 2.0],
+                      [0.0, 0.0, 1.0]])
+        return k, c.width, c.height
+
+    def render_camera(self, robot: str = 'user') -> tuple[np.ndarray, np.ndarray]:
+        """Render the eye-in-hand camera: rgb uint8 (H, W, 3) and depth float32 (H, W), metres
+        along the optical axis (``far`` where nothing is hit)."""
+        c = self.camera
+        p = self._p
+        pos, orn = self.camera_pose(robot)
+        rot = _quat_to_matrix(orn)
+        target = pos + rot[:, 2]
+        up = -rot[:, 1]
+        view = p.computeViewMatrix(pos.tolist(), target.tolist(), up.tolist())
+        if self._proj is None:
+            self._proj = p.computeProjectionMatrixFOV(c.fov_deg, c.width / c.height, c.near, c.far)
+        hidden = self._hide_other_robots(robot)
+        _, _, rgba, depth_buf, _ = p.getCameraImage(
+            c.width, c.height, view, self._proj, renderer=pb.ER_TINY_RENDERER, shadow=0,
+            lightDirection=[0.4, -0.3, 1.0], lightAmbientCoeff=0.55, lightDiffuseCoeff=0.5,
+            lightSpecularCoeff=0.05, flags=pb.ER_NO_SEGMENTATION_MASK)
+        self._unhide(hidden)
+        rgb = np.asarray(rgba, dtype=np.uint8).reshape(c.height, c.width, 4)[:, :, :3].copy()
+        d = np.asarray(depth_buf, dtype=np.float32).reshape(c.height, c.width)
+        depth = (c.far * c.near / (c.far - (c.far - c.near) * d)).astype(np.float32)
+        return rgb, depth
+
+    def _hide_other_robots(self, robot: str) -> list[int]:
+        # the trainer's ghost arm is seen by people, not by the user's camera: park it below
+        # the ground while rendering (it collides with nothing, so physics is unaffected)
+        hidden = []
+        for name, r in self._robots.items():
+            if name != robot and name == 'trainer':
+                self._p.resetBasePositionAndOrientation(r.body, [0, 0, -5.0], [0, 0, 0, 1])
+                hidden.append(r.body)
+        return hidden
+
+    def _unhide(self, hidden: list[int]) -> None:
+        for body in hidden:
+            self._p.resetBasePositionAndOrientation(body, [0, 0, 0], [0, 0, 0, 1])
+
+    # ------------------------------------------------------------------ kinematics
+    def _kin_set(self, q: np.ndarray) -> None:
+        for i, j in enumerate(self._arm_idx):
+            self._kin.resetJointState(self._kin_body, j, float(q[i]))
+
+    def forward_kinematics(self, q: np.ndarray, link: str = 'tcp'
+                           ) -> tuple[np.ndarray, np.ndarray]:
+        """Pose (position (3,) m, quaternion xyzw (4,)) of ``link`` ('tcp' or 'camera') for
+        joint positions q (6,) rad, computed on a kinematic twin (the simulation is untouched)."""
+        self._kin_set(np.asarray(q, dtype=float))
+        idx = {'tcp': self._tcp_idx, 'camera': self._cam_idx}.get(link)
+        if idx is None:
+            msg = f"forward_kinematics link must be 'tcp' or 'camera', got {link!r}."
+            raise SimError(msg)
+        st = self._kin.getLinkState(self._kin_body, idx, computeForwardKinematics=True)
+        return np.array(st[4]), np.array(st[5])
+
+    def inverse_kinematics(self, target_pos: np.ndarray, target_quat: np.ndarray | None = None,
+                           robot: str = 'user', seed_q: np.ndarray | None = None,
+                           iterations: int = 30, tolerance: float = 1e-3) -> np.ndarray:
+        """Joint positions (6,) rad that put the TCP at ``target_pos`` (3,) m (and orientation
+        ``target_quat`` xyzw, if given), within the joint limits.
+
+        Uses pybullet.calculateInverseKinematics (damped least squares with null space towards
+        the home pose) iterated on a kinematic twin from ``seed_q`` (default: the current joints).
+        The result may be approximate when the target is out of reach; check it with
+        :meth:`forward_kinematics`.
+        """
+        target_pos = np.asarray(target_pos, dtype=float).reshape(3)
+        if not np.all(np.isfinite(target_pos)):
+            msg = f'IK target position must be finite (m), got {target_pos.tolist()}.'
+            raise SimError(msg)
+        q = (self.joint_positions(robot) if seed_q is None
+             else np.asarray(seed_q, dtype=float).reshape(6)).copy()
+        n_fingers = len(self._finger_idx)
+        lower = [*self.lower, *[FINGER_OPEN] * n_fingers]
+        upper = [*self.upper, *[FINGER_CLOSED] * n_fingers]
+        ranges = [u - lo for u, lo in zip(upper, lower, strict=True)]
+        best, best_err = q.copy(), math.inf
+        for _ in range(iterations):
+            self._kin_set(q)
+            rest = [*q, *[0.0] * n_fingers]
+            kwargs = {'lowerLimits': lower, 'upperLimits': upper, 'jointRanges': ranges,
+                      'restPoses': rest, 'maxNumIterations': 50, 'residualThreshold': 1e-6}
+            if target_quat is not None:
+                sol = self._kin.calculateInverseKinematics(
+                    self._kin_body, self._tcp_idx, target_pos.tolist(),
+                    np.asarray(target_quat, dtype=float).tolist(), **kwargs)
+            else:
+                sol = self._kin.calculateInverseKinematics(
+                    self._kin_body, self._tcp_idx, target_pos.tolist(), **kwargs)
+            q = np.clip(np.array(sol[:6]), self.lower, self.upper)
+            pos, orn = self.forward_kinematics(q)
+            err = float(np.linalg.norm(pos - target_pos))
+            if target_quat is not None:
+                dot = abs(float(np.dot(orn, np.asarray(target_quat, dtype=float))))
+                err += 0.1 * 2 * math.acos(min(1.0, dot))   # 0.1 m per rad
+            if err < best_err:
+                best, best_err = q.copy(), err
+            if err < tolerance:
+                break
+        return best
+
+    # ------------------------------------------------------------------ lifecycle
+    def close(self) -> None:
+        """Disconnect from PyBullet (the object is unusable afterwards)."""
+        for client in (self._p, self._kin):
+            with contextlib.suppress(pb.error):
+                client.disconnect()
+
+    def __enter__(self) -> Simulation:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+__all__ = ['HOME_POSE', 'CameraConfig', 'SceneObject', 'Simulation', 'top_down_quat']
