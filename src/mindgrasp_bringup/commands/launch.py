@@ -1,0 +1,93 @@
+"""Start a launch profile or a *.launch.py file: every node, the recorder and a run directory."""
+
+from __future__ import annotations
+
+import argparse
+import ast
+import shlex
+import sys
+
+from mindgrasp_bringup.launch_system import LaunchError, LaunchService, profiles
+from mindgrasp_bringup.launch_system.description import LAUNCH_SUFFIX, PROFILE_DIR
+from mindgrasp_bringup.launch_system.service import format_arguments
+
+EPILOG = """examples:
+  mindgrasp launch demo                      headless demo, recorded to runs/<UTC time>_demo/
+  mindgrasp launch demo gui:=true duration:=120
+  mindgrasp launch hardware eeg_stream:=MyAmp arm_driver:=my_arm_driver
+  mindgrasp launch demo --show-args          the arguments of a profile
+  mindgrasp launch my_setup.launch.py record:=false
+"""
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Options of ``mindgrasp launch``."""
+    parser.formatter_class = argparse.RawDescriptionHelpFormatter
+    parser.epilog = EPILOG
+    parser.add_argument('profile', nargs='?',
+                        help='a profile (' + ', '.join(profiles()) + ') or a *.launch.py path')
+    parser.add_argument('launch_arguments', nargs='*', metavar='name:=value',
+                        help='launch arguments (see --show-args)')
+    parser.add_argument('--composed', action='store_true',
+                        help='run the node modules in one process (mindgrasp_ros composition)')
+    parser.add_argument('--run-dir', metavar='DIR',
+                        help='run directory (default: runs/<UTC timestamp>_<profile>/)')
+    parser.add_argument('--duration', type=float, metavar='S',
+                        help='end the launch after S seconds (same as duration:=S)')
+    parser.add_argument('-s', '--show-args', action='store_true',
+                        help='print the launch arguments of the profile and exit')
+    parser.add_argument('--dry-run', action='store_true',
+                        help='print the processes and their command lines, start nothing')
+    parser.add_argument('--list', action='store_true', help='list the profiles and exit')
+    parser.add_argument('--sigint-timeout', type=float, default=5.0, metavar='S',
+                        help='seconds a node gets to stop after SIGINT before SIGTERM '
+                             '(default 5)')
+    parser.add_argument('--sigterm-timeout', type=float, default=5.0, metavar='S',
+                        help='seconds after SIGTERM before SIGKILL (default 5)')
+
+
+def profile_summaries() -> list[tuple[str, str]]:
+    """``(profile, first docstring line)`` of every profile, without importing them."""
+    out = []
+    for name in profiles():
+        path = PROFILE_DIR / f'{name}{LAUNCH_SUFFIX}'
+        try:
+            doc = ast.get_docstring(ast.parse(path.read_text(encoding='utf-8'))) or ''
+        except (OSError, SyntaxError):
+            doc = ''
+        out.append((name, doc.strip().splitlines()[0] if doc.strip() else ''))
+    return out
+
+
+def main(args: argparse.Namespace) -> int:
+    """Run ``mindgrasp launch``; 0 when every node ended cleanly, 1 on a failure, 2 on bad
+    input."""
+    if args.list or args.profile is None:
+        print('profiles (mindgrasp launch <profile> [name:=value ...]):')
+        for name, doc in profile_summaries():
+            print(f'  {name:<10} {doc}')
+        return 0 if args.list else 2
+    launch_arguments = list(args.launch_arguments)
+    if args.duration is not None:
+        launch_arguments.append(f'duration:={args.duration:g}')
+    try:
+        service = LaunchService(args.profile, launch_arguments, run_dir=args.run_dir,
+                                composed=args.composed, sigint_timeout=args.sigint_timeout,
+                                sigterm_timeout=args.sigterm_timeout,
+                                argv=['mindgrasp', 'launch', *sys.argv[2:]])
+        if args.show_args:
+            print(format_arguments(service.declared_arguments()))
+            return 0
+        if args.dry_run:
+            plan = service.plan()
+            print(f"launch '{plan.name}' ({plan.launch_file}), arguments:")
+            for name, value in plan.arguments.items():
+                print(f'  {name}:={value}')
+            print('processes, in start order:')
+            for spec, cmd in zip(plan.processes, service.commands(plan, None), strict=True):
+                print(f'  [{spec.label}] {shlex.join(cmd)}')
+            return 0
+        return service.run()
+    except LaunchError as exc:
+        print(f'mindgrasp launch: error: {exc}', file=sys.stderr)
+        return 2

@@ -1,0 +1,59 @@
+"""The headless main demo: simulated arm and camera, virtual amplifier + virtual subject, EEG
+acquisition, MI classifier, vision and the grasp controller, recorded to the run directory.
+
+    mindgrasp launch demo                          # until Ctrl-C; runs/<UTC time>_demo/
+    mindgrasp launch demo duration:=120 gui:=true subject:=follow seed:=3
+    mindgrasp launch demo --show-args
+
+Parameters: config/params/<package>.yaml of each package, then config/params/demo.yaml (the demo's
+own settings), then the launch arguments below (later entries win).
+"""
+
+from mindgrasp_bringup.launch_system import (
+    DeclareLaunchArgument,
+    LaunchConfiguration,
+    LaunchDescription,
+    Node,
+    config_files,
+)
+
+
+def generate_launch_description() -> LaunchDescription:
+    gui = LaunchConfiguration('gui')
+    seed = LaunchConfiguration('seed')
+    eeg_stream = LaunchConfiguration('eeg_stream')
+    return LaunchDescription([
+        DeclareLaunchArgument('gui', default_value='false', choices=['true', 'false'],
+                              description='open the PyBullet window (needs a display)'),
+        DeclareLaunchArgument('seed', default_value='0',
+                              description='seed of the scene, the virtual subject and the '
+                                          'synthetic EEG (same seed, same run)'),
+        DeclareLaunchArgument('eeg_stream', default_value='MIndGrasp-VirtualAmp',
+                              description='LSL stream name of the virtual amplifier (unique per '
+                                          'host when several demos run at once)'),
+        DeclareLaunchArgument('subject', default_value='pursue',
+                              choices=['noise', 'follow', 'pursue'],
+                              description='virtual subject: noise (no imagery), follow (imagines '
+                                          'what /trainer/prompt asks), pursue (imagines what '
+                                          'brings the arm to /task/target)'),
+        # 1 simulator: arm, gripper, objects, RGB-D camera (the arm contract of ros2_control)
+        Node(package='mindgrasp_sim', executable='sim_node', name='sim',
+             parameters=[*config_files('sim', 'demo'), {'gui': gui, 'seed': seed}]),
+        # 2 virtual amplifier: synthetic EEG of the virtual subject as an LSL stream
+        Node(package='mindgrasp_eeg', executable='virtual_amp_node', name='virtual_amp',
+             parameters=[*config_files('eeg', 'demo'),
+                         {'stream_name': eeg_stream, 'seed': seed,
+                          'subject_mode': LaunchConfiguration('subject')}]),
+        # 3 acquisition: LSL inlet -> /eeg/raw
+        Node(package='mindgrasp_eeg', executable='acquisition_node', name='eeg_acquisition',
+             parameters=[*config_files('eeg', 'demo'), {'stream_name': eeg_stream}]),
+        # 4 classifier: /eeg/raw -> /bci/prediction
+        Node(package='mindgrasp_classifier', executable='classifier_node', name='classifier',
+             parameters=config_files('classifier', 'demo')),
+        # 5 vision: camera -> /vision/detections, /vision/overlay
+        Node(package='mindgrasp_vision', executable='vision_node', name='vision',
+             parameters=config_files('vision', 'demo')),
+        # 6 controller: predictions + detections -> arm and gripper commands
+        Node(package='mindgrasp_fsm', executable='fsm_node', name='fsm',
+             parameters=config_files('fsm', 'demo')),
+    ])

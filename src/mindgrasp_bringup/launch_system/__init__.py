@@ -1,0 +1,69 @@
+"""The launcher of MIndGrasp-ROS, in the manner of ``launch`` / ``launch_ros``.
+
+Launch files (``src/mindgrasp_bringup/launch/<profile>.launch.py``) import from here::
+
+    from mindgrasp_bringup.launch_system import (DeclareLaunchArgument, LaunchConfiguration,
+                                                 LaunchDescription, Node)
+
+    def generate_launch_description():
+        return LaunchDescription([
+            DeclareLaunchArgument('gui', default_value='false', description='PyBullet GUI'),
+            Node(package='mindgrasp_sim', executable='sim_node', name='sim',
+                 parameters=[{'gui': LaunchConfiguration('gui')}]),
+        ])
+
+Layers: ``substitutions``/``conditions`` (values resolved at launch), ``actions/`` (one action
+per module), ``description`` (launch files, includes), ``service`` (resolve + run directory),
+``supervisor`` (processes, output, signals), ``composed`` (one-process mode).
+"""
+
+from mindgrasp_bringup.launch_system.actions import (
+    Action,
+    DeclareLaunchArgument,
+    ExecuteProcess,
+    GroupAction,
+    LogInfo,
+    Node,
+    ProcessSpec,
+    PushRosNamespace,
+    SetLaunchConfiguration,
+    Shutdown,
+)
+from mindgrasp_bringup.launch_system.conditions import (
+    IfCondition,
+    LaunchConfigurationEquals,
+    LaunchConfigurationNotEquals,
+    UnlessCondition,
+)
+from mindgrasp_bringup.launch_system.context import LaunchContext
+from mindgrasp_bringup.launch_system.description import (
+    IncludeLaunchDescription,
+    LaunchDescription,
+    PythonLaunchDescriptionSource,
+    find_launch_file,
+    load_launch_file,
+    profiles,
+)
+from mindgrasp_bringup.launch_system.errors import LaunchError
+from mindgrasp_bringup.launch_system.params import PARAMS_DIR, config_files
+from mindgrasp_bringup.launch_system.rundir import PROJECT_ROOT
+from mindgrasp_bringup.launch_system.service import LaunchService
+from mindgrasp_bringup.launch_system.substitutions import (
+    EnvironmentVariable,
+    LaunchConfiguration,
+    PathJoinSubstitution,
+    PythonExpression,
+    TextSubstitution,
+    ThisLaunchFileDir,
+)
+
+__all__ = [
+    'PARAMS_DIR', 'PROJECT_ROOT', 'Action', 'DeclareLaunchArgument', 'EnvironmentVariable',
+    'ExecuteProcess', 'GroupAction', 'IfCondition', 'IncludeLaunchDescription',
+    'LaunchConfiguration', 'LaunchConfigurationEquals', 'LaunchConfigurationNotEquals',
+    'LaunchContext', 'LaunchDescription', 'LaunchError', 'LaunchService', 'LogInfo', 'Node',
+    'PathJoinSubstitution', 'ProcessSpec', 'PushRosNamespace', 'PythonExpression',
+    'PythonLaunchDescriptionSource', 'SetLaunchConfiguration', 'Shutdown', 'TextSubstitution',
+    'ThisLaunchFileDir', 'UnlessCondition', 'config_files', 'find_launch_file',
+    'load_launch_file', 'profiles',
+]

@@ -1,0 +1,183 @@
+"""``Node``: a ROS 2 node process, as ``launch_ros.actions.Node``."""
+
+from __future__ import annotations
+
+import importlib.util
+import os
+import shutil
+import sys
+from collections.abc import Iterable, Mapping
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import yaml
+
+from mindgrasp_bringup.launch_system import params as ros_params
+from mindgrasp_bringup.launch_system.actions.execute_process import (
+    ExecuteProcess,
+    ProcessSpec,
+    resolve_list,
+)
+from mindgrasp_bringup.launch_system.actions.group_action import join_namespace
+from mindgrasp_bringup.launch_system.errors import LaunchError
+from mindgrasp_bringup.launch_system.substitutions import (
+    SomeSubstitutions,
+    Substitution,
+    is_substitution,
+    perform_substitutions,
+)
+
+if TYPE_CHECKING:
+    from mindgrasp_bringup.launch_system.context import LaunchContext
+
+ParameterItem = str | Path | Substitution | Mapping[str, Any]
+
+
+def find_module(module: str) -> bool:
+    """Whether ``python -m module`` can run, without importing the module itself."""
+    try:
+        return importlib.util.find_spec(module) is not None
+    except (ImportError, ValueError):
+        return False
+
+
+def resolve_program(package: str | None, executable: str) -> tuple[list[str], str | None, str |
+                                                                                         None]:
+    """The program of a node: ``(argv prefix, python module or None, problem or None)``.
+
+    ``package`` + ``executable`` is the module ``package.executable`` of our packages, run as
+    ``python -m``; failing that, an executable of that name on PATH (an external driver).
+    Without a package, ``executable`` is a path, a program on PATH or a dotted module name.
+    """
+    if package:
+        module = f'{package}.{executable}'
+        if find_module(module):
+            return [sys.executable, '-m', module], module, None
+        found = shutil.which(executable)
+        if found:
+            return [found], None, None
+        problem = (f"the node module '{module}' does not exist (yet): it is started as "
+                   f"'python -m {module}'. Install or write that module, check package= and "
+                   f"executable=, or leave the node out of the launch.")
+        return [sys.executable, '-m', module], module, problem
+    path = Path(executable).expanduser()
+    if os.sep in executable and path.is_file():
+        if not os.access(path, os.X_OK):
+            return [str(path)], None, (f"'{path}' is not executable: chmod +x it, or give its "
+                                       f"interpreter with ExecuteProcess.")
+        return [str(path.resolve())], None, None
+    found = shutil.which(executable)
+    if found:
+        return [found], None, None
+    if '.' in executable and find_module(executable):
+        return [sys.executable, '-m', executable], executable, None
+    problem = (f"the executable '{executable}' was found neither on PATH nor as a Python "
+               f"module: install it, give its full path, or fix the launch argument naming it.")
+    return [executable], None, problem
+
+
+def _parse_value(text: str) -> Any:
+    """A substituted parameter value is read as YAML, as launch_ros does ('3' -> 3)."""
+    try:
+        value = yaml.safe_load(text)
+    except yaml.YAMLError:
+        return text
+    if value is None or isinstance(value, dict):
+        return text
+    if isinstance(value, list) and not all(isinstance(v, (bool, int, float, str)) for v in value):
+        return text
+    return value
+
+
+def _resolve_param_value(context: LaunchContext, value: Any) -> Any:
+    if is_substitution(value):
+        return _parse_value(perform_substitutions(context, value))
+    if isinstance(value, Mapping):
+        return {str(k): _resolve_param_value(context, v) for k, v in value.items()}
+    if isinstance(value, Path):
+        return str(value)
+    if isinstance(value, tuple):
+        return list(value)
+    return value
+
+
+class Node(ExecuteProcess):
+    """A ROS 2 node: ``Node(package='mindgrasp_sim', executable='sim_node', name='sim', ...)``.
+
+    parameters: parameter files (paths or substitutions) and dicts, applied in order (later
+    wins); the entries of a file that match the node's name are merged into one parameter file
+    the node gets with ``--params-file``. remappings: ``[(from, to)]``. arguments: command-line
+    arguments before ``--ros-args``; ros_arguments: extra arguments after it (``--log-level``).
+    """
+
+    def __init__(self, *, executable: SomeSubstitutions, package: SomeSubstitutions | None = None,
+                 name: SomeSubstitutions | None = None,
+                 namespace: SomeSubstitutions | None = None,
+                 parameters: Iterable[ParameterItem] | None = None,
+                 remappings: Iterable[tuple[SomeSubstitutions, SomeSubstitutions]] | None = None,
+                 arguments: Iterable[SomeSubstitutions] | None = None,
+                 ros_arguments: Iterable[SomeSubstitutions] | None = None,
+                 **kwargs: Any) -> None:
+        super().__init__(cmd=[executable], **kwargs)
+        self.package = package
+        self.executable = executable
+        self.node_name = name
+        self.node_namespace = namespace
+        self.parameters = list(parameters or [])
+        for item in self.parameters:
+            if not isinstance(item, (str, Path, Substitution, Mapping, list)):
+                msg = (f'parameters=[...] items must be parameter file paths or dicts, got '
+                       f'{type(item).__name__} {item!r}.')
+                raise LaunchError(msg)
+        self.remappings = []
+        for pair in remappings or []:
+            if not (isinstance(pair, (tuple, list)) and len(pair) == 2):
+                msg = f'remappings must be (from, to) pairs, got {pair!r}.'
+                raise LaunchError(msg)
+            self.remappings.append(tuple(pair))
+        self.arguments = list(arguments or [])
+        self.ros_arguments = list(ros_arguments or [])
+
+    def execute(self, context: LaunchContext) -> None:
+        package = None if self.package is None else perform_substitutions(context, self.package)
+        executable = perform_substitutions(context, self.executable)
+        name = None if self.node_name is None else perform_substitutions(context, self.node_name)
+        if name is not None and (not name or '/' in name or ' ' in name):
+            msg = f"node name {name!r} is invalid: a ROS node name has no '/' or spaces."
+            raise LaunchError(msg)
+        namespace = join_namespace(
+            context.ros_namespace,
+            '' if self.node_namespace is None else perform_substitutions(context,
+                                                                         self.node_namespace))
+        program, module, problem = resolve_program(package, executable)
+        spec = ProcessSpec(
+            label=name or Path(executable).name.split('.')[-1], program=program,
+            arguments=resolve_list(context, self.arguments), is_node=True, package=package,
+            executable=executable, module=module, node_name=name, namespace=namespace,
+            remappings=[(perform_substitutions(context, a), perform_substitutions(context, b))
+                        for a, b in self.remappings],
+            ros_arguments=resolve_list(context, self.ros_arguments), problem=problem,
+            composable=module is not None, **self.common_fields(context))
+        spec.parameters, spec.parameter_files = self._resolve_parameters(context, spec)
+        context.processes.append(spec)
+
+    def _resolve_parameters(self, context: LaunchContext, spec: ProcessSpec,
+                            ) -> tuple[dict[str, Any], list[str]]:
+        fqn = spec.fully_qualified_name
+        who = fqn or f"'{spec.label}'"
+        merged: dict[str, Any] = {}
+        files: list[str] = []
+        for item in self.parameters:
+            if isinstance(item, Mapping):
+                resolved = {perform_substitutions(context, k) if is_substitution(k) else str(k):
+                            _resolve_param_value(context, v) for k, v in item.items()}
+                merged.update(ros_params.flatten(resolved))
+                continue
+            path = Path(perform_substitutions(context, item)).expanduser()
+            if context.launch_file is not None and not path.is_absolute() and not path.exists():
+                path = context.launch_file.parent / path
+            files.append(str(path))
+            for key, values in ros_params.load_parameter_file(path).items():
+                if ros_params.node_matches(key, fqn):
+                    merged.update(values)
+        return {k: ros_params.check_value(who, k, v) for k, v in merged.items()}, files

@@ -1,0 +1,52 @@
+"""``SetLaunchConfiguration`` and ``LogInfo``: small actions on the context."""
+
+from __future__ import annotations
+
+import logging
+from typing import TYPE_CHECKING
+
+from mindgrasp_bringup.launch_system.actions.action import Action
+from mindgrasp_bringup.launch_system.substitutions import SomeSubstitutions, perform_substitutions
+
+if TYPE_CHECKING:
+    from mindgrasp_bringup.launch_system.context import LaunchContext
+
+logger = logging.getLogger('launch')
+
+
+class SetLaunchConfiguration(Action):
+    """Set a launch configuration for the actions that follow (in the current scope)."""
+
+    def __init__(self, name: str, value: SomeSubstitutions, **kwargs: object) -> None:
+        super().__init__(**kwargs)  # type: ignore[arg-type]
+        self.name = name
+        self.value = value
+
+    def execute(self, context: LaunchContext) -> None:
+        context.launch_configurations[self.name] = perform_substitutions(context, self.value)
+
+
+class LogInfo(Action):
+    """Log a message when the description is resolved."""
+
+    def __init__(self, *, msg: SomeSubstitutions, **kwargs: object) -> None:
+        super().__init__(**kwargs)  # type: ignore[arg-type]
+        self.msg = msg
+
+    def execute(self, context: LaunchContext) -> None:
+        logger.info('%s', perform_substitutions(context, self.msg))
+
+
+class Shutdown(Action):
+    """Used as ``on_exit=Shutdown()`` of a process: its exit ends the whole launch."""
+
+    def __init__(self, *, reason: str = 'a process with on_exit=Shutdown() ended',
+                 **kwargs: object) -> None:
+        super().__init__(**kwargs)  # type: ignore[arg-type]
+        self.reason = reason
+
+    def execute(self, context: LaunchContext) -> None:
+        msg = 'Shutdown() is only supported as on_exit=Shutdown() of a Node or ExecuteProcess.'
+        from mindgrasp_bringup.launch_system.errors import LaunchError
+
+        raise LaunchError(msg)

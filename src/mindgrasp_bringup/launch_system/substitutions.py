@@ -1,0 +1,166 @@
+"""Substitutions: values resolved when a launch description is executed, as in ``launch``.
+
+A value anywhere a substitution is accepted may be plain text, a :class:`Substitution`, or a list
+of both (concatenated), e.g. ``['/robot', LaunchConfiguration('id')]``.
+"""
+
+from __future__ import annotations
+
+import ast
+import math
+import os
+from collections.abc import Iterable
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from mindgrasp_bringup.launch_system.errors import LaunchError
+
+if TYPE_CHECKING:
+    from mindgrasp_bringup.launch_system.context import LaunchContext
+
+
+class Substitution:
+    """Base class: ``perform(context) -> str``."""
+
+    def perform(self, context: LaunchContext) -> str:  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def describe(self) -> str:
+        """Text shown by ``--show-args`` and error messages."""
+        return type(self).__name__
+
+
+SomeSubstitutions = str | Path | Substitution | Iterable[str | Path | Substitution]
+
+
+class TextSubstitution(Substitution):
+    """Plain text."""
+
+    def __init__(self, *, text: str) -> None:
+        self.text = str(text)
+
+    def perform(self, context: LaunchContext) -> str:
+        return self.text
+
+    def describe(self) -> str:
+        return repr(self.text)
+
+
+class LaunchConfiguration(Substitution):
+    """The value of a launch argument (``name:=value`` on the command line or its default)."""
+
+    def __init__(self, variable_name: str, *, default: SomeSubstitutions | None = None) -> None:
+        self.variable_name = variable_name
+        self.default = default
+
+    def perform(self, context: LaunchContext) -> str:
+        if self.variable_name in context.launch_configurations:
+            return context.launch_configurations[self.variable_name]
+        if self.default is not None:
+            return perform_substitutions(context, self.default)
+        known = ', '.join(sorted(context.launch_configurations)) or '(none)'
+        msg = (f"launch configuration '{self.variable_name}' does not exist: declare it with "
+               f"DeclareLaunchArgument('{self.variable_name}', ...) before using it, or give it "
+               f"as {self.variable_name}:=<value>. Known configurations: {known}.")
+        raise LaunchError(msg)
+
+    def describe(self) -> str:
+        return f'LaunchConfig({self.variable_name!r})'
+
+
+class EnvironmentVariable(Substitution):
+    """An environment variable of the launcher, with an optional default."""
+
+    def __init__(self, name: str, *, default_value: str | None = None) -> None:
+        self.name = name
+        self.default_value = default_value
+
+    def perform(self, context: LaunchContext) -> str:
+        value = os.environ.get(self.name, self.default_value)
+        if value is None:
+            msg = (f"environment variable '{self.name}' is not set: set it, or give "
+                   f"EnvironmentVariable('{self.name}', default_value=...) a default.")
+            raise LaunchError(msg)
+        return value
+
+
+class ThisLaunchFileDir(Substitution):
+    """The folder of the launch file being resolved."""
+
+    def perform(self, context: LaunchContext) -> str:
+        if context.launch_file is None:
+            msg = 'ThisLaunchFileDir used outside a launch file: give the path explicitly.'
+            raise LaunchError(msg)
+        return str(context.launch_file.parent)
+
+
+class PathJoinSubstitution(Substitution):
+    """Path parts joined with ``/``; each part may itself be substitutions."""
+
+    def __init__(self, substitutions: Iterable[SomeSubstitutions]) -> None:
+        self.substitutions = list(substitutions)
+
+    def perform(self, context: LaunchContext) -> str:
+        return str(Path(*[perform_substitutions(context, s) for s in self.substitutions]))
+
+
+_SAFE_NAMES = {'true': True, 'false': False, 'True': True, 'False': False, 'None': None,
+               'math': math, 'min': min, 'max': max, 'abs': abs, 'int': int, 'float': float,
+               'str': str, 'len': len, 'round': round}
+
+
+class PythonExpression(Substitution):
+    """A small Python expression over the concatenated text, e.g. ``['', LaunchConfiguration('n'),
+    ' > 2']``. Only literals, operators, ``math`` and a few builtins are available."""
+
+    def __init__(self, expression: SomeSubstitutions) -> None:
+        self.expression = expression
+
+    def perform(self, context: LaunchContext) -> str:
+        text = perform_substitutions(context, self.expression)
+        try:
+            tree = ast.parse(text, mode='eval')
+            for node in ast.walk(tree):
+                if isinstance(node, ast.Attribute) and node.attr.startswith('_'):
+                    raise ValueError('private attributes are not allowed')
+            value = eval(compile(tree, '<PythonExpression>', 'eval'),
+                         {'__builtins__': {}}, dict(_SAFE_NAMES))
+        except Exception as exc:
+            msg = f'PythonExpression {text!r} cannot be evaluated ({exc}): fix the expression.'
+            raise LaunchError(msg) from exc
+        return str(value).lower() if isinstance(value, bool) else str(value)
+
+
+def normalize(value: SomeSubstitutions) -> list[Substitution]:
+    """Turn text, a substitution or a list of both into a list of substitutions."""
+    if isinstance(value, (str, Path)):
+        return [TextSubstitution(text=str(value))]
+    if isinstance(value, Substitution):
+        return [value]
+    if isinstance(value, (int, float, bool)):
+        return [TextSubstitution(text=str(value).lower() if isinstance(value, bool) else
+                                 str(value))]
+    try:
+        items = list(value)
+    except TypeError:
+        msg = (f'expected text, a Substitution or a list of them, got {type(value).__name__} '
+               f'{value!r}.')
+        raise LaunchError(msg) from None
+    out: list[Substitution] = []
+    for item in items:
+        out.extend(normalize(item))
+    return out
+
+
+def perform_substitutions(context: LaunchContext, value: SomeSubstitutions) -> str:
+    """Resolve ``value`` (text, a substitution or a list of them) to text."""
+    return ''.join(s.perform(context) for s in normalize(value))
+
+
+def is_substitution(value: object) -> bool:
+    """True for a substitution or a list holding one (a value that must be resolved)."""
+    if isinstance(value, Substitution):
+        return True
+    if isinstance(value, (list, tuple)):
+        return any(isinstance(v, Substitution) for v in value)
+    return False
