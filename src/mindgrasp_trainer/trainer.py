@@ -306,7 +306,7 @@ class TrainerProtocol:
         elif self.state in ('move', 'wait'):
             if trainer_ee_z is not None and trainer_ee_z < self.reset_height:
                 reset = (
-                    f'training end-effector at {trainer_ee_z:.3f} m, '
+                    f'training end-effector at {trainer_ee_z:.4f} m, '
                     f'below {self.reset_height:.3f} m'
                 )
             elif entered_grasp:

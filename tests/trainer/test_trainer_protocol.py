@@ -93,7 +93,7 @@ def test_reset_when_training_end_effector_below_0_1_m():
     assert rest.class_index == NO_CLASS and rest.onset == pytest.approx(5.0)
     # next trial: reset answered at 5.2 s, plus 1 s settle
     assert events[4].onset == pytest.approx(6.2) and events[4].trial == 3
-    assert proto.trials[1].aborted.startswith('training end-effector at 0.050 m')
+    assert proto.trials[1].aborted.startswith('training end-effector at 0.0500 m')
     # the robot stops at once when the reset fires and stays still until the next trial
     still = (times >= 5.0 - 1e-9) & (times < 6.2 - 1e-9)
     assert not commands[still].any()

@@ -1,0 +1,133 @@
+"""Graz prompter node across processes: prompts over DDS with the schedule's timing, transient-local
+late joiner, display frames, bad parameters."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pytest
+
+from mindgrasp_trainer.display import ARROW_COLOUR, DIRECTIONS
+from mindgrasp_trainer.graz import GrazProtocol
+
+pytestmark = pytest.mark.slow
+
+FAST = {'fixation': 0.4, 'cue': 0.3, 'imagery': 0.5, 'rest_min': 0.2, 'rest_max': 0.4}
+
+
+def prompt_qos(rclpy):
+    return rclpy.qos.QoSProfile(
+        depth=1,
+        reliability=rclpy.qos.ReliabilityPolicy.RELIABLE,
+        durability=rclpy.qos.DurabilityPolicy.TRANSIENT_LOCAL,
+    )
+
+
+def stamp_s(msg) -> float:
+    return msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
+
+
+def test_prompts_arrive_in_order_with_the_schedule_timing(ros, spawn, spin_until):
+    from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import Prompt
+
+    node = ros.node.Node('graz_listener')
+    got = []  # (message, receive time in ROS seconds)
+    node.create_subscription(
+        Prompt, '/trainer/prompt',
+        lambda m: got.append((m, node.get_clock().now().nanoseconds * 1e-9)), prompt_qos(ros),
+    )  # fmt: skip
+    # Start delay covers process start-up and discovery, so the listener sees the whole session.
+    proc = spawn('mindgrasp_trainer.graz_node', n_trials=4, seed=3, start_delay=3.0,
+                 display_rate=0.0, **FAST)  # fmt: skip
+    expected = GrazProtocol(n_trials=4, seed=3, start_delay=3.0, **FAST).schedule()
+    assert spin_until(node, lambda: got and got[-1][0].phase == 'end', 40.0), (
+        f'prompts received: {[m.phase for m, _ in got]}; node output:\n{proc.stdout.read()}'
+    )
+    assert proc.wait(10) == 0
+    msgs = [m for m, _ in got]
+    assert [(m.phase, m.class_index, m.trial) for m in msgs] == [
+        (e.phase, e.class_index, e.trial) for e in expected
+    ]
+    assert [m.class_name for m in msgs] == [e.class_name for e in expected]
+    assert [m.paradigm for m in msgs] == ['graz'] * len(expected)
+    durations = [e.duration for e in expected]
+    np.testing.assert_allclose([m.duration for m in msgs], durations, atol=1e-6)
+    # phase onsets (header stamps) follow the planned onsets: same gaps within a few timer ticks
+    stamps = np.array([stamp_s(m) for m in msgs])
+    onsets = np.array([e.onset for e in expected])
+    np.testing.assert_allclose(np.diff(stamps), np.diff(onsets), atol=0.05)
+    # and each prompt reached the other process shortly after its stamp
+    delays = np.array([t for _, t in got]) - stamps
+    assert (delays > -0.01).all() and np.median(delays) < 0.1
+    node.destroy_node()
+
+
+def test_late_joiner_gets_the_last_prompt_and_the_display_shows_the_arrow(ros, spawn, spin_until):
+    from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import Prompt
+    from mindgrasp_ros.interfaces.sensor_msgs.msg import Image
+
+    node = ros.node.Node('graz_late_joiner')
+    early, late, frames = [], [], []
+    node.create_subscription(Prompt, '/trainer/prompt', early.append, prompt_qos(ros))
+    node.create_subscription(Image, '/trainer/display', frames.append,
+                             ros.qos.qos_profile_sensor_data)  # fmt: skip
+    proc = spawn('mindgrasp_trainer.graz_node', n_trials=4, seed=5, start_delay=2.0,
+                 fixation=0.5, cue=6.0, display_rate=20.0, display_width=160,
+                 display_height=120)  # fmt: skip
+    assert spin_until(node, lambda: any(m.phase == 'cue' for m in early), 30.0), (
+        f'no cue; node output:\n{proc.stdout.read() if proc.poll() is not None else ""}'
+    )
+    cue = early[-1]
+    assert [m.phase for m in early] == ['fixation', 'cue']
+    # a reader that joins now gets only the current phase (transient local, depth 1)
+    node.create_subscription(Prompt, '/trainer/prompt', late.append, prompt_qos(ros))
+    assert spin_until(node, lambda: late, 10.0)
+    spin_until(node, lambda: False, 0.5)
+    assert len(late) == 1
+    assert (late[0].phase, late[0].trial, late[0].class_index) == ('cue', 1, cue.class_index)
+    assert late[0].header.stamp.sec == cue.header.stamp.sec
+    assert late[0].header.stamp.nanosec == cue.header.stamp.nanosec
+    # the display shows the arrow of the cued class, pointing its way
+    n = len(frames)
+    assert spin_until(node, lambda: len(frames) > n + 2, 5.0)
+    img = frames[-1]
+    assert (img.width, img.height, img.encoding) == (160, 120, 'rgb8')
+    rgb = np.asarray(img.data, np.uint8).reshape(120, 160, 3)
+    ys, xs = np.nonzero(np.all(rgb == ARROW_COLOUR, axis=-1))
+    assert len(xs) > 50
+    dx, dy = DIRECTIONS[cue.class_index]
+    centre = np.array([xs.mean() - 80, ys.mean() - 60])
+    assert np.dot(centre, [dx, dy]) > 5
+    node.destroy_node()
+
+
+def test_duration_ends_the_session(ros, spawn, spin_until):
+    from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import Prompt
+
+    node = ros.node.Node('graz_duration_listener')
+    got = []
+    node.create_subscription(Prompt, '/trainer/prompt', got.append, prompt_qos(ros))
+    t0 = time.monotonic()
+    proc = spawn('mindgrasp_trainer.graz_node', n_trials=400, duration=4.0, start_delay=1.0,
+                 display_rate=0.0, **FAST)  # fmt: skip
+    assert proc.wait(40) == 0
+    assert time.monotonic() - t0 < 30
+    spin_until(node, lambda: got and got[-1].phase == 'end', 5.0)
+    assert got and got[-1].phase == 'end'
+    node.destroy_node()
+
+
+@pytest.mark.parametrize(
+    ('params', 'match'),
+    [
+        ({'rest_min': 3.0, 'rest_max': 2.0}, "'rest_min' (3.0 s) is larger than 'rest_max'"),
+        ({'classes': '[0, 7]'}, 'which are not class indices'),
+        ({'feedback': 'loud'}, "'feedback' is 'loud'; use one of off, move, always"),
+    ],
+)
+def test_bad_parameters_end_the_node_with_the_reason(ros, spawn, params, match):
+    proc = spawn('mindgrasp_trainer.graz_node', **params)
+    assert proc.wait(30) == 2
+    out = proc.stdout.read()
+    assert match in out, out
