@@ -1,0 +1,190 @@
+"""Read MCAP files, finished or not (a recorder killed with SIGKILL leaves no summary).
+
+Finished files are read through their summary with the ``mcap`` library. For unfinished ones the
+``mcap`` library's ``StreamReader`` cannot be used as is: its reads do not check for short reads,
+so a record cut off at the end of the file is parsed from garbage instead of being reported. This
+module therefore does the record framing itself (opcode + length, checked against the file size)
+and hands every complete record to the ``mcap`` library for parsing; the scan stops at the first
+incomplete or corrupt record, so everything before it is recovered.
+"""
+
+from __future__ import annotations
+
+import io
+import struct
+from collections import defaultdict
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from mcap.exceptions import EndOfFile, McapError
+from mcap.reader import make_reader
+from mcap.records import Channel, Chunk, Footer, Message, Schema, Statistics
+from mcap.stream_reader import StreamReader
+
+from .errors import BagError
+
+__all__ = ['ChannelInfo', 'McapContents', 'iter_mcap_messages', 'read_mcap_contents']
+
+MAGIC = b'\x89MCAP0\r\n'
+_RECORD_HEADER = struct.Struct('<BQ')
+
+
+@dataclass
+class ChannelInfo:
+    """An MCAP channel with its schema (``schema_data`` is the message definition text)."""
+
+    id: int
+    topic: str
+    message_encoding: str
+    metadata: dict[str, str]
+    schema_name: str = ''
+    schema_encoding: str = ''
+    schema_data: bytes = b''
+
+
+@dataclass
+class McapContents:
+    """What an MCAP file holds: channels, per-channel counts and the time range (ns)."""
+
+    path: Path
+    channels: dict[int, ChannelInfo] = field(default_factory=dict)
+    channel_counts: dict[int, int] = field(default_factory=dict)
+    message_count: int = 0
+    start_ns: int = 0
+    end_ns: int = 0
+    complete: bool = True        # False: no summary (writer killed), contents from a scan
+    stopped_at: str = ''         # why a scan stopped before the end of the file
+    compression: str = ''
+
+
+def _check_magic(path: Path, head: bytes) -> None:
+    if head[:8] != MAGIC:
+        msg = (f'{path} is not an MCAP file (bad magic bytes); pass a rosbag2 directory or an '
+               '.mcap file written by ros2 bag, rosbags or mindgrasp bag record.')
+        raise BagError(msg)
+
+
+def _is_finished(f: io.BufferedReader, size: int) -> bool:
+    if size < 16 + 37:
+        return False
+    f.seek(size - 8)
+    return f.read(8) == MAGIC
+
+
+def _channel_info(channel: Channel, schemas: dict[int, Schema]) -> ChannelInfo:
+    schema = schemas.get(channel.schema_id)
+    return ChannelInfo(channel.id, channel.topic, channel.message_encoding,
+                       dict(channel.metadata),
+                       schema.name if schema else '', schema.encoding if schema else '',
+                       bytes(schema.data) if schema else b'')
+
+
+def _records(path: Path, f: io.BufferedReader, size: int,
+             contents: McapContents) -> Iterator[object]:
+    """Every complete top-level record, chunks broken up into their records."""
+    f.seek(8)
+    offset = 8
+    while offset + _RECORD_HEADER.size <= size:
+        head = f.read(_RECORD_HEADER.size)
+        opcode, length = _RECORD_HEADER.unpack(head)
+        end = offset + _RECORD_HEADER.size + length
+        if end > size:
+            contents.stopped_at = (f'record at byte {offset} is cut off at the end of the file '
+                                   f'({end - size} bytes missing)')
+            return
+        body = f.read(length)
+        offset = end
+        reader = StreamReader(io.BytesIO(head + body), skip_magic=True, validate_crcs=True)
+        records = reader.records
+        try:
+            while True:
+                yield next(records)
+        except (EndOfFile, StopIteration):
+            pass
+        except (McapError, ValueError, struct.error, UnicodeDecodeError) as exc:
+            contents.stopped_at = f'record at byte {offset} is corrupt ({exc})'
+            return
+        if opcode == 0x02:  # footer: nothing of interest follows
+            return
+
+
+def read_mcap_contents(path: Path) -> McapContents:
+    """Channels, counts and time range of one MCAP file: its summary, else a scan.
+
+    Raises:
+        BagError: the file does not exist or is not MCAP.
+    """
+    path = Path(path)
+    contents = McapContents(path)
+    try:
+        f = path.open('rb')
+    except OSError as exc:
+        msg = f'Cannot open {path}: {exc.strerror}; check the path and its permissions.'
+        raise BagError(msg) from None
+    with f:
+        size = path.stat().st_size
+        _check_magic(path, f.read(8))
+        if _is_finished(f, size):
+            f.seek(0)
+            try:
+                summary = make_reader(f).get_summary()
+            except (McapError, ValueError, struct.error, EOFError):
+                summary = None
+            if summary is not None and summary.statistics is not None:
+                stats: Statistics = summary.statistics
+                contents.channels = {cid: _channel_info(ch, summary.schemas)
+                                     for cid, ch in summary.channels.items()}
+                contents.channel_counts = dict(stats.channel_message_counts)
+                contents.message_count = stats.message_count
+                if stats.message_count:
+                    contents.start_ns = stats.message_start_time
+                    contents.end_ns = stats.message_end_time
+                contents.compression = next(
+                    (c.compression for c in summary.chunk_indexes if c.compression), '')
+                return contents
+        contents.complete = False
+        schemas: dict[int, Schema] = {}
+        counts: dict[int, int] = defaultdict(int)
+        start, end = 2**63 - 1, 0
+        for record in _records(path, f, size, contents):
+            if isinstance(record, Schema):
+                schemas[record.id] = record
+            elif isinstance(record, Channel):
+                contents.channels[record.id] = _channel_info(record, schemas)
+            elif isinstance(record, Message):
+                counts[record.channel_id] += 1
+                start = min(start, record.log_time)
+                end = max(end, record.log_time)
+            elif isinstance(record, Chunk) and record.compression:
+                contents.compression = record.compression
+            elif isinstance(record, Footer):
+                contents.complete = True
+        contents.channel_counts = dict(counts)
+        contents.message_count = sum(counts.values())
+        if contents.message_count:
+            contents.start_ns, contents.end_ns = start, end
+    return contents
+
+
+def iter_mcap_messages(path: Path) -> Iterator[tuple[ChannelInfo, int, bytes]]:
+    """``(channel, log_time_ns, data)`` for every readable message, in file order.
+
+    Works on unfinished files (stops at the first incomplete record).
+    """
+    path = Path(path)
+    contents = McapContents(path)
+    with path.open('rb') as f:
+        size = path.stat().st_size
+        _check_magic(path, f.read(8))
+        schemas: dict[int, Schema] = {}
+        channels: dict[int, ChannelInfo] = {}
+        for record in _records(path, f, size, contents):
+            if isinstance(record, Schema):
+                schemas[record.id] = record
+            elif isinstance(record, Channel):
+                channels[record.id] = _channel_info(record, schemas)
+            elif isinstance(record, Message):
+                channel = channels.get(record.channel_id)
+                if channel is not None:
+                    yield channel, record.log_time, bytes(record.data)

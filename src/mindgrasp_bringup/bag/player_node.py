@@ -1,0 +1,150 @@
+"""Player node: publishes a bag's messages with their original timing (like ``ros2 bag play``).
+
+Run: ``python -m mindgrasp_bringup.bag.player_node --ros-args -p bag:=runs/x/bag -p rate:=2.0
+-p clock:=true``. Publishes the recorded CDR bytes unchanged (raw publishers) with the QoS the
+recording offered; topics whose type the client layer cannot publish are skipped and named.
+"""
+
+from __future__ import annotations
+
+import signal
+import sys
+import threading
+from typing import Any
+
+from mindgrasp_bringup.bag.errors import BagError
+from mindgrasp_bringup.bag.player import Player, PlayStats, parse_remaps, type_problem
+from mindgrasp_bringup.bag.qos import adapted_qos
+from mindgrasp_bringup.bag.reader import BagReader, TopicInfo
+from mindgrasp_bringup.bag.ros_glue import message_class, qos_profile
+from mindgrasp_ros import rclpy
+
+CLOCK_TYPE = 'rosgraph_msgs/msg/Clock'
+
+
+class PlayerNode(rclpy.node.Node):
+    """Opens the bag, creates one raw publisher per playable topic, plays in a thread."""
+
+    def __init__(self, **kwargs: Any) -> None:
+        super().__init__('bag_player', **kwargs)
+        self.declare_parameters('', [
+            ('bag', ''), ('rate', 1.0), ('loop', False), ('start_offset', 0.0),
+            ('topics', ['']), ('regex', ''), ('exclude_regex', ''), ('remap', ['']),
+            ('clock', False), ('clock_frequency', 40.0), ('delay', 0.0)])
+        v = {name: self.get_parameter(name).value for name in (
+            'bag', 'rate', 'loop', 'start_offset', 'topics', 'regex', 'exclude_regex', 'remap',
+            'clock', 'clock_frequency', 'delay')}
+        if not v['bag']:
+            msg = 'The parameter bag is empty; pass the bag directory with -p bag:=<path>.'
+            raise BagError(msg)
+        self.reader = BagReader(v['bag']).open()
+        for note in self.reader.notes:
+            self.get_logger().warning(note)
+        topics = [t for t in (v['topics'] or []) if t] or None
+        self.remap = parse_remaps([r for r in (v['remap'] or []) if r])
+        self.publishers_: dict[str, Any] = {}
+        self.player = Player(
+            self.reader, rate=float(v['rate']), loop=bool(v['loop']),
+            start_offset=float(v['start_offset']), topics=topics, regex=v['regex'],
+            exclude_regex=v['exclude_regex'], remap=self.remap,
+            can_publish=self._create_publisher)
+        for line in self.player.skipped_report():
+            self.get_logger().warning(line)
+        self.clock_publisher = None
+        self.clock_frequency = float(v['clock_frequency'])
+        if v['clock']:
+            clock_qos = rclpy.qos.QoSProfile(depth=1,
+                                             reliability=rclpy.qos.ReliabilityPolicy.BEST_EFFORT)
+            self.clock_publisher = self.create_publisher(
+                message_class(CLOCK_TYPE), '/clock', clock_qos, raw=True)
+        self.delay = float(v['delay'])
+        self.stats: PlayStats | None = None
+        self.error: str | None = None
+        self.stop_event = threading.Event()
+        self.thread = threading.Thread(target=self._play, name='bag-player', daemon=True)
+
+    def _create_publisher(self, info: TopicInfo) -> str | None:
+        """Create the raw publisher of one bag topic; the reason when it cannot be played."""
+        reason = type_problem(info)
+        if reason:
+            return reason
+        try:
+            msg_class = message_class(info.type)
+        except (ImportError, AttributeError, ValueError):
+            return f'its message type {info.type} is unknown to the client layer'
+        qos = adapted_qos(info.offered_qos_profiles)
+        self.publishers_[info.name] = self.create_publisher(
+            msg_class, self.remap.get(info.name, info.name), qos_profile(rclpy, qos), raw=True)
+        return None
+
+    def start(self) -> None:
+        """Start playing (after ``delay`` s, so subscribers can match first)."""
+        self.thread.start()
+
+    def _play(self) -> None:
+        if self.delay > 0 and self.stop_event.wait(self.delay):
+            return
+        ts = rclpy_clock_type()
+        publishers = self.publishers_
+
+        def publish(topic: str, data: bytes) -> None:
+            publishers[topic].publish(data)
+
+        def publish_clock(ns: int) -> None:
+            sec, nanosec = divmod(ns, 1_000_000_000)
+            self.clock_publisher.publish(ts.serialize_cdr(  # type: ignore[union-attr]
+                ts.types[CLOCK_TYPE](ts.types['builtin_interfaces/msg/Time'](sec, nanosec)),
+                CLOCK_TYPE))
+
+        # The player reports output topics; publishers are keyed by bag topic.
+        inverse = {self.player.output_topic(t): t for t in publishers}
+        try:
+            self.stats = self.player.run(
+                lambda out, data: publish(inverse[out], data),
+                publish_clock=publish_clock if self.clock_publisher is not None else None,
+                clock_hz=self.clock_frequency, stop=self.stop_event)
+        except BagError as exc:
+            self.error = str(exc)
+            self.get_logger().error(self.error)
+
+
+def rclpy_clock_type() -> Any:
+    """The type store used to serialise /clock messages."""
+    from mindgrasp_bringup.bag.typestore import typestore
+
+    return typestore()
+
+
+def main(args: list[str] | None = None) -> int:
+    """Play the bag; 0 when played to the end (or stopped), 1 on a bag error."""
+    rclpy.init(args=args)
+    try:
+        node = PlayerNode()
+    except BagError as exc:
+        print(f'bag player: {exc}', file=sys.stderr)
+        rclpy.shutdown()
+        return 1
+    signal.signal(signal.SIGTERM, lambda *_: node.stop_event.set())
+    node.start()
+    try:
+        while rclpy.ok() and node.thread.is_alive():
+            rclpy.spin_once(node, timeout_sec=0.1)
+    except KeyboardInterrupt:
+        pass
+    finally:
+        node.stop_event.set()
+        node.thread.join(5.0)
+        stats, error = node.stats, node.error
+        if stats is not None:
+            total = sum(stats.published.values())
+            node.get_logger().info(f'Published {total} message(s) on {len(stats.published)} '
+                                   f'topic(s); worst lateness {stats.max_late_ms:.1f} ms.')
+        node.reader.close()
+        node.destroy_node()
+        if rclpy.ok():
+            rclpy.shutdown()
+    return 1 if error else 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())

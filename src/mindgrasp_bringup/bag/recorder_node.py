@@ -1,0 +1,166 @@
+"""Recorder node: records all topics (or a pattern list) to a rosbag2 MCAP bag.
+
+Run: ``python -m mindgrasp_bringup.bag.recorder_node --ros-args -p output:=runs/x/bag
+-p topics:="['/eeg/raw']" -p duration:=10.0``. New topics are discovered while it runs; the
+subscriptions take raw CDR bytes, and a :class:`~mindgrasp_bringup.bag.recorder.Recorder`
+writes them from its own thread, so callbacks never wait for the disk.
+"""
+
+from __future__ import annotations
+
+import re
+import signal
+import sys
+import time
+from typing import Any
+
+from mindgrasp_bringup.bag.errors import BagError
+from mindgrasp_bringup.bag.qos import adapted_qos, qos_to_dict
+from mindgrasp_bringup.bag.recorder import Recorder
+from mindgrasp_bringup.bag.ros_glue import message_class, qos_profile
+from mindgrasp_bringup.bag.writer import BagWriter
+from mindgrasp_ros import rclpy
+
+#: Topics of the ROS graph itself that a bag never needs.
+_ALWAYS_EXCLUDED = ('/rosout', '/parameter_events')
+
+
+class RecorderNode(rclpy.node.Node):
+    """Subscribes to matching topics as they appear and feeds a :class:`Recorder`."""
+
+    def __init__(self, **kwargs: Any) -> None:
+        super().__init__('recorder', **kwargs)
+        self.declare_parameters('', [
+            ('output', ''), ('topics', ['']), ('regex', ''), ('exclude_regex', ''),
+            ('max_bag_size', 0), ('max_bag_duration', 0.0), ('compression', 'none'),
+            ('chunk_size', 1 << 20), ('flush_interval', 1.0), ('max_queue_mb', 512),
+            ('discovery_period', 0.5), ('duration', 0.0), ('include_ros_topics', False)])
+        value = {name: self.get_parameter(name).value for name in (
+            'output', 'topics', 'regex', 'exclude_regex', 'max_bag_size', 'max_bag_duration',
+            'compression', 'chunk_size', 'flush_interval', 'max_queue_mb', 'discovery_period',
+            'duration', 'include_ros_topics')}
+        output = value['output'] or time.strftime('rosbag2_%Y_%m_%d-%H_%M_%S')
+        self.topics = [t for t in (value['topics'] or []) if t]
+        self.include = re.compile(value['regex']) if value['regex'] else None
+        self.exclude = re.compile(value['exclude_regex']) if value['exclude_regex'] else None
+        self.include_ros_topics = bool(value['include_ros_topics'])
+        writer = BagWriter(output, chunk_size=int(value['chunk_size']),
+                           compression=str(value['compression']),
+                           flush_interval=float(value['flush_interval']),
+                           max_bag_size=int(value['max_bag_size']),
+                           max_bag_duration=float(value['max_bag_duration']))
+        self.recorder = Recorder(writer, max_queue_bytes=int(value['max_queue_mb']) << 20,
+                                 on_error=self._on_error)
+        self.recorder.start()
+        self._subscriptions: dict[str, Any] = {}
+        self._refused: set[str] = set()
+        self.finished = False
+        self.get_logger().info(f'Recording to {writer.path} (MCAP, compression '
+                               f'{writer.compression}).')
+        self.create_timer(float(value['discovery_period']), self.discover_callback)
+        self.create_timer(1.0, self.report_callback)
+        if value['duration'] > 0:
+            self.create_timer(float(value['duration']), self.duration_callback)
+        self.discover_callback()
+
+    def _wanted(self, topic: str) -> bool:
+        if topic in self.topics:
+            return True
+        if not self.include_ros_topics and topic in _ALWAYS_EXCLUDED:
+            return False
+        if self.exclude is not None and self.exclude.search(topic):
+            return False
+        if self.include is not None:
+            return bool(self.include.search(topic))
+        return not self.topics  # no list and no regex: everything
+
+    def discover_callback(self) -> None:
+        """Subscribe to every new matching topic of the graph."""
+        if self.recorder.error is not None:
+            return
+        for topic, types in self.get_topic_names_and_types():
+            if topic in self._subscriptions or topic in self._refused or not self._wanted(topic):
+                continue
+            msgtype = types[0]
+            if len(types) > 1:
+                self.get_logger().warning(f'{topic} is published with several types {types}; '
+                                          f'recording {msgtype} only.')
+            try:
+                msg_class = message_class(msgtype)
+            except (ImportError, AttributeError, ValueError):
+                self._refused.add(topic)
+                self.get_logger().warning(f'Not recording {topic}: its type {msgtype} is unknown '
+                                          'to the client layer (add its .msg to the type store).')
+                continue
+            offered = [qos_to_dict(i.qos_profile)
+                       for i in self.get_publishers_info_by_topic(topic)]
+            qos = adapted_qos(offered, default_depth=100)
+            self.recorder.add_topic(topic, msgtype, offered)
+            self._subscriptions[topic] = self.create_subscription(
+                msg_class, topic, self._make_callback(topic), qos_profile(rclpy, qos), raw=True)
+            self.get_logger().info(f'Subscribed to {topic} ({msgtype}, {qos["reliability"]}, '
+                                   f'{qos["durability"]}).')
+
+    def _make_callback(self, topic: str) -> Any:
+        push = self.recorder.push
+        clock = self.get_clock()
+
+        def callback(data: bytes) -> None:
+            push(topic, data, clock.now().nanoseconds)
+        return callback
+
+    def report_callback(self) -> None:
+        """Log drops and EEG gaps found since the last report."""
+        for line in self.recorder.reports():
+            self.get_logger().warning(line)
+
+    def duration_callback(self) -> None:
+        """End after the ``duration`` parameter (s)."""
+        self.finished = True
+
+    def _on_error(self, message: str) -> None:
+        # Called from the writer thread: log only; the node keeps running, subscriptions idle.
+        self.get_logger().error(message)
+
+    def stop(self) -> None:
+        """Write what is queued and close the bag; log the counters."""
+        try:
+            counters = self.recorder.stop()
+        except BagError as exc:
+            self.get_logger().error(str(exc))
+            return
+        for line in self.recorder.reports():
+            self.get_logger().warning(line)
+        total = sum(c.written for c in counters.values())
+        dropped = sum(c.dropped_queue_full for c in counters.values())
+        self.get_logger().info(f'Recorded {total} message(s) on {len(counters)} topic(s) to '
+                               f'{self.recorder.writer.path}; {dropped} dropped.')
+
+
+def main(args: list[str] | None = None) -> int:
+    """Run the recorder until Ctrl-C, SIGTERM or its ``duration``; 1 if recording failed."""
+    rclpy.init(args=args)
+    try:
+        node = RecorderNode()
+    except BagError as exc:
+        print(f'recorder: {exc}', file=sys.stderr)
+        rclpy.shutdown()
+        return 1
+    # The launcher stops nodes with SIGINT, then SIGTERM: both end the loop and close the bag.
+    signal.signal(signal.SIGTERM, lambda *_: setattr(node, 'finished', True))
+    try:
+        while rclpy.ok() and not node.finished:
+            rclpy.spin_once(node, timeout_sec=0.1)
+    except KeyboardInterrupt:
+        pass
+    finally:
+        node.stop()
+        error = node.recorder.error
+        node.destroy_node()
+        if rclpy.ok():
+            rclpy.shutdown()
+    return 1 if error else 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())

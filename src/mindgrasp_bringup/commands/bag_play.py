@@ -1,0 +1,53 @@
+"""Play a bag (ours, ros2 bag sqlite3/MCAP, rosbags) with its original timing."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from mindgrasp_bringup.bag.ros_glue import param_args
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Options in the manner of ``ros2 bag play``."""
+    parser.add_argument('bag', help='bag directory (holding metadata.yaml), or an .mcap/.db3 file')
+    parser.add_argument('-r', '--rate', type=float, default=1.0,
+                        help='playback speed factor (default: 1.0, real time)')
+    parser.add_argument('-l', '--loop', action='store_true', help='play again from the start')
+    parser.add_argument('--start-offset', type=float, default=0.0,
+                        help='skip this many seconds of the bag beginning')
+    parser.add_argument('--topics', nargs='+', default=[], help='play only these topics')
+    parser.add_argument('-e', '--regex', default='', help='play only topics matching this regex')
+    parser.add_argument('-x', '--exclude-regex', default='',
+                        help='do not play topics matching this regex')
+    parser.add_argument('--remap', '-m', nargs='+', default=[], metavar='FROM:=TO',
+                        help='publish a topic under another name, e.g. /eeg/raw:=/eeg/replayed')
+    parser.add_argument('--clock', nargs='?', type=float, const=40.0, default=0.0, metavar='HZ',
+                        help='publish /clock with the bag time (default 40 Hz when given)')
+    parser.add_argument('--delay', type=float, default=0.5,
+                        help='wait this many seconds after creating publishers, so subscribers '
+                             'match before the first message (default: 0.5)')
+
+
+def main(args: argparse.Namespace) -> int:
+    """Run the player node in this process until the bag ends (or Ctrl-C)."""
+    from mindgrasp_bringup.bag import BagError
+    from mindgrasp_bringup.bag.player import parse_remaps
+
+    try:  # option errors before any ROS set-up
+        parse_remaps(args.remap)
+        if not args.rate > 0:
+            msg = f'--rate must be > 0 (1.0 = real time); {args.rate} is invalid.'
+            raise BagError(msg)
+    except BagError as exc:
+        print(f'mindgrasp bag play: {exc}', file=sys.stderr)
+        return 2
+    from mindgrasp_bringup.bag import player_node
+
+    params = {
+        'bag': args.bag, 'rate': float(args.rate), 'loop': bool(args.loop),
+        'start_offset': float(args.start_offset), 'topics': list(args.topics) or [''],
+        'regex': args.regex, 'exclude_regex': args.exclude_regex,
+        'remap': list(args.remap) or [''], 'clock': args.clock > 0,
+        'clock_frequency': float(args.clock or 40.0), 'delay': float(args.delay)}
+    return player_node.main(['mindgrasp-bag-play', *param_args(params)])

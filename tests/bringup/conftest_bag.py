@@ -1,0 +1,87 @@
+"""Helpers for the bag tests (imported by tests/bringup/test_bag*.py): sample messages, bags."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from rosbags.rosbag2 import StoragePlugin
+from rosbags.rosbag2 import Writer as RosbagsWriter
+
+from mindgrasp_bringup.bag.typestore import typestore
+
+EEG = 'mindgrasp_msgs/msg/EEGChunk'
+IMAGE = 'sensor_msgs/msg/Image'
+JOINTS = 'sensor_msgs/msg/JointState'
+STRING = 'std_msgs/msg/String'
+
+
+def _t(store, ns: int):
+    sec, nanosec = divmod(ns, 1_000_000_000)
+    return store.types['builtin_interfaces/msg/Time'](sec=sec, nanosec=nanosec)
+
+
+def _header(store, ns: int, frame: str = ''):
+    return store.types['std_msgs/msg/Header'](stamp=_t(store, ns), frame_id=frame)
+
+
+def eeg_chunk(first_sample: int, n_samples: int = 25, n_channels: int = 32, seed: int = 0,
+              stamp_ns: int = 0) -> bytes:
+    """CDR of an EEGChunk (n_samples x n_channels float32, volts)."""
+    store = typestore()
+    rng = np.random.default_rng(seed + first_sample)
+    msg = store.types[EEG](
+        header=_header(store, stamp_ns, 'eeg'), sample_rate=250.0,
+        channel_names=[f'C{i}' for i in range(n_channels)], n_samples=n_samples,
+        first_sample_index=first_sample, unit='V',
+        data=(rng.standard_normal(n_samples * n_channels) * 1e-5).astype(np.float32))
+    return bytes(store.serialize_cdr(msg, EEG))
+
+
+def image(i: int, width: int = 8, height: int = 6, encoding: str = 'rgb8') -> bytes:
+    """CDR of a small Image whose pixels encode ``i``."""
+    store = typestore()
+    channels = {'rgb8': 3, '32FC1': 4}[encoding]
+    data = np.full(width * height * channels, i % 256, dtype=np.uint8)
+    msg = store.types[IMAGE](header=_header(store, i, 'camera'), height=height, width=width,
+                             encoding=encoding, is_bigendian=0, step=width * channels, data=data)
+    return bytes(store.serialize_cdr(msg, IMAGE))
+
+
+def joints(i: int) -> bytes:
+    """CDR of a JointState with six joints."""
+    store = typestore()
+    msg = store.types[JOINTS](header=_header(store, i), name=[f'j{k}' for k in range(6)],
+                              position=np.arange(6, dtype=np.float64) * i,
+                              velocity=np.zeros(6), effort=np.zeros(6))
+    return bytes(store.serialize_cdr(msg, JOINTS))
+
+
+def string(text: str) -> bytes:
+    """CDR of a std_msgs/String."""
+    store = typestore()
+    return bytes(store.serialize_cdr(store.types[STRING](data=text), STRING))
+
+
+def write_rosbags_bag(path: Path, messages: list[tuple[str, str, int, bytes]],
+                      storage: StoragePlugin = StoragePlugin.MCAP,
+                      extra_types: dict[str, tuple[str, str]] | None = None) -> Path:
+    """Write ``(topic, type, t_ns, cdr)`` messages with rosbags' own Writer (not ours).
+
+    ``extra_types`` maps a type name unknown to our store to ``(msgdef, rihs01)``.
+    """
+    store = typestore()
+    connections = {}
+    with RosbagsWriter(path, version=9, storage_plugin=storage) as writer:
+        for topic, msgtype, _, _ in messages:
+            if topic in connections:
+                continue
+            if extra_types and msgtype in extra_types:
+                msgdef, digest = extra_types[msgtype]
+                connections[topic] = writer.add_connection(topic, msgtype, msgdef=msgdef,
+                                                           rihs01=digest)
+            else:
+                connections[topic] = writer.add_connection(topic, msgtype, typestore=store)
+        for topic, _, stamp, data in messages:
+            writer.write(connections[topic], stamp, data)
+    return path
