@@ -1,0 +1,363 @@
+"""``rclpy.executors``: run the callbacks of nodes.
+
+Each executor owns a DDS WaitSet (ReadConditions of its nodes' readers plus a GuardCondition for
+in-process deliveries, timers and shutdown) and blocks on it with the GIL released. Waits are
+capped at 100 ms so that Ctrl-C (KeyboardInterrupt) is handled promptly, as Python signal
+handlers only run between bytecodes.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures
+import os
+import threading
+import time
+from collections.abc import Callable
+from typing import Any
+
+from cyclonedds.core import GuardCondition as DdsGuardCondition
+from cyclonedds.core import InstanceState, ReadCondition, SampleState, ViewState, WaitSet
+
+from mindgrasp_ros.runtime.context import Context
+from mindgrasp_ros.runtime.entities import Client, GuardCondition, Service, Subscription, Timer
+from mindgrasp_ros.runtime.exceptions import RCLError
+from mindgrasp_ros.runtime.task import Future
+
+__all__ = ['ExternalShutdownException', 'Executor', 'MultiThreadedExecutor',
+           'ShutdownException', 'SingleThreadedExecutor', 'TimeoutException']
+
+_MAX_WAIT_S = 0.1
+_ANY = SampleState.Any | ViewState.Any | InstanceState.Any
+
+
+class ExternalShutdownException(RCLError):
+    """The context was shut down while the executor was spinning."""
+
+
+class ShutdownException(RCLError):
+    """The executor was shut down."""
+
+
+class TimeoutException(RCLError):
+    """No work became ready within the timeout."""
+
+
+Work = tuple[Any, Any]  # (entity, item)
+
+
+class Executor:
+    """Base executor: collects ready work from its nodes and runs it."""
+
+    def __init__(self, *, context: Context | None = None) -> None:
+        from mindgrasp_ros.runtime import get_default_context
+
+        self._context = context or get_default_context()
+        self._nodes: list[Any] = []
+        self._lock = threading.RLock()
+        self._is_shutdown = False
+        self._generation = -1
+        self._cond = threading.Condition()
+        self._woken = False
+        self._waitset: WaitSet | None = None
+        self._guard: DdsGuardCondition | None = None
+        self._conditions: dict[int, tuple[Any, ReadCondition]] = {}
+        self._pending: list[Work] = []
+        dds = self._context.dds
+        if dds is not None:
+            self._waitset = WaitSet(dds.participant)
+            self._guard = DdsGuardCondition(dds.participant)
+            self._waitset.attach(self._guard)
+
+    @property
+    def context(self) -> Context:
+        return self._context
+
+    # ------------------------------------------------------------------ nodes
+    def add_node(self, node: Any) -> bool:  # noqa: ANN401
+        with self._lock:
+            if node in self._nodes:
+                return False
+            if node.executor is not None and node.executor is not self:
+                node.executor.remove_node(node)
+            self._nodes.append(node)
+            node.executor = self
+            self._generation = -1
+        self.wake()
+        return True
+
+    def remove_node(self, node: Any) -> None:  # noqa: ANN401
+        with self._lock:
+            if node in self._nodes:
+                self._nodes.remove(node)
+                if node.executor is self:
+                    node.executor = None
+                self._generation = -1
+        self.wake()
+
+    def get_nodes(self) -> list[Any]:
+        with self._lock:
+            return list(self._nodes)
+
+    def wake(self) -> None:
+        with self._cond:
+            self._woken = True
+            self._cond.notify_all()
+        if self._guard is not None:
+            try:
+                self._guard.set(True)
+            except Exception:  # noqa: BLE001, S110 - participant already deleted at shutdown
+                pass
+
+    def shutdown(self, timeout_sec: float | None = None) -> bool:  # noqa: ARG002
+        self._is_shutdown = True
+        self.wake()
+        with self._lock:
+            for node in list(self._nodes):
+                if node.executor is self:
+                    node.executor = None
+            self._nodes.clear()
+        self._release_waitset()
+        return True
+
+    def _release_waitset(self) -> None:
+        if self._waitset is None or self._context.dds is None:
+            return
+        for _entity, cond in self._conditions.values():
+            try:
+                self._waitset.detach(cond)
+                cond.__del__()
+            except Exception:  # noqa: BLE001, S110
+                pass
+        self._conditions.clear()
+
+    # ------------------------------------------------------------------ waiting
+    def _sync_conditions(self) -> None:
+        """Attach ReadConditions for the readers of our nodes (when entities changed)."""
+        generation = sum(n.generation for n in self._nodes) + 1000003 * len(self._nodes)
+        if generation == self._generation or self._waitset is None:
+            return
+        self._generation = generation
+        wanted: dict[int, Any] = {}
+        for node in self._nodes:
+            for entity in (*node.subscriptions, *node.services, *node.clients):
+                reader = getattr(entity, '_reader', None)
+                if reader is not None:
+                    wanted[id(reader)] = reader
+        for key in list(self._conditions):
+            if key not in wanted:
+                _reader, cond = self._conditions.pop(key)
+                try:
+                    self._waitset.detach(cond)
+                    cond.__del__()
+                except Exception:  # noqa: BLE001, S110 - reader already deleted
+                    pass
+        for key, reader in wanted.items():
+            if key not in self._conditions:
+                cond = ReadCondition(reader.reader, _ANY)
+                self._waitset.attach(cond)
+                self._conditions[key] = (reader, cond)
+
+    def _timeout_for_timers(self, timeout_sec: float | None) -> float | None:
+        wait = timeout_sec
+        for node in self._nodes:
+            for timer in node.timers:
+                ns = timer.time_until_next_call()
+                if ns is None:
+                    continue
+                if timer.clock.ros_time_is_active:
+                    continue  # sim time advances with /clock messages, which wake us
+                s = ns / 1e9
+                wait = s if wait is None else min(wait, s)
+        return wait
+
+    def _wait(self, timeout_sec: float | None) -> None:
+        timeout = _MAX_WAIT_S if timeout_sec is None else min(timeout_sec, _MAX_WAIT_S)
+        if timeout <= 0:
+            return
+        with self._cond:
+            if self._woken:
+                self._woken = False
+                return
+        if self._waitset is not None and self._context.dds is not None:
+            self._waitset.wait(int(timeout * 1e9))
+            if self._guard is not None and self._guard.read():
+                self._guard.set(False)
+            with self._cond:
+                self._woken = False
+        else:
+            with self._cond:
+                if not self._woken:
+                    self._cond.wait(timeout)
+                self._woken = False
+
+    # ------------------------------------------------------------------ work
+    def _collect(self) -> list[Work]:
+        """Ready work, in a fixed order: timers, subscriptions, services, clients, guards."""
+        work: list[Work] = []
+        for node in list(self._nodes):
+            for timer in list(node.timers):
+                if not timer._busy and timer.callback_group.can_execute(timer) and \
+                        timer.is_ready():  # noqa: SLF001
+                    timer._mark_called()  # noqa: SLF001
+                    work.append((timer, None))
+            for entity in (*node.subscriptions, *node.services, *node.clients):
+                if entity._busy:  # noqa: SLF001 - keeps per-entity order in multi-threading
+                    continue
+                if isinstance(entity, Client):
+                    # replies complete futures; never hold them back behind a busy group
+                    work.extend((entity, item) for item in entity.take())
+                    continue
+                if not entity.callback_group.can_execute(entity):
+                    continue
+                work.extend((entity, item) for item in entity.take())
+            for guard in list(node.guards):
+                if guard._triggered and guard.callback_group.can_execute(guard):  # noqa: SLF001
+                    guard._triggered = False  # noqa: SLF001
+                    work.append((guard, None))
+        return work
+
+    def _run(self, entity: Any, item: Any) -> None:  # noqa: ANN401
+        try:
+            entity.execute(item)
+        except (KeyboardInterrupt, SystemExit):
+            raise
+        except ExternalShutdownException:
+            raise
+        except Exception:
+            node = entity.node
+            if isinstance(entity, (Subscription, Timer, Service, GuardCondition)) and \
+                    not self._context.ok():
+                return
+            node.get_logger().error(
+                f'Uncaught exception in a callback of {type(entity).__name__} '
+                f"'{getattr(entity, 'topic_name', getattr(entity, 'srv_name', ''))}'.")
+            raise
+
+    def _spin_once_impl(self, timeout_sec: float | None) -> bool:
+        """Wait for and execute work; True if something ran."""
+        if not self._context.ok():
+            raise ExternalShutdownException()
+        if self._is_shutdown:
+            raise ShutdownException()
+        with self._lock:
+            self._sync_conditions()
+            if not self._pending:
+                self._pending = self._collect()
+            has_work = bool(self._pending)
+            wait_s = None if has_work else self._timeout_for_timers(timeout_sec)
+        if not has_work:
+            self._wait(wait_s)
+            if not self._context.ok():
+                raise ExternalShutdownException()
+            with self._lock:
+                self._sync_conditions()
+                self._pending = self._collect()
+                if not self._pending:
+                    return False
+        ran = self._dispatch()
+        if not ran:  # everything ready belongs to busy callback groups: wait for a worker
+            self._wait(_MAX_WAIT_S if timeout_sec is None else min(timeout_sec, _MAX_WAIT_S))
+        return ran
+
+    def _dispatch(self) -> bool:
+        raise NotImplementedError
+
+    # ------------------------------------------------------------------ public API
+    def spin(self) -> None:
+        while self._context.ok() and not self._is_shutdown:
+            self.spin_once()
+
+    def spin_once(self, timeout_sec: float | None = None) -> None:
+        try:
+            self._spin_once_impl(timeout_sec)
+        except ShutdownException:
+            pass
+
+    def spin_until_future_complete(self, future: Future, timeout_sec: float | None = None) -> None:
+        deadline = None if timeout_sec is None else time.monotonic() + timeout_sec
+        future.add_done_callback(lambda _f: self.wake())
+        while self._context.ok() and not future.done() and not self._is_shutdown:
+            remaining = None if deadline is None else deadline - time.monotonic()
+            if remaining is not None and remaining <= 0:
+                return
+            self.spin_once(remaining)
+
+    def spin_once_until_future_complete(self, future: Future,
+                                        timeout_sec: float | None = None) -> None:
+        future.add_done_callback(lambda _f: self.wake())
+        self.spin_once(timeout_sec)
+
+    def create_task(self, callback: Callable, *args: Any) -> Future:  # noqa: ANN401
+        future = Future()
+        try:
+            future.set_result(callback(*args))
+        except Exception as exc:  # noqa: BLE001
+            future.set_exception(exc)
+        return future
+
+    def __enter__(self) -> Executor:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.shutdown()
+
+
+class SingleThreadedExecutor(Executor):
+    """Runs every callback in the thread that spins."""
+
+    def _dispatch(self) -> bool:
+        with self._lock:
+            work, self._pending = self._pending, []
+        for entity, item in work:
+            self._run(entity, item)
+        return bool(work)
+
+
+class MultiThreadedExecutor(Executor):
+    """Runs callbacks in a thread pool; callback groups decide what may run concurrently."""
+
+    def __init__(self, num_threads: int | None = None, *, context: Context | None = None) -> None:
+        super().__init__(context=context)
+        self._pool = concurrent.futures.ThreadPoolExecutor(
+            max_workers=num_threads or max(2, os.cpu_count() or 2),
+            thread_name_prefix='mindgrasp_executor')
+        self._errors: list[BaseException] = []
+
+    def _dispatch(self) -> bool:
+        with self._lock:
+            pending, self._pending = self._pending, []
+        batches: dict[int, list[Work]] = {}
+        ran = False
+        for entity, item in pending:
+            batches.setdefault(id(entity), []).append((entity, item))
+        for batch in batches.values():
+            entity = batch[0][0]
+            group = entity.callback_group
+            if not isinstance(entity, Client) and not group.beginning_execution(entity):
+                with self._lock:
+                    self._pending.extend(batch)  # its group is busy: try again next round
+                continue
+            entity._busy = True  # noqa: SLF001
+            self._pool.submit(self._run_batch, batch)
+            ran = True
+        if self._errors:
+            raise self._errors.pop(0)
+        return ran
+
+    def _run_batch(self, batch: list[Work]) -> None:
+        entity = batch[0][0]
+        try:
+            for _entity, item in batch:
+                self._run(entity, item)
+        except BaseException as exc:  # noqa: BLE001 - re-raised in the spinning thread
+            self._errors.append(exc)
+        finally:
+            entity._busy = False  # noqa: SLF001
+            if not isinstance(entity, Client):
+                entity.callback_group.ending_execution(entity)
+            self.wake()
+
+    def shutdown(self, timeout_sec: float | None = None) -> bool:
+        super().shutdown(timeout_sec)
+        self._pool.shutdown(wait=True, cancel_futures=True)
+        return True

@@ -1,0 +1,236 @@
+"""Graph introspection for any ROS 2 graph on the domain.
+
+Endpoints come from DDS discovery (the built-in DCPSPublication/DCPSSubscription topics); node
+names and which node owns which endpoint come from ``ros_discovery_info`` (rmw_dds_common), which
+every rmw_cyclonedds / rmw_fastrtps participant and ours publish. The same sources ``ros2 node
+list`` and ``ros2 topic info -v`` use, so the answers agree with the ROS 2 tools.
+"""
+
+from __future__ import annotations
+
+import threading
+from collections import defaultdict
+from dataclasses import dataclass
+from typing import Any
+
+from cyclonedds.builtin import (
+    BuiltinDataReader,
+    BuiltinTopicDcpsPublication,
+    BuiltinTopicDcpsSubscription,
+)
+from cyclonedds.core import InstanceState, Policy
+
+from mindgrasp_ros.runtime.dds import (
+    DdsParticipant,
+    ros_topic_name_from_dds,
+    ros_type_name_from_dds,
+)
+from mindgrasp_ros.runtime.duration import Duration
+from mindgrasp_ros.runtime.qos import (
+    DurabilityPolicy,
+    HistoryPolicy,
+    LivelinessPolicy,
+    QoSProfile,
+    ReliabilityPolicy,
+)
+from mindgrasp_ros.typesupport import deserialize
+
+__all__ = ['GraphCache', 'TopicEndpointInfo']
+
+
+@dataclass
+class TopicEndpointInfo:
+    """One publisher or subscription of a topic (``rclpy.topic_endpoint_info``)."""
+
+    node_name: str
+    node_namespace: str
+    topic_type: str
+    endpoint_type: str  # 'PUBLISHER' | 'SUBSCRIPTION'
+    endpoint_gid: bytes
+    qos_profile: QoSProfile
+    topic_type_hash: str = ''
+
+
+def _qos_from_dds(qos: Any) -> QoSProfile:  # noqa: ANN401
+    profile = QoSProfile(depth=0)
+    for policy in qos:
+        scope = getattr(policy, '__scope__', '')
+        if scope == 'Reliability':
+            profile.reliability = (ReliabilityPolicy.BEST_EFFORT
+                                   if 'BestEffort' in type(policy).__name__
+                                   or policy == Policy.Reliability.BestEffort
+                                   else ReliabilityPolicy.RELIABLE)
+        elif scope == 'Durability':
+            profile.durability = (DurabilityPolicy.TRANSIENT_LOCAL
+                                  if policy == Policy.Durability.TransientLocal
+                                  else DurabilityPolicy.VOLATILE)
+        elif scope == 'History':
+            if policy == Policy.History.KeepAll:
+                profile.history = HistoryPolicy.KEEP_ALL
+            else:
+                profile.history = HistoryPolicy.KEEP_LAST
+                profile.depth = int(getattr(policy, 'depth', 0))
+        elif scope == 'Deadline':
+            profile.deadline = _duration(policy.deadline)
+        elif scope == 'Lifespan':
+            profile.lifespan = _duration(policy.lifespan)
+        elif scope == 'Liveliness':
+            profile.liveliness = (LivelinessPolicy.MANUAL_BY_TOPIC
+                                  if 'ManualByTopic' in repr(policy)
+                                  else LivelinessPolicy.AUTOMATIC)
+            profile.liveliness_lease_duration = _duration(policy.lease_duration)
+    return profile
+
+
+def _duration(ns: int) -> Duration:
+    return Duration(nanoseconds=0 if ns >= 2**62 else ns)
+
+
+def _user_data_hash(qos: Any) -> str:  # noqa: ANN401
+    for policy in qos:
+        if getattr(policy, '__scope__', '') == 'Userdata':
+            text = bytes(policy.data).decode(errors='replace')
+            for part in text.split(';'):
+                if part.startswith('typehash='):
+                    return part[len('typehash='):]
+    return ''
+
+
+class GraphCache:
+    """Endpoints and nodes of the domain, updated on every query."""
+
+    def __init__(self, dds: DdsParticipant) -> None:
+        from mindgrasp_ros.runtime.qos import QoSProfile as _Q
+
+        self._dds = dds
+        self._lock = threading.Lock()
+        self._pub_reader = BuiltinDataReader(dds.participant, BuiltinTopicDcpsPublication)
+        self._sub_reader = BuiltinDataReader(dds.participant, BuiltinTopicDcpsSubscription)
+        self._info_reader = dds.create_reader(
+            'ros_discovery_info', 'rmw_dds_common/msg/ParticipantEntitiesInfo',
+            _Q(history=HistoryPolicy.KEEP_ALL, durability=DurabilityPolicy.TRANSIENT_LOCAL))
+        self._endpoints: dict[bytes, tuple[str, Any]] = {}  # gid -> (kind, DcpsEndpoint)
+        #: participant gid -> [(namespace, name, reader gids, writer gids)]
+        self._participants: dict[bytes, list[tuple[str, str, set[bytes], set[bytes]]]] = {}
+
+    def close(self) -> None:
+        try:
+            self._dds.delete_reader(self._info_reader)
+            self._pub_reader.__del__()
+            self._sub_reader.__del__()
+        except Exception:  # noqa: BLE001, S110 - participant already gone
+            pass
+
+    def _update(self) -> None:
+        with self._lock:
+            for kind, reader in (('publisher', self._pub_reader),
+                                 ('subscription', self._sub_reader)):
+                while True:
+                    samples = reader.take(N=512)
+                    if not samples:
+                        break
+                    for s in samples:
+                        alive = s.sample_info.instance_state == InstanceState.Alive
+                        key = s.key.bytes
+                        if alive and s.topic_name:
+                            self._endpoints[key] = (kind, s)
+                        else:
+                            self._endpoints.pop(key, None)
+            for data, _info in self._info_reader.take(1024):
+                try:
+                    msg = deserialize(data, 'rmw_dds_common/msg/ParticipantEntitiesInfo')
+                except Exception:  # noqa: BLE001, S112 - a foreign malformed sample
+                    continue
+                gid = bytes(msg.gid.data)[:16]
+                self._participants[gid] = [
+                    (n.node_namespace, n.node_name,
+                     {bytes(g.data)[:16] for g in n.reader_gid_seq},
+                     {bytes(g.data)[:16] for g in n.writer_gid_seq})
+                    for n in msg.node_entities_info_seq]
+            # forget participants whose endpoints are all gone
+            live_participants = {ep.participant_key.bytes for _k, ep in self._endpoints.values()}
+            for gid in list(self._participants):
+                if gid not in live_participants:
+                    del self._participants[gid]
+
+    def _owner(self, gid: bytes, participant: bytes) -> tuple[str, str]:
+        for ns, name, readers, writers in self._participants.get(participant, []):
+            if gid in readers or gid in writers:
+                return name, ns
+        return '_NODE_NAME_UNKNOWN_', '_NODE_NAMESPACE_UNKNOWN_'
+
+    # ------------------------------------------------------------------ queries
+    def node_names_and_namespaces(self) -> list[tuple[str, str]]:
+        self._update()
+        with self._lock:
+            out = {(name, ns) for nodes in self._participants.values()
+                   for ns, name, _r, _w in nodes}
+        return sorted(out, key=lambda x: (x[1], x[0]))
+
+    def _names_and_types(self, kinds: set[str]) -> list[tuple[str, list[str]]]:
+        self._update()
+        table: dict[str, set[str]] = defaultdict(set)
+        with self._lock:
+            for _kind, ep in self._endpoints.values():
+                parsed = ros_topic_name_from_dds(ep.topic_name)
+                if parsed is None or parsed[1] not in kinds:
+                    continue
+                ros_type = ros_type_name_from_dds(ep.type_name)
+                if ros_type is None:
+                    continue
+                if parsed[1] != 'topic':
+                    ros_type = ros_type.removesuffix('_Request').removesuffix('_Response')
+                table[parsed[0]].add(ros_type)
+        return sorted((k, sorted(v)) for k, v in table.items())
+
+    def topic_names_and_types(self) -> list[tuple[str, list[str]]]:
+        return self._names_and_types({'topic'})
+
+    def service_names_and_types(self) -> list[tuple[str, list[str]]]:
+        return self._names_and_types({'request'})
+
+    def endpoints(self, topic: str, kind: str) -> list[TopicEndpointInfo]:
+        """Publishers (``kind='publisher'``) or subscriptions of a ROS topic."""
+        self._update()
+        out = []
+        dds_name = 'rt' + topic
+        with self._lock:
+            for gid, (k, ep) in self._endpoints.items():
+                if k != kind or ep.topic_name != dds_name:
+                    continue
+                name, ns = self._owner(gid, ep.participant_key.bytes)
+                out.append(TopicEndpointInfo(
+                    node_name=name, node_namespace=ns,
+                    topic_type=ros_type_name_from_dds(ep.type_name) or ep.type_name,
+                    endpoint_type='PUBLISHER' if kind == 'publisher' else 'SUBSCRIPTION',
+                    endpoint_gid=gid, qos_profile=_qos_from_dds(ep.qos),
+                    topic_type_hash=_user_data_hash(ep.qos)))
+        return sorted(out, key=lambda e: (e.node_namespace, e.node_name, e.endpoint_gid))
+
+    def node_endpoints(self, name: str, namespace: str) -> dict[str, list[tuple[str, str]]]:
+        """Topics and services of a node: {'publishers': [(topic, type)], 'subscribers': ...,
+        'services': ..., 'clients': ...}."""
+        self._update()
+        out: dict[str, set[tuple[str, str]]] = defaultdict(set)
+        with self._lock:
+            mine: set[bytes] = set()
+            for nodes in self._participants.values():
+                for ns, n, readers, writers in nodes:
+                    if n == name and ns == namespace:
+                        mine |= readers | writers
+            for gid, (kind, ep) in self._endpoints.items():
+                if gid not in mine:
+                    continue
+                parsed = ros_topic_name_from_dds(ep.topic_name)
+                ros_type = ros_type_name_from_dds(ep.type_name)
+                if parsed is None or ros_type is None:
+                    continue
+                topic, role = parsed
+                srv_type = ros_type.removesuffix('_Request').removesuffix('_Response')
+                if role == 'topic':
+                    out['publishers' if kind == 'publisher' else 'subscribers'].add(
+                        (topic, ros_type))
+                elif role == 'request':
+                    out['services' if kind == 'subscription' else 'clients'].add(
+                        (topic, srv_type))
+        return {k: sorted(v) for k, v in out.items()}

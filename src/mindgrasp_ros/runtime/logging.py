@@ -1,0 +1,147 @@
+"""``rclpy.logging``: named loggers with severities, printed to stderr and sent to /rosout."""
+
+from __future__ import annotations
+
+import enum
+import inspect
+import os
+import sys
+import threading
+import time
+from collections.abc import Callable
+
+__all__ = ['LoggingSeverity', 'RcutilsLogger', 'get_logger', 'set_logger_level']
+
+
+class LoggingSeverity(enum.IntEnum):
+    UNSET = 0
+    DEBUG = 10
+    INFO = 20
+    WARN = 30
+    ERROR = 40
+    FATAL = 50
+
+
+_levels: dict[str, LoggingSeverity] = {}
+_default_level = LoggingSeverity.INFO
+_lock = threading.Lock()
+#: Called for every emitted record: (severity, logger name, message, file, function, line).
+_sinks: list[Callable[[LoggingSeverity, str, str, str, str, int], None]] = []
+
+
+def parse_severity(level: str | int) -> LoggingSeverity:
+    if isinstance(level, int):
+        return LoggingSeverity(level)
+    try:
+        return LoggingSeverity[level.strip().upper().replace('WARNING', 'WARN')]
+    except KeyError:
+        valid = ', '.join(s.name.lower() for s in LoggingSeverity if s)
+        msg = f'Unknown log level {level!r}; use one of {valid}.'
+        raise ValueError(msg) from None
+
+
+def set_logger_level(name: str, level: LoggingSeverity | str | int) -> None:
+    global _default_level
+    sev = parse_severity(level)
+    with _lock:
+        if name == '':
+            _default_level = sev
+        else:
+            _levels[name] = sev
+
+
+def get_logger_effective_level(name: str) -> LoggingSeverity:
+    parts = name.split('.')
+    while parts:
+        level = _levels.get('.'.join(parts))
+        if level:
+            return level
+        parts.pop()
+    return _default_level
+
+
+def _stderr_sink(sev: LoggingSeverity, name: str, message: str, *_: object) -> None:
+    stamp = time.time()
+    line = f'[{sev.name}] [{stamp:.9f}] [{name}]: {message}\n'
+    try:
+        (sys.stderr if sev >= LoggingSeverity.WARN or _to_stderr else sys.stdout).write(line)
+        (sys.stderr if sev >= LoggingSeverity.WARN or _to_stderr else sys.stdout).flush()
+    except (ValueError, OSError):  # stream closed at interpreter exit
+        pass
+
+
+_to_stderr = os.environ.get('RCUTILS_LOGGING_USE_STDOUT', '1') == '0'
+
+
+class RcutilsLogger:
+    """A named logger with rclpy's methods (``info``, ``warning``, ``once``, ``throttle``...)."""
+
+    def __init__(self, name: str = '') -> None:
+        self.name = name
+        self._once: set[tuple[str, int]] = set()
+        self._last: dict[tuple[str, int], float] = {}
+
+    def get_child(self, name: str) -> RcutilsLogger:
+        return RcutilsLogger(f'{self.name}.{name}' if self.name else name)
+
+    def set_level(self, level: LoggingSeverity | str | int) -> None:
+        set_logger_level(self.name, level)
+
+    def get_effective_level(self) -> LoggingSeverity:
+        return get_logger_effective_level(self.name)
+
+    def is_enabled_for(self, severity: LoggingSeverity) -> bool:
+        return severity >= self.get_effective_level()
+
+    def log(self, message: object, severity: LoggingSeverity, *, once: bool = False,
+            throttle_duration_sec: float | None = None, skip_first: bool = False,
+            **_kwargs: object) -> bool:
+        if not self.is_enabled_for(severity):
+            return False
+        frame = inspect.currentframe()
+        caller = frame.f_back.f_back if frame and frame.f_back else None
+        key = (caller.f_code.co_filename, caller.f_lineno) if caller else ('', 0)
+        if once:
+            if key in self._once:
+                return False
+            self._once.add(key)
+        if throttle_duration_sec:
+            now = time.monotonic()
+            last = self._last.get(key)
+            if last is None and skip_first:
+                self._last[key] = now
+                return False
+            if last is not None and now - last < throttle_duration_sec:
+                return False
+            self._last[key] = now
+        text = str(message)
+        file, func, line = (caller.f_code.co_filename, caller.f_code.co_name,
+                            caller.f_lineno) if caller else ('', '', 0)
+        _stderr_sink(severity, self.name, text)
+        for sink in list(_sinks):
+            try:
+                sink(severity, self.name, text, file, func, line)
+            except Exception:  # noqa: BLE001, S110 - logging must never raise
+                pass
+        return True
+
+    def debug(self, message: object, **kw: object) -> bool:
+        return self.log(message, LoggingSeverity.DEBUG, **kw)
+
+    def info(self, message: object, **kw: object) -> bool:
+        return self.log(message, LoggingSeverity.INFO, **kw)
+
+    def warning(self, message: object, **kw: object) -> bool:
+        return self.log(message, LoggingSeverity.WARN, **kw)
+
+    warn = warning
+
+    def error(self, message: object, **kw: object) -> bool:
+        return self.log(message, LoggingSeverity.ERROR, **kw)
+
+    def fatal(self, message: object, **kw: object) -> bool:
+        return self.log(message, LoggingSeverity.FATAL, **kw)
+
+
+def get_logger(name: str) -> RcutilsLogger:
+    return RcutilsLogger(name)
