@@ -22,7 +22,7 @@ def using_real_rclpy() -> bool:
     return os.environ.get('MINDGRASP_RMW', '').strip().lower() == 'rclpy'
 
 
-def __getattr__(name: str):  # noqa: ANN202 - lazy: importing DDS only when rclpy is used
+def __getattr__(name: str):
     if name == 'rclpy':
         import importlib
 

@@ -125,7 +125,7 @@ def typestore() -> Typestore:
 # --------------------------------------------------------------------------- message classes
 
 
-def _field_default_factory(store: Typestore, desc: tuple) -> Any:  # noqa: ANN401
+def _field_default_factory(store: Typestore, desc: tuple) -> Any:
     kind, detail = desc
     if kind == Nodetype.BASE:
         base, _bound = detail
@@ -181,7 +181,7 @@ class Message:
     _numeric: dict[str, tuple[Any, int | None]] = {}
     _fields_and_field_types: dict[str, str] = {}
 
-    def __init__(self, *args: Any, **kwargs: Any) -> None:  # noqa: ANN401
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
         if len(args) > len(self._fields):
             msg = f'{self.__msgtype__} takes at most {len(self._fields)} positional fields.'
             raise TypeError(msg)
@@ -203,7 +203,7 @@ class Message:
             else:
                 object.__setattr__(self, name, factory())
 
-    def __setattr__(self, name: str, value: Any) -> None:  # noqa: ANN401
+    def __setattr__(self, name: str, value: Any) -> None:
         spec = self._numeric.get(name)
         if spec is not None:
             value = _as_array(self.__msgtype__, name, value, *spec)
@@ -240,7 +240,7 @@ class Message:
         return f'{type(self).__module__}.{type(self).__qualname__}({", ".join(parts)})'
 
 
-def _as_array(typename: str, field: str, value: Any, dtype: Any,  # noqa: ANN401
+def _as_array(typename: str, field: str, value: Any, dtype: Any,
               length: int | None) -> np.ndarray:
     if isinstance(value, np.ndarray) and value.dtype == dtype and value.ndim == 1:
         arr = value

@@ -28,7 +28,7 @@ def _packages() -> set[str]:
 class _InterfaceFinder(importlib.abc.MetaPathFinder, importlib.abc.Loader):
     """Creates ``<prefix><package>`` and ``<prefix><package>.msg|srv`` modules on demand."""
 
-    def find_spec(self, fullname, path, target=None):  # noqa: ANN001, ANN201, ARG002
+    def find_spec(self, fullname, path, target=None):
         if not fullname.startswith(_PREFIX):
             return None
         parts = fullname[len(_PREFIX):].split('.')
@@ -37,7 +37,7 @@ class _InterfaceFinder(importlib.abc.MetaPathFinder, importlib.abc.Loader):
         is_package = len(parts) == 1
         return importlib.machinery.ModuleSpec(fullname, self, is_package=is_package)
 
-    def create_module(self, spec):  # noqa: ANN001, ANN201
+    def create_module(self, spec):
         parts = spec.name[len(_PREFIX):].split('.')
         if using_real_rclpy():  # pragma: no cover - needs ROS 2
             return importlib.import_module('.'.join(parts))
@@ -53,7 +53,7 @@ class _InterfaceFinder(importlib.abc.MetaPathFinder, importlib.abc.Loader):
             module.__all__ = _names(parts[0], parts[1])  # type: ignore[attr-defined]
         return module
 
-    def exec_module(self, module):  # noqa: ANN001, ANN201
+    def exec_module(self, module):
         pass
 
 
@@ -69,14 +69,14 @@ def _names(package: str, kind: str) -> list[str]:
     return sorted(names)
 
 
-def _module_getattr(package: str, kind: str):  # noqa: ANN202
+def _module_getattr(package: str, kind: str):
     from mindgrasp_ros.typesupport import (
         MessageTypeError,
         get_message_class,
         get_service_class,
     )
 
-    def __getattr__(name: str):  # noqa: ANN202, N807
+    def __getattr__(name: str):  # noqa: N807
         if name.startswith('__'):
             raise AttributeError(name)
         try:

@@ -42,7 +42,7 @@ def get_default_context() -> Context:
 
 
 def init(*, args: list[str] | None = None, context: Context | None = None,
-         domain_id: int | None = None, signal_handler_options: object = None) -> None:  # noqa: ARG001
+         domain_id: int | None = None, signal_handler_options: object = None) -> None:
     """Initialise the context: parse ``--ros-args`` of ``args`` (default ``sys.argv``) and join
     the DDS domain (``ROS_DOMAIN_ID`` unless ``domain_id`` is given)."""
     ctx = context or _default_context
@@ -62,7 +62,7 @@ def ok(*, context: Context | None = None) -> bool:
     return (context or _default_context).ok()
 
 
-def shutdown(*, context: Context | None = None, uninstall_handlers: bool | None = None) -> None:  # noqa: ARG001
+def shutdown(*, context: Context | None = None, uninstall_handlers: bool | None = None) -> None:
     global _global_executor
     ctx = context or _default_context
     if ctx is _default_context:
@@ -79,13 +79,13 @@ def try_shutdown(*, context: Context | None = None) -> None:
         shutdown(context=ctx)
 
 
-def create_node(node_name: str, **kwargs: Any) -> Any:  # noqa: ANN401
+def create_node(node_name: str, **kwargs: Any) -> Any:
     from mindgrasp_ros.runtime.node import Node
 
     return Node(node_name, **kwargs)
 
 
-def get_global_executor() -> Any:  # noqa: ANN401
+def get_global_executor() -> Any:
     global _global_executor
     from mindgrasp_ros.runtime.executors import SingleThreadedExecutor
 
@@ -95,7 +95,7 @@ def get_global_executor() -> Any:  # noqa: ANN401
         return _global_executor
 
 
-def spin(node: Any, executor: Any = None) -> None:  # noqa: ANN401
+def spin(node: Any, executor: Any = None) -> None:
     """Run the node's callbacks until shutdown (Ctrl-C raises KeyboardInterrupt)."""
     executor = executor or get_global_executor()
     try:
@@ -106,7 +106,7 @@ def spin(node: Any, executor: Any = None) -> None:  # noqa: ANN401
         executor.remove_node(node)
 
 
-def spin_once(node: Any, *, executor: Any = None, timeout_sec: float | None = None) -> None:  # noqa: ANN401
+def spin_once(node: Any, *, executor: Any = None, timeout_sec: float | None = None) -> None:
     executor = executor or get_global_executor()
     try:
         executor.add_node(node)
@@ -115,7 +115,7 @@ def spin_once(node: Any, *, executor: Any = None, timeout_sec: float | None = No
         executor.remove_node(node)
 
 
-def spin_until_future_complete(node: Any, future: Any, executor: Any = None,  # noqa: ANN401
+def spin_until_future_complete(node: Any, future: Any, executor: Any = None,
                                timeout_sec: float | None = None) -> None:
     executor = executor or get_global_executor()
     try:
@@ -125,7 +125,7 @@ def spin_until_future_complete(node: Any, future: Any, executor: Any = None,  # 
         executor.remove_node(node)
 
 
-def __getattr__(name: str) -> Any:  # noqa: ANN401 - heavy submodules load on first use
+def __getattr__(name: str) -> Any:
     import importlib
 
     if name in ('node', 'executors', 'utilities', 'rate', 'graph', 'entities', 'names',

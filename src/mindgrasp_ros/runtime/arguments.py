@@ -71,7 +71,7 @@ class RosArguments:
         return values
 
 
-def _parse_value(text: str) -> Any:  # noqa: ANN401
+def _parse_value(text: str) -> Any:
     try:
         return yaml.safe_load(text) if text != '' else ''
     except yaml.YAMLError:
@@ -155,7 +155,7 @@ def remove_ros_args(args: list[str]) -> list[str]:
     return out
 
 
-def _flatten(prefix: str, value: Any, out: dict[str, Any]) -> None:  # noqa: ANN401
+def _flatten(prefix: str, value: Any, out: dict[str, Any]) -> None:
     if isinstance(value, dict):
         for k, v in value.items():
             _flatten(f'{prefix}.{k}' if prefix else str(k), v, out)
@@ -163,7 +163,7 @@ def _flatten(prefix: str, value: Any, out: dict[str, Any]) -> None:  # noqa: ANN
         out[prefix] = value
 
 
-def _collect(node: Any, path: list[str], found: list[tuple[str, dict]], file: Path) -> None:  # noqa: ANN401
+def _collect(node: Any, path: list[str], found: list[tuple[str, dict]], file: Path) -> None:
     if not isinstance(node, dict):
         msg = (f'{file}: {"/".join(path) or "top level"} must be a mapping of node names to '
                '{ros__parameters: {...}}.')

@@ -21,10 +21,10 @@ class CallbackGroup:
     def has_entity(self, entity: object) -> bool:
         return entity in self.entities
 
-    def can_execute(self, entity: object) -> bool:  # noqa: ARG002
+    def can_execute(self, entity: object) -> bool:
         return True
 
-    def beginning_execution(self, entity: object) -> bool:  # noqa: ARG002
+    def beginning_execution(self, entity: object) -> bool:
         return True
 
     def ending_execution(self, entity: object) -> None:
@@ -42,7 +42,7 @@ class MutuallyExclusiveCallbackGroup(CallbackGroup):
         super().__init__()
         self._active: object | None = None
 
-    def can_execute(self, entity: object) -> bool:  # noqa: ARG002
+    def can_execute(self, entity: object) -> bool:
         return self._active is None
 
     def beginning_execution(self, entity: object) -> bool:
@@ -52,6 +52,6 @@ class MutuallyExclusiveCallbackGroup(CallbackGroup):
                 return True
             return False
 
-    def ending_execution(self, entity: object) -> None:  # noqa: ARG002
+    def ending_execution(self, entity: object) -> None:
         with self._lock:
             self._active = None

@@ -48,7 +48,7 @@ class Clock:
     def _add_time_listener(self, callback: Callable[[], None]) -> None:
         self._listeners.append(callback)
 
-    def sleep_until(self, until: Time, context=None) -> bool:  # noqa: ANN001, ARG002
+    def sleep_until(self, until: Time, context=None) -> bool:
         """Sleep until the clock reaches ``until``; works with sim time too."""
         while True:
             remaining = until.nanoseconds - self.now().nanoseconds
@@ -60,7 +60,7 @@ class Clock:
                 else:
                     self._cond.wait(timeout=remaining / 1e9)
 
-    def sleep_for(self, rel_time: Duration, context=None) -> bool:  # noqa: ANN001
+    def sleep_for(self, rel_time: Duration, context=None) -> bool:
         return self.sleep_until(self.now() + rel_time, context)
 
     def __repr__(self) -> str:

@@ -54,9 +54,9 @@ class IntraProcess:
 
         if sub.qos_profile.durability == DurabilityPolicy.TRANSIENT_LOCAL:
             for pub in pubs:
-                if pub._history and self._compatible(pub, sub):  # noqa: SLF001
-                    for delivery in list(pub._history):  # noqa: SLF001
-                        sub._enqueue(delivery)  # noqa: SLF001
+                if pub._history and self._compatible(pub, sub):
+                    for delivery in list(pub._history):
+                        sub._enqueue(delivery)
 
     def remove_subscription(self, sub: Subscription) -> None:
         with self._lock:
@@ -80,7 +80,7 @@ class IntraProcess:
             return
         for sub in list(subs):
             if self._compatible(pub, sub):
-                sub._enqueue(delivery)  # noqa: SLF001
+                sub._enqueue(delivery)
 
     def count_subscriptions(self, topic: str) -> int:
         return len(self._subs.get(topic, []))
@@ -162,7 +162,7 @@ class Context:
         for cb in callbacks:
             try:
                 cb()
-            except Exception as exc:  # noqa: BLE001
+            except Exception as exc:
                 get_logger('mindgrasp_ros').error(f'Shutdown callback failed: {exc}')
         for node in list(self.nodes):
             node.wake_executor()
@@ -175,7 +175,7 @@ class Context:
                 self._discovery_writer = None
                 try:
                     dds.close()
-                except Exception:  # noqa: BLE001, S110 - process is going away anyway
+                except Exception:
                     pass
 
     def try_shutdown(self) -> None:

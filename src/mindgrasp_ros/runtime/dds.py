@@ -87,7 +87,7 @@ _IDL_BASE = {
 _idl_lock = threading.RLock()
 
 
-def _idl_field(desc: tuple) -> Any:  # noqa: ANN401
+def _idl_field(desc: tuple) -> Any:
     kind, detail = desc
     if kind == Nodetype.BASE:
         base, bound = detail

@@ -14,20 +14,20 @@ class Duration:
     __slots__ = ('_nanoseconds',)
 
     def __init__(self, *, seconds: float = 0, nanoseconds: int = 0) -> None:
-        self._nanoseconds = int(round(seconds * 1e9)) + int(nanoseconds)
+        self._nanoseconds = round(seconds * 1e9) + int(nanoseconds)
 
     @property
     def nanoseconds(self) -> int:
         return self._nanoseconds
 
-    def to_msg(self):  # noqa: ANN201 - builtin_interfaces/Duration
+    def to_msg(self):
         from mindgrasp_ros.typesupport import get_message_class
 
         sec, nsec = divmod(self._nanoseconds, 1_000_000_000)
         return get_message_class('builtin_interfaces/msg/Duration')(sec=sec, nanosec=nsec)
 
     @classmethod
-    def from_msg(cls, msg) -> Duration:  # noqa: ANN001
+    def from_msg(cls, msg) -> Duration:
         return cls(seconds=msg.sec, nanoseconds=msg.nanosec)
 
     def __eq__(self, other: object) -> bool:

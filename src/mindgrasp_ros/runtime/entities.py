@@ -79,7 +79,7 @@ class Publisher(Entity):
     def gid(self) -> bytes:
         return self._writer.guid if self._writer else _local_gid(self)
 
-    def publish(self, msg: Any) -> None:  # noqa: ANN401
+    def publish(self, msg: Any) -> None:
         """Publish a message (or CDR bytes, for a publisher created with ``raw=True``)."""
         raw_bytes: bytes | None = None
         if isinstance(msg, (bytes, bytearray, memoryview)):
@@ -89,13 +89,13 @@ class Publisher(Entity):
                 raise TypeError(text)
             raw_bytes = bytes(msg)
             msg = None
-        elif type(msg) is not self.msg_type:
-            if getattr(type(msg), '__msgtype__', None) != self.type_name:
-                got = getattr(type(msg), '__msgtype__', type(msg).__name__)
-                text = (f"Publisher on '{self.topic_name}' carries {self.type_name}, but was "
-                        f'given {got}; publish a {self.type_name} message or create another '
-                        'publisher.')
-                raise MessageTypeError(text)
+        elif (type(msg) is not self.msg_type
+              and getattr(type(msg), '__msgtype__', None) != self.type_name):
+            got = getattr(type(msg), '__msgtype__', type(msg).__name__)
+            text = (f"Publisher on '{self.topic_name}' carries {self.type_name}, but was "
+                    f'given {got}; publish a {self.type_name} message or create another '
+                    'publisher.')
+            raise MessageTypeError(text)
         ctx = self.node.context
         if ctx.is_shutdown():
             return
@@ -111,13 +111,13 @@ class Publisher(Entity):
         remote = self._writer.matched_count() if self._writer else 0
         return remote + self.node.context.intra.count_subscriptions(self.topic_name)
 
-    def wait_for_all_acked(self, timeout: Any = None) -> bool:  # noqa: ANN401
+    def wait_for_all_acked(self, timeout: Any = None) -> bool:
         if self._writer is None:
             return True
         ns = timeout.nanoseconds if timeout is not None else 10_000_000_000
         try:
             return bool(self._writer.writer.wait_for_acks(ns))
-        except Exception:  # noqa: BLE001 - best effort, as rmw
+        except Exception:
             return False
 
     def destroy(self) -> None:
@@ -133,7 +133,7 @@ class _Delivery:
 
     __slots__ = ('_lock', '_msg', '_raw', 'type_name')
 
-    def __init__(self, type_name: str, msg: Any, raw: bytes | None) -> None:  # noqa: ANN401
+    def __init__(self, type_name: str, msg: Any, raw: bytes | None) -> None:
         self.type_name = type_name
         self._msg = msg
         self._raw = raw
@@ -146,7 +146,7 @@ class _Delivery:
                     self._raw = serialize(self._msg, self.type_name)
         return self._raw
 
-    def message(self) -> Any:  # noqa: ANN401
+    def message(self) -> Any:
         if self._msg is None:
             with self._lock:
                 if self._msg is None:
@@ -201,7 +201,7 @@ class Subscription(Entity):
             delivery = self._queue.popleft()
             try:
                 out.append((delivery.raw() if self.raw else delivery.message(), MessageInfo()))
-            except Exception as exc:  # noqa: BLE001 - a bad sample must not kill the node
+            except Exception as exc:
                 self._report_malformed(exc)
         if self._reader is not None:
             for data, info in self._reader.take(256):
@@ -210,7 +210,7 @@ class Subscription(Entity):
                     continue
                 try:
                     msg = deserialize(data, self.type_name)
-                except Exception as exc:  # noqa: BLE001
+                except Exception as exc:
                     self._report_malformed(exc)
                     continue
                 out.append((msg, MessageInfo(source_timestamp=info.source_timestamp)))
@@ -278,7 +278,7 @@ class Timer(Entity):
         if not period_sec >= 0:
             msg = f'Timer period must be a non-negative number of seconds, not {period_sec!r}.'
             raise ValueError(msg)
-        self.timer_period_ns = int(round(period_sec * 1e9))
+        self.timer_period_ns = round(period_sec * 1e9)
         self.callback = callback
         self.clock = clock
         self._canceled = not autostart
@@ -405,7 +405,7 @@ class Service(Entity):
             try:
                 guid, seq, payload = _unpack_service(data)
                 out.append((guid, seq, deserialize(payload, self._req_type)))
-            except Exception as exc:  # noqa: BLE001
+            except Exception as exc:
                 self.node.get_logger().warning(
                     f"Dropped a malformed request on service '{self.srv_name}': {exc}")
         return out
@@ -475,7 +475,7 @@ class Client(Entity):
             time.sleep(0.01)
         return True
 
-    def call_async(self, request: Any) -> Future:  # noqa: ANN401
+    def call_async(self, request: Any) -> Future:
         if type_name_of(request) != self._req_type:
             msg = (f"Client of '{self.srv_name}' sends {self._req_type}, but was given "
                    f'{type_name_of(request)}.')
@@ -493,7 +493,7 @@ class Client(Entity):
             with self._lock:
                 self._pending.pop(seq, None)
 
-    def call(self, request: Any, timeout_sec: float | None = None) -> Any:  # noqa: ANN401
+    def call(self, request: Any, timeout_sec: float | None = None) -> Any:
         """Blocking call; another thread must spin this node (as in rclpy)."""
         future = self.call_async(request)
         if not future.wait(timeout_sec):
@@ -523,7 +523,7 @@ class Client(Entity):
                 continue
             try:
                 out.append((future, deserialize(payload, self._res_type)))
-            except Exception as exc:  # noqa: BLE001
+            except Exception as exc:
                 future.set_exception(exc)
         return out
 

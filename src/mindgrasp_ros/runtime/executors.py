@@ -23,8 +23,14 @@ from mindgrasp_ros.runtime.entities import Client, GuardCondition, Service, Subs
 from mindgrasp_ros.runtime.exceptions import RCLError
 from mindgrasp_ros.runtime.task import Future
 
-__all__ = ['ExternalShutdownException', 'Executor', 'MultiThreadedExecutor',
-           'ShutdownException', 'SingleThreadedExecutor', 'TimeoutException']
+__all__ = [
+    'Executor',
+    'ExternalShutdownException',
+    'MultiThreadedExecutor',
+    'ShutdownException',
+    'SingleThreadedExecutor',
+    'TimeoutException',
+]
 
 _MAX_WAIT_S = 0.1
 _ANY = SampleState.Any | ViewState.Any | InstanceState.Any
@@ -73,7 +79,7 @@ class Executor:
         return self._context
 
     # ------------------------------------------------------------------ nodes
-    def add_node(self, node: Any) -> bool:  # noqa: ANN401
+    def add_node(self, node: Any) -> bool:
         with self._lock:
             if node in self._nodes:
                 return False
@@ -85,7 +91,7 @@ class Executor:
         self.wake()
         return True
 
-    def remove_node(self, node: Any) -> None:  # noqa: ANN401
+    def remove_node(self, node: Any) -> None:
         with self._lock:
             if node in self._nodes:
                 self._nodes.remove(node)
@@ -105,10 +111,10 @@ class Executor:
         if self._guard is not None:
             try:
                 self._guard.set(True)
-            except Exception:  # noqa: BLE001, S110 - participant already deleted at shutdown
+            except Exception:
                 pass
 
-    def shutdown(self, timeout_sec: float | None = None) -> bool:  # noqa: ARG002
+    def shutdown(self, timeout_sec: float | None = None) -> bool:
         self._is_shutdown = True
         self.wake()
         with self._lock:
@@ -126,7 +132,7 @@ class Executor:
             try:
                 self._waitset.detach(cond)
                 cond.__del__()
-            except Exception:  # noqa: BLE001, S110
+            except Exception:
                 pass
         self._conditions.clear()
 
@@ -149,7 +155,7 @@ class Executor:
                 try:
                     self._waitset.detach(cond)
                     cond.__del__()
-                except Exception:  # noqa: BLE001, S110 - reader already deleted
+                except Exception:
                     pass
         for key, reader in wanted.items():
             if key not in self._conditions:
@@ -197,11 +203,11 @@ class Executor:
         for node in list(self._nodes):
             for timer in list(node.timers):
                 if not timer._busy and timer.callback_group.can_execute(timer) and \
-                        timer.is_ready():  # noqa: SLF001
-                    timer._mark_called()  # noqa: SLF001
+                        timer.is_ready():
+                    timer._mark_called()
                     work.append((timer, None))
             for entity in (*node.subscriptions, *node.services, *node.clients):
-                if entity._busy:  # noqa: SLF001 - keeps per-entity order in multi-threading
+                if entity._busy:
                     continue
                 if isinstance(entity, Client):
                     # replies complete futures; never hold them back behind a busy group
@@ -211,12 +217,12 @@ class Executor:
                     continue
                 work.extend((entity, item) for item in entity.take())
             for guard in list(node.guards):
-                if guard._triggered and guard.callback_group.can_execute(guard):  # noqa: SLF001
-                    guard._triggered = False  # noqa: SLF001
+                if guard._triggered and guard.callback_group.can_execute(guard):
+                    guard._triggered = False
                     work.append((guard, None))
         return work
 
-    def _run(self, entity: Any, item: Any) -> None:  # noqa: ANN401
+    def _run(self, entity: Any, item: Any) -> None:
         try:
             entity.execute(item)
         except (KeyboardInterrupt, SystemExit):
@@ -287,11 +293,11 @@ class Executor:
         future.add_done_callback(lambda _f: self.wake())
         self.spin_once(timeout_sec)
 
-    def create_task(self, callback: Callable, *args: Any) -> Future:  # noqa: ANN401
+    def create_task(self, callback: Callable, *args: Any) -> Future:
         future = Future()
         try:
             future.set_result(callback(*args))
-        except Exception as exc:  # noqa: BLE001
+        except Exception as exc:
             future.set_exception(exc)
         return future
 
@@ -337,7 +343,7 @@ class MultiThreadedExecutor(Executor):
                 with self._lock:
                     self._pending.extend(batch)  # its group is busy: try again next round
                 continue
-            entity._busy = True  # noqa: SLF001
+            entity._busy = True
             self._pool.submit(self._run_batch, batch)
             ran = True
         if self._errors:
@@ -349,10 +355,10 @@ class MultiThreadedExecutor(Executor):
         try:
             for _entity, item in batch:
                 self._run(entity, item)
-        except BaseException as exc:  # noqa: BLE001 - re-raised in the spinning thread
+        except BaseException as exc:
             self._errors.append(exc)
         finally:
-            entity._busy = False  # noqa: SLF001
+            entity._busy = False
             if not isinstance(entity, Client):
                 entity.callback_group.ending_execution(entity)
             self.wake()

@@ -51,7 +51,7 @@ class TopicEndpointInfo:
     topic_type_hash: str = ''
 
 
-def _qos_from_dds(qos: Any) -> QoSProfile:  # noqa: ANN401
+def _qos_from_dds(qos: Any) -> QoSProfile:
     profile = QoSProfile(depth=0)
     for policy in qos:
         scope = getattr(policy, '__scope__', '')
@@ -86,7 +86,7 @@ def _duration(ns: int) -> Duration:
     return Duration(nanoseconds=0 if ns >= 2**62 else ns)
 
 
-def _user_data_hash(qos: Any) -> str:  # noqa: ANN401
+def _user_data_hash(qos: Any) -> str:
     for policy in qos:
         if getattr(policy, '__scope__', '') == 'Userdata':
             text = bytes(policy.data).decode(errors='replace')
@@ -100,15 +100,13 @@ class GraphCache:
     """Endpoints and nodes of the domain, updated on every query."""
 
     def __init__(self, dds: DdsParticipant) -> None:
-        from mindgrasp_ros.runtime.qos import QoSProfile as _Q
-
         self._dds = dds
         self._lock = threading.Lock()
         self._pub_reader = BuiltinDataReader(dds.participant, BuiltinTopicDcpsPublication)
         self._sub_reader = BuiltinDataReader(dds.participant, BuiltinTopicDcpsSubscription)
         self._info_reader = dds.create_reader(
             'ros_discovery_info', 'rmw_dds_common/msg/ParticipantEntitiesInfo',
-            _Q(history=HistoryPolicy.KEEP_ALL, durability=DurabilityPolicy.TRANSIENT_LOCAL))
+            QoSProfile(history=HistoryPolicy.KEEP_ALL, durability=DurabilityPolicy.TRANSIENT_LOCAL))
         self._endpoints: dict[bytes, tuple[str, Any]] = {}  # gid -> (kind, DcpsEndpoint)
         #: participant gid -> [(namespace, name, reader gids, writer gids)]
         self._participants: dict[bytes, list[tuple[str, str, set[bytes], set[bytes]]]] = {}
@@ -118,7 +116,7 @@ class GraphCache:
             self._dds.delete_reader(self._info_reader)
             self._pub_reader.__del__()
             self._sub_reader.__del__()
-        except Exception:  # noqa: BLE001, S110 - participant already gone
+        except Exception:
             pass
 
     def _update(self) -> None:
@@ -139,7 +137,7 @@ class GraphCache:
             for data, _info in self._info_reader.take(1024):
                 try:
                     msg = deserialize(data, 'rmw_dds_common/msg/ParticipantEntitiesInfo')
-                except Exception:  # noqa: BLE001, S112 - a foreign malformed sample
+                except Exception:
                     continue
                 gid = bytes(msg.gid.data)[:16]
                 self._participants[gid] = [

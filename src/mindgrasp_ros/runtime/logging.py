@@ -121,7 +121,7 @@ class RcutilsLogger:
         for sink in list(_sinks):
             try:
                 sink(severity, self.name, text, file, func, line)
-            except Exception:  # noqa: BLE001, S110 - logging must never raise
+            except Exception:
                 pass
         return True
 

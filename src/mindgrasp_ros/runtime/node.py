@@ -119,7 +119,7 @@ class Node:
         if enable_rosout:
             self._rosout_pub = self.create_publisher(
                 _interfaces('Log'), '/rosout', qos_profile_rosout_default)
-            rlog._sinks.append(self._rosout_sink)  # noqa: SLF001
+            rlog._sinks.append(self._rosout_sink)
         self.declare_parameter('use_sim_time', False)
         self._apply_use_sim_time(self.get_parameter('use_sim_time').value)
         self.add_on_set_parameters_callback(self._on_use_sim_time)
@@ -170,7 +170,7 @@ class Node:
         if executor is not None:
             executor.wake()
 
-    def _add(self, collection: list, entity: Entity) -> Any:  # noqa: ANN401
+    def _add(self, collection: list, entity: Entity) -> Any:
         with self._lock:
             collection.append(entity)
             self.generation += 1
@@ -194,10 +194,10 @@ class Node:
         writers: list[bytes] = []
         with self._lock:
             for s in self.subscriptions:
-                if s._reader is not None:  # noqa: SLF001
+                if s._reader is not None:
                     readers.append(s.gid)
             for p in self.publishers:
-                if p._writer is not None:  # noqa: SLF001
+                if p._writer is not None:
                     writers.append(p.gid)
             for srv in self.services:
                 readers.append(srv.gid)
@@ -219,9 +219,9 @@ class Node:
     def create_publisher(self, msg_type: type | str, topic: str,
                          qos_profile: QoSProfile | int, *,
                          callback_group: CallbackGroup | None = None,
-                         event_callbacks: object = None,  # noqa: ARG002
-                         qos_overriding_options: object = None,  # noqa: ARG002
-                         publisher_class: object = None,  # noqa: ARG002
+                         event_callbacks: object = None,
+                         qos_overriding_options: object = None,
+                         publisher_class: object = None,
                          raw: bool = False) -> Publisher:
         """Publisher of ``msg_type`` (a class or ``'pkg/msg/Name'``); ``raw=True`` publishes
         CDR bytes too."""
@@ -234,8 +234,8 @@ class Node:
     def create_subscription(self, msg_type: type | str, topic: str, callback: Callable,
                             qos_profile: QoSProfile | int, *,
                             callback_group: CallbackGroup | None = None,
-                            event_callbacks: object = None,  # noqa: ARG002
-                            qos_overriding_options: object = None,  # noqa: ARG002
+                            event_callbacks: object = None,
+                            qos_overriding_options: object = None,
                             raw: bool = False) -> Subscription:
         """Subscription; ``raw=True`` hands the callback CDR bytes (with the 4-byte header)."""
         cls, name = self._resolve_type(msg_type)
@@ -251,7 +251,7 @@ class Node:
                       autostart)
         return self._add(self.timers, timer)
 
-    def create_rate(self, frequency: float, clock: Clock | None = None):  # noqa: ANN201
+    def create_rate(self, frequency: float, clock: Clock | None = None):
         from mindgrasp_ros.runtime.rate import Rate
 
         return Rate(frequency, clock or self._clock)
@@ -299,8 +299,8 @@ class Node:
         if self._destroyed:
             return
         self._destroyed = True
-        if self._rosout_sink in rlog._sinks:  # noqa: SLF001
-            rlog._sinks.remove(self._rosout_sink)  # noqa: SLF001
+        if self._rosout_sink in rlog._sinks:
+            rlog._sinks.remove(self._rosout_sink)
         if self.executor is not None:
             self.executor.remove_node(self)
         if self.context.ok():
@@ -327,31 +327,30 @@ class Node:
     # ------------------------------------------------------------------ time
     def _apply_use_sim_time(self, enabled: bool) -> None:
         if enabled and self._clock_sub is None:
-            self._clock._set_ros_time_override(0)  # noqa: SLF001 - no /clock yet: time 0
+            self._clock._set_ros_time_override(0)
             self._clock_sub = self.create_subscription(
                 get_message_class('rosgraph_msgs/msg/Clock'), '/clock', self._on_clock,
                 qos_profile_clock)
         elif not enabled and self._clock_sub is not None:
             self.destroy_subscription(self._clock_sub)
             self._clock_sub = None
-            self._clock._set_ros_time_override(None)  # noqa: SLF001
+            self._clock._set_ros_time_override(None)
 
-    def _on_clock(self, msg: Any) -> None:  # noqa: ANN401
-        self._clock._set_ros_time_override(  # noqa: SLF001
+    def _on_clock(self, msg: Any) -> None:
+        self._clock._set_ros_time_override(
             int(msg.clock.sec) * 1_000_000_000 + int(msg.clock.nanosec))
 
-    def _on_use_sim_time(self, params: list[Parameter]) -> Any:  # noqa: ANN401
+    def _on_use_sim_time(self, params: list[Parameter]) -> Any:
         for p in params:
-            if p.name == 'use_sim_time':
-                if p.type_ != Parameter.Type.BOOL:
-                    return _interfaces('SetParametersResult')(
-                        successful=False, reason='use_sim_time must be a bool')
+            if p.name == 'use_sim_time' and p.type_ != Parameter.Type.BOOL:
+                return _interfaces('SetParametersResult')(
+                    successful=False, reason='use_sim_time must be a bool')
                 # applied after acceptance, below in _set_parameter_unchecked
         return _interfaces('SetParametersResult')(successful=True)
 
     # ------------------------------------------------------------------ parameters
-    def declare_parameter(self, name: str, value: Any = None,  # noqa: ANN401
-                          descriptor: Any = None, ignore_override: bool = False) -> Parameter:  # noqa: ANN401
+    def declare_parameter(self, name: str, value: Any = None,
+                          descriptor: Any = None, ignore_override: bool = False) -> Parameter:
         """Declare a parameter; an override (file or ``-p``) replaces the default.
 
         ``value`` may be a default value or a :class:`Parameter.Type` for a parameter that
@@ -443,7 +442,7 @@ class Node:
         pre = f'{prefix}.' if prefix else ''
         return {k[len(pre):]: v for k, v in self._parameters.items() if k.startswith(pre)}
 
-    def describe_parameter(self, name: str) -> Any:  # noqa: ANN401
+    def describe_parameter(self, name: str) -> Any:
         if name not in self._descriptors:
             raise ParameterNotDeclaredException(name)
         return self._descriptors[name]
@@ -460,10 +459,10 @@ class Node:
     def set_parameters(self, parameter_list: list[Parameter]) -> list[Any]:
         return [self._set_parameters_atomically([p]) for p in parameter_list]
 
-    def set_parameters_atomically(self, parameter_list: list[Parameter]) -> Any:  # noqa: ANN401
+    def set_parameters_atomically(self, parameter_list: list[Parameter]) -> Any:
         return self._set_parameters_atomically(parameter_list)
 
-    def _check_range(self, param: Parameter, desc: Any) -> None:  # noqa: ANN401
+    def _check_range(self, param: Parameter, desc: Any) -> None:
         value = param.value
         if param.type_ == Parameter.Type.DOUBLE and len(desc.floating_point_range):
             r = desc.floating_point_range[0]
@@ -476,7 +475,7 @@ class Node:
                 raise InvalidParameterValueException(
                     param.name, value, f'must be within [{r.from_value}, {r.to_value}]')
 
-    def _call_set_callbacks(self, params: list[Parameter]) -> Any:  # noqa: ANN401
+    def _call_set_callbacks(self, params: list[Parameter]) -> Any:
         result_cls = _interfaces('SetParametersResult')
         for cb in list(self._set_callbacks):
             result = cb(params)
@@ -484,7 +483,7 @@ class Node:
                 return result or result_cls(successful=False, reason='rejected by a callback')
         return result_cls(successful=True)
 
-    def _set_parameters_atomically(self, params: list[Parameter]) -> Any:  # noqa: ANN401
+    def _set_parameters_atomically(self, params: list[Parameter]) -> Any:
         result_cls = _interfaces('SetParametersResult')
         staged = []
         for p in params:
@@ -552,16 +551,16 @@ class Node:
     def get_node_names_and_namespaces(self) -> list[tuple[str, str]]:
         return self.context.graph.node_names_and_namespaces()
 
-    def get_topic_names_and_types(self, no_demangle: bool = False) -> list[tuple[str, list[str]]]:  # noqa: ARG002
+    def get_topic_names_and_types(self, no_demangle: bool = False) -> list[tuple[str, list[str]]]:
         return self.context.graph.topic_names_and_types()
 
     def get_service_names_and_types(self) -> list[tuple[str, list[str]]]:
         return self.context.graph.service_names_and_types()
 
-    def get_publishers_info_by_topic(self, topic_name: str, no_mangle: bool = False) -> list:  # noqa: ARG002
+    def get_publishers_info_by_topic(self, topic_name: str, no_mangle: bool = False) -> list:
         return self.context.graph.endpoints(self.resolve_topic_name(topic_name), 'publisher')
 
-    def get_subscriptions_info_by_topic(self, topic_name: str, no_mangle: bool = False) -> list:  # noqa: ARG002
+    def get_subscriptions_info_by_topic(self, topic_name: str, no_mangle: bool = False) -> list:
         return self.context.graph.endpoints(self.resolve_topic_name(topic_name), 'subscription')
 
     def count_publishers(self, topic_name: str) -> int:

@@ -32,7 +32,7 @@ class Parameter:
         STRING_ARRAY = 9
 
         @classmethod
-        def from_parameter_value(cls, value: Any) -> Parameter.Type:  # noqa: ANN401
+        def from_parameter_value(cls, value: Any) -> Parameter.Type:
             """Infer the type of a Python value, as rclpy does."""
             if value is None:
                 return cls.NOT_SET
@@ -65,7 +65,7 @@ class Parameter:
             msg = f'{type(value).__name__} is not a ROS parameter type: {value!r}.'
             raise TypeError(msg)
 
-        def check(self, value: Any) -> bool:  # noqa: ANN401
+        def check(self, value: Any) -> bool:
             if self == Parameter.Type.NOT_SET:
                 return value is None
             try:
@@ -80,7 +80,7 @@ class Parameter:
             return self == Parameter.Type.DOUBLE_ARRAY and inferred == Parameter.Type.INTEGER_ARRAY
 
     def __init__(self, name: str, type_: Parameter.Type | None = None,
-                 value: Any = None) -> None:  # noqa: ANN401
+                 value: Any = None) -> None:
         if type_ is None:
             type_ = Parameter.Type.from_parameter_value(value)
         type_ = Parameter.Type(type_)
@@ -106,10 +106,10 @@ class Parameter:
         return self._type
 
     @property
-    def value(self) -> Any:  # noqa: ANN401
+    def value(self) -> Any:
         return self._value
 
-    def get_parameter_value(self):  # noqa: ANN201 - rcl_interfaces/ParameterValue
+    def get_parameter_value(self):
         pv = _msg('ParameterValue')(type=int(self._type))
         t = Parameter.Type
         v = self._value
@@ -133,11 +133,11 @@ class Parameter:
             pv.string_array_value = list(v)
         return pv
 
-    def to_parameter_msg(self):  # noqa: ANN201 - rcl_interfaces/Parameter
+    def to_parameter_msg(self):
         return _msg('Parameter')(name=self._name, value=self.get_parameter_value())
 
     @classmethod
-    def from_parameter_msg(cls, msg) -> Parameter:  # noqa: ANN001
+    def from_parameter_msg(cls, msg) -> Parameter:
         return cls(msg.name, Parameter.Type(msg.value.type),
                    parameter_value_to_python(msg.value))
 
@@ -150,7 +150,7 @@ class Parameter:
         return f'Parameter({self._name!r}, {self._type.name}, {self._value!r})'
 
 
-def parameter_value_to_python(pv) -> Any:  # noqa: ANN001, ANN401
+def parameter_value_to_python(pv) -> Any:
     """Python value of an rcl_interfaces/ParameterValue."""
     t = Parameter.Type(pv.type)
     if t == t.NOT_SET:

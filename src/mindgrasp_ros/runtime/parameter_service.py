@@ -36,7 +36,7 @@ class ParameterService:
             node.create_service(_srv(srv_type), f'{fqn}/{name}', handler,
                                 qos_profile=qos_profile_parameters)
 
-    def _get(self, request: Any, response: Any) -> Any:  # noqa: ANN401
+    def _get(self, request: Any, response: Any) -> Any:
         values = []
         for name in request.names:
             param = self._node.get_parameter_or(name)
@@ -44,11 +44,11 @@ class ParameterService:
         response.values = values
         return response
 
-    def _get_types(self, request: Any, response: Any) -> Any:  # noqa: ANN401
+    def _get_types(self, request: Any, response: Any) -> Any:
         response.types = [int(self._node.get_parameter_or(n).type_) for n in request.names]
         return response
 
-    def _describe(self, request: Any, response: Any) -> Any:  # noqa: ANN401
+    def _describe(self, request: Any, response: Any) -> Any:
         out = []
         for name in request.names:
             try:
@@ -58,8 +58,8 @@ class ParameterService:
         response.descriptors = out
         return response
 
-    def _list(self, request: Any, response: Any) -> Any:  # noqa: ANN401
-        names = sorted(self._node._parameters)  # noqa: SLF001
+    def _list(self, request: Any, response: Any) -> Any:
+        names = sorted(self._node._parameters)
         prefixes = list(request.prefixes)
         depth = int(request.depth)
         selected = []
@@ -80,12 +80,12 @@ class ParameterService:
         response.result = result
         return response
 
-    def _set(self, request: Any, response: Any) -> Any:  # noqa: ANN401
+    def _set(self, request: Any, response: Any) -> Any:
         params = [Parameter.from_parameter_msg(p) for p in request.parameters]
         response.results = self._node.set_parameters(params)
         return response
 
-    def _set_atomically(self, request: Any, response: Any) -> Any:  # noqa: ANN401
+    def _set_atomically(self, request: Any, response: Any) -> Any:
         params = [Parameter.from_parameter_msg(p) for p in request.parameters]
         response.result = self._node.set_parameters_atomically(params)
         return response

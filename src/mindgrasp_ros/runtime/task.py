@@ -12,7 +12,7 @@ __all__ = ['Future']
 class Future:
     """A value that arrives later; thread safe."""
 
-    def __init__(self, *, executor: object = None) -> None:  # noqa: ARG002 - rclpy signature
+    def __init__(self, *, executor: object = None) -> None:
         self._done = threading.Event()
         self._result: Any = None
         self._exception: BaseException | None = None
@@ -31,7 +31,7 @@ class Future:
             self._cancelled = True
             self._finish()
 
-    def result(self) -> Any:  # noqa: ANN401
+    def result(self) -> Any:
         if self._exception is not None:
             raise self._exception
         return self._result
@@ -39,7 +39,7 @@ class Future:
     def exception(self) -> BaseException | None:
         return self._exception
 
-    def set_result(self, result: Any) -> None:  # noqa: ANN401
+    def set_result(self, result: Any) -> None:
         self._result = result
         self._finish()
 
@@ -65,7 +65,7 @@ class Future:
         """Block until done (not in rclpy; used by ``Client.call``)."""
         return self._done.wait(timeout)
 
-    def __await__(self):  # noqa: ANN204
+    def __await__(self):
         while not self.done():
             yield
         return self.result()

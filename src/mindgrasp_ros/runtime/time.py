@@ -18,7 +18,7 @@ class Time:
 
     def __init__(self, *, seconds: float = 0, nanoseconds: int = 0,
                  clock_type: ClockType = ClockType.SYSTEM_TIME) -> None:
-        total = int(round(seconds * 1e9)) + int(nanoseconds)
+        total = round(seconds * 1e9) + int(nanoseconds)
         if total < 0:
             msg = 'Time cannot be negative; use a Duration for signed spans.'
             raise ValueError(msg)
@@ -36,14 +36,14 @@ class Time:
     def seconds_nanoseconds(self) -> tuple[int, int]:
         return divmod(self._nanoseconds, 1_000_000_000)
 
-    def to_msg(self):  # noqa: ANN201 - builtin_interfaces/Time
+    def to_msg(self):
         from mindgrasp_ros.typesupport import get_message_class
 
         sec, nsec = self.seconds_nanoseconds()
         return get_message_class('builtin_interfaces/msg/Time')(sec=sec, nanosec=nsec)
 
     @classmethod
-    def from_msg(cls, msg, clock_type: ClockType = ClockType.ROS_TIME) -> Time:  # noqa: ANN001
+    def from_msg(cls, msg, clock_type: ClockType = ClockType.ROS_TIME) -> Time:
         return cls(seconds=msg.sec, nanoseconds=msg.nanosec, clock_type=clock_type)
 
     def __add__(self, other: Duration) -> Time:
