@@ -47,7 +47,7 @@ class Preprocessing:
     """
 
     size: int = 128
-    depth_range: float = 0.1
+    depth_range: float = 0.05
     margin: float = 0.15
 
 
