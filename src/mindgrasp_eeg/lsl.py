@@ -1,0 +1,265 @@
+"""Thin wrappers around pylsl: the amplifier side (outlets) and the acquisition side (resolve,
+inlet, stream description, validation).
+
+Units: LSL carries numbers without a mandatory unit. Outlets made here declare the unit of each
+channel in the stream description (``<channels><channel><unit>microvolts</unit>``), as g.tec's and
+most other amplifiers' LSL apps do; :func:`unit_scale` turns that unit into the factor to volts.
+
+Time: LSL timestamps are seconds of ``pylsl.local_clock()`` (a monotonic clock, CLOCK_MONOTONIC on
+Linux) of the sending host. An inlet opened with :data:`PROC_FLAGS` adds the estimated offset
+between the sender's and the receiver's clocks (clock synchronisation) and smooths the timestamps
+with a linear regression over sample index (dejitter), so pulled timestamps are in the receiver's
+``local_clock()`` domain. See :mod:`mindgrasp_eeg.acquisition` for the mapping to ROS time.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import pylsl
+from pylsl.util import TimeoutError as LSLTimeoutError
+
+from . import EEGError
+
+#: factor from a unit name (as found in LSL metadata) to volts
+UNIT_SCALES: dict[str, float] = {
+    'v': 1.0, 'volt': 1.0, 'volts': 1.0,
+    'mv': 1e-3, 'millivolt': 1e-3, 'millivolts': 1e-3,
+    'uv': 1e-6, 'µv': 1e-6, 'μv': 1e-6, 'microvolt': 1e-6, 'microvolts': 1e-6,
+    'nv': 1e-9, 'nanovolt': 1e-9, 'nanovolts': 1e-9,
+}
+
+#: post-processing of pulled timestamps: clock synchronisation and dejitter (no monotonize,
+#: so out-of-order samples stay visible to the counters)
+PROC_FLAGS = pylsl.proc_clocksync | pylsl.proc_dejitter
+
+
+def unit_scale(unit: str) -> float:
+    """Factor that converts values in ``unit`` (e.g. ``'microvolts'``, ``'uV'``) to volts."""
+    key = unit.strip().lower()
+    if key not in UNIT_SCALES:
+        msg = (f'The EEG unit {unit!r} is unknown; use one of volts, millivolts, microvolts, '
+               f'nanovolts (or V, mV, uV, nV), or set the stream_unit parameter.')
+        raise EEGError(msg)
+    return UNIT_SCALES[key]
+
+
+@dataclass(frozen=True)
+class StreamDescription:
+    """What an LSL stream says about itself.
+
+    ``unit`` is the channels' common unit from the metadata, empty when the stream declares none.
+    """
+
+    name: str
+    type: str
+    source_id: str
+    n_channels: int
+    sample_rate: float
+    channel_names: tuple[str, ...]
+    unit: str
+    channel_format: int
+    hostname: str
+    uid: str
+    created_at: float
+
+    @classmethod
+    def from_info(cls, info: pylsl.StreamInfo) -> StreamDescription:
+        """Read a (full, i.e. from ``inlet.info()``) StreamInfo; missing labels become ``ch<k>``."""
+        names, units = [], set()
+        ch = info.desc().child('channels').child('channel')
+        while not ch.empty() and len(names) < info.channel_count():
+            names.append(ch.child_value('label'))
+            units.add(ch.child_value('unit'))
+            ch = ch.next_sibling('channel')
+        if len(names) != info.channel_count():
+            names = [f'ch{k + 1}' for k in range(info.channel_count())]
+            units = set()
+        units.discard('')
+        return cls(info.name(), info.type(), info.source_id(), info.channel_count(),
+                   float(info.nominal_srate()), tuple(names),
+                   units.pop() if len(units) == 1 else '', info.channel_format(),
+                   info.hostname(), info.uid(), info.created_at())
+
+    def summary(self) -> str:
+        """One line: ``'name' (type, n ch @ rate Hz, source_id, host)``."""
+        return (f"'{self.name}' (type {self.type!r}, {self.n_channels} ch @ "
+                f"{self.sample_rate:g} Hz, source_id {self.source_id!r}, host {self.hostname!r})")
+
+
+def _predicate(name: str, stream_type: str, source_id: str) -> str:
+    parts = [f"{key}='{value}'" for key, value in
+             (('name', name), ('type', stream_type), ('source_id', source_id)) if value]
+    return ' and '.join(parts)
+
+
+def visible_streams(wait_time: float = 1.0) -> list[StreamDescription]:
+    """All LSL streams visible from this host (short description, no channel labels)."""
+    return [StreamDescription.from_info(i) for i in pylsl.resolve_streams(wait_time=wait_time)]
+
+
+def resolve_stream(name: str = '', stream_type: str = '', source_id: str = '',
+                   timeout: float = 10.0, exclude_uids: Sequence[str] = ()) -> pylsl.StreamInfo:
+    """Find one LSL stream by name, type and/or source_id (the newest if several match).
+
+    Raises
+    ------
+    EEGError
+        Nothing matched within ``timeout`` seconds; the message lists the visible streams.
+    """
+    pred = _predicate(name, stream_type, source_id)
+    if not pred:
+        msg = ('No LSL stream selector given: set at least one of eeg_stream (name), '
+               'stream_type or source_id.')
+        raise EEGError(msg)
+    found = [i for i in pylsl.resolve_bypred(pred, minimum=1, timeout=timeout)
+             if i.uid() not in exclude_uids]
+    if not found:
+        seen = visible_streams(1.0)
+        listing = '; '.join(s.summary() for s in seen) or 'none'
+        msg = (f'No LSL stream with {pred} was found within {timeout:g} s. Visible streams: '
+               f'{listing}. Start the amplifier (or `mindgrasp eeg virtual-amp`) or select one of '
+               f'the visible streams by name, type or source_id.')
+        raise EEGError(msg)
+    return max(found, key=lambda i: i.created_at())
+
+
+def open_inlet(info: pylsl.StreamInfo, *, max_buflen: float = 1.0, dejitter: bool = True,
+               clocksync: bool = True, timeout: float = 5.0) -> tuple[pylsl.StreamInlet,
+                                                                      StreamDescription]:
+    """Open an inlet with a bounded buffer and the full stream description.
+
+    ``max_buflen`` (s) bounds what LSL keeps for us: after a stall we get at most that much
+    backlog, never minutes of stale data. LSL's own recovery is off; the caller re-resolves.
+    """
+    flags = (pylsl.proc_clocksync if clocksync else 0) | (pylsl.proc_dejitter if dejitter else 0)
+    inlet = pylsl.StreamInlet(info, max_buflen=max(1, math.ceil(max_buflen)), recover=False,
+                              processing_flags=flags)
+    try:
+        full = inlet.info(timeout=timeout)
+        inlet.open_stream(timeout=timeout)
+    except LSLTimeoutError as exc:
+        msg = (f"The LSL stream '{info.name()}' did not answer within {timeout:g} s; check that "
+               f'the sender is running and reachable (network, firewall).')
+        raise EEGError(msg) from exc
+    return inlet, StreamDescription.from_info(full)
+
+
+def check_stream(desc: StreamDescription, *, n_channels: int = 0, sample_rate: float = 0.0,
+                 channel_names: Sequence[str] = (), adapt: bool = False) -> list[str]:
+    """Compare a stream with the expected layout (0 / empty = accept anything).
+
+    Returns the warnings when ``adapt`` is true (the stream's layout is adopted).
+
+    Raises
+    ------
+    EEGError
+        On a mismatch when ``adapt`` is false; the message names the stream's and the expected
+        values and how to fix it.
+    """
+    problems = []
+    if desc.channel_format not in (pylsl.cf_float32, pylsl.cf_double64, pylsl.cf_int32,
+                                   pylsl.cf_int16):
+        msg = (f"The LSL stream '{desc.name}' has a non-numeric channel format "
+               f'({desc.channel_format}); select an EEG stream, not a marker stream.')
+        raise EEGError(msg)
+    if desc.sample_rate <= 0:
+        msg = (f"The LSL stream '{desc.name}' has an irregular sampling rate; EEG needs a nominal "
+               f'rate: select the EEG stream, not a marker stream.')
+        raise EEGError(msg)
+    if n_channels and desc.n_channels != n_channels:
+        problems.append(f'has {desc.n_channels} channels, expected {n_channels} (n_channels)')
+    if sample_rate and abs(desc.sample_rate - sample_rate) > 1e-6 * sample_rate:
+        problems.append(f'runs at {desc.sample_rate:g} Hz, expected {sample_rate:g} Hz '
+                        f'(sample_rate)')
+    if channel_names and tuple(channel_names) != desc.channel_names:
+        problems.append(f'has channels {list(desc.channel_names)}, expected {list(channel_names)} '
+                        f'(channel_names)')
+    if not problems:
+        return []
+    text = f"The LSL stream '{desc.name}' " + '; it '.join(problems)
+    if not adapt:
+        raise EEGError(text + '. Fix the parameters (or set adapt_to_stream:=true to adopt the '
+                       "stream's layout), or select the right stream.")
+    return [text + "; adopting the stream's layout (adapt_to_stream is true)."]
+
+
+class EEGOutlet:
+    """An LSL EEG outlet, as an amplifier app would create it.
+
+    Parameters
+    ----------
+    name : str
+        Stream name (make it unique per host; LSL streams are visible host-wide).
+    channel_names : sequence of str
+    sample_rate : float
+        Nominal rate (Hz).
+    source_id : str
+        Stable id so receivers can recognise a restarted amplifier; default ``name``.
+    unit : str
+        Unit of the pushed values declared in the metadata (``'microvolts'`` by default, as most
+        amplifier apps); :meth:`push_volts` converts from volts.
+    """
+
+    def __init__(self, name: str, channel_names: Sequence[str], sample_rate: float, *,
+                 stream_type: str = 'EEG', source_id: str = '', unit: str = 'microvolts',
+                 manufacturer: str = 'MIndGrasp', model: str = 'virtual amplifier',
+                 chunk_size: int = 0) -> None:
+        self.scale = unit_scale(unit)
+        self.n_channels = len(channel_names)
+        info = pylsl.StreamInfo(name, stream_type, self.n_channels, float(sample_rate),
+                                pylsl.cf_float32, source_id or name)
+        chans = info.desc().append_child('channels')
+        for label in channel_names:
+            ch = chans.append_child('channel')
+            ch.append_child_value('label', label)
+            ch.append_child_value('unit', unit)
+            ch.append_child_value('type', 'EEG')
+        acq = info.desc().append_child('acquisition')
+        acq.append_child_value('manufacturer', manufacturer)
+        acq.append_child_value('model', model)
+        self.info = info
+        self._outlet = pylsl.StreamOutlet(info, chunk_size=chunk_size, max_buffered=30)
+
+    def push_volts(self, data: np.ndarray, timestamp: float = 0.0) -> None:
+        """Push samples given in volts, shape (n_samples, n_channels).
+
+        ``timestamp`` (LSL s) is that of the LAST sample (0: now); earlier samples are placed
+        back at the nominal rate, as LSL does.
+        """
+        data = np.asarray(data)
+        if data.ndim != 2 or data.shape[1] != self.n_channels:
+            msg = (f'push_volts expects an array of shape (n_samples, {self.n_channels}); got '
+                   f'{data.shape}.')
+            raise EEGError(msg)
+        if len(data):
+            self._outlet.push_chunk(np.ascontiguousarray(data / self.scale, dtype=np.float32),
+                                    timestamp)
+
+    def have_consumers(self) -> bool:
+        """True when at least one inlet is connected."""
+        return self._outlet.have_consumers()
+
+    def close(self) -> None:
+        """Withdraw the stream."""
+        del self._outlet
+
+
+class MarkerOutlet:
+    """An LSL string marker stream (type ``Markers``, irregular rate), one string per event."""
+
+    def __init__(self, name: str, source_id: str = '') -> None:
+        info = pylsl.StreamInfo(name, 'Markers', 1, pylsl.IRREGULAR_RATE, pylsl.cf_string,
+                                source_id or name)
+        self._outlet = pylsl.StreamOutlet(info)
+
+    def push(self, marker: str, timestamp: float = 0.0) -> None:
+        """Push one marker at ``timestamp`` (LSL s; 0 = now)."""
+        self._outlet.push_sample([marker], timestamp)
+
+    def close(self) -> None:
+        """Withdraw the stream."""
+        del self._outlet

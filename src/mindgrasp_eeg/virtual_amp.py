@@ -1,0 +1,80 @@
+"""The virtual amplifier: synthetic EEG driven by a virtual subject, streamed over LSL (ROS-free).
+
+:class:`VirtualAmplifier` owns a :class:`~mindgrasp_eeg.synthetic.SyntheticEEG`, a
+:class:`~mindgrasp_eeg.subject.VirtualSubject` and an :class:`~mindgrasp_eeg.lsl.EEGOutlet`.
+Call :meth:`VirtualAmplifier.step` with the pacing clock (s): it generates every sample due by then,
+in blocks of at most ``block`` samples so imagery onsets are resolved to ``block / rate`` seconds,
+and pushes them.
+
+Timestamps: in real-time pacing, sample ``k`` gets the LSL timestamp ``t0 + k / rate``, where
+``t0`` is ``local_clock()`` at the first step, like an amplifier with its own sample clock. In
+simulated-time pacing (``/clock``) samples are pushed with the push time (LSL's default), since LSL
+has no notion of simulated time.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pylsl
+
+from .lsl import EEGOutlet
+from .subject import VirtualSubject
+from .synthetic import SyntheticEEG
+
+
+class VirtualAmplifier:
+    """Synthetic EEG + virtual subject + LSL outlet.
+
+    Parameters
+    ----------
+    generator : SyntheticEEG
+    subject : VirtualSubject
+    outlet : EEGOutlet or None
+        None generates without streaming (offline use, tests).
+    realtime_stamps : bool
+        Stamp samples on the amplifier's own sample clock (real-time pacing) instead of push time.
+    block : int
+        Largest block generated with one imagery decision (samples).
+    """
+
+    def __init__(self, generator: SyntheticEEG, subject: VirtualSubject,
+                 outlet: EEGOutlet | None = None, *, realtime_stamps: bool = True,
+                 block: int = 8) -> None:
+        self.generator, self.subject, self.outlet = generator, subject, outlet
+        self.realtime_stamps, self.block = realtime_stamps, max(1, int(block))
+        self.t_start: float | None = None        # pacing clock at the first step (s)
+        self.lsl_start = 0.0
+        self.current_class: int | None = None
+
+    @property
+    def n_samples(self) -> int:
+        """Samples generated (and pushed) so far."""
+        return self.generator.n_generated
+
+    def step(self, now: float) -> np.ndarray:
+        """Generate and push all samples due at pacing time ``now`` (s).
+
+        Returns
+        -------
+        data : ndarray, shape (n_new, n_channels), volts (what was pushed)
+        """
+        if self.t_start is None:
+            self.t_start = now
+            self.lsl_start = pylsl.local_clock()
+        fs = self.generator.sample_rate
+        due = math.floor((now - self.t_start) * fs + 1e-9) + 1   # sample 0 is due at t_start
+        out = []
+        while self.n_samples < due:
+            k = self.n_samples
+            n = min(self.block, due - k)
+            self.current_class = self.subject.intent(self.t_start + k / fs)
+            data = self.generator.generate(n, self.current_class)
+            if self.outlet is not None:
+                stamp = self.lsl_start + (k + n - 1) / fs if self.realtime_stamps else 0.0
+                self.outlet.push_volts(data, stamp)
+            out.append(data)
+        if not out:
+            return np.zeros((0, self.generator.n_channels))
+        return np.vstack(out)

@@ -1,0 +1,167 @@
+"""Acquisition core against real LSL outlets in other processes."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pytest
+
+from mindgrasp_eeg import EEGError
+from mindgrasp_eeg.acquisition import ERROR, OK, WARN, EEGAcquisition, ros_stamp_ns
+from mindgrasp_eeg.montage import NAUTILUS_32
+
+pytestmark = pytest.mark.slow
+
+
+def collect(acq: EEGAcquisition, seconds: float, period: float = 1 / 32):
+    chunks, t_end = [], time.monotonic() + seconds
+    while time.monotonic() < t_end:
+        chunks.extend(acq.poll())
+        time.sleep(period)
+    return chunks
+
+
+def test_acquires_from_a_real_outlet(lsl_source, stream_name) -> None:
+    lsl_source(stream_name, '--duration', '8')
+    acq = EEGAcquisition(stream_name, n_channels=32, sample_rate=250, channel_names=NAUTILUS_32)
+    desc = acq.connect(timeout=5)
+    assert desc.channel_names == NAUTILUS_32 and desc.unit == 'microvolts'
+    chunks = collect(acq, 3.0)
+    data = np.vstack([c.data for c in chunks])
+    ts = np.concatenate([c.timestamps for c in chunks])
+    assert 2.5 * 250 <= len(data) <= 3.5 * 250
+    assert data.dtype == np.float32 and data.shape[1] == 32
+    assert 3e-6 < float(np.std(data)) < 50e-6          # microvolts on the wire, volts out
+    assert np.all(np.diff(ts) > 0)
+    np.testing.assert_allclose(np.diff(ts), 1 / 250, atol=2e-4)
+    idx = [c.first_index for c in chunks]
+    sizes = [len(c.data) for c in chunks]
+    assert idx[0] == 0 and all(i + n == j for i, n, j in zip(idx, sizes, idx[1:], strict=False))
+    assert acq.counters['dropped'] == 0 and acq.counters['out_of_order'] == 0
+    assert acq.status().level == OK
+    acq.close()
+
+
+def test_resolve_timeout_lists_visible_streams(lsl_source, stream_name) -> None:
+    lsl_source(stream_name, '--duration', '8')
+    acq = EEGAcquisition(stream_name + '_missing')
+    with pytest.raises(EEGError, match=rf"No LSL stream with name='{stream_name}_missing'.*"
+                                       rf"Visible streams:.*'{stream_name}' \(type 'EEG', 32 ch"):
+        acq.connect(timeout=0.5)
+
+
+def test_layout_validation_and_adaptation(lsl_source, stream_name) -> None:
+    lsl_source(stream_name, '--n-channels', '8', '--rate', '160', '--duration', '8')
+    with pytest.raises(EEGError, match=r'has 8 channels, expected 32 .*runs at 160 Hz, expected '
+                                       r'250 Hz.*adapt_to_stream'):
+        EEGAcquisition(stream_name, n_channels=32, sample_rate=250).connect(timeout=5)
+    with pytest.raises(EEGError, match=r"has channels \['E1'"):
+        EEGAcquisition(stream_name, channel_names=[f'X{k}' for k in range(8)]).connect(timeout=5)
+    acq = EEGAcquisition(stream_name, n_channels=32, sample_rate=250, adapt=True)
+    desc = acq.connect(timeout=5)
+    assert desc.n_channels == 8 and desc.sample_rate == 160
+    assert any('adopting' in w for w in acq.warnings)
+    chunks = collect(acq, 1.0)
+    assert chunks and chunks[0].data.shape[1] == 8
+    acq.close()
+
+
+@pytest.mark.parametrize('policy', ['replace', 'drop'])
+def test_nan_flat_railed_are_flagged(lsl_source, stream_name, policy) -> None:
+    lsl_source(stream_name, '--nan-channel', '3', '--flat-channel', '5', '--railed-channel', '7',
+               '--duration', '8')
+    acq = EEGAcquisition(stream_name, nan_policy=policy)
+    acq.connect(timeout=5)
+    chunks = collect(acq, 2.5)
+    status = acq.status()
+    assert status.level == WARN
+    assert f'NaN/inf on {NAUTILUS_32[3]}' in status.message
+    assert f'flat on {NAUTILUS_32[5]}' in status.message
+    assert f'railed on {NAUTILUS_32[7]}' in status.message
+    data = np.vstack([c.data for c in chunks])
+    assert np.isfinite(data).all()
+    assert acq.counters['nonfinite_samples'] > 100
+    if policy == 'drop':
+        assert acq.counters['nan_dropped'] == acq.counters['nonfinite_samples']
+        assert len(data) < 0.8 * acq.counters['samples']
+    else:
+        assert len(data) == acq.counters['samples']
+    acq.close()
+
+
+def test_dropped_and_out_of_order_samples_are_counted(lsl_source, stream_name) -> None:
+    lsl_source(stream_name, '--gap-at', '1.0', '--gap-samples', '50', '--disorder-at', '1.5',
+               '--duration', '8')
+    acq = EEGAcquisition(stream_name, dejitter=False)     # raw amplifier stamps
+    acq.connect(timeout=5)
+    chunks = collect(acq, 2.5)
+    assert acq.counters['dropped'] == 50
+    assert acq.counters['out_of_order'] == 1
+    idx = np.concatenate([c.first_index + np.arange(len(c.data)) for c in chunks])
+    assert np.all(np.diff(idx) >= 1) and np.sum(np.diff(idx) - 1) == 50
+    acq.close()
+
+
+def test_stream_loss_and_reconnection(lsl_source, stream_name) -> None:
+    amp = lsl_source(stream_name, '--duration', '30')
+    acq = EEGAcquisition(stream_name, lost_timeout=0.5)
+    acq.connect(timeout=5)
+    collect(acq, 1.0)
+    before = acq.counters['samples']
+    amp.kill()
+    amp.wait()
+    t_kill = time.monotonic()
+    while acq.status().level != ERROR and time.monotonic() - t_kill < 5:
+        acq.poll()
+        time.sleep(0.02)
+    detected_after = time.monotonic() - t_kill
+    status = acq.status()
+    assert status.level == ERROR and 'is lost: no samples for' in status.message
+    assert detected_after < 1.5                 # a closed connection is reported at once
+    time.sleep(0.5)
+    lsl_source(stream_name, '--duration', '30')            # a new amplifier process
+    t_new = time.monotonic()
+    while not acq.connected and time.monotonic() - t_new < 10:
+        acq.poll()
+        time.sleep(0.05)
+    assert acq.connected, acq.status().message
+    chunks = collect(acq, 1.0)
+    assert acq.counters['reconnects'] == 1 and acq.counters['losses'] == 1
+    assert acq.counters['samples'] > before + 150
+    assert acq.counters['dropped'] > 100                  # the outage shows up as a gap
+    assert chunks[-1].first_index > before
+    assert acq.status().level == OK
+    acq.close()
+
+
+def test_stalled_stream_is_lost_after_timeout(lsl_source, stream_name) -> None:
+    lsl_source(stream_name, '--stall-at', '1.0', '--stall-len', '2.5', '--duration', '30')
+    acq = EEGAcquisition(stream_name, lost_timeout=0.5)
+    acq.connect(timeout=5)
+    t0 = time.monotonic()
+    last_data = t0
+    while acq.status().level != ERROR and time.monotonic() - t0 < 5:
+        if acq.poll():
+            last_data = time.monotonic()
+        time.sleep(0.01)
+    assert acq.lost and 0.45 < time.monotonic() - last_data < 0.7
+    while not acq.connected and time.monotonic() - t0 < 10:
+        acq.poll()
+        time.sleep(0.05)
+    collect(acq, 0.5)
+    assert acq.connected and acq.counters['reconnects'] == 1 and acq.status().level == OK
+    acq.close()
+
+
+def test_ros_stamp_keeps_sample_age() -> None:
+    assert ros_stamp_ns(99.5, 100.0, 1_000_000_000_000) == 1_000_000_000_000 - 500_000_000
+
+
+def test_bad_parameters() -> None:
+    with pytest.raises(EEGError, match='nan_policy must be one of'):
+        EEGAcquisition('x', nan_policy='ignore')
+    with pytest.raises(EEGError, match="EEG unit 'furlongs' is unknown"):
+        EEGAcquisition('x', stream_unit='furlongs')
+    with pytest.raises(EEGError, match='No LSL stream selector given'):
+        EEGAcquisition('', stream_type='').connect(timeout=0.1)
