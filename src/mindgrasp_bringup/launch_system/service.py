@@ -52,8 +52,11 @@ COMMON_ARGUMENTS = (
                     'node'),
     DeclareLaunchArgument(
         'record_topics', default_value='',
-        description='topics or regular expressions to record, separated by spaces or commas '
-                    '(empty: every topic)'),
+        description='topic names to record, separated by spaces or commas (empty: every topic, '
+                    'or those matching record_regex)'),
+    DeclareLaunchArgument(
+        'record_regex', default_value='',
+        description='record the topics matching this regular expression (empty: no filter)'),
     DeclareLaunchArgument(
         'duration', default_value='0',
         description='end the launch after this many seconds (0: run until Ctrl-C or until '
@@ -208,9 +211,12 @@ class LaunchService:
     def _recorder(self, context: LaunchContext) -> ProcessSpec:
         bag = '<run dir>/bag'  # set when the run directory exists
         topics = context.launch_configurations.get('record_topics', '')
+        regex = context.launch_configurations.get('record_regex', '')
         parameters: dict[str, Any] = {'output': bag}
         if topics.strip():
             parameters['topics'] = [t for t in topics.replace(',', ' ').split() if t]
+        if regex:
+            parameters['regex'] = regex
         inner = LaunchContext(launch_configurations=dict(context.launch_configurations))
         Node(package=RECORDER_PACKAGE, executable=RECORDER_EXECUTABLE, name=RECORDER_NAME,
              parameters=[parameters]).visit(inner)

@@ -1,6 +1,10 @@
 """Process supervision: start every process, prefix and log its output, report deaths, respawn,
 and stop everything in reverse order (SIGINT, then SIGTERM, then SIGKILL, with timeouts).
 
+``respawn=True`` restarts a process that *dies* (non-zero exit code or a signal) while the launch
+runs; a process that ends with exit code 0 has finished its work and is not restarted (so a
+launch of nodes that end by themselves ends too).
+
 A process ended *cleanly* when it exited with code 0 by itself, or when it stopped within the
 SIGINT timeout once the launch asked it to (exit code 0, or killed by that SIGINT). A process
 that needed SIGTERM or SIGKILL, or died with another code, did not; the launch's exit code is 0
@@ -224,13 +228,11 @@ class Supervisor:
                 logger.error("process '%s' (pid %d) died during shutdown: %s. %s", spec.label,
                              proc.popen.pid, describe_exit(rc), self._report_tail(proc))
             return
-        if spec.respawn and (spec.respawn_max_retries < 0
-                             or proc.restarts < spec.respawn_max_retries):
-            level = logging.INFO if rc == 0 else logging.ERROR
-            tail = '' if rc == 0 else ' ' + self._report_tail(proc)
-            logger.log(level, "process '%s' (pid %d) ended: %s; respawning in %.1f s "
-                       "(respawn=True, restart %d).%s", spec.label, proc.popen.pid,
-                       describe_exit(rc), spec.respawn_delay, proc.restarts + 1, tail)
+        if rc != 0 and spec.respawn and (spec.respawn_max_retries < 0
+                                         or proc.restarts < spec.respawn_max_retries):
+            logger.error("process '%s' (pid %d) died: %s; respawning in %.1f s (respawn=True, "
+                         "restart %d). %s", spec.label, proc.popen.pid, describe_exit(rc),
+                         spec.respawn_delay, proc.restarts + 1, self._report_tail(proc))
             proc.restart_at = now + spec.respawn_delay
             proc.how = 'respawning'
             return

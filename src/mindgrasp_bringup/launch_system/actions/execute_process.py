@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING, Any
 
 from mindgrasp_bringup.launch_system.actions.action import Action
 from mindgrasp_bringup.launch_system.actions.set_launch_configuration import Shutdown
+from mindgrasp_bringup.launch_system.conditions import evaluate_bool
 from mindgrasp_bringup.launch_system.errors import LaunchError
 from mindgrasp_bringup.launch_system.substitutions import SomeSubstitutions, perform_substitutions
 
@@ -117,8 +118,9 @@ class ExecuteProcess(Action):
                  cwd: SomeSubstitutions | None = None,
                  env: Mapping[SomeSubstitutions, SomeSubstitutions] | None = None,
                  additional_env: Mapping[SomeSubstitutions, SomeSubstitutions] | None = None,
-                 shell: bool = False, output: str = 'screen', respawn: bool = False,
-                 respawn_delay: float = 0.0, respawn_max_retries: int = -1,
+                 shell: bool = False, output: str = 'screen',
+                 respawn: bool | SomeSubstitutions = False,
+                 respawn_delay: float | SomeSubstitutions = 0.0, respawn_max_retries: int = -1,
                  on_exit: Shutdown | None = None, sigterm_timeout: float | None = None,
                  sigkill_timeout: float | None = None, **kwargs: object) -> None:
         super().__init__(**kwargs)  # type: ignore[arg-type]
@@ -131,8 +133,8 @@ class ExecuteProcess(Action):
         self.additional_env = additional_env
         self.shell = shell
         self.output = check_output(output)
-        self.respawn = bool(respawn)
-        self.respawn_delay = float(respawn_delay)
+        self.respawn = respawn
+        self.respawn_delay = respawn_delay
         self.respawn_max_retries = int(respawn_max_retries)
         if on_exit is not None and not isinstance(on_exit, Shutdown):
             raise LaunchError('on_exit: only on_exit=Shutdown() is supported.')
@@ -146,11 +148,27 @@ class ExecuteProcess(Action):
             'cwd': None if self.cwd is None else perform_substitutions(context, self.cwd),
             'env': resolve_env(context, self.env),
             'additional_env': resolve_env(context, self.additional_env) or {},
-            'shell': self.shell, 'output': self.output, 'respawn': self.respawn,
-            'respawn_delay': self.respawn_delay, 'respawn_max_retries': self.respawn_max_retries,
+            'shell': self.shell, 'output': self.output,
+            'respawn': (self.respawn if isinstance(self.respawn, bool)
+                        else evaluate_bool(perform_substitutions(context, self.respawn),
+                                           'respawn')),
+            'respawn_delay': self._delay(context),
+            'respawn_max_retries': self.respawn_max_retries,
             'shutdown_on_exit': self.on_exit is not None,
             'sigterm_timeout': self.sigterm_timeout, 'sigkill_timeout': self.sigkill_timeout,
         }
+
+    def _delay(self, context: LaunchContext) -> float:
+        text = (str(self.respawn_delay) if isinstance(self.respawn_delay, (int, float))
+                else perform_substitutions(context, self.respawn_delay))
+        try:
+            delay = float(text)
+        except ValueError:
+            delay = -1.0
+        if delay < 0:
+            msg = f'respawn_delay must be a number of seconds >= 0, got {text!r}.'
+            raise LaunchError(msg)
+        return delay
 
     def execute(self, context: LaunchContext) -> None:
         cmd = resolve_list(context, self.cmd)
