@@ -11,7 +11,7 @@ import sys
 import threading
 from collections import defaultdict
 from collections.abc import Callable
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from mindgrasp_ros.runtime.arguments import RosArguments, parse_ros_args
 from mindgrasp_ros.runtime.exceptions import NotInitializedException, RCLError
@@ -35,6 +35,7 @@ class IntraProcess:
         self._pubs: dict[str, list[Publisher]] = defaultdict(list)
         self._subs: dict[str, list[Subscription]] = defaultdict(list)
         self._warned: set[tuple[str, str]] = set()
+        self.services: dict[str, Any] = {}  # in-process services of DDS-less contexts
 
     def add_publisher(self, pub: Publisher) -> None:
         with self._lock:

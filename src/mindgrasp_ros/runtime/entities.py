@@ -387,20 +387,37 @@ class Service(Entity):
         self._req_type = type_name_of(srv_type.Request)
         self._res_type = type_name_of(srv_type.Response)
         req_topic, rep_topic = _service_topics(name)
-        dds = node.context.require_dds('services')
-        self._reader = dds.create_reader(req_topic, self._req_type, qos, service_role='request')
-        self._writer = dds.create_writer(rep_topic, self._res_type, qos, service_role='reply')
+        dds = node.context.dds
+        self._reader = self._writer = None
+        # in-process requests (always used in DDS-less contexts): (request, future) pairs
+        self._local: deque[tuple[Any, Future]] = deque()
+        if dds is not None:
+            self._reader = dds.create_reader(req_topic, self._req_type, qos,
+                                             service_role='request')
+            self._writer = dds.create_writer(rep_topic, self._res_type, qos,
+                                             service_role='reply')
+        else:
+            node.context.intra.services[name] = self
 
     @property
     def gid(self) -> bytes:
-        return self._reader.guid
+        return self._reader.guid if self._reader else _local_gid(self)
 
     @property
     def reply_gid(self) -> bytes:
-        return self._writer.guid
+        return self._writer.guid if self._writer else _local_gid(self)
+
+    def _enqueue_local(self, request: Any, future: Future) -> None:  # noqa: ANN401
+        self._local.append((request, future))
+        self.node.wake_executor()
 
     def take(self) -> list[tuple[int, int, Any]]:
-        out = []
+        out: list[Any] = []
+        while self._local:
+            request, future = self._local.popleft()
+            out.append((future, 0, request))
+        if self._reader is None:
+            return out
         for data, _info in self._reader.take(64):
             try:
                 guid, seq, payload = _unpack_service(data)
@@ -419,11 +436,15 @@ class Service(Entity):
                 f"Service callback of '{self.srv_name}' returned None; it must return the "
                 'response object.')
             return
+        if isinstance(guid, Future):  # an in-process call
+            guid.set_result(result)
+            return
         self._writer.write(_pack_service(guid, seq, serialize(result, self._res_type)))
 
     def destroy(self) -> None:
         dds = self.node.context.dds
-        if dds is not None:
+        self.node.context.intra.services.pop(self.srv_name, None)
+        if dds is not None and self._reader is not None:
             dds.delete_reader(self._reader)
             dds.delete_writer(self._writer)
 
@@ -443,24 +464,31 @@ class Client(Entity):
         self._req_type = type_name_of(srv_type.Request)
         self._res_type = type_name_of(srv_type.Response)
         req_topic, rep_topic = _service_topics(name)
-        dds = node.context.require_dds('service clients')
-        self._writer = dds.create_writer(req_topic, self._req_type, qos, service_role='request')
-        self._reader = dds.create_reader(rep_topic, self._res_type, qos, service_role='reply')
-        # Unique per client across processes: pid, a per-process counter, a random salt.
-        self._guid = int.from_bytes(self._writer.guid[:8], 'little') ^ next(Client._guids)
+        dds = node.context.dds
+        self._writer = self._reader = None
+        self._guid = next(Client._guids)
+        if dds is not None:
+            self._writer = dds.create_writer(req_topic, self._req_type, qos,
+                                             service_role='request')
+            self._reader = dds.create_reader(rep_topic, self._res_type, qos,
+                                             service_role='reply')
+            # unique across processes: derived from the request writer's DDS GUID
+            self._guid ^= int.from_bytes(self._writer.guid[:8], 'little')
         self._seq = itertools.count(1)
         self._pending: dict[int, Future] = {}
         self._lock = threading.Lock()
 
     @property
     def gid(self) -> bytes:
-        return self._writer.guid
+        return self._writer.guid if self._writer else _local_gid(self)
 
     @property
     def reply_gid(self) -> bytes:
-        return self._reader.guid
+        return self._reader.guid if self._reader else _local_gid(self)
 
     def service_is_ready(self) -> bool:
+        if self._writer is None:
+            return self.srv_name in self.node.context.intra.services
         return self._writer.matched_count() > 0 and self._reader.matched_count() > 0
 
     def wait_for_service(self, timeout_sec: float | None = None) -> bool:
@@ -485,6 +513,13 @@ class Client(Entity):
         with self._lock:
             self._pending[seq] = future
         future.add_done_callback(lambda f: self._forget(seq, f))
+        if self._writer is None:
+            service = self.node.context.intra.services.get(self.srv_name)
+            if service is None:
+                future.set_exception(RuntimeError(f"No service '{self.srv_name}' in process."))
+            else:
+                service._enqueue_local(request, future)  # noqa: SLF001
+            return future
         self._writer.write(_pack_service(self._guid, seq, serialize(request, self._req_type)))
         return future
 
@@ -509,7 +544,9 @@ class Client(Entity):
                     del self._pending[seq]
 
     def take(self) -> list[tuple[Future, Any]]:
-        out = []
+        out: list[tuple[Future, Any]] = []
+        if self._reader is None:
+            return out
         for data, _info in self._reader.take(64):
             try:
                 guid, seq, payload = _unpack_service(data)
@@ -534,6 +571,6 @@ class Client(Entity):
 
     def destroy(self) -> None:
         dds = self.node.context.dds
-        if dds is not None:
+        if dds is not None and self._reader is not None:
             dds.delete_reader(self._reader)
             dds.delete_writer(self._writer)

@@ -82,6 +82,11 @@ class Node:
         if cli_args:
             args.extend(parse_ros_args(['--ros-args', *cli_args]
                                        if '--ros-args' not in cli_args else cli_args))
+        from mindgrasp_ros.composition import pending_component_arguments
+
+        component_args = pending_component_arguments()
+        if component_args:  # a node loaded as a component gets its own --ros-args
+            args.extend(parse_ros_args(component_args))
         self._args = args
         validate_node_name(node_name)
         self._name = validate_node_name(args.node_name_override(node_name) or node_name)
@@ -200,11 +205,13 @@ class Node:
                 if p._writer is not None:
                     writers.append(p.gid)
             for srv in self.services:
-                readers.append(srv.gid)
-                writers.append(srv.reply_gid)
+                if srv._reader is not None:  # noqa: SLF001
+                    readers.append(srv.gid)
+                    writers.append(srv.reply_gid)
             for cli in self.clients:
-                writers.append(cli.gid)
-                readers.append(cli.reply_gid)
+                if cli._reader is not None:  # noqa: SLF001
+                    writers.append(cli.gid)
+                    readers.append(cli.reply_gid)
         return readers, writers
 
     # ------------------------------------------------------------------ entities
