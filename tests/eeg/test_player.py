@@ -1,0 +1,140 @@
+"""Dataset player: EEGMMIDB S001 over LSL (real player process), rate, marker alignment, errors."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pylsl
+import pytest
+
+from mindgrasp_eeg import EEGError
+from mindgrasp_eeg.player import eegbci_path, expand_sources, load_recording
+
+FS = 160.0
+
+
+def eegbci_file(run: int) -> str:
+    """S001 run file via MNE's loader, from the local copy only (tests never download)."""
+    root = eegbci_path()
+    local = (Path(root) / 'MNE-eegbci-data/files/eegmmidb/1.0.0/S001' / f'S001R{run:02d}.edf'
+             if root else None)
+    if local is None or not local.is_file():
+        pytest.skip(f'EEGMMIDB S001 is not available here ({local}); set '
+                    f'MNE_DATASETS_EEGBCI_PATH to the shared data folder.')
+    return expand_sources([f'eegbci:1:{run}'])[0]
+
+
+def start_player(name: str, *args: str) -> subprocess.Popen:
+    return subprocess.Popen([sys.executable, '-m', 'mindgrasp_bringup', 'eeg', 'play', *args,
+                             '--name', name], stdout=subprocess.PIPE,
+                            stderr=subprocess.DEVNULL, text=True)
+
+
+def open_inlet(name: str) -> pylsl.StreamInlet:
+    found = pylsl.resolve_byprop('name', name, timeout=10)
+    assert found, f'stream {name} not found'
+    inlet = pylsl.StreamInlet(found[0], processing_flags=pylsl.proc_clocksync)
+    inlet.open_stream(timeout=5)
+    return inlet
+
+
+@pytest.mark.slow
+def test_eegmmidb_playback_rate_and_marker_alignment(stream_name) -> None:
+    path = eegbci_file(4)
+    rec = load_recording(path)
+    player = start_player(stream_name, path, '--duration', '12')
+    try:
+        eeg, markers = open_inlet(stream_name), open_inlet(stream_name + '-markers')
+        info = eeg.info()
+        assert info.channel_count() == 64 and info.nominal_srate() == FS
+        data, ts, arrival, mk = [], [], [], []
+        t_end = time.monotonic() + 6.5
+        while time.monotonic() < t_end:
+            d, t = eeg.pull_chunk(timeout=0.0, max_samples=1024, as_numpy=True)
+            if len(t):
+                data.append(d)
+                ts.append(t)
+                arrival.append((time.monotonic(), len(t)))
+            m, mt = markers.pull_chunk(timeout=0.0)
+            mk += [(row[0], stamp) for row, stamp in zip(m, mt, strict=True)]
+            time.sleep(0.01)
+    finally:
+        player.kill()
+        player.wait()
+    data, ts = np.vstack(data) * 1e-6, np.concatenate(ts)
+    # the samples are the file's, in order: locate the first one in the file
+    k0 = int(np.argmin(np.abs(rec.data[:2000] - data[0]).sum(axis=1)))
+    np.testing.assert_allclose(data, rec.data[k0:k0 + len(data)], atol=1e-9)
+    # effective rate from arrival times (wall clock) within 1 %
+    t_arr = np.array([a for a, _ in arrival])
+    counts = np.cumsum([n for _, n in arrival])
+    warm = t_arr > t_arr[0] + 1.0
+    rate = (counts[warm][-1] - counts[warm][0]) / (t_arr[warm][-1] - t_arr[warm][0])
+    assert rate == pytest.approx(FS, rel=0.01)
+    # markers: each one within 10 ms of the timestamp of its annotation's sample
+    assert mk, 'no marker arrived'
+    onsets = {round(o * FS): desc for o, _d, desc in rec.annotations}
+    checked = 0
+    for desc, stamp in mk:
+        k = round((stamp - ts[0]) * FS) + k0          # nearest sample
+        assert onsets.get(k) == desc, (desc, k)
+        i = k - k0
+        if 0 <= i < len(ts):
+            assert abs(ts[i] - stamp) < 0.010
+            checked += 1
+    assert checked >= 1
+
+
+@pytest.mark.slow
+def test_rate_and_loop(tmp_path, stream_name) -> None:
+    import mne
+
+    sfreq, n = 100.0, 300                               # a 3 s recording with two annotations
+    info = mne.create_info(['C3', 'Cz', 'C4'], sfreq, 'eeg')
+    raw = mne.io.RawArray(np.arange(n * 3, dtype=float).reshape(3, n) * 1e-7, info,
+                          verbose='error')
+    raw.set_annotations(mne.Annotations([0.5, 2.0], [1.0, 1.0], ['left_hand', 'rest']))
+    path = tmp_path / 'tiny_raw.fif'
+    raw.save(path, verbose='error')
+    player = start_player(stream_name, str(path), '--rate', '4', '--loop', '--duration', '20')
+    try:
+        eeg, markers = open_inlet(stream_name), open_inlet(stream_name + '-markers')
+        t_end, got, mk = time.monotonic() + 3.0, 0, []
+        while time.monotonic() < t_end:
+            _d, t = eeg.pull_chunk(timeout=0.0, max_samples=1024)
+            got += len(t)
+            m, _mt = markers.pull_chunk(timeout=0.0)
+            mk += [row[0] for row in m]
+            time.sleep(0.01)
+    finally:
+        player.kill()
+        player.wait()
+    assert got == pytest.approx(3.0 * 4 * sfreq, rel=0.1)    # 4x real time, more than 3 loops
+    assert mk.count('left_hand') >= 3 and mk.count('rest') >= 3
+
+
+def test_corrupt_and_unsupported_files(tmp_path) -> None:
+    bad = tmp_path / 'broken.edf'
+    bad.write_bytes(b'0       not an EDF header at all' * 3)
+    with pytest.raises(EEGError, match=r'Cannot read the EEG file .*broken\.edf.*corrupt'):
+        load_recording(bad)
+    with pytest.raises(EEGError, match=r"unsupported format '\.txt'"):
+        (tmp_path / 'x.txt').write_text('1 2 3')
+        load_recording(tmp_path / 'x.txt')
+    with pytest.raises(EEGError, match='does not exist'):
+        load_recording(tmp_path / 'missing.gdf')
+    with pytest.raises(EEGError, match='is not an EEGMMIDB reference'):
+        expand_sources(['eegbci:one:4'])
+
+
+def test_cli_reports_bad_file(tmp_path) -> None:
+    bad = tmp_path / 'broken.fif'
+    bad.write_bytes(b'\x00' * 100)
+    proc = subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', 'eeg', 'play', str(bad)],
+                          capture_output=True, text=True, timeout=60)
+    assert proc.returncode == 1
+    assert 'Cannot read the EEG file' in proc.stderr
