@@ -19,6 +19,7 @@ def generate_launch_description() -> LaunchDescription:
         Node(package='launch_fixtures', executable='ticker', name='beta',
              arguments=['--count', '0', '--period', '0.1', '--label', 'beta']),
         Node(package='launch_fixtures', executable='ticker', name='stubborn',
-             arguments=['--count', '0', '--period', '0.1', '--ignore-sigint'],
+             arguments=['--count', '0', '--period', '0.1', '--ignore-sigint', '--label',
+                        'stubborn'],
              condition=IfCondition(LaunchConfiguration('stubborn'))),
     ])
