@@ -57,12 +57,14 @@ class NodeProcess:
         self.module = module
         self.log_path = log
         self._log = log.open('wb')
+        target = [module] if module.endswith('.py') else ['-m', module]
         self.proc = subprocess.Popen(  # noqa: S603 - our own interpreter and module
-            [sys.executable, '-u', '-m', module, *args], stdout=self._log,
+            [sys.executable, '-u', *target, *args], stdout=self._log,
             stderr=subprocess.STDOUT, env=env, start_new_session=True)
 
     def output(self) -> str:
-        self._log.flush()
+        if not self._log.closed:
+            self._log.flush()
         return self.log_path.read_text(errors='replace')
 
     def stop(self, timeout: float = 5.0) -> int:
@@ -82,6 +84,17 @@ class NodeProcess:
     def wait(self, timeout: float) -> int:
         return self.proc.wait(timeout)
 
+    def wait_for_output(self, text: str, timeout: float = 20.0) -> bool:
+        """Wait until the process printed ``text`` (e.g. a "ready" line)."""
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            if text in self.output():
+                return True
+            if self.proc.poll() is not None:
+                return text in self.output()
+            time.sleep(0.05)
+        return False
+
 
 @pytest.fixture
 def spawn_node(tmp_path: Path) -> Iterator[Callable[..., NodeProcess]]:
@@ -92,11 +105,12 @@ def spawn_node(tmp_path: Path) -> Iterator[Callable[..., NodeProcess]]:
     procs: list[NodeProcess] = []
 
     def start(module: str, *args: str, env: dict[str, str] | None = None) -> NodeProcess:
+        """``module`` is a module name (run with -m) or a path to a .py script."""
         full_env = dict(os.environ)
         full_env.update(env or {})
         full_env.setdefault('PYTHONUNBUFFERED', '1')
         proc = NodeProcess(module, list(args), full_env,
-                           tmp_path / f'{module.rsplit(".", 1)[-1]}-{len(procs)}.log')
+                           tmp_path / f'{Path(module).stem.rsplit(".", 1)[-1]}-{len(procs)}.log')
         procs.append(proc)
         return proc
 

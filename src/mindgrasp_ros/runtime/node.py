@@ -302,6 +302,12 @@ class Node:
     def destroy_guard_condition(self, guard: GuardCondition) -> bool:
         return self._remove(self.guards, guard)
 
+    def _context_shutdown(self) -> None:
+        """The context ended: the node is dead; its DDS entities go with the participant."""
+        self._destroyed = True
+        if self._rosout_sink in rlog._sinks:  # noqa: SLF001
+            rlog._sinks.remove(self._rosout_sink)  # noqa: SLF001
+
     def destroy_node(self) -> None:
         if self._destroyed:
             return
