@@ -28,6 +28,7 @@ import numpy as np
 import pybullet as pb
 from pybullet_utils.bullet_client import BulletClient
 
+from mindgrasp_sim.control import validate_velocities
 from mindgrasp_sim.errors import SimError
 from mindgrasp_sim.robot_model import ARM_JOINTS, FINGER_JOINTS
 from mindgrasp_sim.scene import ObjectSpec, SceneSpec, config_dir, load_scene
@@ -37,6 +38,8 @@ from mindgrasp_sim.scene import ObjectSpec, SceneSpec, config_dir, load_scene
 HOME_POSE = (0.0, 0.0, 0.0, math.pi / 2, 1.2, 0.0)
 #: finger joint angles (rad) for closure 0 (open) and 1 (closed)
 FINGER_OPEN, FINGER_CLOSED = -0.55, 1.25
+#: PD motor position gain (pybullet's per-step error fraction): stiff, so gravity sag < 1 mrad
+ARM_POSITION_GAIN = 0.8
 GROUND_RGBA = (0.78, 0.77, 0.74, 1.0)
 TRAINER_RGBA = (0.1, 0.85, 0.1, 0.35)
 ROBOTS = ('user', 'trainer')
@@ -222,6 +225,7 @@ class Simulation:
         self._objects: list[tuple[ObjectSpec, int]] = []
         self._step_count = 0
         self._proj = None
+        self.last_ik_error = 0.0
         self._scene: SceneSpec | None = None
         self.seed = int(seed)
         self.load_scene(scene, seed=seed)
@@ -354,15 +358,7 @@ class Simulation:
 
         Raises SimError for a wrong length or NaN/inf (the previous command stays in force).
         """
-        v = np.asarray(velocities, dtype=float).reshape(-1)
-        if v.shape != (6,):
-            msg = f'Joint velocity command must have 6 values (one per joint, rad/s), got ' \
-                  f'{v.size}; send [v1, ..., v6].'
-            raise SimError(msg)
-        if not np.all(np.isfinite(v)):
-            msg = f'Joint velocity command contains NaN or inf ({v.tolist()}); send finite ' \
-                  'velocities in rad/s.'
-            raise SimError(msg)
+        v = validate_velocities(velocities, 6)
         self._robot(robot).v_cmd = np.clip(v, -self.max_velocity, self.max_velocity)
 
     def stop(self, robot: str = 'user') -> None:
@@ -403,8 +399,8 @@ class Simulation:
                 r.q_ref = new_ref
                 p.setJointMotorControlArray(
                     r.body, self._arm_idx, pb.POSITION_CONTROL, targetPositions=new_ref,
-                    targetVelocities=v_ff, forces=self.max_effort, positionGains=[0.2] * 6,
-                    velocityGains=[1.0] * 6)
+                    targetVelocities=v_ff, forces=self.max_effort,
+                    positionGains=[ARM_POSITION_GAIN] * 6, velocityGains=[1.0] * 6)
                 if r.gripper_dirty:
                     target = FINGER_OPEN + (FINGER_CLOSED - FINGER_OPEN) * r.closure
                     for k, j in enumerate(self._finger_idx):
@@ -591,17 +587,31 @@ class Simulation:
         """Joint positions (6,) rad that put the TCP at ``target_pos`` (3,) m (and orientation
         ``target_quat`` xyzw, if given), within the joint limits.
 
-        Uses pybullet.calculateInverseKinematics (damped least squares with null space towards
-        the home pose) iterated on a kinematic twin from ``seed_q`` (default: the current joints).
-        The result may be approximate when the target is out of reach; check it with
+        Uses pybullet.calculateInverseKinematics (damped least squares, null space towards the
+        seed) iterated on a kinematic twin from ``seed_q`` (default: the current joints).
+        The result may be approximate when the target is out of reach: ``last_ik_error`` holds
+        the residual (m, plus 0.1 m per rad of orientation error); check it, or the pose from
         :meth:`forward_kinematics`.
         """
         target_pos = np.asarray(target_pos, dtype=float).reshape(3)
         if not np.all(np.isfinite(target_pos)):
             msg = f'IK target position must be finite (m), got {target_pos.tolist()}.'
             raise SimError(msg)
-        q = (self.joint_positions(robot) if seed_q is None
-             else np.asarray(seed_q, dtype=float).reshape(6)).copy()
+        q0 = (self.joint_positions(robot) if seed_q is None
+              else np.asarray(seed_q, dtype=float).reshape(6)).copy()
+        best, best_err = self._ik_from(q0, target_pos, target_quat, iterations, tolerance)
+        if best_err > tolerance:
+            # damped least squares rarely swings the base far: retry with joint 1 facing the target
+            q1 = q0.copy()
+            q1[0] = np.clip(math.atan2(target_pos[1], target_pos[0]), self.lower[0], self.upper[0])
+            q, err = self._ik_from(q1, target_pos, target_quat, iterations, tolerance)
+            if err < best_err:
+                best, best_err = q, err
+        self.last_ik_error = best_err
+        return best
+
+    def _ik_from(self, q: np.ndarray, target_pos: np.ndarray, target_quat: np.ndarray | None,
+                 iterations: int, tolerance: float) -> tuple[np.ndarray, float]:
         n_fingers = len(self._finger_idx)
         lower = [*self.lower, *[FINGER_OPEN] * n_fingers]
         upper = [*self.upper, *[FINGER_CLOSED] * n_fingers]
@@ -629,7 +639,7 @@ class Simulation:
                 best, best_err = q.copy(), err
             if err < tolerance:
                 break
-        return best
+        return best, best_err
 
     # ------------------------------------------------------------------ lifecycle
     def close(self) -> None:

@@ -1,0 +1,82 @@
+"""Command handling shared by the node and tests (ROS-free): validation of joint velocity and
+gripper commands and the command timeout of a forward velocity controller."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from mindgrasp_sim.errors import SimError
+
+
+def validate_velocities(values: object, n_joints: int = 6) -> np.ndarray:
+    """A velocity command as a float array (n_joints,) rad/s; SimError naming the problem for a
+    wrong length or NaN/inf."""
+    v = np.asarray(values, dtype=float).reshape(-1)
+    if v.size != n_joints:
+        msg = (f'Joint velocity command has {v.size} values but the arm has {n_joints} joints; '
+               f'send {n_joints} velocities in rad/s (joint_1 .. joint_{n_joints}).')
+        raise SimError(msg)
+    if not np.all(np.isfinite(v)):
+        msg = f'Joint velocity command contains NaN or inf ({v.tolist()}); send finite ' \
+              'velocities in rad/s.'
+        raise SimError(msg)
+    return v
+
+
+def gripper_closure(values: object) -> float:
+    """Closure 0 (open) .. 1 (closed) from a gripper command: ``[c]`` (one closure for all
+    fingers) or ``[c_thumb, c_left, c_right]`` finger targets (their mean is used: the fingers
+    share one force-limited actuation, like the Jaco's). SimError for empty or NaN input."""
+    v = np.asarray(values, dtype=float).reshape(-1)
+    if v.size not in (1, 3):
+        msg = (f'Gripper command has {v.size} values; send [closure] with 0 = open and '
+               '1 = closed, or three finger closures [thumb, left, right].')
+        raise SimError(msg)
+    if not np.all(np.isfinite(v)):
+        msg = f'Gripper command contains NaN or inf ({v.tolist()}); send closures in [0, 1].'
+        raise SimError(msg)
+    return float(np.clip(v.mean(), 0.0, 1.0))
+
+
+class CommandGate:
+    """Holds the latest velocity command and drops it to zero when it is older than
+    ``timeout`` seconds (a silent controller must not leave the arm moving).
+
+    Times are in seconds on any monotonic clock (the node uses its ROS clock).
+    """
+
+    def __init__(self, timeout: float = 0.25, n_joints: int = 6) -> None:
+        if not (math.isfinite(timeout) and timeout > 0):
+            msg = f'Command timeout must be a positive number of seconds, got {timeout!r}; ' \
+                  'use e.g. 0.25.'
+            raise SimError(msg)
+        self.timeout = float(timeout)
+        self.n_joints = n_joints
+        self._cmd = np.zeros(n_joints)
+        self._stamp = -math.inf
+        self.timed_out = True
+
+    def command(self, values: object, now: float) -> np.ndarray:
+        """Accept a command at time ``now`` (s); raises SimError (command ignored) if invalid."""
+        self._cmd = validate_velocities(values, self.n_joints)
+        self._stamp = now
+        self.timed_out = False
+        return self._cmd
+
+    def current(self, now: float) -> np.ndarray:
+        """The command in force at ``now`` (s): the latest one, or zeros after the timeout."""
+        if now - self._stamp > self.timeout:
+            self.timed_out = True
+            return np.zeros(self.n_joints)
+        return self._cmd.copy()
+
+    def clear(self) -> None:
+        """Forget the command (e.g. after a reset)."""
+        self._cmd = np.zeros(self.n_joints)
+        self._stamp = -math.inf
+        self.timed_out = True
+
+
+__all__ = ['CommandGate', 'gripper_closure', 'validate_velocities']
