@@ -53,6 +53,7 @@ from mindgrasp_bringup.launch_system.substitutions import (
     LaunchConfiguration,
     PathJoinSubstitution,
     PythonExpression,
+    SplitArguments,
     TextSubstitution,
     ThisLaunchFileDir,
 )
@@ -63,7 +64,8 @@ __all__ = [
     'LaunchConfiguration', 'LaunchConfigurationEquals', 'LaunchConfigurationNotEquals',
     'LaunchContext', 'LaunchDescription', 'LaunchError', 'LaunchService', 'LogInfo', 'Node',
     'PathJoinSubstitution', 'ProcessSpec', 'PushRosNamespace', 'PythonExpression',
-    'PythonLaunchDescriptionSource', 'SetLaunchConfiguration', 'Shutdown', 'TextSubstitution',
+    'PythonLaunchDescriptionSource', 'SetLaunchConfiguration', 'Shutdown', 'SplitArguments',
+    'TextSubstitution',
     'ThisLaunchFileDir', 'UnlessCondition', 'config_files', 'find_launch_file',
     'load_launch_file', 'profiles',
 ]

@@ -176,6 +176,13 @@ class LaunchService:
     def plan(self) -> LaunchPlan:
         """Resolve every substitution and condition; raises :class:`LaunchError` on problems."""
         self._check_given()
+        missing = [e for e in self.description.entities
+                   if isinstance(e, DeclareLaunchArgument) and e.default_value is None
+                   and e.condition is None and e.name not in self.given]
+        if len(missing) > 1:
+            listing = '; '.join(f'{a.name}:=<value> ({a.description})' for a in missing)
+            msg = f"launch '{self.name}' needs these arguments, which were not given: {listing}."
+            raise LaunchError(msg)
         context = LaunchContext(launch_configurations=dict(self.given),
                                 launch_file=self.launch_file)
         for argument in COMMON_ARGUMENTS:

@@ -131,6 +131,28 @@ class PythonExpression(Substitution):
         return str(value).lower() if isinstance(value, bool) else str(value)
 
 
+class SplitArguments(Substitution):
+    """In ``arguments=[...]``/``cmd=[...]``: the resolved text split into several arguments with
+    shell quoting rules, e.g. ``SplitArguments(LaunchConfiguration('driver_args'))``."""
+
+    def __init__(self, value: SomeSubstitutions) -> None:
+        self.value = value
+
+    def perform(self, context: LaunchContext) -> str:
+        return perform_substitutions(context, self.value)
+
+    def perform_list(self, context: LaunchContext) -> list[str]:
+        """The arguments (shlex rules)."""
+        import shlex
+
+        text = self.perform(context)
+        try:
+            return shlex.split(text)
+        except ValueError as exc:
+            msg = f'cannot split {text!r} into arguments ({exc}): check the quotes.'
+            raise LaunchError(msg) from exc
+
+
 def normalize(value: SomeSubstitutions) -> list[Substitution]:
     """Turn text, a substitution or a list of both into a list of substitutions."""
     if isinstance(value, (str, Path)):

@@ -12,7 +12,11 @@ from mindgrasp_bringup.launch_system.actions.action import Action
 from mindgrasp_bringup.launch_system.actions.set_launch_configuration import Shutdown
 from mindgrasp_bringup.launch_system.conditions import evaluate_bool
 from mindgrasp_bringup.launch_system.errors import LaunchError
-from mindgrasp_bringup.launch_system.substitutions import SomeSubstitutions, perform_substitutions
+from mindgrasp_bringup.launch_system.substitutions import (
+    SomeSubstitutions,
+    SplitArguments,
+    perform_substitutions,
+)
 
 if TYPE_CHECKING:
     from mindgrasp_bringup.launch_system.context import LaunchContext
@@ -88,8 +92,15 @@ class ProcessSpec:
 
 
 def resolve_list(context: LaunchContext, values: Iterable[SomeSubstitutions] | None) -> list[str]:
-    """Resolve each item of a list of substitutions to one string."""
-    return [perform_substitutions(context, v) for v in (values or [])]
+    """Resolve each item of a list of substitutions to one string (``SplitArguments``: to
+    several)."""
+    out: list[str] = []
+    for value in values or []:
+        if isinstance(value, SplitArguments):
+            out.extend(value.perform_list(context))
+        else:
+            out.append(perform_substitutions(context, value))
+    return out
 
 
 def resolve_env(context: LaunchContext,

@@ -56,9 +56,9 @@ def resolve_program(package: str | None, executable: str) -> tuple[list[str], st
         found = shutil.which(executable)
         if found:
             return [found], None, None
-        problem = (f"the node module '{module}' does not exist (yet): it is started as "
-                   f"'python -m {module}'. Install or write that module, check package= and "
-                   f"executable=, or leave the node out of the launch.")
+        problem = (f"the node module '{module}' does not exist (yet), so 'python -m {module}' "
+                   f"cannot start: write or install it, check package= and executable=, or "
+                   f"leave the node out.")
         return [sys.executable, '-m', module], module, problem
     path = Path(executable).expanduser()
     if os.sep in executable and path.is_file():

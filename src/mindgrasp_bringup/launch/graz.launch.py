@@ -1,0 +1,52 @@
+"""Graz-BCI calibration: fixation cross, arrow cue, imagery, rest; no robot. The prompts and the
+EEG are recorded so that the classifier can be trained on them.
+
+    mindgrasp launch graz                             # virtual amplifier, virtual subject
+    mindgrasp launch graz amp:=lsl eeg_stream:=MyAmp trials:=80
+    mindgrasp launch graz feedback:=true              # classifier feedback bar (trained model)
+
+The launch ends when the prompter has run all its trials (or after duration:=S).
+"""
+
+from mindgrasp_bringup.launch_system import (
+    DeclareLaunchArgument,
+    IfCondition,
+    LaunchConfiguration,
+    LaunchConfigurationEquals,
+    LaunchDescription,
+    Node,
+    Shutdown,
+    config_files,
+)
+
+
+def generate_launch_description() -> LaunchDescription:
+    seed = LaunchConfiguration('seed')
+    eeg_stream = LaunchConfiguration('eeg_stream')
+    return LaunchDescription([
+        DeclareLaunchArgument('amp', default_value='virtual', choices=['virtual', 'lsl'],
+                              description='EEG source: virtual (virtual amplifier + virtual '
+                                          'subject) or lsl (a real amplifier streaming over LSL)'),
+        DeclareLaunchArgument('eeg_stream', default_value='MIndGrasp-VirtualAmp',
+                              description='LSL stream name of the amplifier'),
+        DeclareLaunchArgument('trials', default_value='40',
+                              description='number of trials (a multiple of 4 balances classes)'),
+        DeclareLaunchArgument('seed', default_value='0',
+                              description='seed of the cue order and the virtual subject'),
+        DeclareLaunchArgument('feedback', default_value='false', choices=['true', 'false'],
+                              description='run the classifier so the display shows a feedback '
+                                          'bar (needs a trained model)'),
+        Node(package='mindgrasp_eeg', executable='virtual_amp_node', name='virtual_amp',
+             parameters=[*config_files('eeg'),
+                         {'stream_name': eeg_stream, 'seed': seed, 'subject_mode': 'follow'}],
+             condition=LaunchConfigurationEquals('amp', 'virtual')),
+        Node(package='mindgrasp_eeg', executable='acquisition_node', name='eeg_acquisition',
+             parameters=[*config_files('eeg'), {'stream_name': eeg_stream}]),
+        Node(package='mindgrasp_classifier', executable='classifier_node', name='classifier',
+             parameters=config_files('classifier'),
+             condition=IfCondition(LaunchConfiguration('feedback'))),
+        Node(package='mindgrasp_trainer', executable='graz_node', name='graz_prompter',
+             parameters=[*config_files('trainer'),
+                         {'n_trials': LaunchConfiguration('trials'), 'seed': seed}],
+             on_exit=Shutdown()),
+    ])

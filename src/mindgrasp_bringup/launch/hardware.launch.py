@@ -1,0 +1,56 @@
+"""Real hardware: an LSL amplifier and an external arm driver (no simulator), with acquisition,
+classifier, vision and the grasp controller.
+
+    mindgrasp launch hardware eeg_stream:=gNautilus arm_driver:=my_arm_driver
+    mindgrasp launch hardware eeg_stream:=gNautilus arm_driver:=/opt/arm/bin/driver \\
+        arm_driver_args:="--ip 192.168.1.10" camera_driver:=my_camera_node
+
+The arm driver must serve the arm contract of ros2_control's forward velocity controller:
+subscribe /arm_controller/commands and /gripper_controller/commands (std_msgs/Float64MultiArray,
+rad/s), publish /joint_states (sensor_msgs/JointState). The camera (the driver itself or
+camera_driver) publishes /camera/color/image_raw (rgb8), /camera/depth/image_raw (32FC1, m) and
+/camera/color/camera_info. Drivers are started as ROS nodes (``--ros-args -r __node:=...``).
+"""
+
+from mindgrasp_bringup.launch_system import (
+    DeclareLaunchArgument,
+    LaunchConfiguration,
+    LaunchConfigurationNotEquals,
+    LaunchDescription,
+    Node,
+    SplitArguments,
+    config_files,
+)
+
+
+def generate_launch_description() -> LaunchDescription:
+    return LaunchDescription([
+        DeclareLaunchArgument('eeg_stream',
+                              description='LSL stream name of the amplifier (as its streaming '
+                                          'software names it)'),
+        DeclareLaunchArgument('arm_driver',
+                              description='arm driver: an executable on PATH, a path, or a '
+                                          'Python module (pkg.module) run with python -m'),
+        DeclareLaunchArgument('arm_driver_args', default_value='',
+                              description='command-line arguments of the arm driver (shell '
+                                          'quoting)'),
+        DeclareLaunchArgument('camera_driver', default_value='',
+                              description='camera driver started like arm_driver (empty: the '
+                                          'arm driver or another system publishes the camera)'),
+        DeclareLaunchArgument('camera_driver_args', default_value='',
+                              description='command-line arguments of the camera driver'),
+        Node(executable=LaunchConfiguration('arm_driver'), name='arm_driver',
+             arguments=[SplitArguments(LaunchConfiguration('arm_driver_args'))]),
+        Node(executable=LaunchConfiguration('camera_driver'), name='camera_driver',
+             arguments=[SplitArguments(LaunchConfiguration('camera_driver_args'))],
+             condition=LaunchConfigurationNotEquals('camera_driver', '')),
+        Node(package='mindgrasp_eeg', executable='acquisition_node', name='eeg_acquisition',
+             parameters=[*config_files('eeg', 'hardware'),
+                         {'stream_name': LaunchConfiguration('eeg_stream')}]),
+        Node(package='mindgrasp_classifier', executable='classifier_node', name='classifier',
+             parameters=config_files('classifier', 'hardware')),
+        Node(package='mindgrasp_vision', executable='vision_node', name='vision',
+             parameters=config_files('vision', 'hardware')),
+        Node(package='mindgrasp_fsm', executable='fsm_node', name='fsm',
+             parameters=config_files('fsm', 'hardware')),
+    ])

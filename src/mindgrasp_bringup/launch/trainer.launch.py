@@ -1,0 +1,63 @@
+"""MIndGrasp Trainer calibration: a green training robot moves, the user (or the virtual subject)
+follows it with their own arm by motor imagery; prompts and EEG are recorded for training.
+
+    mindgrasp launch trainer                          # virtual subject, simulated arms
+    mindgrasp launch trainer amp:=lsl eeg_stream:=MyAmp trials:=80
+    mindgrasp train classifier runs/<run>/bag         # then train on the recording
+
+The launch ends when the trainer has run all its trials (or after duration:=S).
+"""
+
+from mindgrasp_bringup.launch_system import (
+    DeclareLaunchArgument,
+    LaunchConfiguration,
+    LaunchConfigurationEquals,
+    LaunchDescription,
+    Node,
+    Shutdown,
+    config_files,
+)
+
+
+def generate_launch_description() -> LaunchDescription:
+    seed = LaunchConfiguration('seed')
+    eeg_stream = LaunchConfiguration('eeg_stream')
+    return LaunchDescription([
+        DeclareLaunchArgument('amp', default_value='virtual', choices=['virtual', 'lsl'],
+                              description='EEG source: virtual (virtual amplifier + virtual '
+                                          'subject) or lsl (a real amplifier streaming over LSL)'),
+        DeclareLaunchArgument('eeg_stream', default_value='MIndGrasp-VirtualAmp',
+                              description='LSL stream name of the amplifier'),
+        DeclareLaunchArgument('subject', default_value='follow',
+                              choices=['noise', 'follow', 'pursue'],
+                              description='virtual subject (amp:=virtual): follow imagines what '
+                                          'the prompts ask'),
+        DeclareLaunchArgument('trials', default_value='40',
+                              description='number of trials (a multiple of 4 balances classes)'),
+        DeclareLaunchArgument('seed', default_value='0',
+                              description='seed of the trial order, scene and virtual subject'),
+        DeclareLaunchArgument('gui', default_value='false', choices=['true', 'false'],
+                              description='open the PyBullet window (needs a display)'),
+        Node(package='mindgrasp_sim', executable='sim_node', name='sim',
+             parameters=[*config_files('sim'),
+                         {'gui': LaunchConfiguration('gui'), 'seed': seed,
+                          'training_robot': True}]),
+        Node(package='mindgrasp_eeg', executable='virtual_amp_node', name='virtual_amp',
+             parameters=[*config_files('eeg'),
+                         {'stream_name': eeg_stream, 'seed': seed,
+                          'subject_mode': LaunchConfiguration('subject')}],
+             condition=LaunchConfigurationEquals('amp', 'virtual')),
+        Node(package='mindgrasp_eeg', executable='acquisition_node', name='eeg_acquisition',
+             parameters=[*config_files('eeg'), {'stream_name': eeg_stream}]),
+        Node(package='mindgrasp_classifier', executable='classifier_node', name='classifier',
+             parameters=config_files('classifier')),
+        Node(package='mindgrasp_vision', executable='vision_node', name='vision',
+             parameters=config_files('vision')),
+        Node(package='mindgrasp_fsm', executable='fsm_node', name='fsm',
+             parameters=config_files('fsm')),
+        # last: it starts prompting once everything else runs, and its end ends the launch
+        Node(package='mindgrasp_trainer', executable='trainer_node', name='trainer',
+             parameters=[*config_files('trainer'),
+                         {'n_trials': LaunchConfiguration('trials'), 'seed': seed}],
+             on_exit=Shutdown()),
+    ])
