@@ -7,16 +7,23 @@ callbacks; tests pass recording functions. Message ``k`` is published at wall ti
 
 from __future__ import annotations
 
+import collections
+import contextlib
+import os
 import re
 import threading
 import time
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field
 from typing import Any
 
 from .errors import BagError
 from .reader import BagReader, TopicInfo
 from .typestore import typestore as default_typestore
+
+#: Messages (and bytes) read ahead of the playback position, as rosbag2's read-ahead queue.
+READ_AHEAD = 200
+READ_AHEAD_BYTES = 64 << 20
 
 __all__ = ['PlayStats', 'Player', 'parse_remaps', 'type_problem']
 
@@ -30,6 +37,27 @@ class PlayStats:
     loops: int = 0
     max_late_ms: float = 0.0         # worst lateness of a publication behind its schedule (ms)
     stopped: bool = False
+    notes: list[str] = field(default_factory=list)
+
+
+@contextlib.contextmanager
+def _realtime(priority: int) -> Iterator[str | None]:
+    """SCHED_FIFO for the calling thread inside the block (restored after); yields a problem."""
+    if not hasattr(os, 'sched_setscheduler'):
+        yield 'Real-time priority is not available on this system; playing with normal priority.'
+        return
+    try:
+        old_policy, old_param = os.sched_getscheduler(0), os.sched_getparam(0)
+        os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(min(int(priority), 99)))
+    except (OSError, ValueError) as exc:
+        yield (f'Real-time priority {priority} was refused ({exc}); playing with normal '
+               'priority (run as root or grant CAP_SYS_NICE for tighter timing).')
+        return
+    try:
+        yield None
+    finally:
+        with contextlib.suppress(OSError):
+            os.sched_setscheduler(0, old_policy, old_param)
 
 
 def type_problem(info: TopicInfo, store: Any = None) -> str | None:
@@ -140,7 +168,7 @@ class Player:
 
     def run(self, publish: Callable[[str, bytes], None], *,
             publish_clock: Callable[[int], None] | None = None, clock_hz: float = 40.0,
-            stop: threading.Event | None = None, max_loops: int = 0,
+            stop: threading.Event | None = None, max_loops: int = 0, priority: int = 0,
             now: Callable[[], int] = time.monotonic_ns,
             sleep: Callable[[float], None] = time.sleep) -> PlayStats:
         """Play until the end (or ``stop`` is set; with ``loop``, until stopped or max_loops).
@@ -151,16 +179,53 @@ class Player:
             clock_hz: /clock publication rate (Hz).
             stop: Set it to stop early.
             max_loops: With ``loop``, stop after this many passes (0 = endless).
+            priority: Real-time (SCHED_FIFO) priority 1-99 of the calling thread while playing;
+                0 = normal scheduling. On a loaded machine normal scheduling wakes the player up
+                to several ms late; real-time priority keeps it within ~0.1 ms. Needs root or
+                CAP_SYS_NICE; without, playback runs normally and ``stats.notes`` says so.
         """
+        if priority <= 0:
+            return self._run(publish, publish_clock, clock_hz, stop, max_loops, now, sleep)
+        with _realtime(priority) as problem:
+            stats = self._run(publish, publish_clock, clock_hz, stop, max_loops, now, sleep)
+        if problem:
+            stats.notes.append(problem)
+        return stats
+
+    def _run(self, publish: Callable[[str, bytes], None],
+             publish_clock: Callable[[int], None] | None, clock_hz: float,
+             stop: threading.Event | None, max_loops: int, now: Callable[[], int],
+             sleep: Callable[[float], None]) -> PlayStats:
         stats = PlayStats(skipped=dict(self.skipped))
         if not self.playable:
             return stats
         clock_period = int(1e9 / clock_hz) if publish_clock is not None and clock_hz > 0 else 0
         start = self.reader.start_ns + self.start_offset_ns
         while True:
+            source = iter(self.reader.messages(self.playable, start_ns=start))
+            buffer: collections.deque = collections.deque()
+            buffered = [0]   # bytes in the buffer
+
+            def fill(limit: int, source=source, buffer=buffer, buffered=buffered) -> bool:
+                """Read up to ``limit`` messages ahead; False once the bag is exhausted."""
+                while len(buffer) < limit and buffered[0] < READ_AHEAD_BYTES:
+                    item = next(source, None)
+                    if item is None:
+                        return False
+                    buffer.append(item)
+                    buffered[0] += len(item[2])
+                return True
+
+            more = fill(READ_AHEAD)
+            if not buffer:
+                return stats
+            # The clock starts once messages are in hand, so opening the bag (indexes, first
+            # chunk) does not delay the first publications.
             wall0 = now()
             next_clock = wall0
-            for topic, stamp, data in self.reader.messages(self.playable, start_ns=start):
+            while buffer:
+                topic, stamp, data = buffer.popleft()
+                buffered[0] -= len(data)
                 target = wall0 + int((stamp - start) / self.rate)
                 while True:
                     if stop is not None and stop.is_set():
@@ -173,12 +238,18 @@ class Player:
                     remaining = target - t
                     if remaining <= 0:
                         break
+                    if more and len(buffer) < READ_AHEAD and remaining > 2_000_000:
+                        # Read the bag while waiting, one message at a time, never late.
+                        more = fill(len(buffer) + 1)
+                        continue
                     wait = remaining if not clock_period else min(remaining, next_clock - t)
                     sleep(min(wait, 50_000_000) / 1e9)
                 out = self.output_topic(topic)
                 publish(out, data)
                 stats.published[out] = stats.published.get(out, 0) + 1
                 stats.max_late_ms = max(stats.max_late_ms, (now() - target) / 1e6)
+                if more and not buffer:
+                    more = fill(1)   # the bag is read slower than played: read on demand
             stats.loops += 1
             if not self.loop or (max_loops and stats.loops >= max_loops):
                 return stats

@@ -30,10 +30,10 @@ class PlayerNode(rclpy.node.Node):
         self.declare_parameters('', [
             ('bag', ''), ('rate', 1.0), ('loop', False), ('start_offset', 0.0),
             ('topics', ['']), ('regex', ''), ('exclude_regex', ''), ('remap', ['']),
-            ('clock', False), ('clock_frequency', 40.0), ('delay', 0.0)])
+            ('clock', False), ('clock_frequency', 40.0), ('delay', 0.0), ('priority', 0)])
         v = {name: self.get_parameter(name).value for name in (
             'bag', 'rate', 'loop', 'start_offset', 'topics', 'regex', 'exclude_regex', 'remap',
-            'clock', 'clock_frequency', 'delay')}
+            'clock', 'clock_frequency', 'delay', 'priority')}
         if not v['bag']:
             msg = 'The parameter bag is empty; pass the bag directory with -p bag:=<path>.'
             raise BagError(msg)
@@ -58,6 +58,7 @@ class PlayerNode(rclpy.node.Node):
             self.clock_publisher = self.create_publisher(
                 message_class(CLOCK_TYPE), '/clock', clock_qos, raw=True)
         self.delay = float(v['delay'])
+        self.priority = int(v['priority'])
         self.stats: PlayStats | None = None
         self.error: str | None = None
         self.stop_event = threading.Event()
@@ -102,7 +103,9 @@ class PlayerNode(rclpy.node.Node):
             self.stats = self.player.run(
                 lambda out, data: publish(inverse[out], data),
                 publish_clock=publish_clock if self.clock_publisher is not None else None,
-                clock_hz=self.clock_frequency, stop=self.stop_event)
+                clock_hz=self.clock_frequency, stop=self.stop_event, priority=self.priority)
+            for note in self.stats.notes:
+                self.get_logger().warning(note)
         except BagError as exc:
             self.error = str(exc)
             self.get_logger().error(self.error)

@@ -24,6 +24,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help='publish a topic under another name, e.g. /eeg/raw:=/eeg/replayed')
     parser.add_argument('--clock', nargs='?', type=float, const=40.0, default=0.0, metavar='HZ',
                         help='publish /clock with the bag time (default 40 Hz when given)')
+    parser.add_argument('--priority', type=int, default=0, metavar='1-99',
+                        help='real-time (SCHED_FIFO) priority of the playback thread, for timing '
+                             'within ~0.1 ms on a loaded machine (needs root or CAP_SYS_NICE)')
     parser.add_argument('--delay', type=float, default=0.5,
                         help='wait this many seconds after creating publishers, so subscribers '
                              'match before the first message (default: 0.5)')
@@ -49,5 +52,6 @@ def main(args: argparse.Namespace) -> int:
         'start_offset': float(args.start_offset), 'topics': list(args.topics) or [''],
         'regex': args.regex, 'exclude_regex': args.exclude_regex,
         'remap': list(args.remap) or [''], 'clock': args.clock > 0,
-        'clock_frequency': float(args.clock or 40.0), 'delay': float(args.delay)}
+        'clock_frequency': float(args.clock or 40.0), 'delay': float(args.delay),
+        'priority': int(args.priority)}
     return player_node.main(['mindgrasp-bag-play', *param_args(params)])

@@ -1,0 +1,158 @@
+"""Recorder core: background writing, drop and gap reports, SIGKILL, full disk."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import threading
+import time
+import uuid
+from pathlib import Path
+
+import pytest
+from conftest_bag import EEG, IMAGE, STRING, eeg_chunk, image, string
+
+from mindgrasp_bringup.bag import BagReader, BagWriter, Recorder
+from mindgrasp_bringup.cli import main as cli_main
+
+
+def test_messages_from_many_threads_are_all_written(tmp_path):
+    recorder = Recorder(BagWriter(tmp_path / 'bag'))
+    recorder.start()
+    recorder.add_topic('/a', STRING)
+    recorder.add_topic('/b', STRING)
+
+    def produce(topic: str) -> None:
+        for i in range(500):
+            assert recorder.push(topic, string(f'{topic} {i}'), 1_000 + i)
+
+    threads = [threading.Thread(target=produce, args=(t,)) for t in ('/a', '/b')]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    counters = recorder.stop()
+    assert counters['/a'].written == counters['/b'].written == 500
+    assert recorder.error is None
+    with BagReader(tmp_path / 'bag') as reader:
+        got = [d for topic, _, d in reader.messages() if topic == '/a']
+    assert got == [string(f'/a {i}') for i in range(500)]
+
+
+def test_full_queue_drops_are_counted_and_reported(tmp_path):
+    data = image(1, 64, 64)
+    recorder = Recorder(BagWriter(tmp_path / 'bag'), max_queue_bytes=3 * len(data))
+    recorder.add_topic('/camera/color/image_raw', IMAGE)
+    # Writer thread not started yet: the queue fills, the rest is dropped without blocking.
+    accepted = [recorder.push('/camera/color/image_raw', data, i) for i in range(10)]
+    assert accepted == [True] * 3 + [False] * 7
+    reports = recorder.reports()
+    assert len(reports) == 1
+    assert 'dropped 7 message(s) because the write queue was full' in reports[0]
+    assert recorder.reports() == []         # reported once
+    recorder.start()
+    counters = recorder.stop()
+    assert counters['/camera/color/image_raw'].written == 3
+    assert counters['/camera/color/image_raw'].dropped_queue_full == 7
+
+
+def test_eeg_sample_gaps_are_detected(tmp_path):
+    recorder = Recorder(BagWriter(tmp_path / 'bag'))
+    recorder.start()
+    recorder.add_topic('/eeg/raw', EEG)
+    for k, first in enumerate([0, 25, 50, 100, 125, 175]):     # 25 + 25 samples missing
+        recorder.push('/eeg/raw', eeg_chunk(first), k)
+    counters = recorder.stop()
+    assert counters['/eeg/raw'].gaps == 2
+    assert counters['/eeg/raw'].samples_missing == 50
+    reports = recorder.reports()
+    assert any('25 EEG sample(s) missing before sample 100' in r for r in reports)
+
+
+CHILD = textwrap.dedent('''
+    import sys, time
+    sys.path.insert(0, sys.argv[2])
+    from conftest_bag import image
+    from mindgrasp_bringup.bag import BagWriter, Recorder
+    recorder = Recorder(BagWriter(sys.argv[1], flush_interval=0.2))
+    recorder.start()
+    recorder.add_topic('/camera/color/image_raw', 'sensor_msgs/msg/Image')
+    k = 0
+    while True:
+        recorder.push('/camera/color/image_raw', image(k, 32, 24), 1_000_000 * k)
+        k += 1
+        print(k, time.monotonic(), flush=True)
+        time.sleep(0.01)
+''')
+
+
+@pytest.mark.slow
+def test_sigkill_during_recording_leaves_a_readable_bag(tmp_path, capsys):
+    bag = tmp_path / 'killed'
+    proc = subprocess.Popen([sys.executable, '-c', CHILD, str(bag), str(Path(__file__).parent)],
+                            stdout=subprocess.PIPE, text=True)
+    lines = []
+    try:
+        start = time.monotonic()
+        for line in proc.stdout:
+            lines.append(line.split())
+            if time.monotonic() - start > 2.0 and len(lines) > 50:
+                break
+    finally:
+        os.kill(proc.pid, signal.SIGKILL)
+        proc.wait(10)
+        proc.stdout.close()
+    killed_at = time.monotonic()
+    assert not (bag / 'metadata.yaml').exists()
+    # Everything pushed more than flush_interval (0.2 s) + margin before the kill is on disk.
+    safe = max(int(k) for k, t in lines if float(t) < killed_at - 0.7)
+    with BagReader(bag) as reader:
+        assert not reader.complete
+        got = [d for _, _, d in reader.messages()]
+    assert len(got) >= safe
+    assert got == [image(k, 32, 24) for k in range(len(got))]
+    # bag info rebuilds metadata.yaml from the unfinished file.
+    capsys.readouterr()
+    assert cli_main(['bag', 'info', str(bag)]) == 0
+    out = capsys.readouterr().out
+    assert f'Messages:          {len(got)}' in out
+    assert 'rebuilt' in out and (bag / 'metadata.yaml').exists()
+
+
+@pytest.fixture
+def tiny_disk(tmp_path):
+    """A 1 MiB tmpfs (needs root); skipped where mounting is not allowed."""
+    mount = tmp_path / f'tiny-{uuid.uuid4().hex[:6]}'
+    mount.mkdir()
+    result = subprocess.run(['mount', '-t', 'tmpfs', '-o', 'size=1m', 'tmpfs', str(mount)],
+                            capture_output=True, text=True)
+    if result.returncode != 0:
+        pytest.skip(f'cannot mount a 1 MiB tmpfs to fill (needs root): {result.stderr.strip()}')
+    try:
+        yield mount
+    finally:
+        subprocess.run(['umount', '-l', str(mount)], check=False)
+
+
+def test_full_disk_stops_recording_with_an_error_and_keeps_what_was_written(tiny_disk):
+    errors = []
+    recorder = Recorder(BagWriter(tiny_disk / 'bag', chunk_size=64 << 10, flush_interval=0.0),
+                        on_error=errors.append)
+    recorder.start()
+    recorder.add_topic('/camera/color/image_raw', IMAGE)
+    frames = [image(k, 160, 120) for k in range(40)]     # 57.6 kB each: 2.3 MB > 1 MiB
+    for k, frame in enumerate(frames):
+        recorder.push('/camera/color/image_raw', frame, k)
+        time.sleep(0.005)
+    recorder.stop()
+    assert len(errors) == 1
+    assert 'disk is full; free space or record to another disk' in errors[0]
+    assert recorder.error == errors[0]
+    assert recorder.push('/camera/color/image_raw', frames[0], 99) is False   # stopped
+    with BagReader(tiny_disk / 'bag') as reader:
+        got = [d for _, _, d in reader.messages()]
+    assert 3 <= len(got) < len(frames)
+    assert got == frames[:len(got)]
