@@ -119,8 +119,14 @@ def test_ros_discovery_info_lists_nodes_and_endpoints(rclpy_ctx, spawn_node):
     assert spin_until(node, lambda: 'peer_echo' in node.get_node_names(), timeout=15)
     assert 'observer' in node.get_node_names()
     graph = node.context.graph
-    assert spin_until(node, lambda: ('/echo', 'std_msgs/msg/String') in
-                      graph.node_endpoints('peer_echo', '/').get('publishers', []), timeout=10)
+
+    def complete() -> bool:
+        ep = graph.node_endpoints('peer_echo', '/')
+        return (('/echo', 'std_msgs/msg/String') in ep.get('publishers', [])
+                and ('/chatter', 'std_msgs/msg/String') in ep.get('subscribers', [])
+                and len(ep.get('services', [])) >= 6)
+
+    assert spin_until(node, complete, timeout=15)
     endpoints = graph.node_endpoints('peer_echo', '/')
     assert ('/chatter', 'std_msgs/msg/String') in endpoints['subscribers']
     assert ('/rosout', 'rcl_interfaces/msg/Log') in endpoints['publishers']

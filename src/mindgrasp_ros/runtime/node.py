@@ -379,6 +379,13 @@ class Node:
             declared_type, value = value, None
         elif isinstance(value, Parameter):
             value = value.value
+        if declared_type is None and value is not None:
+            # the default's type is the parameter's type; an int override of a float
+            # default stays a float (rclpy would silently make it an int)
+            try:
+                declared_type = Parameter.Type.from_parameter_value(value)
+            except TypeError as exc:
+                raise InvalidParameterValueException(name, value, str(exc)) from None
         if not ignore_override and name in self._overrides:
             value = self._overrides[name]
         try:

@@ -1,0 +1,280 @@
+"""mindgrasp_ros in one process: type support, CDR against rosbags, RIHS01, names, arguments,
+parameters, sim time, composition and lock-step, malformed samples, error messages."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from conftest import spin_until
+from rosbags.typesys import Stores, get_typestore
+
+from mindgrasp_ros import typesupport
+from mindgrasp_ros.runtime.arguments import ParamsFileError, parse_ros_args
+from mindgrasp_ros.runtime.exceptions import InvalidNameError
+from mindgrasp_ros.runtime.names import expand_topic_name, validate_topic_name
+
+# every message type the MIndGrasp graph puts on the wire
+GRAPH_TYPES = [
+    'mindgrasp_msgs/msg/EEGChunk', 'mindgrasp_msgs/msg/MIPrediction', 'mindgrasp_msgs/msg/Prompt',
+    'mindgrasp_msgs/msg/Detection', 'mindgrasp_msgs/msg/DetectionArray',
+    'mindgrasp_msgs/msg/FsmState', 'mindgrasp_msgs/msg/TaskTarget',
+    'mindgrasp_msgs/msg/GraspResult', 'sensor_msgs/msg/Image', 'sensor_msgs/msg/CameraInfo',
+    'sensor_msgs/msg/JointState', 'std_msgs/msg/Float64MultiArray', 'std_msgs/msg/String',
+    'geometry_msgs/msg/PoseStamped', 'visualization_msgs/msg/MarkerArray',
+    'diagnostic_msgs/msg/DiagnosticArray', 'rosgraph_msgs/msg/Clock', 'rcl_interfaces/msg/Log',
+    'rcl_interfaces/msg/ParameterEvent', 'rmw_dds_common/msg/ParticipantEntitiesInfo',
+]
+
+
+def _random_message(typename: str, rng: np.random.Generator, depth: int = 0):  # noqa: ANN202
+    """A message of ``typename`` with every field filled with seeded random content."""
+    cls = typesupport.get_message_class(typename)
+    msg = cls()
+    store = typesupport.typestore()
+    for name, desc in store.fielddefs[typename][1]:
+        value = getattr(msg, name)
+        if isinstance(value, np.ndarray):
+            n = value.shape[0] if value.shape[0] else int(rng.integers(0, 7))
+            if value.dtype == np.bool_:
+                setattr(msg, name, rng.integers(0, 2, n).astype(bool))
+            elif value.dtype.kind == 'f':
+                setattr(msg, name, rng.normal(size=n).astype(value.dtype))
+            else:
+                info = np.iinfo(value.dtype)
+                setattr(msg, name, rng.integers(max(info.min, -1000), min(info.max, 1000), n,
+                                                dtype=value.dtype))
+        elif isinstance(value, bool):
+            setattr(msg, name, bool(rng.integers(0, 2)))
+        elif isinstance(value, int):
+            setattr(msg, name, int(rng.integers(0, 200)))
+        elif isinstance(value, float):
+            setattr(msg, name, float(rng.normal()))
+        elif isinstance(value, str):
+            setattr(msg, name, 'x' * int(rng.integers(0, 9)))
+        elif isinstance(value, list) and depth < 3:
+            kind, detail = desc
+            inner = detail[0]
+            if inner[0].name == 'NAME':
+                setattr(msg, name, [_random_message(inner[1], rng, depth + 1)
+                                    for _ in range(int(rng.integers(0, 3)))])
+            elif value and isinstance(value[0], str) or inner[1][0] == 'string':
+                n = len(value) if value else int(rng.integers(0, 4))
+                setattr(msg, name, [f's{i}' for i in range(n)])
+        elif hasattr(value, '__msgtype__') and depth < 3:
+            setattr(msg, name, _random_message(value.__msgtype__, rng, depth + 1))
+    return msg
+
+
+def _to_rosbags(msg, store):  # noqa: ANN001, ANN202
+    """The same message as a rosbags dataclass (the reference implementation)."""
+    cls = store.types[msg.__msgtype__]
+    values = []
+    for name in msg._fields:
+        v = getattr(msg, name)
+        if hasattr(v, '__msgtype__'):
+            v = _to_rosbags(v, store)
+        elif isinstance(v, list) and v and hasattr(v[0], '__msgtype__'):
+            v = [_to_rosbags(x, store) for x in v]
+        values.append(v)
+    return cls(*values)
+
+
+@pytest.mark.parametrize('typename', GRAPH_TYPES)
+def test_cdr_is_byte_exact_with_rosbags(typename):
+    reference = get_typestore(Stores.ROS2_JAZZY)
+    if typename.startswith('mindgrasp_msgs/'):
+        reference.register({k: v for k, v in typesupport.typestore().fielddefs.items()
+                            if k.startswith('mindgrasp_msgs/msg/')})
+    rng = np.random.default_rng(1234)
+    for _ in range(5):
+        msg = _random_message(typename, rng)
+        ours = typesupport.serialize(msg)
+        theirs = bytes(reference.serialize_cdr(_to_rosbags(msg, reference), typename))
+        assert ours == theirs
+        assert typesupport.serialize(typesupport.deserialize(ours, typename)) == ours
+
+
+def test_rihs01_known_values():
+    assert typesupport.rihs01('std_msgs/msg/String') == (
+        'RIHS01_df668c740482bbd48fb39d76a70dfd4bd59db1288021743503259e948f6b1a18')
+    # has char fields (Gid): rosbags alone gets this one wrong
+    assert typesupport.rihs01('rmw_dds_common/msg/ParticipantEntitiesInfo') == (
+        'RIHS01_91a0593bacdcc50ea9bdcf849a938b128412cc1ea821245c663bcd26f83c295e')
+
+
+def test_messages_behave_like_rclpy():
+    from mindgrasp_ros.interfaces.geometry_msgs.msg import Quaternion
+    from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import FsmState
+    from mindgrasp_ros.interfaces.sensor_msgs.msg import CameraInfo, JointState
+
+    js = JointState(name=['j1'], position=[0.5])
+    assert js.position.dtype == np.float64 and js.position.tolist() == [0.5]
+    assert Quaternion().w == 1.0
+    assert CameraInfo().k.shape == (9,)
+    assert FsmState.GRASP_OBJECT == 5
+    assert 'position' in JointState.get_fields_and_field_types()
+    with pytest.raises(TypeError, match="has no field 'pos'; its fields are"):
+        JointState(pos=[1.0])
+    with pytest.raises(ValueError, match='exactly 9 elements'):
+        CameraInfo(k=[1.0, 2.0])
+    with pytest.raises(ImportError, match="Unknown msg type 'sensor_msgs/msg/Nope'"):
+        from mindgrasp_ros.interfaces.sensor_msgs.msg import Nope  # noqa: F401
+
+
+def test_names_and_arguments(tmp_path):
+    assert expand_topic_name('~/status', 'amp', '/eeg') == '/eeg/amp/status'
+    assert expand_topic_name('raw', 'amp', '/eeg') == '/eeg/raw'
+    with pytest.raises(InvalidNameError, match="part '2raw'"):
+        validate_topic_name('/eeg/2raw')
+    f = tmp_path / 'p.yaml'
+    f.write_text('/**:\n  ros__parameters: {a: 1}\n/lab/amp:\n  ros__parameters:\n'
+                 '    b: {c: x}\nother:\n  ros__parameters: {d: 2}\n')
+    args = parse_ros_args(['prog', '--ros-args', '--params-file', str(f), '-p', 'a:=5',
+                           '-p', 'amp:e:=[1, 2]', '-r', 'amp:x:=y', '--log-level', 'debug'])
+    assert args.parameters_for('amp', '/lab') == {'a': 5, 'b.c': 'x', 'e': [1, 2]}
+    assert args.parameters_for('other', '/') == {'a': 5, 'd': 2}
+    assert args.remaps[0].node == 'amp'
+    bad = tmp_path / 'bad.yaml'
+    bad.write_text('node:\n  parameters: {a: 1}\n')
+    with pytest.raises(ParamsFileError, match='must be a mapping of node names to {ros__par'):
+        parse_ros_args(['--ros-args', '--params-file', str(bad)])
+    with pytest.raises(ParamsFileError, match='does not exist'):
+        parse_ros_args(['--ros-args', '--params-file', str(tmp_path / 'missing.yaml')])
+    with pytest.raises(Exception, match='Unknown ROS argument'):
+        parse_ros_args(['--ros-args', '--bogus'])
+
+
+def test_parameters_typed_and_callbacks(rclpy_ctx):
+    rclpy = rclpy_ctx
+    from mindgrasp_ros.interfaces.rcl_interfaces.msg import SetParametersResult
+
+    node = rclpy.node.Node('params', parameter_overrides=[rclpy.parameter.Parameter('gain', value=2)])
+    assert node.declare_parameter('gain', 1.0).value == 2.0  # int override into a double
+    node.declare_parameter('model', rclpy.parameter.Parameter.Type.STRING)
+    with pytest.raises(rclpy.exceptions.ParameterUninitializedException, match='-p model:='):
+        node.get_parameter('model')
+    with pytest.raises(rclpy.exceptions.ParameterNotDeclaredException, match='not been declared'):
+        node.get_parameter('nope')
+    seen = []
+
+    def check(params):  # noqa: ANN001, ANN202
+        seen.extend(p.name for p in params)
+        ok = all(p.value > 0 for p in params if p.name == 'gain')
+        return SetParametersResult(successful=ok, reason='' if ok else 'gain must be > 0')
+
+    node.add_on_set_parameters_callback(check)
+    P = rclpy.parameter.Parameter  # noqa: N806
+    res = node.set_parameters([P('gain', value=-1.0), P('gain', value='x'), P('gain', value=3.0)])
+    assert [r.successful for r in res] == [False, False, True]
+    assert res[0].reason == 'gain must be > 0' and 'expected DOUBLE' in res[1].reason
+    assert node.get_parameter('gain').value == 3.0
+    node.destroy_node()
+
+
+def test_timers_follow_sim_time(rclpy_ctx):
+    rclpy = rclpy_ctx
+    from mindgrasp_ros.interfaces.rosgraph_msgs.msg import Clock
+
+    node = rclpy.node.Node('sim_timer', parameter_overrides=[
+        rclpy.parameter.Parameter('use_sim_time', value=True)])
+    clock_node = rclpy.node.Node('clock_source')
+    pub = clock_node.create_publisher(Clock, '/clock', rclpy.qos.qos_profile_clock)
+    ticks = []
+    node.create_timer(0.5, lambda: ticks.append(node.get_clock().now().nanoseconds))
+    executor = rclpy.executors.SingleThreadedExecutor()
+    executor.add_node(node)
+    executor.add_node(clock_node)
+    for i in range(1, 21):  # 2 s of sim time in 0.1 s steps, as fast as we can
+        t = rclpy.time.Time(seconds=0.1 * i)
+        pub.publish(Clock(clock=t.to_msg()))
+        spin_until(node, lambda: False, timeout=0.01, executor=executor)
+    spin_until(node, lambda: len(ticks) >= 4, timeout=2, executor=executor)
+    assert [round(t / 1e9, 1) for t in ticks] == [0.5, 1.0, 1.5, 2.0]
+    executor.shutdown()
+
+
+def test_in_process_delivery_skips_serialisation(rclpy_ctx, monkeypatch):
+    rclpy = rclpy_ctx
+    from mindgrasp_ros.interfaces.sensor_msgs.msg import Image
+
+    calls = []
+    real = typesupport.serialize
+    monkeypatch.setattr('mindgrasp_ros.runtime.entities.serialize',
+                        lambda *a, **k: calls.append(1) or real(*a, **k))
+    a, b = rclpy.node.Node('producer'), rclpy.node.Node('consumer')
+    got = []
+    b.create_subscription(Image, '/camera/color/image_raw', got.append, 5)
+    pub = a.create_publisher(Image, '/camera/color/image_raw', 5)
+    msg = Image(height=480, width=640, encoding='rgb8', step=1920,
+                data=np.zeros(640 * 480 * 3, np.uint8))
+    executor = rclpy.executors.SingleThreadedExecutor()
+    executor.add_node(b)
+    pub.publish(msg)
+    assert spin_until(b, lambda: bool(got), timeout=5, executor=executor)
+    assert got[0] is msg and calls == []  # same object, never serialised (no remote reader)
+    executor.shutdown()
+
+
+def test_malformed_sample_is_dropped_with_a_warning(rclpy_ctx, capfd):
+    rclpy = rclpy_ctx
+    from mindgrasp_ros.interfaces.std_msgs.msg import String
+
+    a, b = rclpy.node.Node('bad_writer'), rclpy.node.Node('reader')
+    got = []
+    sub = b.create_subscription(String, '/x', lambda m: got.append(m.data), 10)
+    raw = a.create_publisher(String, '/x', 10, raw=True)
+    executor = rclpy.executors.SingleThreadedExecutor()
+    executor.add_node(b)
+    raw.publish(b'\x00\x01\x00\x00\xff\xff\xff\x7f')  # string length 2**31: malformed
+    raw.publish(typesupport.serialize(String(data='fine')))
+    assert spin_until(b, lambda: got == ['fine'], timeout=5, executor=executor)
+    assert sub.malformed_count == 1
+    assert 'Dropped a malformed std_msgs/msg/String' in capfd.readouterr().err
+    with pytest.raises(typesupport.MessageTypeError, match='carries std_msgs/msg/String'):
+        a.create_publisher(String, '/y', 1).publish(rclpy.parameter.Parameter('x', value=1)
+                                                      .get_parameter_value())
+    executor.shutdown()
+
+
+def test_lockstep_is_deterministic_and_serves_services():
+    import random
+
+    from mindgrasp_ros import rclpy
+    from mindgrasp_ros.composition import LockstepRunner
+    from mindgrasp_ros.interfaces.std_msgs.msg import Float64
+    from mindgrasp_ros.interfaces.std_srvs.srv import Trigger
+
+    class Noise(rclpy.node.Node):
+        def __init__(self) -> None:
+            super().__init__('noise')
+            self.rng = random.Random(self.declare_parameter('seed', 0).value)
+            pub = self.create_publisher(Float64, 'x', 10)
+            self.create_timer(0.01, lambda: pub.publish(Float64(data=self.rng.random())))
+            self.create_service(Trigger, 'reset', self.reset)
+
+        def reset(self, _req, res):  # noqa: ANN001, ANN202
+            self.rng.seed(0)
+            res.success = True
+            return res
+
+    class Log(rclpy.node.Node):
+        def __init__(self) -> None:
+            super().__init__('log')
+            self.values: list[tuple[int, float]] = []
+            self.create_subscription(Float64, 'x', lambda m: self.values.append(
+                (self.get_clock().now().nanoseconds, m.data)), 10)
+            self.reset = self.create_client(Trigger, 'reset')
+
+    runs = []
+    for _ in range(2):
+        with LockstepRunner() as runner:
+            runner.add(Noise, ros_args=['-p', 'seed:=7'])
+            log = runner.add(Log)
+            for _ in range(50):
+                runner.step(0.005)
+            future = log.reset.call_async(Trigger.Request())
+            runner.step(0.0)
+            assert future.result().success
+            runs.append(list(log.values))
+    assert len(runs[0]) == 25 and runs[0] == runs[1]
+    assert runs[0][0][0] == 10_000_000  # first tick at t = 10 ms of sim time
