@@ -149,6 +149,7 @@ class EEGAcquisition:
         self._last_data_at = 0.0                 # local_clock() when samples last arrived
         self._last_finite: np.ndarray | None = None
         self.lost = False
+        self._lost_reason = ''
         self.counters = {'samples': 0, 'dropped': 0, 'out_of_order': 0, 'nonfinite_samples': 0,
                          'nan_dropped': 0, 'reconnects': 0, 'losses': 0}
 
@@ -204,7 +205,7 @@ class EEGAcquisition:
         """Stop reconnecting and close the inlet."""
         self._stop.set()
         if self._reconnect_thread is not None:
-            self._reconnect_thread.join(timeout=2.0)
+            self._reconnect_thread.join(timeout=1.0)
         if self._inlet is not None:
             self._inlet.close_stream()
             self._inlet = None
@@ -216,7 +217,7 @@ class EEGAcquisition:
         def run() -> None:
             while not self._stop.is_set():
                 try:
-                    info = resolve_stream(*self.selector, timeout=0.5)
+                    info = resolve_stream(*self.selector, timeout=0.5, list_visible=False)
                     if info.uid() == lost_uid and pylsl.local_clock() - self._last_data_at < 2.0:
                         # the lost outlet may still be listed for a moment; give it time
                         self._stop.wait(0.1)
@@ -284,11 +285,13 @@ class EEGAcquisition:
         try:
             raw, ts = self._inlet.pull_chunk(timeout=0.0, max_samples=4096, as_numpy=True)
         except LostError:
+            self._lost_reason = 'the sender closed the connection'
             self._mark_lost()
             return []
         now = pylsl.local_clock()
         if len(ts) == 0:
             if now - self._last_data_at > self.lost_timeout:
+                self._lost_reason = f'no samples for more than {self.lost_timeout:g} s'
                 self._mark_lost()
             return []
         self._last_data_at = now
@@ -359,8 +362,9 @@ class EEGAcquisition:
             since = pylsl.local_clock() - self._last_data_at
             with self._lock:
                 err = self._reconnect_error
-            msg = (f"The LSL stream '{desc.name}' is lost: no samples for {since:.2f} s; "
-                   f'waiting for it (or a new stream matching the selector) to come back.')
+            msg = (f"The LSL stream '{desc.name}' is lost ({self._lost_reason}; last sample "
+                   f'{since:.2f} s ago); waiting for it (or a new stream matching the selector) '
+                   f'to come back. Check the amplifier and its LSL app.')
             if err:
                 msg += f' Last reconnection problem: {err}'
             return Status(ERROR, msg, values)

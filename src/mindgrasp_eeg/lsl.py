@@ -102,13 +102,15 @@ def visible_streams(wait_time: float = 1.0) -> list[StreamDescription]:
 
 
 def resolve_stream(name: str = '', stream_type: str = '', source_id: str = '',
-                   timeout: float = 10.0, exclude_uids: Sequence[str] = ()) -> pylsl.StreamInfo:
+                   timeout: float = 10.0, exclude_uids: Sequence[str] = (),
+                   list_visible: bool = True) -> pylsl.StreamInfo:
     """Find one LSL stream by name, type and/or source_id (the newest if several match).
 
     Raises
     ------
     EEGError
-        Nothing matched within ``timeout`` seconds; the message lists the visible streams.
+        Nothing matched within ``timeout`` seconds; the message lists the visible streams
+        (looked up for one more second) unless ``list_visible`` is false.
     """
     pred = _predicate(name, stream_type, source_id)
     if not pred:
@@ -118,7 +120,7 @@ def resolve_stream(name: str = '', stream_type: str = '', source_id: str = '',
     found = [i for i in pylsl.resolve_bypred(pred, minimum=1, timeout=timeout)
              if i.uid() not in exclude_uids]
     if not found:
-        seen = visible_streams(1.0)
+        seen = visible_streams(1.0) if list_visible else []
         listing = '; '.join(s.summary() for s in seen) or 'none'
         msg = (f'No LSL stream with {pred} was found within {timeout:g} s. Visible streams: '
                f'{listing}. Start the amplifier (or `mindgrasp eeg virtual-amp`) or select one of '
@@ -146,6 +148,13 @@ def open_inlet(info: pylsl.StreamInfo, *, max_buflen: float = 1.0, dejitter: boo
                f'the sender is running and reachable (network, firewall).')
         raise EEGError(msg) from exc
     return inlet, StreamDescription.from_info(full)
+
+
+def _short(names: Sequence[str], n: int = 8) -> str:
+    """``[a, b, ... (k more)]`` for long channel lists in messages."""
+    names = list(names)
+    more = f', ... ({len(names) - n} more)' if len(names) > n else ''
+    return '[' + ', '.join(names[:n]) + more + ']'
 
 
 def check_stream(desc: StreamDescription, *, n_channels: int = 0, sample_rate: float = 0.0,
@@ -176,8 +185,8 @@ def check_stream(desc: StreamDescription, *, n_channels: int = 0, sample_rate: f
         problems.append(f'runs at {desc.sample_rate:g} Hz, expected {sample_rate:g} Hz '
                         f'(sample_rate)')
     if channel_names and tuple(channel_names) != desc.channel_names:
-        problems.append(f'has channels {list(desc.channel_names)}, expected {list(channel_names)} '
-                        f'(channel_names)')
+        problems.append(f'has channels {_short(desc.channel_names)}, expected '
+                        f'{_short(channel_names)} (channel_names)')
     if not problems:
         return []
     text = f"The LSL stream '{desc.name}' " + '; it '.join(problems)

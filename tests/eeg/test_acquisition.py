@@ -56,7 +56,7 @@ def test_layout_validation_and_adaptation(lsl_source, stream_name) -> None:
     with pytest.raises(EEGError, match=r'has 8 channels, expected 32 .*runs at 160 Hz, expected '
                                        r'250 Hz.*adapt_to_stream'):
         EEGAcquisition(stream_name, n_channels=32, sample_rate=250).connect(timeout=5)
-    with pytest.raises(EEGError, match=r"has channels \['E1'"):
+    with pytest.raises(EEGError, match=r"has channels \[E1, E2, .*expected \[X0"):
         EEGAcquisition(stream_name, channel_names=[f'X{k}' for k in range(8)]).connect(timeout=5)
     acq = EEGAcquisition(stream_name, n_channels=32, sample_rate=250, adapt=True)
     desc = acq.connect(timeout=5)
@@ -117,7 +117,7 @@ def test_stream_loss_and_reconnection(lsl_source, stream_name) -> None:
         time.sleep(0.02)
     detected_after = time.monotonic() - t_kill
     status = acq.status()
-    assert status.level == ERROR and 'is lost: no samples for' in status.message
+    assert status.level == ERROR and 'is lost (the sender closed the connection' in status.message
     assert detected_after < 1.5                 # a closed connection is reported at once
     time.sleep(0.5)
     lsl_source(stream_name, '--duration', '30')            # a new amplifier process

@@ -1,0 +1,57 @@
+"""EEG only: the acquisition node against any LSL EEG stream (optionally with a virtual amplifier).
+
+    mindgrasp launch eeg eeg_stream:=MyAmp                 # a real amplifier's LSL stream
+    mindgrasp launch eeg eeg_stream:=eegmmidb              # e.g. `mindgrasp eeg play eegbci:1:4 --name eegmmidb`
+    mindgrasp launch eeg virtual_amp:=true subject:=noise  # with the virtual amplifier
+    mindgrasp launch eeg --show-args
+
+The acquisition node publishes /eeg/raw and /eeg/status; the run directory records them. With
+adapt:=true (the default here) the node adopts the stream's channel count, rate and names with a
+warning; adapt:=false holds the stream to config/params/eeg.yaml (32 ch, 250 Hz, g.Nautilus names).
+"""
+
+from mindgrasp_bringup.launch_system import (
+    DeclareLaunchArgument,
+    IfCondition,
+    LaunchConfiguration,
+    LaunchDescription,
+    Node,
+    config_files,
+)
+
+
+def generate_launch_description() -> LaunchDescription:
+    eeg_stream = LaunchConfiguration('eeg_stream')
+    duration = LaunchConfiguration('duration')
+    return LaunchDescription([
+        DeclareLaunchArgument('eeg_stream', default_value='MIndGrasp-VirtualAmp',
+                              description='LSL name of the EEG stream to acquire'),
+        DeclareLaunchArgument('stream_type', default_value='',
+                              description="LSL type to match as well (e.g. 'EEG'); empty: any"),
+        DeclareLaunchArgument('source_id', default_value='',
+                              description='LSL source_id to match as well; empty: any'),
+        DeclareLaunchArgument('adapt', default_value='true', choices=['true', 'false'],
+                              description="adopt the stream's channel count/rate/names (with a "
+                                          'warning) instead of failing on a mismatch'),
+        DeclareLaunchArgument('virtual_amp', default_value='false', choices=['true', 'false'],
+                              description='also start the virtual amplifier as eeg_stream'),
+        DeclareLaunchArgument('subject', default_value='noise',
+                              choices=['noise', 'follow', 'pursue'],
+                              description='virtual subject mode (with virtual_amp:=true)'),
+        DeclareLaunchArgument('seed', default_value='0', description='virtual subject/EEG seed'),
+        DeclareLaunchArgument('duration', default_value='0.0',
+                              description='seconds until the nodes end by themselves (0: never)'),
+        Node(package='mindgrasp_eeg', executable='virtual_amp_node', name='virtual_amp',
+             condition=IfCondition(LaunchConfiguration('virtual_amp')),
+             parameters=[*config_files('eeg'),
+                         {'stream_name': eeg_stream, 'seed': LaunchConfiguration('seed'),
+                          'subject_mode': LaunchConfiguration('subject'),
+                          'duration': duration}]),
+        Node(package='mindgrasp_eeg', executable='acquisition_node', name='eeg_acquisition',
+             parameters=[*config_files('eeg'),
+                         {'stream_name': eeg_stream,
+                          'stream_type': LaunchConfiguration('stream_type'),
+                          'source_id': LaunchConfiguration('source_id'),
+                          'adapt_to_stream': LaunchConfiguration('adapt'),
+                          'duration': duration}]),
+    ])

@@ -1,0 +1,149 @@
+"""EEG acquisition node: one LSL EEG stream -> mindgrasp_msgs/EEGChunk on /eeg/raw.
+
+    python -m mindgrasp_eeg.acquisition_node --ros-args -p stream_name:=MyAmp
+    python -m mindgrasp_eeg.acquisition_node --ros-args --params-file config/params/eeg.yaml
+
+Publishes ``/eeg/raw`` (sensor-data QoS, depth 100) every ``chunk_period`` seconds with the
+samples that arrived, in volts, stamped with the ROS time of the first sample (see
+:mod:`mindgrasp_eeg.acquisition` for the LSL-to-ROS time mapping), and ``/eeg/status``
+(diagnostic_msgs/DiagnosticArray, reliable) every ``status_period`` seconds and on every change
+of level. All the work is done by :class:`~mindgrasp_eeg.acquisition.EEGAcquisition`.
+"""
+
+from __future__ import annotations
+
+import sys
+
+import numpy as np
+from mindgrasp_ros.interfaces.diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
+from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import EEGChunk
+
+from mindgrasp_eeg import EEGError
+from mindgrasp_eeg.acquisition import ERROR, OK, WARN, EEGAcquisition, ros_stamp_ns
+from mindgrasp_eeg.montage import NAUTILUS_32
+from mindgrasp_eeg.ros_conversions import ns_to_time_fields
+from mindgrasp_ros import rclpy
+
+PARAMETERS = [
+    ('stream_name', 'MIndGrasp-VirtualAmp'), ('stream_type', ''), ('source_id', ''),
+    ('n_channels', 32), ('sample_rate', 250.0), ('channel_names', list(NAUTILUS_32)),
+    ('check_channel_names', True), ('adapt_to_stream', False), ('stream_unit', 'auto'),
+    ('chunk_period', 1.0 / 32.0), ('max_buflen', 1.0), ('resolve_timeout', 10.0),
+    ('lost_timeout', 0.5), ('nan_policy', 'replace'), ('dejitter', True), ('clocksync', True),
+    ('quality_window', 1.0), ('flat_threshold', 1e-7), ('rail_threshold', 0.1),
+    ('status_period', 1.0), ('frame_id', 'eeg'), ('duration', 0.0),
+]
+_LEVELS = {OK: DiagnosticStatus.OK, WARN: DiagnosticStatus.WARN, ERROR: DiagnosticStatus.ERROR}
+
+
+class AcquisitionNode(rclpy.node.Node):
+    """Wires :class:`EEGAcquisition` to ``/eeg/raw`` and ``/eeg/status``."""
+
+    def __init__(self, **kwargs) -> None:
+        super().__init__('eeg_acquisition', **kwargs)
+        self.declare_parameters('', PARAMETERS)
+        p = {name: self.get_parameter(name).value for name, _ in PARAMETERS}
+        self.p = p
+        self.acq = EEGAcquisition(
+            p['stream_name'], p['stream_type'], p['source_id'], n_channels=p['n_channels'],
+            sample_rate=p['sample_rate'],
+            channel_names=p['channel_names'] if p['check_channel_names'] else (),
+            adapt=p['adapt_to_stream'], stream_unit=p['stream_unit'], max_buflen=p['max_buflen'],
+            resolve_timeout=p['resolve_timeout'], lost_timeout=p['lost_timeout'],
+            nan_policy=p['nan_policy'], dejitter=p['dejitter'], clocksync=p['clocksync'],
+            quality_window=p['quality_window'], flat_threshold=p['flat_threshold'],
+            rail_threshold=p['rail_threshold'])
+        qos_raw = rclpy.qos.QoSProfile(depth=100,
+                                       reliability=rclpy.qos.ReliabilityPolicy.BEST_EFFORT,
+                                       durability=rclpy.qos.DurabilityPolicy.VOLATILE)
+        self.pub_raw = self.create_publisher(EEGChunk, '/eeg/raw', qos_raw)
+        self.pub_status = self.create_publisher(DiagnosticArray, '/eeg/status', 10)
+        self.get_logger().info(f'Looking for the LSL stream (name {p["stream_name"]!r}, type '
+                               f'{p["stream_type"]!r}, source_id {p["source_id"]!r}) for up to '
+                               f'{p["resolve_timeout"]:g} s.')
+        desc = self.acq.connect()
+        for warning in self.acq.warnings:
+            self.get_logger().warning(warning)
+        self.get_logger().info(f'Connected to {desc.summary()}, unit {desc.unit or "?"} '
+                               f'(x{self.acq.scale:g} to volts); publishing /eeg/raw every '
+                               f'{p["chunk_period"] * 1e3:.1f} ms.')
+        self._n_warnings = len(self.acq.warnings)
+        self._last_level = -1
+        self._last_stamp_ns = -1
+        self.create_timer(p['chunk_period'], self.poll_callback)
+        self.create_timer(p['status_period'], self.status_callback)
+        self._start_ns = self.get_clock().now().nanoseconds
+        self.done = False
+
+    def poll_callback(self) -> None:
+        """Pull what LSL has and publish it."""
+        chunks = self.acq.poll()
+        if chunks:
+            ros_now = self.get_clock().now().nanoseconds
+            desc = self.acq.desc
+            for chunk in chunks:
+                stamp = ros_stamp_ns(float(chunk.timestamps[0]), chunk.lsl_now, ros_now)
+                stamp = max(stamp, self._last_stamp_ns + 1)   # never backwards
+                self._last_stamp_ns = stamp
+                msg = EEGChunk(sample_rate=desc.sample_rate, channel_names=list(desc.channel_names),
+                               n_samples=len(chunk.data), first_sample_index=chunk.first_index,
+                               unit='V', data=np.ascontiguousarray(chunk.data).ravel())
+                msg.header.stamp.sec, msg.header.stamp.nanosec = ns_to_time_fields(stamp)
+                msg.header.frame_id = self.p['frame_id']
+                self.pub_raw.publish(msg)
+        if len(self.acq.warnings) > self._n_warnings:
+            for warning in self.acq.warnings[self._n_warnings:]:
+                self.get_logger().warning(warning)
+            self._n_warnings = len(self.acq.warnings)
+        if self.acq.status().level != self._last_level:
+            self.status_callback()
+        duration = self.p['duration']
+        if duration > 0 and self.get_clock().now().nanoseconds - self._start_ns > duration * 1e9:
+            self.done = True
+
+    def status_callback(self) -> None:
+        """Publish /eeg/status; log level changes."""
+        status = self.acq.status()
+        if status.level != self._last_level:
+            log = {OK: self.get_logger().info, WARN: self.get_logger().warning,
+                   ERROR: self.get_logger().error}[status.level]
+            log(status.message)
+            self._last_level = status.level
+        desc = self.acq.desc
+        item = DiagnosticStatus(level=_LEVELS[status.level], name='eeg_acquisition',
+                                message=status.message,
+                                hardware_id=desc.source_id if desc else '',
+                                values=[KeyValue(key=k, value=v)
+                                        for k, v in sorted(status.values.items())])
+        msg = DiagnosticArray(status=[item])
+        msg.header.stamp = self.get_clock().now().to_msg()
+        self.pub_status.publish(msg)
+
+    def destroy_node(self) -> None:
+        """Close the inlet, then the node."""
+        self.acq.close()
+        super().destroy_node()
+
+
+def main(args: list[str] | None = None) -> int:
+    """Run the node until Ctrl-C or ``duration``; exit 1 with a message on bad input."""
+    rclpy.init(args=args)
+    node = None
+    try:
+        node = AcquisitionNode()
+        while rclpy.ok() and not node.done:
+            rclpy.spin_once(node, timeout_sec=0.1)
+    except EEGError as exc:
+        print(f'[eeg_acquisition] ERROR: {exc}', file=sys.stderr, flush=True)
+        return 1
+    except KeyboardInterrupt:
+        pass
+    finally:
+        if node is not None:
+            node.destroy_node()
+        rclpy.try_shutdown()
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())

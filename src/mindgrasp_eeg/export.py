@@ -1,0 +1,196 @@
+"""Export the EEG of a recorded session (rosbag2) to a file MNE reads: FIF or EDF (ROS-free).
+
+The bag is read with ``rosbags``' rosbag2 ``Reader`` and the project's typestore (which registers
+``mindgrasp_msgs`` from its ``.msg`` files). Samples are placed by ``EEGChunk.first_sample_index``,
+so the exported time axis is the amplifier's: sample ``i`` lies ``i / sample_rate`` seconds after
+the first one, whose ROS stamp becomes the file's measurement date. Samples the acquisition never
+received (drops, a lost stream) are written as zeros and covered by a ``BAD_gap`` annotation.
+
+Annotations (onset in seconds from the first sample, from the message header stamps):
+
+- ``/trainer/prompt`` -> ``prompt/<phase>/<class>`` with the phase's planned duration
+  (e.g. ``prompt/cue/left_hand``, ``prompt/fixation/rest``),
+- ``/task/target`` -> ``target/<colour> <shape>``,
+- ``/virtual_subject/intent`` (virtual amplifier ground truth) -> ``intent/<class>``.
+
+Units: EEGChunk data are volts; MNE keeps volts (FIF float32; EDF scales to 16-bit per channel).
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from . import EEGError
+from .montage import class_name
+
+FORMATS = ('fif', 'edf')
+
+
+@dataclass
+class Session:
+    """EEG of one recording.
+
+    data : ndarray, shape (n_samples, n_channels), float64, volts (zeros in gaps)
+    sample_rate : Hz
+    channel_names : n_channels labels
+    start_ns : ROS time of sample 0 (ns)
+    annotations : (onset s, duration s, description)
+    n_missing : samples not received (in gaps)
+    """
+
+    data: np.ndarray
+    sample_rate: float
+    channel_names: list[str]
+    start_ns: int
+    annotations: list[tuple[float, float, str]] = field(default_factory=list)
+    n_missing: int = 0
+
+
+def find_bag(path: str | Path) -> Path:
+    """The rosbag2 folder of a run directory (``<run>/bag``) or the bag folder itself."""
+    p = Path(path)
+    for cand in (p / 'bag', p):
+        if (cand / 'metadata.yaml').is_file():
+            return cand
+    if p.is_dir() and any(p.glob('**/*.mcap')):
+        msg = (f'The bag under {str(p)!r} has no metadata.yaml (the recording did not end '
+               f'cleanly); rebuild it with `mindgrasp bag info --fix` or the bag tools, then '
+               f'export again.')
+        raise EEGError(msg)
+    msg = f'{str(p)!r} is neither a run directory with a bag nor a rosbag2 folder; check the path.'
+    raise EEGError(msg)
+
+
+def _typestore():
+    try:
+        from mindgrasp_ros.typesupport import typestore
+
+        return typestore()
+    except ImportError:          # without the ROS layer: the Jazzy store + our .msg files
+        from rosbags.typesys import Stores, get_types_from_msg, get_typestore
+
+        store = get_typestore(Stores.ROS2_JAZZY)
+        msg_dir = Path(__file__).resolve().parents[1] / 'mindgrasp_msgs' / 'msg'
+        types = {}
+        for f in msg_dir.glob('*.msg'):
+            types.update(get_types_from_msg(f.read_text(), f'mindgrasp_msgs/msg/{f.stem}'))
+        store.register(types)
+        return store
+
+
+def _stamp_ns(header: object) -> int:
+    return int(header.stamp.sec) * 1_000_000_000 + int(header.stamp.nanosec)
+
+
+def read_session(path: str | Path, eeg_topic: str = '/eeg/raw') -> Session:
+    """Read EEG and annotation topics of a run directory or bag.
+
+    Raises
+    ------
+    EEGError
+        No bag, no EEG on ``eeg_topic``, or an unreadable bag.
+    """
+    from rosbags.rosbag2 import Reader
+
+    bag = find_bag(path)
+    store = _typestore()
+    chunks: list[tuple[int, int, np.ndarray]] = []          # (first index, stamp ns, data)
+    events: list[tuple[int, float, str]] = []              # (stamp ns, duration s, description)
+    layout: tuple[float, tuple[str, ...]] | None = None
+    skipped = 0
+    try:
+        with Reader(bag) as reader:
+            wanted = {eeg_topic, '/trainer/prompt', '/task/target', '/virtual_subject/intent'}
+            conns = [c for c in reader.connections if c.topic in wanted]
+            for conn, t_log, raw in reader.messages(connections=conns):
+                msg = store.deserialize_cdr(raw, conn.msgtype)
+                if conn.topic == eeg_topic:
+                    this = (float(msg.sample_rate), tuple(msg.channel_names))
+                    layout = layout or this
+                    if this != layout:
+                        skipped += 1                     # a reconnection to another layout
+                        continue
+                    data = np.asarray(msg.data, dtype=np.float64).reshape(
+                        int(msg.n_samples), len(this[1]))
+                    chunks.append((int(msg.first_sample_index), _stamp_ns(msg.header), data))
+                elif conn.topic == '/trainer/prompt':
+                    events.append((_stamp_ns(msg.header), float(msg.duration),
+                                   f'prompt/{msg.phase}/{class_name(int(msg.class_index))}'))
+                elif conn.topic == '/task/target':
+                    events.append((_stamp_ns(msg.header) or t_log, 0.0,
+                                   f'target/{msg.colour} {msg.shape}'))
+                else:
+                    events.append((t_log, 0.0, f'intent/{msg.data}'))
+    except EEGError:
+        raise
+    except Exception as exc:
+        msg = (f'Cannot read the bag {str(bag)!r} ({type(exc).__name__}: {exc}); check that it '
+               f'is a complete rosbag2 recording.')
+        raise EEGError(msg) from exc
+    if not chunks or layout is None:
+        msg = (f'The bag {str(bag)!r} holds no EEG on {eeg_topic!r}; record the acquisition '
+               f'node (or pass the topic the EEG was recorded on).')
+        raise EEGError(msg)
+    fs, names = layout
+    chunks.sort(key=lambda c: c[0])
+    i0 = chunks[0][0]
+    n_total = chunks[-1][0] + len(chunks[-1][2]) - i0
+    data = np.zeros((n_total, len(names)))
+    have = np.zeros(n_total, dtype=bool)
+    for first, _stamp, block in chunks:
+        data[first - i0:first - i0 + len(block)] = block
+        have[first - i0:first - i0 + len(block)] = True
+    start_ns = chunks[0][1]
+    ann = [((t - start_ns) * 1e-9, d, desc) for t, d, desc in sorted(events)
+           if 0 <= (t - start_ns) * 1e-9 < n_total / fs]
+    # gaps as BAD_ annotations so MNE excludes them from epochs
+    edges = np.flatnonzero(np.diff(np.concatenate([[1], have.astype(np.int8), [1]])))
+    for a, b in zip(edges[::2], edges[1::2], strict=True):
+        ann.append((a / fs, (b - a) / fs, 'BAD_gap'))
+    if skipped:
+        ann.append((0.0, 0.0, f'note/{skipped} chunks with another channel layout skipped'))
+    return Session(data, fs, list(names), start_ns, sorted(ann), int((~have).sum()))
+
+
+def to_raw(session: Session):
+    """An ``mne.io.RawArray`` (volts, EEG channels) with annotations and measurement date."""
+    import mne
+
+    info = mne.create_info(session.channel_names, session.sample_rate, 'eeg')
+    raw = mne.io.RawArray(session.data.T, info, verbose='error')
+    raw.set_meas_date(dt.datetime.fromtimestamp(session.start_ns * 1e-9, tz=dt.timezone.utc))
+    if session.annotations:
+        onset, duration, desc = zip(*session.annotations, strict=True)
+        raw.set_annotations(mne.Annotations(onset, duration, desc,
+                                            orig_time=raw.info['meas_date']))
+    return raw
+
+
+def export_session(path: str | Path, output: str | Path | None = None, fmt: str = 'fif',
+                   eeg_topic: str = '/eeg/raw', overwrite: bool = False) -> Path:
+    """Write the EEG of a run directory or bag as FIF or EDF; returns the file written.
+
+    The default output is ``<run dir>/eeg_raw.fif`` (or ``eeg.edf``) next to the bag.
+    """
+    if fmt not in FORMATS:
+        msg = f'The export format must be one of {FORMATS}; {fmt!r} is not supported.'
+        raise EEGError(msg)
+    session = read_session(path, eeg_topic)
+    bag = find_bag(path)
+    base = bag.parent if bag.name == 'bag' else bag
+    out = Path(output) if output else base / ('eeg_raw.fif' if fmt == 'fif' else 'eeg.edf')
+    if out.exists() and not overwrite:
+        msg = f'{str(out)!r} exists already; pass --overwrite or another --output.'
+        raise EEGError(msg)
+    raw = to_raw(session)
+    if fmt == 'fif':
+        raw.save(out, overwrite=True, verbose='error')
+    else:
+        import mne
+
+        mne.export.export_raw(out, raw, fmt='edf', overwrite=True, verbose='error')
+    return out

@@ -1,0 +1,42 @@
+"""Export the EEG of a recorded run (rosbag2) to FIF or EDF, with prompts/targets as annotations.
+
+Examples::
+
+    mindgrasp export eeg runs/20261121T010000_demo                 # -> <run>/eeg_raw.fif
+    mindgrasp export eeg runs/20261121T010000_demo/bag --format edf -o session.edf
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from . import EEGError
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Arguments of ``mindgrasp export eeg``."""
+    parser.add_argument('path', metavar='RUN_DIR_OR_BAG', help='run directory or rosbag2 folder')
+    parser.add_argument('--format', choices=['fif', 'edf'], default='fif', help='output format')
+    parser.add_argument('-o', '--output', default=None,
+                        help='output file (default: eeg_raw.fif / eeg.edf in the run directory)')
+    parser.add_argument('--eeg-topic', default='/eeg/raw', help='topic of the EEGChunk messages')
+    parser.add_argument('--overwrite', action='store_true', help='replace an existing file')
+
+
+def main(args: argparse.Namespace) -> int:
+    """Export; 0 on success, 1 with a message on bad input."""
+    from .export import export_session, read_session
+
+    try:
+        session = read_session(args.path, args.eeg_topic)
+        out = export_session(args.path, args.output, args.format, args.eeg_topic,
+                             overwrite=args.overwrite)
+    except EEGError as exc:
+        print(f'mindgrasp export eeg: {exc}', file=sys.stderr)
+        return 1
+    n_ann = sum(1 for a in session.annotations if not a[2].startswith('BAD_'))
+    print(f'Wrote {out}: {len(session.data)} samples x {len(session.channel_names)} channels at '
+          f'{session.sample_rate:g} Hz ({len(session.data) / session.sample_rate:.1f} s), '
+          f'{n_ann} annotations, {session.n_missing} missing samples.')
+    return 0

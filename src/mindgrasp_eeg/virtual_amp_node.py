@@ -1,0 +1,162 @@
+"""Virtual amplifier node: synthetic EEG of a virtual subject as an LSL stream.
+
+    python -m mindgrasp_eeg.virtual_amp_node --ros-args -p subject_mode:=follow -p seed:=3
+
+The LSL outlet (``stream_name``, 32 g.Nautilus channels at 250 Hz in microvolts by default) lives
+in this process, like an amplifier app; the acquisition node reads it as any other amplifier.
+Subscriptions depend on ``subject_mode``: ``follow`` listens to ``/trainer/prompt``; ``pursue`` to
+``/task/target``, ``/sim/objects``, ``/joint_states`` and ``/fsm/state``; ``noise`` to nothing.
+Samples are paced by the node clock: wall time, or ``/clock`` with ``use_sim_time``. The imagined
+class is published on ``/virtual_subject/intent`` (std_msgs/String, on change) and as an LSL
+marker on ``<stream_name>-markers``, as ground truth for evaluations.
+"""
+
+from __future__ import annotations
+
+import sys
+
+from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import FsmState, Prompt, TaskTarget
+from mindgrasp_ros.interfaces.sensor_msgs.msg import JointState
+from mindgrasp_ros.interfaces.std_msgs.msg import String
+from mindgrasp_ros.interfaces.visualization_msgs.msg import MarkerArray
+
+from mindgrasp_eeg import EEGError
+from mindgrasp_eeg.lsl import EEGOutlet, MarkerOutlet
+from mindgrasp_eeg.montage import NAUTILUS_32, class_name
+from mindgrasp_eeg.ros_conversions import base_yaw_from_joint_state, markers_to_objects, time_to_s
+from mindgrasp_eeg.subject import VirtualSubject
+from mindgrasp_eeg.synthetic import SyntheticEEG
+from mindgrasp_eeg.virtual_amp import VirtualAmplifier
+from mindgrasp_ros import rclpy
+
+PARAMETERS = [
+    ('stream_name', 'MIndGrasp-VirtualAmp'), ('stream_type', 'EEG'), ('source_id', ''),
+    ('channel_names', list(NAUTILUS_32)), ('sample_rate', 250.0), ('unit', 'microvolts'),
+    ('subject_mode', 'noise'), ('accuracy', 0.9), ('reaction_delay', 0.5), ('lapse_rate', 0.0),
+    ('active_phases', ['cue', 'move']), ('decision_period', 0.5), ('heading_tolerance', 0.1),
+    ('base_joint', ''), ('base_position', [0.0, 0.0]), ('heading_offset', 0.0),
+    ('seed', 0), ('head_seed', 0), ('background_rms', 10e-6), ('alpha_rms', 8e-6),
+    ('mu_rms', 6e-6), ('beta_rms', 3e-6), ('sensor_noise_rms', 0.5e-6), ('erd_depth', 0.5),
+    ('erd_tau', 0.3), ('blink_rate', 0.0), ('blink_amplitude', 100e-6), ('emg_rate', 0.0),
+    ('emg_rms', 20e-6), ('line_noise', 0.0), ('line_freq', 50.0),
+    ('push_period', 1.0 / 32.0), ('block', 8), ('duration', 0.0),
+]
+
+
+class VirtualAmpNode(rclpy.node.Node):
+    """Feeds the virtual subject from ROS topics and paces the virtual amplifier."""
+
+    def __init__(self, **kwargs) -> None:
+        super().__init__('virtual_amp', **kwargs)
+        self.declare_parameters('', PARAMETERS)
+        p = {name: self.get_parameter(name).value for name, _ in PARAMETERS}
+        self.p = p
+        gen = SyntheticEEG(
+            list(p['channel_names']), p['sample_rate'], seed=p['seed'], head_seed=p['head_seed'],
+            background_rms=p['background_rms'], alpha_rms=p['alpha_rms'], mu_rms=p['mu_rms'],
+            beta_rms=p['beta_rms'], sensor_noise_rms=p['sensor_noise_rms'],
+            erd_depth=p['erd_depth'], erd_tau=p['erd_tau'], blink_rate=p['blink_rate'],
+            blink_amplitude=p['blink_amplitude'], emg_rate=p['emg_rate'], emg_rms=p['emg_rms'],
+            line_noise=p['line_noise'], line_freq=p['line_freq'])
+        self.subject = VirtualSubject(
+            p['subject_mode'], accuracy=p['accuracy'], reaction_delay=p['reaction_delay'],
+            lapse_rate=p['lapse_rate'], seed=p['seed'], active_phases=p['active_phases'],
+            decision_period=p['decision_period'], heading_tolerance=p['heading_tolerance'])
+        outlet = EEGOutlet(p['stream_name'], list(p['channel_names']), p['sample_rate'],
+                           stream_type=p['stream_type'], source_id=p['source_id'],
+                           unit=p['unit'])
+        self.markers = MarkerOutlet(f'{p["stream_name"]}-markers',
+                                    f'{p["source_id"] or p["stream_name"]}-markers')
+        sim_time = bool(self.get_parameter('use_sim_time').value)
+        self.amp = VirtualAmplifier(gen, self.subject, outlet, realtime_stamps=not sim_time,
+                                    block=p['block'])
+        latched = rclpy.qos.QoSProfile(depth=10,
+                                       reliability=rclpy.qos.ReliabilityPolicy.RELIABLE,
+                                       durability=rclpy.qos.DurabilityPolicy.TRANSIENT_LOCAL)
+        mode = p['subject_mode']
+        if mode == 'follow':
+            self.create_subscription(Prompt, '/trainer/prompt', self.prompt_callback, latched)
+        elif mode == 'pursue':
+            self.create_subscription(TaskTarget, '/task/target', self.target_callback, latched)
+            self.create_subscription(MarkerArray, '/sim/objects', self.objects_callback, 10)
+            self.create_subscription(JointState, '/joint_states', self.joints_callback,
+                                     rclpy.qos.qos_profile_sensor_data)
+            self.create_subscription(FsmState, '/fsm/state', self.fsm_callback, latched)
+        self.pub_intent = self.create_publisher(String, '/virtual_subject/intent', latched)
+        self._last_intent: object = 'unset'
+        self.create_timer(p['push_period'], self.push_callback)
+        self._start = self.now_s()
+        self.done = False
+        self.get_logger().info(
+            f"Virtual amplifier '{p['stream_name']}': {len(p['channel_names'])} channels at "
+            f"{p['sample_rate']:g} Hz in {p['unit']}, subject mode {mode!r}, seed {p['seed']}, "
+            f"paced by {'/clock' if sim_time else 'wall time'}.")
+
+    def now_s(self) -> float:
+        """Node clock (s): wall time, or simulated time with use_sim_time."""
+        return self.get_clock().now().nanoseconds * 1e-9
+
+    def prompt_callback(self, msg: Prompt) -> None:
+        """A trainer prompt: the subject reacts from its onset (header stamp, else arrival)."""
+        t = time_to_s(msg.header.stamp) or self.now_s()
+        self.subject.on_prompt(t, int(msg.class_index), msg.phase, int(msg.trial))
+
+    def target_callback(self, msg: TaskTarget) -> None:
+        """The desired object."""
+        self.subject.set_target(int(msg.object_id), msg.colour, msg.shape)
+
+    def objects_callback(self, msg: MarkerArray) -> None:
+        """Scene objects (world frame, base at ``base_position``)."""
+        self.subject.set_objects(markers_to_objects(msg.markers, self.p['base_position']))
+
+    def joints_callback(self, msg: JointState) -> None:
+        """Arm heading from the base joint."""
+        yaw = base_yaw_from_joint_state(msg.name, msg.position, self.p['base_joint'])
+        if yaw is not None:
+            self.subject.set_base_yaw(yaw + self.p['heading_offset'])
+
+    def fsm_callback(self, msg: FsmState) -> None:
+        """Controller state and its object of interest."""
+        self.subject.set_fsm(int(msg.state), msg.object_of_interest)
+
+    def push_callback(self) -> None:
+        """Generate and push every sample due by now; report imagery changes."""
+        now = self.now_s()
+        self.amp.step(now)
+        if self.amp.current_class != self._last_intent:
+            self._last_intent = self.amp.current_class
+            name = class_name(self.amp.current_class)
+            self.markers.push(name)
+            self.pub_intent.publish(String(data=name))
+        if self.p['duration'] > 0 and now - self._start > self.p['duration']:
+            self.done = True
+
+    def destroy_node(self) -> None:
+        """Withdraw the LSL streams, then the node."""
+        self.amp.outlet.close()
+        self.markers.close()
+        super().destroy_node()
+
+
+def main(args: list[str] | None = None) -> int:
+    """Run until Ctrl-C or ``duration``; exit 1 with a message on bad parameters."""
+    rclpy.init(args=args)
+    node = None
+    try:
+        node = VirtualAmpNode()
+        while rclpy.ok() and not node.done:
+            rclpy.spin_once(node, timeout_sec=0.1)
+    except EEGError as exc:
+        print(f'[virtual_amp] ERROR: {exc}', file=sys.stderr, flush=True)
+        return 1
+    except KeyboardInterrupt:
+        pass
+    finally:
+        if node is not None:
+            node.destroy_node()
+        rclpy.try_shutdown()
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())
