@@ -58,7 +58,7 @@ class NodeProcess:
         self.log_path = log
         self._log = log.open('wb')
         target = [module] if module.endswith('.py') else ['-m', module]
-        self.proc = subprocess.Popen(  # noqa: S603 - our own interpreter and module
+        self.proc = subprocess.Popen(
             [sys.executable, '-u', *target, *args], stdout=self._log,
             stderr=subprocess.STDOUT, env=env, start_new_session=True)
 

@@ -85,7 +85,7 @@ class Component:
     module: str
     ros_args: list[str] = field(default_factory=list)
 
-    def create(self) -> Any:  # noqa: ANN401
+    def create(self) -> Any:
         cls = load_node_class(self.module)
         args = list(self.ros_args)
         if args and args[0] != '--ros-args':
@@ -140,7 +140,7 @@ class LockstepRunner:
         self.context = context_mod.Context()
         self.context.init([], transport='intra')
         self.executor = SingleThreadedExecutor(context=self.context)
-        self._time_ns = int(round(start_time_s * 1e9))
+        self._time_ns = round(start_time_s * 1e9)
         self._max_rounds = max_rounds
         self._clock_node = Node('lockstep_clock', context=self.context,
                                 start_parameter_services=False, enable_rosout=False)
@@ -155,8 +155,8 @@ class LockstepRunner:
     def time_s(self) -> float:
         return self._time_ns / 1e9
 
-    def add(self, node_class: type | Component, *args: Any, ros_args: Sequence[str] = (),  # noqa: ANN401
-            **kwargs: Any) -> Any:  # noqa: ANN401
+    def add(self, node_class: type | Component, *args: Any, ros_args: Sequence[str] = (),
+            **kwargs: Any) -> Any:
         """Construct a node in the lock-step context (``use_sim_time`` forced on)."""
         if isinstance(node_class, Component):
             ros_args = [*node_class.ros_args, *ros_args]
@@ -180,11 +180,11 @@ class LockstepRunner:
         """Run ready callbacks until none is ready; returns how many rounds ran."""
         rounds = 0
         while rounds < self._max_rounds:
-            work = self.executor._collect()  # noqa: SLF001 - deterministic, no waiting
+            work = self.executor._collect()
             if not work:
                 return rounds
             for entity, item in work:
-                self.executor._run(entity, item)  # noqa: SLF001
+                self.executor._run(entity, item)
             rounds += 1
         msg = (f'The composed graph did not settle within {self._max_rounds} rounds at '
                f't={self.time_s:.6f} s: a callback keeps producing work.')
@@ -195,7 +195,7 @@ class LockstepRunner:
         if dt_s < 0:
             msg = f'Lock-step time cannot go backwards (dt_s={dt_s}).'
             raise CompositionError(msg)
-        self._time_ns += int(round(dt_s * 1e9))
+        self._time_ns += round(dt_s * 1e9)
         self._publish_clock()
         self.spin_until_quiescent()
 
@@ -214,13 +214,13 @@ class LockstepRunner:
 
 
 @contextlib.contextmanager
-def _default_context(ctx: Any) -> Iterator[None]:  # noqa: ANN401
+def _default_context(ctx: Any) -> Iterator[None]:
     """Make ``ctx`` the default context while nodes are constructed (they call Node(...))."""
     from mindgrasp_ros import runtime
 
-    previous = runtime._default_context  # noqa: SLF001
-    runtime._default_context = ctx  # noqa: SLF001
+    previous = runtime._default_context
+    runtime._default_context = ctx
     try:
         yield
     finally:
-        runtime._default_context = previous  # noqa: SLF001
+        runtime._default_context = previous

@@ -8,9 +8,10 @@ latched (publishes 3 messages transient-local on 'latched' then idles).
 
 import sys
 
-from mindgrasp_ros import rclpy
 from mindgrasp_ros.interfaces.std_msgs.msg import String
 from mindgrasp_ros.interfaces.std_srvs.srv import SetBool
+
+from mindgrasp_ros import rclpy
 
 
 def qos(node: rclpy.node.Node) -> rclpy.qos.QoSProfile:

@@ -5,9 +5,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import spin_until
 from rosbags.typesys import Stores, get_typestore
 
+from conftest import spin_until
 from mindgrasp_ros import typesupport
 from mindgrasp_ros.runtime.arguments import ParamsFileError, parse_ros_args
 from mindgrasp_ros.runtime.exceptions import InvalidNameError
@@ -26,7 +26,7 @@ GRAPH_TYPES = [
 ]
 
 
-def _random_message(typename: str, rng: np.random.Generator, depth: int = 0):  # noqa: ANN202
+def _random_message(typename: str, rng: np.random.Generator, depth: int = 0):
     """A message of ``typename`` with every field filled with seeded random content."""
     cls = typesupport.get_message_class(typename)
     msg = cls()
@@ -52,12 +52,12 @@ def _random_message(typename: str, rng: np.random.Generator, depth: int = 0):  #
         elif isinstance(value, str):
             setattr(msg, name, 'x' * int(rng.integers(0, 9)))
         elif isinstance(value, list) and depth < 3:
-            kind, detail = desc
+            _kind, detail = desc
             inner = detail[0]
             if inner[0].name == 'NAME':
                 setattr(msg, name, [_random_message(inner[1], rng, depth + 1)
                                     for _ in range(int(rng.integers(0, 3)))])
-            elif value and isinstance(value[0], str) or inner[1][0] == 'string':
+            elif (value and isinstance(value[0], str)) or inner[1][0] == 'string':
                 n = len(value) if value else int(rng.integers(0, 4))
                 setattr(msg, name, [f's{i}' for i in range(n)])
         elif hasattr(value, '__msgtype__') and depth < 3:
@@ -65,7 +65,7 @@ def _random_message(typename: str, rng: np.random.Generator, depth: int = 0):  #
     return msg
 
 
-def _to_rosbags(msg, store):  # noqa: ANN001, ANN202
+def _to_rosbags(msg, store):
     """The same message as a rosbags dataclass (the reference implementation)."""
     cls = store.types[msg.__msgtype__]
     values = []
@@ -136,7 +136,7 @@ def test_names_and_arguments(tmp_path):
     assert args.remaps[0].node == 'amp'
     bad = tmp_path / 'bad.yaml'
     bad.write_text('node:\n  parameters: {a: 1}\n')
-    with pytest.raises(ParamsFileError, match='must be a mapping of node names to {ros__par'):
+    with pytest.raises(ParamsFileError, match='must be a mapping of node names to'):
         parse_ros_args(['--ros-args', '--params-file', str(bad)])
     with pytest.raises(ParamsFileError, match='does not exist'):
         parse_ros_args(['--ros-args', '--params-file', str(tmp_path / 'missing.yaml')])
@@ -148,7 +148,8 @@ def test_parameters_typed_and_callbacks(rclpy_ctx):
     rclpy = rclpy_ctx
     from mindgrasp_ros.interfaces.rcl_interfaces.msg import SetParametersResult
 
-    node = rclpy.node.Node('params', parameter_overrides=[rclpy.parameter.Parameter('gain', value=2)])
+    node = rclpy.node.Node(
+        'params', parameter_overrides=[rclpy.parameter.Parameter('gain', value=2)])
     assert node.declare_parameter('gain', 1.0).value == 2.0  # int override into a double
     node.declare_parameter('model', rclpy.parameter.Parameter.Type.STRING)
     with pytest.raises(rclpy.exceptions.ParameterUninitializedException, match='-p model:='):
@@ -157,7 +158,7 @@ def test_parameters_typed_and_callbacks(rclpy_ctx):
         node.get_parameter('nope')
     seen = []
 
-    def check(params):  # noqa: ANN001, ANN202
+    def check(params):
         seen.extend(p.name for p in params)
         ok = all(p.value > 0 for p in params if p.name == 'gain')
         return SetParametersResult(successful=ok, reason='' if ok else 'gain must be > 0')
@@ -239,10 +240,11 @@ def test_malformed_sample_is_dropped_with_a_warning(rclpy_ctx, capfd):
 def test_lockstep_is_deterministic_and_serves_services():
     import random
 
-    from mindgrasp_ros import rclpy
-    from mindgrasp_ros.composition import LockstepRunner
     from mindgrasp_ros.interfaces.std_msgs.msg import Float64
     from mindgrasp_ros.interfaces.std_srvs.srv import Trigger
+
+    from mindgrasp_ros import rclpy
+    from mindgrasp_ros.composition import LockstepRunner
 
     class Noise(rclpy.node.Node):
         def __init__(self) -> None:
@@ -252,7 +254,7 @@ def test_lockstep_is_deterministic_and_serves_services():
             self.create_timer(0.01, lambda: pub.publish(Float64(data=self.rng.random())))
             self.create_service(Trigger, 'reset', self.reset)
 
-        def reset(self, _req, res):  # noqa: ANN001, ANN202
+        def reset(self, _req, res):
             self.rng.seed(0)
             res.success = True
             return res

@@ -167,7 +167,7 @@ class Context:
                 get_logger('mindgrasp_ros').error(f'Shutdown callback failed: {exc}')
         for node in list(self.nodes):
             node.wake_executor()
-            node._context_shutdown()  # noqa: SLF001
+            node._context_shutdown()
         with self._lock:
             self.nodes.clear()
             self.intra = IntraProcess()

@@ -407,7 +407,7 @@ class Service(Entity):
     def reply_gid(self) -> bytes:
         return self._writer.guid if self._writer else _local_gid(self)
 
-    def _enqueue_local(self, request: Any, future: Future) -> None:  # noqa: ANN401
+    def _enqueue_local(self, request: Any, future: Future) -> None:
         self._local.append((request, future))
         self.node.wake_executor()
 
@@ -518,7 +518,7 @@ class Client(Entity):
             if service is None:
                 future.set_exception(RuntimeError(f"No service '{self.srv_name}' in process."))
             else:
-                service._enqueue_local(request, future)  # noqa: SLF001
+                service._enqueue_local(request, future)
             return future
         self._writer.write(_pack_service(self._guid, seq, serialize(request, self._req_type)))
         return future

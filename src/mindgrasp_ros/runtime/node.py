@@ -205,11 +205,11 @@ class Node:
                 if p._writer is not None:
                     writers.append(p.gid)
             for srv in self.services:
-                if srv._reader is not None:  # noqa: SLF001
+                if srv._reader is not None:
                     readers.append(srv.gid)
                     writers.append(srv.reply_gid)
             for cli in self.clients:
-                if cli._reader is not None:  # noqa: SLF001
+                if cli._reader is not None:
                     writers.append(cli.gid)
                     readers.append(cli.reply_gid)
         return readers, writers
@@ -305,8 +305,8 @@ class Node:
     def _context_shutdown(self) -> None:
         """The context ended: the node is dead; its DDS entities go with the participant."""
         self._destroyed = True
-        if self._rosout_sink in rlog._sinks:  # noqa: SLF001
-            rlog._sinks.remove(self._rosout_sink)  # noqa: SLF001
+        if self._rosout_sink in rlog._sinks:
+            rlog._sinks.remove(self._rosout_sink)
 
     def destroy_node(self) -> None:
         if self._destroyed:
