@@ -145,8 +145,9 @@ def read_session(path: str | Path, eeg_topic: str = '/eeg/raw') -> Session:
         data[first - i0:first - i0 + len(block)] = block
         have[first - i0:first - i0 + len(block)] = True
     start_ns = chunks[0][1]
-    ann = [((t - start_ns) * 1e-9, d, desc) for t, d, desc in sorted(events)
-           if 0 <= (t - start_ns) * 1e-9 < n_total / fs]
+    end = n_total / fs
+    ann = [(on, min(d, end - on), desc) for on, d, desc in
+           (((t - start_ns) * 1e-9, d, desc) for t, d, desc in sorted(events)) if 0 <= on < end]
     # gaps as BAD_ annotations so MNE excludes them from epochs
     edges = np.flatnonzero(np.diff(np.concatenate([[1], have.astype(np.int8), [1]])))
     for a, b in zip(edges[::2], edges[1::2], strict=True):
