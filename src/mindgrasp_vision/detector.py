@@ -206,12 +206,15 @@ class ColourDetector:
         Camera model, used for ``position`` and the pixel-size distance.
     max_depth : float
         Depth readings beyond this (m) count as no reading.
+    min_split_fraction : float
+        A depth split keeps only parts with at least this fraction of the component's pixels
+        (smaller parts are grazing faces of the same object).
     """
 
     def __init__(self, colours: Mapping[str, ColourRange] | None = None, *, min_pixels: int = 6,
                  morph_kernel: int = 3, depth_edge: float = 0.03,
                  object_size: float | None = None, intrinsics: CameraIntrinsics | None = None,
-                 max_depth: float = 10.0) -> None:
+                 max_depth: float = 10.0, min_split_fraction: float = 0.15) -> None:
         self.colours = dict(DEFAULT_COLOURS if colours is None else colours)
         if not self.colours:
             msg = 'The detector needs at least one colour range; pass e.g. DEFAULT_COLOURS.'
@@ -234,6 +237,7 @@ class ColourDetector:
         self.object_size = object_size
         self.intrinsics = intrinsics
         self.max_depth = float(max_depth)
+        self.min_split_fraction = float(min_split_fraction)
         self._kernels: dict[int, np.ndarray] = {}
 
     # ------------------------------------------------------------------ helpers
@@ -404,6 +408,11 @@ class ColourDetector:
                     groups[-1].append(j)
                 else:
                     groups.append([j])
+            # a part smaller than min_split_fraction of the component is a face of the same
+            # object seen at a grazing angle (its depth changes fast), not a second object:
+            # leave it unseeded so that it joins its neighbour
+            area = max(min_pixels, self.min_split_fraction * stats[parent, cv2.CC_STAT_AREA])
+            groups = [g for g in groups if core_stats[g, cv2.CC_STAT_AREA].sum() >= area]
             if len(groups) < 2:
                 continue
             split_any = True
