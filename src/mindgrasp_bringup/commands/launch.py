@@ -20,14 +20,7 @@ EPILOG = """examples:
 """
 
 
-def add_arguments(parser: argparse.ArgumentParser) -> None:
-    """Options of ``mindgrasp launch``."""
-    parser.formatter_class = argparse.RawDescriptionHelpFormatter
-    parser.epilog = EPILOG
-    parser.add_argument('profile', nargs='?',
-                        help='a profile (' + ', '.join(profiles()) + ') or a *.launch.py path')
-    parser.add_argument('launch_arguments', nargs='*', metavar='name:=value',
-                        help='launch arguments (see --show-args)')
+def _options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--composed', action='store_true',
                         help='run the node modules in one process (mindgrasp_ros composition)')
     parser.add_argument('--run-dir', metavar='DIR',
@@ -46,6 +39,34 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help='seconds after SIGTERM before SIGKILL (default 5)')
 
 
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Options of ``mindgrasp launch``; launch arguments and options may come in any order."""
+    parser.formatter_class = argparse.RawDescriptionHelpFormatter
+    parser.epilog = EPILOG
+    parser.add_argument('profile', nargs='?',
+                        help='a profile (' + ', '.join(profiles()) + ') or a *.launch.py path')
+    _options(parser)
+    parser.add_argument('launch_arguments', nargs=argparse.REMAINDER, metavar='name:=value',
+                        help='launch arguments (see --show-args)')
+
+
+def _split_remainder(args: argparse.Namespace) -> argparse.Namespace:
+    """Options written after the first name:=value are parsed here (argparse stops there)."""
+    given, options = [], []
+    for item in args.launch_arguments:
+        (options if item.startswith('-') or (options and options[-1] in _TAKES_VALUE
+                                             and ':=' not in item) else given).append(item)
+    if options:
+        parser = argparse.ArgumentParser(prog='mindgrasp launch')
+        _options(parser)
+        parser.parse_args(options, namespace=args)  # keeps what is set, adds the rest
+    args.launch_arguments = given
+    return args
+
+
+_TAKES_VALUE = ('--run-dir', '--duration', '--sigint-timeout', '--sigterm-timeout')
+
+
 def profile_summaries() -> list[tuple[str, str]]:
     """``(profile, first docstring line)`` of every profile, without importing them."""
     out = []
@@ -62,6 +83,7 @@ def profile_summaries() -> list[tuple[str, str]]:
 def main(args: argparse.Namespace) -> int:
     """Run ``mindgrasp launch``; 0 when every node ended cleanly, 1 on a failure, 2 on bad
     input."""
+    args = _split_remainder(args)
     if args.list or args.profile is None:
         print('profiles (mindgrasp launch <profile> [name:=value ...]):')
         for name, doc in profile_summaries():

@@ -302,17 +302,16 @@ class LaunchService:
         handlers = configure_launch_logger(run_dir / 'logs' / 'launch.log')
         try:
             processes = plan.processes
-            if self.composed:
-                from mindgrasp_bringup.launch_system.composed import compose
-
-                processes = compose(processes, run_dir)
-                plan.processes = processes
             commands = self.commands(plan, run_dir)
             self._write_run_dir(plan, commands, run_dir)
             logger.info("run directory: %s", run_dir)
+            if self.composed:
+                from mindgrasp_bringup.launch_system.composed import compose
+
+                processes, commands = compose(processes, commands, run_dir)
             env = dict(os.environ)
             env['MINDGRASP_RUN_DIR'] = str(run_dir)
-            supervisor = Supervisor(list(zip(processes, commands, strict=False)), run_dir / 'logs',
+            supervisor = Supervisor(list(zip(processes, commands, strict=True)), run_dir / 'logs',
                                     sigint_timeout=self.sigint_timeout,
                                     sigterm_timeout=self.sigterm_timeout,
                                     duration=plan.duration, printer=self.printer, env=env)
