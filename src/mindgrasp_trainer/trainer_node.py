@@ -70,6 +70,8 @@ class TrainerNode(rclpy.node.Node):
         self.reset_deadline: float | None = None  # wall time by which /sim/reset must answer
         self.reset_future = None
         self.created = time.monotonic()
+        self.trainer_pose_time = math.inf  # wall time of the last training robot pose
+        self.stale_warned = 0.0
         self.finished = False
         self.exit_code = 0
 
@@ -106,6 +108,7 @@ class TrainerNode(rclpy.node.Node):
 
     def trainer_pose_callback(self, msg: PoseStamped) -> None:
         self.trainer_pos = _position(msg)
+        self.trainer_pose_time = time.monotonic()
 
     def user_pose_callback(self, msg: PoseStamped) -> None:
         self.user_pos = _position(msg)
@@ -161,6 +164,7 @@ class TrainerNode(rclpy.node.Node):
             z = self.trainer_pos[2] if self.trainer_pos is not None else None
             step = self.protocol.update(t, z, self.fsm_state)
         self._check_reset_timeout(t)
+        self._check_stale_pose()
         if self.trainer_pos is not None and self.user_pos is not None:
             d = ee_distance(self.trainer_pos, self.user_pos)
             self.protocol.record_distance(d)
@@ -183,6 +187,17 @@ class TrainerNode(rclpy.node.Node):
             self._request_reset(step.reset, t)
         if step.done:
             self._finish(0)
+
+    def _check_stale_pose(self) -> None:
+        """Warn (every 5 s at most) when the training robot's pose stops arriving."""
+        now = time.monotonic()
+        age = now - self.trainer_pose_time
+        if self.protocol.state in ('move', 'wait') and age > 1.0 and now - self.stale_warned > 5:
+            self.stale_warned = now
+            self.get_logger().warning(
+                f'No /trainer_robot/ee_pose for {age:.1f} s: the reset rule and the distance '
+                'metric use it. Is the simulator still running?'
+            )
 
     def _request_reset(self, reason: str, t: float) -> None:
         self.get_logger().info(f'Resetting both robots: {reason}.')

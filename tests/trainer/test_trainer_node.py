@@ -154,6 +154,8 @@ def test_trainer_prompts_moves_resets_and_measures(ros, spawn, spin_until):
         if reason == 'training end-effector':
             assert 0.0 < z < 0.1
     rests = [m for m in msgs if m.phase == 'rest']
+    assert msgs[0].phase == 'rest' and msgs[0].trial == 0  # the start delay
+    rests = rests[1:]
     assert [m.trial for m in rests] == [trial for trial, _ in resets]
     assert all(m.class_index == NO_CLASS for m in rests)
     assert 'Resetting both robots: training end-effector at' in out
