@@ -250,3 +250,25 @@ def test_missing_profile_module_fails_before_starting_anything(tmp_path: Path) -
     assert result.returncode == 2
     assert "sim: the node module 'mindgrasp_sim.not_written_yet' does not exist" in result.stderr
     assert not (tmp_path / 'r').exists()  # nothing started, no run directory
+
+
+def test_nodes_get_sigint_even_when_the_launcher_started_with_it_ignored(tmp_path: Path) -> None:
+    # `mindgrasp launch demo &` in a script starts the launcher with SIGINT ignored; the nodes
+    # must still stop on SIGINT (Python only raises KeyboardInterrupt if SIGINT is not ignored)
+    import subprocess
+
+    from launch_fixtures.runner import launch_cmd, launch_env
+
+    run_dir = tmp_path / 'run'
+    proc = subprocess.Popen(
+        launch_cmd(fixture('interrupt.launch.py'), 'record:=false', '--run-dir', str(run_dir)),
+        env=launch_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        start_new_session=True, preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_IGN))
+    try:
+        _started(run_dir, 'gamma')
+        proc.send_signal(signal.SIGINT)
+        out, err = proc.communicate(timeout=30)
+    finally:
+        kill_group(proc)
+    assert proc.returncode == 0, err
+    assert '[gamma] stopping on KeyboardInterrupt' in out

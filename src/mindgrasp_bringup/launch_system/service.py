@@ -11,6 +11,7 @@ import datetime as dt
 import logging
 import math
 import os
+import re
 import sys
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -237,8 +238,9 @@ class LaunchService:
 
     @staticmethod
     def _unique_labels(processes: list[ProcessSpec]) -> None:
-        seen: dict[str, int] = {}
+        seen: dict[str, int] = {'launch': 1}  # logs/launch.log is the launcher's
         for spec in processes:
+            spec.label = re.sub(r'[^A-Za-z0-9_.-]+', '_', spec.label).strip('.') or 'process'
             base = spec.label
             seen[base] = seen.get(base, 0) + 1
             if seen[base] > 1:

@@ -18,6 +18,7 @@ import contextlib
 import ctypes
 import logging
 import os
+import shlex
 import signal
 import subprocess
 import threading
@@ -46,6 +47,10 @@ except OSError:  # pragma: no cover - not Linux
 def _child_setup() -> None:
     if _LIBC is not None:
         _LIBC.prctl(_PR_SET_PDEATHSIG, signal.SIGTERM)
+        # a launcher started in the background (`&`, nohup) ignores SIGINT, and exec keeps
+        # ignored signals ignored: give the nodes the default so that SIGINT reaches rclpy
+        _LIBC.signal(signal.SIGINT, 0)   # SIG_DFL
+        _LIBC.signal(signal.SIGTERM, 0)
 
 
 def describe_exit(returncode: int) -> str:
@@ -157,9 +162,10 @@ class Supervisor:
         if proc.log_file is None:
             proc.log_file = proc.log_path.open('a', encoding='utf-8')
         what = 'restarting' if proc.restarts else 'starting'
-        proc.log_file.write(f'--- launch: {what} {spec.shell_line() if spec.shell else ""}'
-                            f'{" ".join(proc.command) if not spec.shell else ""}\n')
-        proc.log_file.flush()
+        line = proc.command[0] if spec.shell else shlex.join(proc.command)
+        with contextlib.suppress(OSError, ValueError):
+            proc.log_file.write(f'--- launch: {what} {line}\n')
+            proc.log_file.flush()
         try:
             proc.popen = subprocess.Popen(
                 proc.command[0] if spec.shell else proc.command, shell=spec.shell,
@@ -196,8 +202,14 @@ class Supervisor:
             with proc.lock:
                 proc.tail.append(text)
                 if proc.log_file is not None and not proc.log_file.closed:
-                    proc.log_file.write(text + '\n')
-                    proc.log_file.flush()
+                    try:
+                        proc.log_file.write(text + '\n')
+                        proc.log_file.flush()
+                    except OSError as exc:  # disk full: keep draining the pipe, say it once
+                        proc.log_file.close()
+                        logger.error("cannot write the log of '%s' any more (%s); its output "
+                                     "still goes to the terminal. Free disk space.",
+                                     proc.label, exc)
             if show:
                 self.printer.line(proc.label, text, stderr=is_err)
         stream.close()
@@ -267,7 +279,7 @@ class Supervisor:
             for proc in self.procs:
                 self._collect(proc)
                 if proc.log_file is not None:
-                    with proc.lock:
+                    with proc.lock, contextlib.suppress(OSError):
                         proc.log_file.close()
         return self.results()
 

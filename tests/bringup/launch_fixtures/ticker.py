@@ -5,6 +5,7 @@
 
 Prints its ROS arguments and the parameter file it got (``params <json>``), stops on SIGINT with
 exit code 0 (``stopping on SIGINT``), ``--ignore-sigint`` ignores it (the launcher must escalate),
+``--keyboard-interrupt`` relies on Python's own SIGINT handling (as rclpy nodes do),
 ``--crash-once FILE`` exits with code 3 when FILE does not exist yet (and creates it), so a
 respawned process runs normally the second time. ``--count 0`` ticks until stopped.
 """
@@ -37,13 +38,18 @@ def main() -> int:
     parser.add_argument('--ignore-sigint', action='store_true')
     parser.add_argument('--crash-once')
     parser.add_argument('--label', default='ticker')
+    parser.add_argument('--keyboard-interrupt', action='store_true',
+                        help="rely on Python's default SIGINT handling, as rclpy nodes do")
     args = parser.parse_args(own)
     stop = {'flag': False}
 
     def on_sigint(signum: int, frame: object) -> None:
         stop['flag'] = True
 
-    signal.signal(signal.SIGINT, signal.SIG_IGN if args.ignore_sigint else on_sigint)
+    if args.ignore_sigint:
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+    elif not args.keyboard_interrupt:
+        signal.signal(signal.SIGINT, on_sigint)
     print(f'ros-args {json.dumps(ros)}')
     if '--params-file' in ros:
         with open(ros[ros.index('--params-file') + 1], encoding='utf-8') as f:
@@ -53,6 +59,14 @@ def main() -> int:
         open(args.crash_once, 'w').close()
         print('crashing once on purpose', file=sys.stderr)
         return 3
+    try:
+        return _tick(args, stop)
+    except KeyboardInterrupt:
+        print('stopping on KeyboardInterrupt')
+        return 0
+
+
+def _tick(args: argparse.Namespace, stop: dict[str, bool]) -> int:
     i = 0
     while args.count == 0 or i < args.count:
         if stop['flag']:
