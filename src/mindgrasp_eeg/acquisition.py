@@ -3,9 +3,10 @@
 How LSL time maps to ROS time
 -----------------------------
 Pulled LSL timestamps ``t_lsl`` (s) are in this host's ``pylsl.local_clock()`` domain after clock
-synchronisation and dejitter (see :mod:`mindgrasp_eeg.lsl`). At each pull the node reads both
-clocks back to back, ``lsl_now = local_clock()`` and ``ros_now`` (the node clock: system time, or
-``/clock`` with ``use_sim_time``), and stamps a sample with ::
+synchronisation and dejitter (see :mod:`mindgrasp_eeg.lsl`); a sender on the same host shares that
+clock, so clock synchronisation is skipped for it (its estimate would only add jitter). At each
+pull the node reads both clocks back to back, ``lsl_now = local_clock()`` and ``ros_now`` (the
+node clock: system time, or ``/clock`` with ``use_sim_time``), and stamps a sample with ::
 
     stamp_ros = ros_now - (lsl_now - t_lsl)
 
@@ -36,6 +37,7 @@ from __future__ import annotations
 
 import contextlib
 import math
+import socket
 import threading
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -171,7 +173,7 @@ class EEGAcquisition:
         timeout = self.resolve_timeout if timeout is None else timeout
         info = resolve_stream(*self.selector, timeout=timeout)
         inlet, desc = open_inlet(info, max_buflen=self.max_buflen, dejitter=self.dejitter,
-                                 clocksync=self.clocksync)
+                                 clocksync=self._clocksync_for(info))
         try:
             self._adopt(desc)
         except EEGError:
@@ -180,6 +182,11 @@ class EEGAcquisition:
         self._inlet = inlet
         self._last_data_at = pylsl.local_clock()
         return desc
+
+    def _clocksync_for(self, info: pylsl.StreamInfo) -> bool:
+        # a sender on this host shares our local_clock(): the offset is exactly 0, and skipping
+        # the estimate avoids its jumps (RTT/2 errors) on a loaded machine
+        return self.clocksync and info.hostname() != socket.gethostname()
 
     def _adopt(self, desc: StreamDescription) -> None:
         n_ch, rate, names = self.expected
@@ -223,7 +230,8 @@ class EEGAcquisition:
                         self._stop.wait(0.1)
                         continue
                     inlet, desc = open_inlet(info, max_buflen=self.max_buflen,
-                                             dejitter=self.dejitter, clocksync=self.clocksync)
+                                             dejitter=self.dejitter,
+                                             clocksync=self._clocksync_for(info))
                 except EEGError as exc:
                     with self._lock:
                         self._reconnect_error = str(exc).split(' Visible streams')[0]
@@ -353,7 +361,8 @@ class EEGAcquisition:
             values.update(stream=desc.name, source_id=desc.source_id, hostname=desc.hostname,
                           n_channels=str(desc.n_channels), sample_rate=f'{desc.sample_rate:g}',
                           unit_scale_to_volts=f'{self.scale:g}')
-        if self._inlet is not None and self.clocksync:
+        if self._inlet is not None and self.clocksync and desc is not None and \
+                desc.hostname != socket.gethostname():
             with contextlib.suppress(Exception):   # not estimated yet
                 values['lsl_clock_offset_ms'] = f'{self._inlet.time_correction(0.0) * 1e3:.3f}'
         if desc is None:

@@ -1,0 +1,137 @@
+"""The EEG nodes as processes over real DDS and real LSL: virtual amp -> acquisition -> /eeg/raw."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pytest
+
+from mindgrasp_eeg.montage import NAUTILUS_32
+
+pytestmark = pytest.mark.slow
+
+
+class Listener:
+    """A test node collecting /eeg/raw (with arrival times), /eeg/status and the intent topic."""
+
+    def __init__(self, rclpy) -> None:
+        from mindgrasp_ros.interfaces.diagnostic_msgs.msg import DiagnosticArray
+        from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import EEGChunk, Prompt
+        from mindgrasp_ros.interfaces.std_msgs.msg import String
+
+        self.rclpy = rclpy
+        self.node = rclpy.node.Node('eeg_test_listener')
+        self.chunks: list[tuple[float, object]] = []
+        self.status: list[object] = []
+        self.intents: list[str] = []
+        sensor = rclpy.qos.QoSProfile(depth=100,
+                                      reliability=rclpy.qos.ReliabilityPolicy.BEST_EFFORT)
+        latched = rclpy.qos.QoSProfile(depth=10,
+                                       reliability=rclpy.qos.ReliabilityPolicy.RELIABLE,
+                                       durability=rclpy.qos.DurabilityPolicy.TRANSIENT_LOCAL)
+        self.node.create_subscription(EEGChunk, '/eeg/raw', self._on_chunk, sensor)
+        self.node.create_subscription(DiagnosticArray, '/eeg/status',
+                                      lambda m: self.status.append(m), 10)
+        self.node.create_subscription(String, '/virtual_subject/intent',
+                                      lambda m: self.intents.append(m.data), latched)
+        self.prompt_pub = self.node.create_publisher(Prompt, '/trainer/prompt', latched)
+        self.Prompt = Prompt
+
+    def _on_chunk(self, msg) -> None:
+        self.chunks.append((self.node.get_clock().now().nanoseconds, msg))
+
+    def spin(self, seconds: float, until=None) -> bool:
+        end = time.monotonic() + seconds
+        while time.monotonic() < end:
+            self.rclpy.spin_once(self.node, timeout_sec=0.02)
+            if until is not None and until():
+                return True
+        return until() if until is not None else True
+
+def level_of(msg) -> int:
+    lvl = msg.status[0].level
+    return int(lvl[0]) if isinstance(lvl, (bytes, bytearray)) else int(lvl)
+
+
+@pytest.fixture
+def listener(rclpy_ctx):
+    lst = Listener(rclpy_ctx)
+    yield lst
+    lst.node.destroy_node()
+
+
+def test_virtual_amp_to_acquisition_over_lsl_and_dds(spawn_node, listener, stream_name) -> None:
+    amp = spawn_node('mindgrasp_eeg.virtual_amp_node', '--ros-args', '-p',
+                     f'stream_name:={stream_name}', '-p', 'subject_mode:=follow', '-p',
+                     'accuracy:=1.0', '-p', 'reaction_delay:=0.0')
+    acq = spawn_node('mindgrasp_eeg.acquisition_node', '--ros-args', '-p',
+                     f'stream_name:={stream_name}')
+    assert listener.spin(20, lambda: len(listener.chunks) > 10), acq.output()
+    listener.chunks.clear()
+    listener.prompt_pub.publish(_prompt(listener))        # cue: imagine the left hand
+    listener.spin(3.0)
+    chunks = [m for _, m in listener.chunks]
+    assert len(chunks) > 50
+    m0 = chunks[0]
+    assert list(m0.channel_names) == list(NAUTILUS_32) and m0.sample_rate == 250.0
+    assert m0.unit == 'V' and m0.header.frame_id == 'eeg'
+    data = np.vstack([np.asarray(m.data).reshape(m.n_samples, 32) for m in chunks])
+    assert data.dtype == np.float32 and 3e-6 < data.std() < 50e-6
+    # sample counts, order, monotonic stamps consistent with the sample index
+    idx = np.array([m.first_sample_index for m in chunks])
+    n = np.array([m.n_samples for m in chunks])
+    assert np.all(idx[1:] == idx[:-1] + n[:-1]), 'samples missing or out of order'
+    assert 2.5 * 250 < n.sum() < 3.5 * 250
+    stamps = np.array([m.header.stamp.sec * 10**9 + m.header.stamp.nanosec for m in chunks])
+    assert np.all(np.diff(stamps) > 0)
+    expected = (idx - idx[0]) / 250.0 * 1e9
+    assert np.max(np.abs(stamps - stamps[0] - expected)) < 5e6      # within 5 ms of the grid
+    # push-to-publish latency: arrival minus the ROS time of the chunk's last sample
+    arrival = np.array([t for t, _ in listener.chunks])
+    latency = (arrival - (stamps + (n - 1) / 250.0 * 1e9)) * 1e-9
+    assert np.median(latency) > -0.005 and np.median(latency) < 0.5
+    # the follow subject imagined the prompted class
+    assert listener.spin(3, lambda: 'left_hand' in listener.intents), listener.intents
+    assert listener.status and level_of(listener.status[-1]) == 0
+    amp.stop()
+    acq.stop()
+
+
+def _prompt(listener):
+    msg = listener.Prompt(paradigm='graz', class_index=0, class_name='left_hand', phase='cue',
+                          trial=1, duration=4.0)
+    msg.header.stamp = listener.node.get_clock().now().to_msg()
+    return msg
+
+
+def test_loss_reported_and_reconnected(spawn_node, listener, stream_name) -> None:
+    amp = spawn_node('mindgrasp_eeg.virtual_amp_node', '--ros-args', '-p',
+                     f'stream_name:={stream_name}')
+    acq = spawn_node('mindgrasp_eeg.acquisition_node', '--ros-args', '-p',
+                     f'stream_name:={stream_name}')
+    assert listener.spin(20, lambda: len(listener.chunks) > 10), acq.output()
+    amp.stop()                                          # the amplifier process ends mid-run
+    assert listener.spin(5, lambda: any(level_of(s) == 2 and 'is lost' in s.status[0].message
+                                        for s in listener.status)), acq.output()
+    n_before = len(listener.chunks)
+    spawn_node('mindgrasp_eeg.virtual_amp_node', '--ros-args', '-p',
+               f'stream_name:={stream_name}', '-p', 'seed:=1')
+    assert listener.spin(20, lambda: len(listener.chunks) > n_before + 20), acq.output()
+    assert listener.spin(3, lambda: level_of(listener.status[-1]) == 0)
+    values = dict((kv.key, kv.value) for kv in listener.status[-1].status[0].values)
+    assert values['reconnects'] == '1' and int(values['dropped']) > 0
+    assert 'is lost' in acq.output()
+
+
+def test_acquisition_node_rejects_wrong_layout(spawn_node, stream_name, lsl_source) -> None:
+    lsl_source(stream_name, '--n-channels', '8', '--duration', '20')
+    acq = spawn_node('mindgrasp_eeg.acquisition_node', '--ros-args', '-p',
+                     f'stream_name:={stream_name}')
+    assert acq.wait(30) == 1
+    assert 'has 8 channels, expected 32 (n_channels)' in acq.output()
+    missing = spawn_node('mindgrasp_eeg.acquisition_node', '--ros-args', '-p',
+                         f'stream_name:={stream_name}_nope', '-p', 'resolve_timeout:=1.0')
+    assert missing.wait(30) == 1
+    out = missing.output()
+    assert f"No LSL stream with name='{stream_name}_nope'" in out and stream_name in out
