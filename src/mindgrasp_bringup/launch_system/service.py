@@ -174,8 +174,12 @@ class LaunchService:
             raise LaunchError(msg)
 
     # -- resolving -----------------------------------------------------------------------------
-    def plan(self) -> LaunchPlan:
-        """Resolve every substitution and condition; raises :class:`LaunchError` on problems."""
+    def plan(self, *, strict: bool = True) -> LaunchPlan:
+        """Resolve every substitution and condition; raises :class:`LaunchError` on problems.
+
+        ``strict=False`` returns the plan even when a process cannot start (its ``problem``
+        says why), e.g. to show what a profile would start.
+        """
         self._check_given()
         missing = [e for e in self.description.entities
                    if isinstance(e, DeclareLaunchArgument) and e.default_value is None
@@ -204,7 +208,7 @@ class LaunchService:
             processes.insert(0, self._recorder(context))
         self._unique_labels(processes)
         problems = [f"  - {p.label}: {p.problem}" for p in processes if p.problem]
-        if problems:
+        if problems and strict:
             msg = (f"launch '{self.name}' cannot start:\n" + '\n'.join(problems))
             if record and processes[0].problem:
                 msg += '\n  (record:=false launches without the recorder.)'

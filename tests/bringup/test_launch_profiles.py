@@ -1,0 +1,76 @@
+"""What each launch profile starts, resolved without starting anything."""
+
+from __future__ import annotations
+
+import pytest
+
+from mindgrasp_bringup.launch_system import LaunchError, LaunchService, profiles
+
+
+def processes(profile: str, *args: str) -> dict[str, object]:
+    plan = LaunchService(profile, list(args)).plan(strict=False)
+    for spec in plan.processes:  # a missing node module is the only acceptable problem
+        assert spec.problem is None or 'does not exist (yet)' in spec.problem, spec.problem
+    return {spec.label: spec for spec in plan.processes}
+
+
+def test_mine_and_the_helpers_profiles_exist() -> None:
+    assert {'demo', 'trainer', 'graz', 'hardware', 'replay'} <= set(profiles())
+
+
+def test_demo_starts_every_node_after_the_recorder() -> None:
+    procs = processes('demo', 'seed:=4', 'eeg_stream:=amp-x')
+    assert list(procs) == ['recorder', 'sim', 'virtual_amp', 'eeg_acquisition', 'classifier',
+                           'vision', 'fsm']
+    assert procs['recorder'].daemon
+    assert procs['sim'].module == 'mindgrasp_sim.sim_node'
+    assert procs['sim'].parameters['seed'] == 4 and procs['sim'].parameters['gui'] is False
+    assert procs['virtual_amp'].parameters['stream_name'] == 'amp-x'
+    assert procs['eeg_acquisition'].parameters['stream_name'] == 'amp-x'
+    assert procs['virtual_amp'].parameters['subject_mode'] == 'pursue'
+    procs = processes('demo', 'record:=false', 'gui:=true')
+    assert 'recorder' not in procs and procs['sim'].parameters['gui'] is True
+
+
+def test_hardware_has_drivers_and_no_simulator() -> None:
+    procs = processes('hardware', 'eeg_stream:=gNautilus', 'arm_driver:=true',
+                      'arm_driver_args:=--ip "10.0.0.2" --rate 100')
+    assert 'sim' not in procs and 'virtual_amp' not in procs and 'camera_driver' not in procs
+    driver = procs['arm_driver']
+    assert driver.program[0].endswith('/true') and driver.node_name == 'arm_driver'
+    assert driver.arguments == ['--ip', '10.0.0.2', '--rate', '100']
+    assert procs['eeg_acquisition'].parameters['stream_name'] == 'gNautilus'
+    procs = processes('hardware', 'eeg_stream:=a', 'arm_driver:=true', 'camera_driver:=true')
+    assert 'camera_driver' in procs
+    with pytest.raises(LaunchError, match=r"needs these arguments, which were not given: "
+                                          r"eeg_stream:=<value>.*; arm_driver:=<value>"):
+        LaunchService('hardware').plan()
+    with pytest.raises(LaunchError, match="'no-such-arm-driver' was found neither on PATH"):
+        LaunchService('hardware', ['eeg_stream:=a', 'arm_driver:=no-such-arm-driver',
+                                   'record:=false']).plan()
+
+
+def test_replay_plays_the_bag_last_without_the_rerun_outputs() -> None:
+    procs = processes('replay', 'bag:=/data/run/bag', 'rate:=2')
+    assert list(procs) == ['recorder', 'classifier', 'fsm', 'bag_player']
+    player = procs['bag_player']
+    assert player.module == 'mindgrasp_bringup.bag.player_node' and player.shutdown_on_exit
+    assert player.parameters['bag'] == '/data/run/bag' and player.parameters['rate'] == 2
+    assert player.parameters['exclude_regex'] == \
+        '^/(bci/prediction|fsm/|arm_controller/|gripper_controller/)'
+    procs = processes('replay', 'bag:=b', 'vision:=true')
+    assert 'vision' in procs and procs['bag_player'].parameters['exclude_regex'].endswith(
+        '|vision/)')
+
+
+def test_trainer_and_graz_end_with_their_prompter() -> None:
+    procs = processes('trainer', 'trials:=8', 'amp:=lsl', 'eeg_stream:=amp')
+    assert 'virtual_amp' not in procs and list(procs)[-1] == 'trainer'
+    assert procs['trainer'].shutdown_on_exit and procs['trainer'].parameters['n_trials'] == 8
+    assert procs['sim'].parameters['training_robot'] is True
+    procs = processes('trainer')
+    assert procs['virtual_amp'].parameters['subject_mode'] == 'follow'
+    procs = processes('graz')
+    assert list(procs) == ['recorder', 'virtual_amp', 'eeg_acquisition', 'graz_prompter']
+    assert procs['graz_prompter'].module == 'mindgrasp_trainer.graz_node'
+    assert 'classifier' in processes('graz', 'feedback:=true')
