@@ -74,3 +74,22 @@ def test_trainer_and_graz_end_with_their_prompter() -> None:
     assert list(procs) == ['recorder', 'virtual_amp', 'eeg_acquisition', 'graz_prompter']
     assert procs['graz_prompter'].module == 'mindgrasp_trainer.graz_node'
     assert 'classifier' in processes('graz', 'feedback:=true')
+
+
+def test_a_profile_can_be_included_by_name() -> None:
+    from mindgrasp_bringup.launch_system import (
+        IncludeLaunchDescription,
+        LaunchDescription,
+        PythonLaunchDescriptionSource,
+    )
+
+    description = LaunchDescription([
+        IncludeLaunchDescription(PythonLaunchDescriptionSource('eeg'),
+                                 launch_arguments={'virtual_amp': 'true',
+                                                   'eeg_stream': 'inner-amp'}),
+    ])
+    plan = LaunchService(description, ['record:=false', 'seed:=7']).plan(strict=False)
+    procs = {p.label: p for p in plan.processes}
+    assert list(procs) == ['virtual_amp', 'eeg_acquisition']
+    assert procs['virtual_amp'].parameters['stream_name'] == 'inner-amp'
+    assert procs['virtual_amp'].parameters['seed'] == 7  # the including launch's argument

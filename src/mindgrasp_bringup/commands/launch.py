@@ -101,14 +101,16 @@ def main(args: argparse.Namespace) -> int:
             print(format_arguments(service.declared_arguments()))
             return 0
         if args.dry_run:
-            plan = service.plan()
+            plan = service.plan(strict=False)
             print(f"launch '{plan.name}' ({plan.launch_file}), arguments:")
             for name, value in plan.arguments.items():
                 print(f'  {name}:={value}')
             print('processes, in start order:')
             for spec, cmd in zip(plan.processes, service.commands(plan, None), strict=True):
                 print(f'  [{spec.label}] {shlex.join(cmd)}')
-            return 0
+                if spec.problem:
+                    print(f'      cannot start: {spec.problem}')
+            return 2 if any(spec.problem for spec in plan.processes) else 0
         return service.run()
     except LaunchError as exc:
         print(f'mindgrasp launch: error: {exc}', file=sys.stderr)
