@@ -272,3 +272,14 @@ def test_nodes_get_sigint_even_when_the_launcher_started_with_it_ignored(tmp_pat
         kill_group(proc)
     assert proc.returncode == 0, err
     assert '[gamma] stopping on KeyboardInterrupt' in out
+
+
+def test_a_launch_with_nothing_to_start_ends_at_once(tmp_path: Path) -> None:
+    from mindgrasp_bringup.launch_system import IfCondition
+
+    description = LaunchDescription([Node(package='launch_fixtures', executable='ticker',
+                                          condition=IfCondition('false'))])
+    service = LaunchService(description, ['record:=false'], run_dir=tmp_path / 'run',
+                            printer=Printer(io.StringIO(), io.StringIO()))
+    assert service.run() == 0
+    assert service.stop_reason == 'the launch description starts no process'

@@ -267,6 +267,8 @@ class Supervisor:
                 handlers[signum] = signal.signal(signum, self._on_signal)
         try:
             self._started_at = time.monotonic()
+            if not self.procs:
+                self.request_shutdown('the launch description starts no process')
             for proc in self.procs:
                 if self._stop_reason is not None:
                     break
