@@ -85,3 +85,65 @@ def write_rosbags_bag(path: Path, messages: list[tuple[str, str, int, bytes]],
         for topic, _, stamp, data in messages:
             writer.write(connections[topic], stamp, data)
     return path
+
+
+# ---------------------------------------------------------------- multi-process helpers
+#: A publisher process: waits for the recorder to match, then publishes known CDR bytes on a
+#: schedule (EEG chunks at 10 Hz, a latched String every 130 ms), prints "done" and exits.
+PUBLISHER = '''
+import sys, time
+sys.path.insert(0, sys.argv[1])
+from conftest_bag import eeg_chunk, string
+from mindgrasp_ros import rclpy
+QoSProfile, ReliabilityPolicy = rclpy.qos.QoSProfile, rclpy.qos.ReliabilityPolicy
+DurabilityPolicy = rclpy.qos.DurabilityPolicy
+prefix, n = sys.argv[2], int(sys.argv[3])
+rclpy.init()
+node = rclpy.node.Node('bag_test_publisher')
+eeg = node.create_publisher('mindgrasp_msgs/msg/EEGChunk', prefix + '/eeg', 50, raw=True)
+latched = QoSProfile(depth=5, reliability=ReliabilityPolicy.RELIABLE,
+                     durability=DurabilityPolicy.TRANSIENT_LOCAL)
+text = node.create_publisher('std_msgs/msg/String', prefix + '/chatter', latched, raw=True)
+deadline = time.monotonic() + 20
+while (eeg.get_subscription_count() == 0 or text.get_subscription_count() == 0) \\
+        and time.monotonic() < deadline:
+    rclpy.spin_once(node, timeout_sec=0.05)
+time.sleep(0.3)
+t0 = time.monotonic()
+events = sorted([(k * 0.100, 'eeg', k) for k in range(n)] +
+                [(k * 0.130, 'text', k) for k in range(int(n * 100 / 130))])
+for at, kind, k in events:
+    while time.monotonic() - t0 < at:
+        time.sleep(max(0.0, min(0.005, at - (time.monotonic() - t0))))
+    if kind == 'eeg':
+        eeg.publish(eeg_chunk(25 * k))
+    else:
+        text.publish(string(f'message {k}'))
+time.sleep(0.5)
+print('done', flush=True)
+node.destroy_node()
+rclpy.shutdown()
+'''
+
+#: A subscriber process: prints "<topic> <DDS source timestamp ns> <sha1 of the CDR bytes>" per
+#: message; the source timestamp is taken by the publishing process when it writes the sample.
+PROBE = '''
+import hashlib, sys, time
+from mindgrasp_ros import rclpy
+QoSProfile, ReliabilityPolicy = rclpy.qos.QoSProfile, rclpy.qos.ReliabilityPolicy
+rclpy.init()
+node = rclpy.node.Node('bag_test_probe')
+qos = QoSProfile(depth=200, reliability=ReliabilityPolicy.RELIABLE)
+subs = []
+for spec in sys.argv[1:]:
+    topic, msgtype = spec.split('=')
+    def cb(data, info, topic=topic):
+        t = info.get('source_timestamp') or time.time_ns()
+        print(topic, t, hashlib.sha1(bytes(data)).hexdigest(), flush=True)
+    subs.append(node.create_subscription(msgtype, topic, cb, qos, raw=True))
+print('ready', flush=True)
+try:
+    rclpy.spin(node)
+except KeyboardInterrupt:
+    pass
+'''

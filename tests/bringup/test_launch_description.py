@@ -124,6 +124,28 @@ def test_group_scopes_namespace_and_configurations() -> None:
     assert outside.arguments == ['arm1']
 
 
+def test_set_parameter_and_set_remap_apply_to_the_nodes_that_follow() -> None:
+    from mindgrasp_bringup.launch_system import SetParameter, SetRemap
+
+    description = LaunchDescription([
+        DeclareLaunchArgument('sim_time', default_value='true'),
+        ticker('before'),
+        GroupAction([
+            SetParameter('use_sim_time', LaunchConfiguration('sim_time')),
+            SetRemap('/clock', '/bag/clock'),
+            ticker('inside', parameters=[{'rate': 3}]),
+            ticker('own', parameters=[{'use_sim_time': False}]),
+        ]),
+        ticker('after'),
+    ])
+    procs = {p.label: p for p in plan(description).processes}
+    assert procs['before'].parameters == {} and procs['after'].parameters == {}
+    assert procs['inside'].parameters == {'use_sim_time': True, 'rate': 3}
+    assert procs['own'].parameters == {'use_sim_time': False}  # the node's own value wins
+    assert procs['inside'].remappings == [('/clock', '/bag/clock')]
+    assert procs['after'].remappings == []
+
+
 def test_include_passes_arguments_and_keeps_scope() -> None:
     description = LaunchDescription([
         IncludeLaunchDescription(str(FIXTURES / 'two_tickers.launch.py'),

@@ -58,6 +58,10 @@ def test_replay_plays_the_bag_last_without_the_rerun_outputs() -> None:
     assert player.parameters['bag'] == '/data/run/bag' and player.parameters['rate'] == 2
     assert player.parameters['exclude_regex'] == \
         '^/(bci/prediction|fsm/|arm_controller/|gripper_controller/)'
+    assert procs['fsm'].parameters['use_sim_time'] is False
+    procs = processes('replay', 'bag:=b', 'clock:=true')
+    assert procs['fsm'].parameters['use_sim_time'] is True and procs['bag_player'].parameters[
+        'clock'] is True
     procs = processes('replay', 'bag:=b', 'vision:=true')
     assert 'vision' in procs and procs['bag_player'].parameters['exclude_regex'].endswith(
         '|vision/)')

@@ -3,6 +3,7 @@ another classifier model or controller setting on the same EEG and camera data).
 
     mindgrasp launch replay bag:=runs/<run>/bag
     mindgrasp launch replay bag:=runs/<run>/bag rate:=2.0 vision:=true
+    mindgrasp launch replay bag:=runs/<run>/bag clock:=true    # nodes on the bag's time
 
 The recorded outputs of the nodes that run again (/bci/prediction, /fsm/state, arm and gripper
 commands; /vision/* with vision:=true) are not played, so they come only from the new run. The
@@ -15,6 +16,7 @@ from mindgrasp_bringup.launch_system import (
     LaunchConfiguration,
     LaunchDescription,
     Node,
+    SetParameter,
     Shutdown,
     UnlessCondition,
     config_files,
@@ -32,6 +34,7 @@ def generate_launch_description() -> LaunchDescription:
                                  'rate': LaunchConfiguration('rate'),
                                  'loop': LaunchConfiguration('loop'),
                                  'delay': LaunchConfiguration('delay'),
+                                 'clock': LaunchConfiguration('clock'),
                                  'exclude_regex': exclude}],
                     on_exit=Shutdown(), condition=condition)
 
@@ -46,6 +49,10 @@ def generate_launch_description() -> LaunchDescription:
         DeclareLaunchArgument('vision', default_value='false', choices=['true', 'false'],
                               description='run the vision node again on the recorded camera '
                                           'images (false: play the recorded detections)'),
+        DeclareLaunchArgument('clock', default_value='false', choices=['true', 'false'],
+                              description='the player publishes /clock from the bag and the '
+                                          'nodes run on it (use_sim_time)'),
+        SetParameter('use_sim_time', LaunchConfiguration('clock')),
         Node(package='mindgrasp_classifier', executable='classifier_node', name='classifier',
              parameters=config_files('classifier', 'replay')),
         Node(package='mindgrasp_vision', executable='vision_node', name='vision',

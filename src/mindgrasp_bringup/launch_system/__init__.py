@@ -27,6 +27,8 @@ from mindgrasp_bringup.launch_system.actions import (
     ProcessSpec,
     PushRosNamespace,
     SetLaunchConfiguration,
+    SetParameter,
+    SetRemap,
     Shutdown,
 )
 from mindgrasp_bringup.launch_system.conditions import (
@@ -64,8 +66,8 @@ __all__ = [
     'LaunchConfiguration', 'LaunchConfigurationEquals', 'LaunchConfigurationNotEquals',
     'LaunchContext', 'LaunchDescription', 'LaunchError', 'LaunchService', 'LogInfo', 'Node',
     'PathJoinSubstitution', 'ProcessSpec', 'PushRosNamespace', 'PythonExpression',
-    'PythonLaunchDescriptionSource', 'SetLaunchConfiguration', 'Shutdown', 'SplitArguments',
-    'TextSubstitution',
+    'PythonLaunchDescriptionSource', 'SetLaunchConfiguration', 'SetParameter', 'SetRemap',
+    'Shutdown', 'SplitArguments', 'TextSubstitution',
     'ThisLaunchFileDir', 'UnlessCondition', 'config_files', 'find_launch_file',
     'load_launch_file', 'profiles',
 ]

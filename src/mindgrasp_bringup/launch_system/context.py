@@ -30,11 +30,15 @@ class LaunchContext:
     declared_arguments: dict[str, DeclareLaunchArgument] = field(default_factory=dict)
     #: names of the launch files being resolved, outermost first (include cycles are errors)
     include_stack: list[str] = field(default_factory=list)
-    locals: dict[str, Any] = field(default_factory=dict)
+    #: set by SetParameter / SetRemap for the nodes that follow (in the current scope)
+    global_parameters: dict[str, Any] = field(default_factory=dict)
+    global_remappings: list[tuple[str, str]] = field(default_factory=list)
 
     def scoped(self) -> LaunchContext:
         """A child context: configurations and namespace changed inside do not leak out."""
         child = copy.copy(self)
         child.launch_configurations = dict(self.launch_configurations)
         child.include_stack = list(self.include_stack)
+        child.global_parameters = dict(self.global_parameters)
+        child.global_remappings = list(self.global_remappings)
         return child

@@ -8,8 +8,11 @@ from mindgrasp_bringup.launch_system.actions.node import Node
 from mindgrasp_bringup.launch_system.actions.set_launch_configuration import (
     LogInfo,
     SetLaunchConfiguration,
+    SetParameter,
+    SetRemap,
     Shutdown,
 )
 
 __all__ = ['Action', 'DeclareLaunchArgument', 'ExecuteProcess', 'GroupAction', 'LogInfo', 'Node',
-           'ProcessSpec', 'PushRosNamespace', 'SetLaunchConfiguration', 'Shutdown']
+           'ProcessSpec', 'PushRosNamespace', 'SetLaunchConfiguration', 'SetParameter',
+           'SetRemap', 'Shutdown']

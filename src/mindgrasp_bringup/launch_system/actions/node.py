@@ -89,11 +89,12 @@ def _parse_value(text: str) -> Any:
     return value
 
 
-def _resolve_param_value(context: LaunchContext, value: Any) -> Any:
+def resolve_parameter_value(context: LaunchContext, value: Any) -> Any:
+    """Resolve substitutions in a parameter value (text read as YAML, as launch_ros does)."""
     if is_substitution(value):
         return _parse_value(perform_substitutions(context, value))
     if isinstance(value, Mapping):
-        return {str(k): _resolve_param_value(context, v) for k, v in value.items()}
+        return {str(k): resolve_parameter_value(context, v) for k, v in value.items()}
     if isinstance(value, Path):
         return str(value)
     if isinstance(value, tuple):
@@ -154,8 +155,9 @@ class Node(ExecuteProcess):
             label=name or Path(executable).name.split('.')[-1], program=program,
             arguments=resolve_list(context, self.arguments), is_node=True, package=package,
             executable=executable, module=module, node_name=name, namespace=namespace,
-            remappings=[(perform_substitutions(context, a), perform_substitutions(context, b))
-                        for a, b in self.remappings],
+            remappings=[*context.global_remappings,
+                        *((perform_substitutions(context, a), perform_substitutions(context, b))
+                          for a, b in self.remappings)],
             ros_arguments=resolve_list(context, self.ros_arguments), problem=problem,
             composable=module is not None, **self.common_fields(context))
         spec.parameters, spec.parameter_files = self._resolve_parameters(context, spec)
@@ -165,12 +167,12 @@ class Node(ExecuteProcess):
                             ) -> tuple[dict[str, Any], list[str]]:
         fqn = spec.fully_qualified_name
         who = fqn or f"'{spec.label}'"
-        merged: dict[str, Any] = {}
+        merged: dict[str, Any] = ros_params.flatten(context.global_parameters)
         files: list[str] = []
         for item in self.parameters:
             if isinstance(item, Mapping):
                 resolved = {perform_substitutions(context, k) if is_substitution(k) else str(k):
-                            _resolve_param_value(context, v) for k, v in item.items()}
+                            resolve_parameter_value(context, v) for k, v in item.items()}
                 merged.update(ros_params.flatten(resolved))
                 continue
             path = Path(perform_substitutions(context, item)).expanduser()

@@ -37,6 +37,34 @@ class LogInfo(Action):
         logger.info('%s', perform_substitutions(context, self.msg))
 
 
+class SetParameter(Action):
+    """Give every node that follows (in the current scope) this parameter, as
+    ``launch_ros.actions.SetParameter``; a node's own parameters win."""
+
+    def __init__(self, name: str, value: object, **kwargs: object) -> None:
+        super().__init__(**kwargs)  # type: ignore[arg-type]
+        self.name = name
+        self.value = value
+
+    def execute(self, context: LaunchContext) -> None:
+        from mindgrasp_bringup.launch_system.actions.node import resolve_parameter_value
+
+        context.global_parameters[self.name] = resolve_parameter_value(context, self.value)
+
+
+class SetRemap(Action):
+    """Remap a topic or service for every node that follows (in the current scope)."""
+
+    def __init__(self, src: SomeSubstitutions, dst: SomeSubstitutions, **kwargs: object) -> None:
+        super().__init__(**kwargs)  # type: ignore[arg-type]
+        self.src = src
+        self.dst = dst
+
+    def execute(self, context: LaunchContext) -> None:
+        context.global_remappings.append((perform_substitutions(context, self.src),
+                                          perform_substitutions(context, self.dst)))
+
+
 class Shutdown(Action):
     """Used as ``on_exit=Shutdown()`` of a process: its exit ends the whole launch."""
 
