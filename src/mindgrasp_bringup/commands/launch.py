@@ -76,7 +76,10 @@ def profile_summaries() -> list[tuple[str, str]]:
             doc = ast.get_docstring(ast.parse(path.read_text(encoding='utf-8'))) or ''
         except (OSError, SyntaxError):
             doc = ''
-        out.append((name, doc.strip().splitlines()[0] if doc.strip() else ''))
+        paragraph = ' '.join(doc.strip().split('\n\n')[0].split())
+        if len(paragraph) > 86:
+            paragraph = paragraph[:85].rsplit(' ', 1)[0] + ' ...'
+        out.append((name, paragraph))
     return out
 
 
