@@ -144,8 +144,12 @@ def main(args: list[str] | None = None) -> int:
     node = None
     try:
         node = VirtualAmpNode()
+        # one executor for the node's lifetime (adding/removing a node per spin_once wakes the
+        # wait set every time, i.e. busy-waits)
+        executor = rclpy.executors.SingleThreadedExecutor()
+        executor.add_node(node)
         while rclpy.ok() and not node.done:
-            rclpy.spin_once(node, timeout_sec=0.1)
+            executor.spin_once(timeout_sec=0.1)
     except EEGError as exc:
         print(f'[virtual_amp] ERROR: {exc}', file=sys.stderr, flush=True)
         return 1

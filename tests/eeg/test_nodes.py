@@ -22,6 +22,8 @@ class Listener:
 
         self.rclpy = rclpy
         self.node = rclpy.node.Node('eeg_test_listener')
+        self.executor = rclpy.executors.SingleThreadedExecutor()
+        self.executor.add_node(self.node)
         self.chunks: list[tuple[float, object]] = []
         self.status: list[object] = []
         self.intents: list[str] = []
@@ -44,7 +46,7 @@ class Listener:
     def spin(self, seconds: float, until=None) -> bool:
         end = time.monotonic() + seconds
         while time.monotonic() < end:
-            self.rclpy.spin_once(self.node, timeout_sec=0.02)
+            self.executor.spin_once(timeout_sec=0.02)
             if until is not None and until():
                 return True
         return until() if until is not None else True
