@@ -287,11 +287,20 @@ class DdsParticipant:
         return self.participant.guid.bytes
 
     def _topic(self, dds_topic: str, data_type: type) -> Topic:
+        # One Topic per name per participant: Cyclone refuses a second one with other QoS,
+        # and a topic has one type.
         with self._lock:
             topic = self._topics.get(dds_topic)
             if topic is None:
                 topic = Topic(self.participant, dds_topic, data_type)
                 self._topics[dds_topic] = topic
+            elif topic.data_type is not data_type:
+                have = ros_type_name_from_dds(topic.data_type.__idl_typename__.replace('.', '::'))
+                want = ros_type_name_from_dds(data_type.__idl_typename__.replace('.', '::'))
+                msg = (f"Topic '{dds_topic[2:] if dds_topic[:3] in ('rt/',) else dds_topic}' "
+                       f'is already used with type {have} in this process; it cannot also carry '
+                       f'{want}. Use one type per topic (or another topic name).')
+                raise DdsError(msg)
             return topic
 
     def create_writer(self, dds_topic: str, ros_type: str, qos: QoSProfile, *,
