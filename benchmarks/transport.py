@@ -1,4 +1,4 @@
-"""Transport benchmark of mindgrasp_ros: latency and sustained rate, across processes and in-process.
+"""Transport benchmark of mindgrasp_ros: latency and sustained rate, cross- and in-process.
 
 Run:  .venv/bin/python benchmarks/transport.py [--quick]
 
@@ -27,7 +27,7 @@ RATE_STEPS_HZ = {'eeg': [500, 1000, 2000, 4000], 'joint': [500, 1000, 2000, 4000
                  'image': [30, 60, 90, 120]}
 
 
-def make_message(case: str):  # noqa: ANN201
+def make_message(case: str):
     from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import EEGChunk
     from mindgrasp_ros.interfaces.sensor_msgs.msg import Image, JointState
 
@@ -42,17 +42,17 @@ def make_message(case: str):  # noqa: ANN201
                  data=np.zeros(640 * 480 * 3, np.uint8))
 
 
-def _qos(rclpy):  # noqa: ANN001, ANN202
+def _qos(rclpy):
     return rclpy.qos.QoSProfile(depth=1000, reliability=rclpy.qos.ReliabilityPolicy.RELIABLE)
 
 
-def _stamp(msg) -> None:  # noqa: ANN001
+def _stamp(msg) -> None:
     sec, nsec = divmod(time.monotonic_ns(), 1_000_000_000)
     msg.header.stamp.sec = sec
     msg.header.stamp.nanosec = nsec
 
 
-def _latency_ns(msg) -> int:  # noqa: ANN001
+def _latency_ns(msg) -> int:
     return time.monotonic_ns() - (msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec)
 
 
@@ -64,7 +64,8 @@ def receiver(case: str, count: int, out: str, idle_s: float) -> None:
     node = rclpy.node.Node('bench_receiver')
     lat: list[int] = []
     cls = type(make_message(case))
-    node.create_subscription(cls, f'/bench_{case}', lambda m: lat.append(_latency_ns(m)), _qos(rclpy))
+    node.create_subscription(cls, f'/bench_{case}', lambda m: lat.append(_latency_ns(m)),
+                             _qos(rclpy))
     print('ready', flush=True)
     last = time.monotonic()
     seen = 0
@@ -78,7 +79,7 @@ def receiver(case: str, count: int, out: str, idle_s: float) -> None:
     rclpy.shutdown()
 
 
-def _send(node, case: str, rate_hz: float, count: int) -> float:  # noqa: ANN001
+def _send(node, case: str, rate_hz: float, count: int) -> float:
     """Publish ``count`` messages at ``rate_hz``; returns the achieved rate."""
     from mindgrasp_ros import rclpy
 
@@ -107,7 +108,7 @@ def cross_process(case: str, rate_hz: float, count: int) -> tuple[list[int], flo
 
     with tempfile.NamedTemporaryFile(suffix='.json', delete=False) as f:
         out = f.name
-    proc = subprocess.Popen(  # noqa: S603
+    proc = subprocess.Popen(
         [sys.executable, __file__, '--role', 'recv', '--case', case, '--count', str(count),
          '--out', out], stdout=subprocess.PIPE, text=True)
     assert proc.stdout is not None
