@@ -301,25 +301,37 @@ class ColourDetector:
         height, width = rgb.shape[:2]
         if depth is not None:
             depth = check_depth(depth, shape=(height, width))
-        area = float(height * width)
-        min_pixels = max(1, round(self.min_pixels * area / (128.0 * 128.0)))
+        min_pixels = max(1, round(self.min_pixels * height * width / (128.0 * 128.0)))
         hsv = cv2.cvtColor(rgb, cv2.COLOR_RGB2HSV)
-        edges = None
-        if depth is not None and self.depth_edge > 0:
-            edges = self._depth_edges(depth)
+        kernel = self._kernel(height, width)
+        pad = 1 if kernel is None else kernel.shape[0]
         out: list[Detection] = []
         for colour, colour_range in self.colours.items():
-            mask = self._clean(colour_range.mask(hsv), height, width)
-            if not mask.any():
+            raw = colour_range.mask(hsv)
+            # work in the box round this colour's pixels (objects are small in 640x480)
+            x, y, w, h = cv2.boundingRect(raw)
+            if w == 0 or h == 0:
                 continue
-            out.extend(self._components(colour, mask, edges, depth, min_pixels, area))
+            x0, y0 = max(0, x - pad), max(0, y - pad)
+            x1, y1 = min(width, x + w + pad), min(height, y + h + pad)
+            mask = self._clean(raw[y0:y1, x0:x1], height, width)
+            if cv2.countNonZero(mask) < min_pixels:
+                continue
+            sub_depth = None if depth is None else depth[y0:y1, x0:x1]
+            out.extend(self._components(colour, mask, sub_depth, (x0, y0), (height, width),
+                                        min_pixels))
         return out
 
-    def _components(self, colour: str, mask: np.ndarray, edges: np.ndarray | None,
-                    depth: np.ndarray | None, min_pixels: int, area: float) -> list[Detection]:
-        height, width = mask.shape
+    def _components(self, colour: str, mask: np.ndarray, depth: np.ndarray | None,
+                    offset: tuple[int, int], image_size: tuple[int, int], min_pixels: int
+                    ) -> list[Detection]:
+        """Detections of one colour in a region of interest (``mask``/``depth`` are the region,
+        ``offset`` (x, y) its corner in the image, ``image_size`` (height, width))."""
+        height, width = image_size
+        area = float(height * width)
         n, labels, stats, _ = cv2.connectedComponentsWithStats(mask, connectivity=8)
-        if edges is not None and depth is not None and n > 1:
+        if depth is not None and self.depth_edge > 0 and n > 1:
+            edges = self._depth_edges(depth)
             n, labels, stats = self._split_by_depth(mask, labels, stats, n, edges, depth,
                                                     min_pixels)
         dets: list[Detection] = []
@@ -330,7 +342,6 @@ class ColourDetector:
             x, y = int(stats[i, cv2.CC_STAT_LEFT]), int(stats[i, cv2.CC_STAT_TOP])
             w, h = int(stats[i, cv2.CC_STAT_WIDTH]), int(stats[i, cv2.CC_STAT_HEIGHT])
             sub = labels[y:y + h, x:x + w] == i
-            centre = (x + (w - 1) / 2.0, y + (h - 1) / 2.0)
             distance, source = math.nan, 'none'
             if depth is not None:
                 values = depth[y:y + h, x:x + w][sub]
@@ -340,6 +351,8 @@ class ColourDetector:
             if source == 'none':
                 distance = self._distance_from_size(count)
                 source = 'none' if math.isnan(distance) else 'size'
+            x, y = x + offset[0], y + offset[1]   # image coordinates from here on
+            centre = (x + (w - 1) / 2.0, y + (h - 1) / 2.0)
             position = None
             if self.intrinsics is not None and not math.isnan(distance):
                 k = self.intrinsics
