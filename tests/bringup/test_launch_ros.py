@@ -68,6 +68,11 @@ def test_composed_runs_the_nodes_in_one_process(tmp_path: Path) -> None:
     assert 'composing 2 node(s) in one process: talker, listener' in result.stderr
     log = (run_dir / 'logs' / 'composed.log').read_text()
     assert 'Publishing: "greetings' in log and 'I heard: "greetings' in log
+    # output is prefixed by the node, and split into per-node logs
+    assert re.search(r'^\[listener\] \[INFO\] .*I heard: "greetings', result.stdout + result.stderr,
+                     re.MULTILINE)
+    assert 'I heard' in (run_dir / 'logs' / 'listener.log').read_text()
+    assert 'I heard' not in (run_dir / 'logs' / 'talker.log').read_text()
     pids = re.findall(r'process started with pid \[(\d+)\]', result.stderr)
     assert len(pids) == 1
     components = yaml.safe_load((run_dir / 'composed.yaml').read_text())['components']

@@ -4,7 +4,8 @@
 A node is composed when it is a Python node module (``Node(package, executable)`` that resolves
 to ``python -m package.executable``) without command-line ``arguments`` (components get only
 ``--ros-args``). The recorder, external drivers and ``ExecuteProcess`` actions keep their own
-processes. The container takes the composed nodes' place in the start order.
+processes. The container takes the composed nodes' place in the start order; its output is
+prefixed with each node's name (from the ROS log line) and also split into ``<node>.log``.
 """
 
 from __future__ import annotations
@@ -63,7 +64,9 @@ def compose(processes: list[ProcessSpec], commands: list[list[str]], run_dir: Pa
     rundir.write_yaml(plan_file, {'components': components},
                       header='nodes composed into one process (mindgrasp launch --composed)')
     container = ProcessSpec(label=CONTAINER_LABEL,
-                            program=[sys.executable, '-m', CONTAINER_MODULE, str(plan_file)])
+                            program=[sys.executable, '-m', CONTAINER_MODULE, str(plan_file)],
+                            logger_labels={c['node'].strip('/').replace('/', '.'): c['label']
+                                           for c in components if c['node']})
     out.insert(container_at or 0, (container, container.command()))
     logger.info('composing %d node(s) in one process: %s.', len(components),
                 ', '.join(c['label'] for c in components))

@@ -18,6 +18,7 @@ import contextlib
 import ctypes
 import logging
 import os
+import re
 import shlex
 import signal
 import subprocess
@@ -36,6 +37,8 @@ logger = logging.getLogger('launch')
 TAIL_LINES = 20
 _POLL_S = 0.05
 _CLEAN_ON_SIGINT = (0, -signal.SIGINT, 128 + signal.SIGINT)
+#: a ROS log line: [LEVEL] [stamp] [logger.name]: message (rcutils' default format)
+_LOG_LINE = re.compile(r'^\[[A-Z]+\] \[[0-9.]+\] \[([^\]]+)\]: ')
 
 try:  # children get SIGTERM if the launcher itself is killed (Linux)
     _LIBC = ctypes.CDLL(None, use_errno=True)
@@ -96,6 +99,7 @@ class ManagedProcess:
     how: str = 'not started'
     clean: bool = True
     lock: threading.Lock = field(default_factory=threading.Lock)
+    component_logs: dict[str, IO[str]] = field(default_factory=dict)
 
     @property
     def running(self) -> bool:
@@ -210,9 +214,29 @@ class Supervisor:
                         logger.error("cannot write the log of '%s' any more (%s); its output "
                                      "still goes to the terminal. Free disk space.",
                                      proc.label, exc)
+            label = proc.label
+            if proc.spec.logger_labels:  # composed: lines of a node's logger under its name
+                match = _LOG_LINE.match(text)
+                if match and match.group(1) in proc.spec.logger_labels:
+                    label = proc.spec.logger_labels[match.group(1)]
+                    self._component_log(proc, label, text)
             if show:
-                self.printer.line(proc.label, text, stderr=is_err)
+                self.printer.line(label, text, stderr=is_err)
         stream.close()
+
+    def _component_log(self, proc: ManagedProcess, label: str, text: str) -> None:
+        """Also write a composed node's lines to ``<label>.log``."""
+        with proc.lock:
+            handle = proc.component_logs.get(label)
+            if handle is None:
+                try:
+                    handle = (self.log_dir / f'{label}.log').open('a', encoding='utf-8')
+                except OSError:
+                    return
+                proc.component_logs[label] = handle
+            with contextlib.suppress(OSError, ValueError):
+                handle.write(text + '\n')
+                handle.flush()
 
     def _collect(self, proc: ManagedProcess) -> None:
         """Wait for the output threads of an exited process so its tail is complete."""
@@ -283,6 +307,9 @@ class Supervisor:
                 if proc.log_file is not None:
                     with proc.lock, contextlib.suppress(OSError):
                         proc.log_file.close()
+                for handle in proc.component_logs.values():
+                    with contextlib.suppress(OSError):
+                        handle.close()
         return self.results()
 
     def _loop(self) -> None:

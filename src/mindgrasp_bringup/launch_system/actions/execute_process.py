@@ -60,6 +60,8 @@ class ProcessSpec:
     problem: str | None = None             #: why it cannot start (e.g. missing module)
     daemon: bool = False                   #: stopped when every other process has ended
     composable: bool = False               #: a node module that composed mode can load
+    #: composed container: logger name ('ns.node') -> label, to prefix and split its output
+    logger_labels: dict[str, str] = field(default_factory=dict)
 
     @property
     def fully_qualified_name(self) -> str | None:
