@@ -6,10 +6,10 @@ Modes (all seeded: same seed and same inputs, same decisions):
     Never imagines anything, like the paper's unworn cap: the EEG carries no class information.
 ``follow``
     Imagines the class of each trainer prompt (``/trainer/prompt``) during the active phases
-    (default ``cue`` and ``move``), starting ``reaction_delay`` seconds after the prompt. Per
-    prompted trial it lapses (imagines nothing) with probability ``lapse_rate``; otherwise it
-    imagines the prompted class with probability ``accuracy`` and one of the three other classes
-    (uniformly) otherwise.
+    (default ``cue``, ``move``, ``wait``: Graz cue + imagery, Trainer move + wait), starting
+    ``reaction_delay`` seconds after the prompt. Per prompted trial it lapses (imagines nothing)
+    with probability ``lapse_rate``; otherwise it imagines the prompted class with probability
+    ``accuracy`` and one of the three other classes (uniformly) otherwise.
 ``pursue``
     Acts as a competent user of the MIndGrasp controller (see :func:`pursue_class`), from the task
     target, the scene objects, the base joint angle and the controller state. Every
@@ -136,7 +136,8 @@ class VirtualSubject:
 
     def __init__(self, mode: str = 'noise', *, accuracy: float = 1.0, reaction_delay: float = 0.5,
                  lapse_rate: float = 0.0, seed: int = 0,
-                 active_phases: Sequence[str] = ('cue', 'move'), decision_period: float = 0.5,
+                 active_phases: Sequence[str] = ('cue', 'move', 'wait'),
+                 decision_period: float = 0.5,
                  heading_tolerance: float = 0.1) -> None:
         if mode not in MODES:
             msg = f'The virtual subject mode must be one of {MODES}; {mode!r} is unknown.'
