@@ -1,0 +1,241 @@
+"""Labelled continuous EEG for training and evaluation: EDF files and recorded run bags.
+
+Every loader returns :class:`Recording` objects: continuous EEG in volts plus cue events
+(onset sample, MIndGrasp class), so training and evaluation window the data exactly as the online
+decoder does.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from mindgrasp_classifier.errors import ClassifierError
+from mindgrasp_classifier.model import CLASS_NAMES, class_index
+
+#: EEGMMIDB run -> {annotation: MIndGrasp class} (../shared/data/EEGMMIDB-README.md).
+EEGMMIDB_RUNS: dict[int, dict[str, int]] = {
+    **{r: {'T1': 0, 'T2': 1} for r in (3, 4, 7, 8, 11)},   # left / right fist
+    **{r: {'T1': 2, 'T2': 3} for r in (5, 6, 9, 10, 12, 13, 14)},  # both fists / both feet
+}
+EEGMMIDB_IMAGERY_RUNS = (4, 6, 8, 10, 12, 14)
+_EEGMMIDB_NAME = re.compile(r'^S(\d{3})R(\d{2})\.edf$', re.IGNORECASE)
+NO_CLASS = 255
+
+
+@dataclass
+class Recording:
+    """Continuous labelled EEG.
+
+    Attributes
+    ----------
+    data : ndarray, shape (n_samples, n_channels)
+        EEG in volts; NaN where samples were lost.
+    rate : float
+        Sampling rate (Hz).
+    channels : list of str
+    events : ndarray of int, shape (n_events, 2)
+        ``[onset_sample, class_index]`` of each cue, onset relative to ``data[0]``.
+    source : str
+        File or bag the data came from.
+    first_sample_index : int
+        Stream index of ``data[0]`` (0 for files).
+    """
+
+    data: np.ndarray
+    rate: float
+    channels: list[str]
+    events: np.ndarray
+    source: str
+    first_sample_index: int = 0
+
+
+def parse_event_map(text: str) -> dict[str, int]:
+    """Parse ``'T1=left_hand,T2=right_hand'`` into ``{'T1': 0, 'T2': 1}``."""
+    out: dict[str, int] = {}
+    for item in filter(None, (s.strip() for s in text.split(','))):
+        if '=' not in item:
+            msg = (f'The event map entry {item!r} has no "="; write entries as '
+                   'annotation=class, e.g. T1=left_hand,T2=right_hand.')
+            raise ClassifierError(msg)
+        key, value = (s.strip() for s in item.split('=', 1))
+        out[key] = class_index(value)
+    if not out:
+        msg = 'The event map is empty; give entries such as T1=left_hand,T2=right_hand.'
+        raise ClassifierError(msg)
+    return out
+
+
+def eegmmidb_run(path: str | Path) -> tuple[int, int] | None:
+    """(subject, run) if ``path`` is named like an EEGMMIDB file (SxxxRyy.edf), else None."""
+    m = _EEGMMIDB_NAME.match(Path(path).name)
+    return (int(m.group(1)), int(m.group(2))) if m else None
+
+
+def load_edf(path: str | Path, event_map: dict[str, int] | None = None) -> Recording:
+    """Load an EDF/BDF/GDF file (through MNE) with cue events from its annotations.
+
+    EEGMMIDB files (SxxxRyy.edf) are labelled with the dataset's run/class mapping and their
+    channel names standardised; other files need ``event_map`` (annotation -> class).
+    """
+    import mne
+
+    path = Path(path)
+    if not path.is_file():
+        msg = f'The EEG file {path} does not exist; check the path.'
+        raise ClassifierError(msg)
+    run = eegmmidb_run(path)
+    if event_map is None:
+        if run is None:
+            msg = (f'{path.name} is not an EEGMMIDB file (SxxxRyy.edf), so its annotations have '
+                   'no known classes; pass --event-map, e.g. T1=left_hand,T2=right_hand.')
+            raise ClassifierError(msg)
+        if run[1] not in EEGMMIDB_RUNS:
+            msg = (f'{path.name} is EEGMMIDB run {run[1]}, a baseline run without MI cues; use '
+                   'runs 4, 8, 12 (left/right) or 6, 10, 14 (hands/feet).')
+            raise ClassifierError(msg)
+        event_map = EEGMMIDB_RUNS[run[1]]
+    try:
+        raw = mne.io.read_raw(path, preload=True, verbose='error')
+    except Exception as exc:  # MNE raises many types for unreadable files
+        msg = f'MNE cannot read {path} ({type(exc).__name__}: {exc}); check that it is EDF/BDF/GDF.'
+        raise ClassifierError(msg) from None
+    if run is not None:
+        mne.datasets.eegbci.standardize(raw)
+    raw.pick('eeg')
+    rate = float(raw.info['sfreq'])
+    events = []
+    for ann in raw.annotations:
+        label = ann['description']
+        if label in event_map:
+            onset = int(raw.time_as_index(ann['onset'], use_rounding=True)[0])
+            events.append((onset, event_map[label]))
+    return Recording(data=raw.get_data().T, rate=rate, channels=list(raw.ch_names),
+                     events=np.array(events, dtype=int).reshape(-1, 2), source=str(path))
+
+
+def eegbci_files(subject: int, runs: Sequence[int], path: str | None = None) -> list[Path]:
+    """Paths of EEGMMIDB runs through MNE's loader (``MNE_DATASETS_EEGBCI_PATH`` by default)."""
+    import mne
+
+    path = path or os.environ.get('MNE_DATASETS_EEGBCI_PATH')
+    try:
+        files = mne.datasets.eegbci.load_data(subject, list(runs), path=path, update_path=False)
+    except Exception as exc:  # network or file errors from pooch/MNE
+        msg = (f'MNE could not provide EEGMMIDB subject {subject} runs {list(runs)} from {path} '
+               f'({type(exc).__name__}: {exc}); set MNE_DATASETS_EEGBCI_PATH to the data folder.')
+        raise ClassifierError(msg) from None
+    return [Path(f) for f in files]
+
+
+# --------------------------------------------------------------------------- bags
+def load_bag(path: str | Path, eeg_topic: str = '/eeg/raw',
+             prompt_topic: str = '/trainer/prompt') -> Recording:
+    """Load a recorded run (rosbag2 folder) with EEG chunks and trainer prompts.
+
+    The label of a trial is the prompt class; its onset is the first prompt of the trial that
+    carries a class (the Graz ``cue`` or the trainer's ``move`` phase). Lost samples (gaps in
+    ``first_sample_index``) are NaN, and windows over them are skipped.
+    """
+    from rosbags.rosbag2 import Reader
+
+    from mindgrasp_ros.typesupport import typestore
+
+    path = Path(path)
+    if not path.exists():
+        msg = f'The bag {path} does not exist; give a run directory or its rosbag2 folder.'
+        raise ClassifierError(msg)
+    bag_dir = _find_bag_dir(path)
+    store = typestore()
+    chunks, prompts = [], []
+    try:
+        with Reader(bag_dir) as reader:
+            topics = {c.topic for c in reader.connections}
+            if eeg_topic not in topics:
+                msg = (f'The bag {bag_dir} has no {eeg_topic} topic (it has {sorted(topics)}); '
+                       'record the EEG stream or name the EEG topic.')
+                raise ClassifierError(msg)
+            conns = [c for c in reader.connections if c.topic in (eeg_topic, prompt_topic)]
+            for conn, _t, raw in reader.messages(connections=conns):
+                msg_obj = store.deserialize_cdr(raw, conn.msgtype)
+                (chunks if conn.topic == eeg_topic else prompts).append(msg_obj)
+    except ClassifierError:
+        raise
+    except Exception as exc:  # rosbags raises its own error types for damaged bags
+        msg = f'Cannot read the bag {bag_dir} ({type(exc).__name__}: {exc}); is it a rosbag2?'
+        raise ClassifierError(msg) from None
+    if not chunks:
+        msg = f'The bag {bag_dir} has no EEG messages on {eeg_topic}; record a run with EEG.'
+        raise ClassifierError(msg)
+    rate = float(chunks[0].sample_rate)
+    channels = list(chunks[0].channel_names)
+    n_ch = len(channels)
+    base = min(int(c.first_sample_index) for c in chunks)
+    stop = max(int(c.first_sample_index) + int(c.n_samples) for c in chunks)
+    data = np.full((stop - base, n_ch), np.nan)
+    offsets = []
+    for c in chunks:
+        if list(c.channel_names) != channels or float(c.sample_rate) != rate:
+            msg = (f'The EEG stream in {bag_dir} changes channels or rate mid-run; split the bag '
+                   'at the change.')
+            raise ClassifierError(msg)
+        block = np.asarray(c.data, dtype=float).reshape(int(c.n_samples), n_ch)
+        if c.unit and c.unit not in ('V', 'volt', 'volts'):
+            scale = {'uV': 1e-6, 'µV': 1e-6, 'mV': 1e-3}.get(c.unit)
+            if scale is None:
+                msg = f'Unknown EEG unit {c.unit!r} in {bag_dir}; record in V, mV or uV.'
+                raise ClassifierError(msg)
+            block = block * scale
+        i0 = int(c.first_sample_index) - base
+        data[i0:i0 + block.shape[0]] = block
+        t0 = c.header.stamp.sec + 1e-9 * c.header.stamp.nanosec
+        offsets.append(t0 - int(c.first_sample_index) / rate)
+    # Stream time of stream index i: offset + i / rate (median over chunks: robust to jitter).
+    offset = float(np.median(offsets))
+    events, seen = [], set()
+    for p in sorted(prompts, key=lambda m: (m.header.stamp.sec, m.header.stamp.nanosec)):
+        if int(p.class_index) == NO_CLASS or p.phase not in ('cue', 'move') or p.trial in seen:
+            continue
+        seen.add(p.trial)
+        t = p.header.stamp.sec + 1e-9 * p.header.stamp.nanosec
+        onset = round((t - offset) * rate) - base
+        if 0 <= onset < data.shape[0] and int(p.class_index) < len(CLASS_NAMES):
+            events.append((onset, int(p.class_index)))
+    return Recording(data=data, rate=rate, channels=channels,
+                     events=np.array(events, dtype=int).reshape(-1, 2), source=str(bag_dir),
+                     first_sample_index=base)
+
+
+def _find_bag_dir(path: Path) -> Path:
+    """The rosbag2 folder (with metadata.yaml) at or below ``path``."""
+    if (path / 'metadata.yaml').is_file():
+        return path
+    found = sorted(p.parent for p in path.rglob('metadata.yaml'))
+    if len(found) == 1:
+        return found[0]
+    if not found:
+        msg = f'{path} holds no rosbag2 (no metadata.yaml); give the run directory of a recording.'
+    else:
+        msg = f'{path} holds several bags ({[str(f) for f in found]}); give one of them.'
+    raise ClassifierError(msg)
+
+
+def load_inputs(edf: Iterable[str] = (), bags: Iterable[str] = (), event_map: str | None = None,
+                eegbci_subject: int | None = None, eegbci_runs: Sequence[int] = (),
+                eeg_topic: str = '/eeg/raw',
+                prompt_topic: str = '/trainer/prompt') -> list[Recording]:
+    """Load every input named on a command line; raises if none is given."""
+    emap = parse_event_map(event_map) if event_map else None
+    recs = [load_edf(p, emap) for p in edf]
+    if eegbci_subject is not None:
+        recs += [load_edf(p) for p in eegbci_files(eegbci_subject, eegbci_runs or (4, 6, 8, 10))]
+    recs += [load_bag(p, eeg_topic, prompt_topic) for p in bags]
+    if not recs:
+        msg = 'No input data; give --edf FILES, --bag RUNS or --eegbci SUBJECT.'
+        raise ClassifierError(msg)
+    return recs

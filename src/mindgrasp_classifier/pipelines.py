@@ -1,0 +1,274 @@
+# ruff: noqa: N803, N806 - X is scikit-learn's name for the data
+"""Riemannian classifiers on covariance matrices, with explicit-array state for safe model files.
+
+Each classifier is a scikit-learn estimator over SPD matrices, shape (n_matrices, n_channels,
+n_channels), fitted through pyRiemann, that also exposes per-class ``distances`` (the quantity of
+MIndGrasp's certainty, Eq. 1) and ``to_arrays``/``from_arrays`` so a model is stored as plain
+numpy arrays (no pickle).
+
+- :class:`MdmClassifier`: minimum distance to Riemannian class means (pyRiemann ``MDM``).
+- :class:`FgMdmClassifier`: MDM after geodesic filtering (pyRiemann ``FgMDM``).
+- :class:`TsLrClassifier`: tangent space + logistic regression; its "distances" are
+  ``-log p(class)``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from pyriemann.classification import MDM, FgMDM
+from pyriemann.geometry.base import invsqrtm
+from pyriemann.geometry.geodesic import geodesic_riemann
+from pyriemann.geometry.mean import mean_riemann
+from pyriemann.geometry.tangentspace import tangent_space, untangent_space
+from sklearn.base import BaseEstimator, ClassifierMixin
+from sklearn.linear_model import LogisticRegression
+
+from mindgrasp_classifier.errors import ClassifierError
+
+PIPELINES = ('mdm', 'fgmdm', 'ts_lr')
+
+
+def riemann_distances(covs: np.ndarray, means_invsqrt: np.ndarray) -> np.ndarray:
+    """Affine-invariant Riemannian distances of each matrix to each class mean.
+
+    Parameters
+    ----------
+    covs : ndarray, shape (n_matrices, n_channels, n_channels)
+    means_invsqrt : ndarray, shape (n_classes, n_channels, n_channels)
+        ``M_k^{-1/2}`` of each class mean (precomputed once per model/update).
+
+    Returns
+    -------
+    d : ndarray, shape (n_matrices, n_classes)
+        ``|| log(M_k^{-1/2} C M_k^{-1/2}) ||_F`` (same as pyRiemann ``distance_riemann``).
+    """
+    whitened = np.einsum('kab,nbc,kdc->nkad', means_invsqrt, covs, means_invsqrt, optimize=True)
+    eig = np.linalg.eigvalsh(whitened)
+    return np.sqrt(np.sum(np.log(np.clip(eig, 1e-300, None)) ** 2, axis=-1))
+
+
+def certainty(distances: np.ndarray) -> np.ndarray:
+    """MIndGrasp certainty (paper Eq. 1): ``mean(d) - min(d)`` over classes.
+
+    Parameters
+    ----------
+    distances : ndarray, shape (..., n_classes)
+
+    Returns
+    -------
+    c : ndarray, shape (...)
+    """
+    d = np.asarray(distances, dtype=float)
+    return d.mean(axis=-1) - d.min(axis=-1)
+
+
+def _check_covs(X: np.ndarray) -> np.ndarray:
+    X = np.asarray(X, dtype=float)
+    if X.ndim != 3 or X.shape[1] != X.shape[2]:
+        msg = (f'Expected covariance matrices of shape (n_matrices, n_channels, n_channels); '
+               f'got {X.shape}. Estimate covariances of the windows first.')
+        raise ClassifierError(msg)
+    return X
+
+
+class _DistanceClassifier(ClassifierMixin, BaseEstimator):
+    """Common predict/score on top of ``distances``."""
+
+    classes_: np.ndarray
+
+    def distances(self, X: np.ndarray) -> np.ndarray:  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def predict(self, X: np.ndarray) -> np.ndarray:
+        """Class of each matrix: the one at the smallest distance."""
+        return self.classes_[np.argmin(self.distances(X), axis=1)]
+
+    def predict_proba(self, X: np.ndarray) -> np.ndarray:
+        """Softmax of ``-d**2`` (as pyRiemann's MDM)."""
+        d = self.distances(X)
+        z = -(d ** 2)
+        z -= z.max(axis=1, keepdims=True)
+        p = np.exp(z)
+        return p / p.sum(axis=1, keepdims=True)
+
+    def certainty(self, X: np.ndarray) -> np.ndarray:
+        """Certainty of each matrix, ``mean(d) - min(d)``, shape (n_matrices,)."""
+        return certainty(self.distances(X))
+
+
+class MdmClassifier(_DistanceClassifier):
+    """Minimum distance to Riemannian class means (pyRiemann ``MDM``, affine-invariant metric).
+
+    Attributes
+    ----------
+    classes_ : ndarray, shape (n_classes,)
+    covmeans_ : ndarray, shape (n_classes, n_channels, n_channels)
+    """
+
+    name = 'mdm'
+    supports_mean_update = True
+
+    def fit(self, X: np.ndarray, y: np.ndarray) -> MdmClassifier:
+        """Fit class means on covariances ``X`` with labels ``y``."""
+        X = _check_covs(X)
+        mdm = MDM(metric='riemann').fit(X, np.asarray(y))
+        self.classes_ = mdm.classes_
+        self.covmeans_ = np.asarray(mdm.covmeans_, dtype=float)
+        self._refresh()
+        return self
+
+    def _refresh(self) -> None:
+        self._means_invsqrt = invsqrtm(self.covmeans_)
+
+    def _features(self, X: np.ndarray) -> np.ndarray:
+        return X
+
+    def distances(self, X: np.ndarray) -> np.ndarray:
+        """Riemannian distance to each class mean, shape (n_matrices, n_classes)."""
+        return riemann_distances(self._features(_check_covs(X)), self._means_invsqrt)
+
+    def update_mean(self, class_position: int, cov: np.ndarray, rate: float) -> None:
+        """Move one class mean along the geodesic towards ``cov`` by ``rate`` (0..1)."""
+        target = self._features(_check_covs(cov[None]))[0]
+        self.covmeans_[class_position] = geodesic_riemann(
+            self.covmeans_[class_position], target, rate)
+        self._means_invsqrt[class_position] = invsqrtm(self.covmeans_[class_position])
+
+    def to_arrays(self) -> dict[str, np.ndarray]:
+        """State as named arrays."""
+        return {'covmeans': self.covmeans_}
+
+    @classmethod
+    def from_arrays(cls, classes: np.ndarray, arrays: dict[str, np.ndarray]) -> MdmClassifier:
+        """Rebuild a fitted classifier from :meth:`to_arrays` output."""
+        self = cls()
+        self.classes_ = np.asarray(classes)
+        self.covmeans_ = np.array(arrays['covmeans'], dtype=float)
+        self._refresh()
+        return self
+
+
+class FgMdmClassifier(MdmClassifier):
+    """MDM after geodesic filtering (FGDA, pyRiemann ``FgMDM``).
+
+    Attributes
+    ----------
+    reference_ : ndarray, shape (n_channels, n_channels)
+        Tangent-space reference point of the filter.
+    filter_ : ndarray, shape (n_features, n_features)
+        Projection in the tangent space (FGDA's ``W``), ``n_features = n(n+1)/2``.
+    covmeans_ : ndarray, shape (n_classes, n_channels, n_channels)
+        Class means of the filtered matrices.
+    """
+
+    name = 'fgmdm'
+
+    def fit(self, X: np.ndarray, y: np.ndarray) -> FgMdmClassifier:
+        """Fit the geodesic filter and the class means."""
+        X = _check_covs(X)
+        fg = FgMDM(metric='riemann').fit(X, np.asarray(y))
+        self.classes_ = fg.classes_
+        self.reference_ = np.asarray(fg._fgda._ts.reference_, dtype=float)
+        self.filter_ = np.asarray(fg._fgda._W, dtype=float)
+        self.covmeans_ = np.asarray(fg._mdm.covmeans_, dtype=float)
+        self._refresh()
+        return self
+
+    def _features(self, X: np.ndarray) -> np.ndarray:
+        ts = tangent_space(X, self.reference_, metric='riemann')
+        return untangent_space(ts @ self.filter_, self.reference_, metric='riemann')
+
+    def to_arrays(self) -> dict[str, np.ndarray]:
+        """State as named arrays."""
+        return {'covmeans': self.covmeans_, 'reference': self.reference_, 'filter': self.filter_}
+
+    @classmethod
+    def from_arrays(cls, classes: np.ndarray, arrays: dict[str, np.ndarray]) -> FgMdmClassifier:
+        """Rebuild a fitted classifier from :meth:`to_arrays` output."""
+        self = cls()
+        self.classes_ = np.asarray(classes)
+        self.covmeans_ = np.array(arrays['covmeans'], dtype=float)
+        self.reference_ = np.array(arrays['reference'], dtype=float)
+        self.filter_ = np.array(arrays['filter'], dtype=float)
+        self._refresh()
+        return self
+
+
+class TsLrClassifier(_DistanceClassifier):
+    """Tangent space at the Riemannian mean + L2 logistic regression.
+
+    ``distances`` are ``-log p(class | X)``, so the certainty formula applies unchanged.
+
+    Parameters
+    ----------
+    C : float
+        Inverse L2 regularisation strength of the logistic regression.
+    """
+
+    name = 'ts_lr'
+    supports_mean_update = False
+
+    def __init__(self, C: float = 1.0) -> None:
+        self.C = C
+
+    def fit(self, X: np.ndarray, y: np.ndarray) -> TsLrClassifier:
+        """Fit the reference point and the logistic regression."""
+        X = _check_covs(X)
+        self.reference_ = mean_riemann(X)
+        lr = LogisticRegression(C=self.C, max_iter=2000)
+        lr.fit(tangent_space(X, self.reference_, metric='riemann'), np.asarray(y))
+        self.classes_ = lr.classes_
+        self.coef_ = np.atleast_2d(lr.coef_).astype(float)
+        self.intercept_ = np.atleast_1d(lr.intercept_).astype(float)
+        return self
+
+    def _log_proba(self, X: np.ndarray) -> np.ndarray:
+        z = tangent_space(_check_covs(X), self.reference_, metric='riemann') @ self.coef_.T
+        z = z + self.intercept_
+        if z.shape[1] == 1:  # binary: scikit-learn's single decision function
+            z = np.hstack([np.zeros_like(z), z])
+        z -= z.max(axis=1, keepdims=True)
+        return z - np.log(np.exp(z).sum(axis=1, keepdims=True))
+
+    def predict_proba(self, X: np.ndarray) -> np.ndarray:
+        """Class probabilities of the logistic regression."""
+        return np.exp(self._log_proba(X))
+
+    def distances(self, X: np.ndarray) -> np.ndarray:
+        """``-log p(class)``, shape (n_matrices, n_classes)."""
+        return -self._log_proba(X)
+
+    def to_arrays(self) -> dict[str, np.ndarray]:
+        """State as named arrays."""
+        return {'reference': self.reference_, 'coef': self.coef_, 'intercept': self.intercept_}
+
+    @classmethod
+    def from_arrays(cls, classes: np.ndarray, arrays: dict[str, np.ndarray]) -> TsLrClassifier:
+        """Rebuild a fitted classifier from :meth:`to_arrays` output."""
+        self = cls()
+        self.classes_ = np.asarray(classes)
+        self.reference_ = np.array(arrays['reference'], dtype=float)
+        self.coef_ = np.array(arrays['coef'], dtype=float)
+        self.intercept_ = np.array(arrays['intercept'], dtype=float)
+        return self
+
+
+_CLASSES = {'mdm': MdmClassifier, 'fgmdm': FgMdmClassifier, 'ts_lr': TsLrClassifier}
+
+
+def make_classifier(name: str) -> _DistanceClassifier:
+    """A new, unfitted classifier by pipeline name (``mdm``, ``fgmdm`` or ``ts_lr``)."""
+    try:
+        return _CLASSES[name]()
+    except KeyError:
+        msg = f'Unknown pipeline {name!r}; choose one of {list(PIPELINES)}.'
+        raise ClassifierError(msg) from None
+
+
+def classifier_from_arrays(name: str, classes: np.ndarray,
+                           arrays: dict[str, np.ndarray]) -> _DistanceClassifier:
+    """Rebuild a fitted classifier of pipeline ``name`` from stored arrays."""
+    if name not in _CLASSES:
+        msg = f'The model names an unknown pipeline {name!r}; known: {list(PIPELINES)}.'
+        raise ClassifierError(msg)
+    return _CLASSES[name].from_arrays(classes, arrays)

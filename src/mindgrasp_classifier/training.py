@@ -1,0 +1,351 @@
+"""Training and offline evaluation of MI models on labelled recordings.
+
+Windows are cut from the causally filtered continuous recording on the online decoder's window
+grid (see :mod:`mindgrasp_classifier.decoder`), so offline figures describe the online decoder.
+A trial is decided by the smallest mean distance over its windows.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import asdict, dataclass, field
+from typing import Any
+
+import numpy as np
+from pyriemann.geometry.mean import mean_riemann
+from sklearn.metrics import balanced_accuracy_score, confusion_matrix
+from sklearn.model_selection import StratifiedGroupKFold
+
+from mindgrasp_classifier.data import Recording
+from mindgrasp_classifier.decoder import decode_windows, filter_recording, window_covariances
+from mindgrasp_classifier.errors import ClassifierError
+from mindgrasp_classifier.model import CLASS_NAMES, MiModel, library_versions
+from mindgrasp_classifier.pipelines import PIPELINES, certainty, make_classifier
+from mindgrasp_classifier.preprocessing import (
+    select_channels,
+    step_samples,
+    window_ends,
+    window_samples,
+)
+
+
+@dataclass
+class TrainingConfig:
+    """Settings of a model (all times in seconds, frequencies in Hz).
+
+    Attributes
+    ----------
+    pipeline : str
+        ``mdm`` (default), ``fgmdm`` or ``ts_lr``.
+    channels : str or list of str
+        ``motor`` (default), ``all`` or channel names.
+    band : (float, float)
+        Band-pass edges, 8-30 Hz by default.
+    filter_order : int
+    window, step : float
+        Window length (1 s) and online step (1/16 s).
+    train_step : float
+        Step between training windows inside an epoch.
+    tmin, tmax : float
+        Epoch relative to the cue (0.5 s to 2.5 s).
+    estimator : str
+        pyRiemann covariance estimator (``oas``).
+    classes : list of int or None
+        Classes to keep (None: every class in the data).
+    cv_folds : int
+        Cross-validation folds (grouped by trial).
+    min_trials : int
+        Fewest trials per class to train.
+    seed : int
+        Seed of the fold shuffling.
+    """
+
+    pipeline: str = 'mdm'
+    channels: str | list[str] = 'motor'
+    band: tuple[float, float] = (8.0, 30.0)
+    filter_order: int = 4
+    window: float = 1.0
+    step: float = 1.0 / 16.0
+    train_step: float = 1.0 / 16.0
+    tmin: float = 0.5
+    tmax: float = 2.5
+    estimator: str = 'oas'
+    classes: list[int] | None = None
+    cv_folds: int = 5
+    min_trials: int = 5
+    seed: int = 0
+
+    def check(self) -> None:
+        """Raise :class:`ClassifierError` on an invalid setting."""
+        if self.pipeline not in PIPELINES:
+            msg = f'Unknown pipeline {self.pipeline!r}; choose one of {list(PIPELINES)}.'
+            raise ClassifierError(msg)
+        if self.tmax - self.tmin < self.window:
+            msg = (f'The epoch {self.tmin}-{self.tmax} s is shorter than the window '
+                   f'({self.window} s); widen the epoch or shorten the window.')
+            raise ClassifierError(msg)
+        if self.step <= 0 or self.train_step <= 0:
+            msg = (f'Window steps must be positive; got step={self.step}, '
+                   f'train_step={self.train_step}.')
+            raise ClassifierError(msg)
+
+
+@dataclass
+class Windows:
+    """Covariances of epoch windows with their trial labels.
+
+    Attributes
+    ----------
+    covs : ndarray, shape (n_windows, n_channels, n_channels)
+    labels : ndarray of int, shape (n_windows,)
+    trials : ndarray of int, shape (n_windows,)
+        Global trial id of each window.
+    ends : ndarray of int, shape (n_windows,)
+        Last sample of each window, in its recording.
+    trial_labels : ndarray of int, shape (n_trials,)
+    """
+
+    covs: np.ndarray
+    labels: np.ndarray
+    trials: np.ndarray
+    ends: np.ndarray
+    trial_labels: np.ndarray
+    session_covs: list[np.ndarray] = field(default_factory=list)
+
+
+def epoch_windows(model: MiModel, recordings: Sequence[Recording], tmin: float, tmax: float,
+                  step: float, classes: Sequence[int] | None = None,
+                  session_step: float | None = None) -> Windows:
+    """Filter each recording, cut windows inside each cue epoch, estimate covariances.
+
+    ``session_step`` (s), when given, also collects covariances over each whole recording (for
+    re-centering on a session) in ``session_covs``.
+    """
+    n_window = window_samples(model.rate, model.window)
+    n_step = step_samples(model.rate, step)
+    covs, labels, trials, ends_all, trial_labels = [], [], [], [], []
+    session_covs = []
+    for rec in recordings:
+        filtered = filter_recording(model, rec.data, rec.channels, rec.rate)
+        finite = np.isfinite(filtered).all(axis=1)
+        bad_before = np.concatenate([[0], np.cumsum(~finite)])
+        for onset, cls in rec.events:
+            if classes is not None and cls not in classes:
+                continue
+            start = onset + round(tmin * rec.rate)
+            stop = min(onset + round(tmax * rec.rate), filtered.shape[0])
+            ends = window_ends(start, stop, n_window, n_step)
+            ends = ends[bad_before[ends + 1] - bad_before[ends - n_window + 1] == 0]
+            if len(ends) == 0:
+                continue
+            covs.append(window_covariances(model, filtered, ends))
+            labels += [int(cls)] * len(ends)
+            trials += [len(trial_labels)] * len(ends)
+            ends_all.append(ends)
+            trial_labels.append(int(cls))
+        if session_step is not None:
+            ends = window_ends(0, filtered.shape[0], n_window,
+                               step_samples(model.rate, session_step))
+            ends = ends[bad_before[ends + 1] - bad_before[ends - n_window + 1] == 0]
+            session_covs.append(window_covariances(model, filtered, ends))
+    n = len(model.channels)
+    return Windows(
+        covs=np.concatenate(covs) if covs else np.zeros((0, n, n)),
+        labels=np.array(labels, dtype=int), trials=np.array(trials, dtype=int),
+        ends=np.concatenate(ends_all) if ends_all else np.zeros(0, dtype=int),
+        trial_labels=np.array(trial_labels, dtype=int), session_covs=session_covs)
+
+
+def _check_counts(trial_labels: np.ndarray, min_trials: int) -> list[int]:
+    classes, counts = np.unique(trial_labels, return_counts=True)
+    table = {CLASS_NAMES[c]: int(n) for c, n in zip(classes, counts, strict=True)}
+    if len(classes) < 2:
+        msg = (f'Training needs at least two classes; the data have trials of {table or "none"}. '
+               'Add recordings with other classes (or check the event map).')
+        raise ClassifierError(msg)
+    if counts.min() < min_trials:
+        msg = (f'Too few trials per class to train: {table} (at least {min_trials} per class are '
+               'needed); record more trials or lower --min-trials.')
+        raise ClassifierError(msg)
+    return [int(c) for c in classes]
+
+
+def trial_decisions(distances: np.ndarray, trials: np.ndarray,
+                    n_trials: int) -> tuple[np.ndarray, np.ndarray]:
+    """Mean distance per trial and the position of its smallest class distance.
+
+    Returns (mean_distances (n_trials, n_classes), argmin positions (n_trials,)).
+    """
+    sums = np.zeros((n_trials, distances.shape[1]))
+    np.add.at(sums, trials, distances)
+    counts = np.bincount(trials, minlength=n_trials)[:, None]
+    mean = sums / np.maximum(counts, 1)
+    return mean, np.argmin(mean, axis=1)
+
+
+def score(classes: Sequence[int], distances: np.ndarray, window_labels: np.ndarray,
+          trials: np.ndarray, trial_labels: np.ndarray) -> dict[str, Any]:
+    """Accuracy figures of window distances against labels.
+
+    Parameters
+    ----------
+    classes : sequence of int
+        Model classes, the column order of ``distances``.
+    distances : ndarray, shape (n_windows, n_classes)
+    window_labels, trials : ndarray of int, shape (n_windows,)
+    trial_labels : ndarray of int, shape (n_trials,)
+
+    Returns
+    -------
+    report : dict
+        ``accuracy`` and ``balanced_accuracy`` (per trial), ``window_accuracy``, ``n_trials``,
+        ``n_windows``, ``confusion`` (rows true, columns predicted, order of ``classes``),
+        ``classes`` (names), ``chance``, and ``certainty`` per true class (window statistics).
+    """
+    classes = np.asarray(classes)
+    win_pred = classes[np.argmin(distances, axis=1)]
+    _, pos = trial_decisions(distances, trials, len(trial_labels))
+    trial_pred = classes[pos]
+    cert = certainty(distances)
+    cert_stats = {}
+    for c in classes:
+        sel = cert[window_labels == c]
+        if len(sel):
+            cert_stats[CLASS_NAMES[c]] = {
+                'mean': float(sel.mean()), 'std': float(sel.std()),
+                'q25': float(np.quantile(sel, 0.25)), 'median': float(np.median(sel)),
+                'q75': float(np.quantile(sel, 0.75)),
+                'mean_correct': float(cert[(window_labels == c) & (win_pred == c)].mean())
+                if np.any((window_labels == c) & (win_pred == c)) else None,
+            }
+    return {
+        'accuracy': float(np.mean(trial_pred == trial_labels)),
+        'balanced_accuracy': float(balanced_accuracy_score(trial_labels, trial_pred)),
+        'window_accuracy': float(np.mean(win_pred == window_labels)),
+        'window_balanced_accuracy': float(balanced_accuracy_score(window_labels, win_pred)),
+        'n_trials': len(trial_labels),
+        'n_windows': len(window_labels),
+        'trials_per_class': {CLASS_NAMES[c]: int(np.sum(trial_labels == c)) for c in classes},
+        'confusion': confusion_matrix(trial_labels, trial_pred, labels=classes).tolist(),
+        'classes': [CLASS_NAMES[c] for c in classes],
+        'chance': float(1.0 / len(classes)),
+        'certainty': cert_stats,
+    }
+
+
+def _blank_model(cfg: TrainingConfig, rec: Recording, classes: list[int]) -> MiModel:
+    channels = select_channels(rec.channels, cfg.channels)
+    n = len(channels)
+    return MiModel(classes=classes, channels=channels, rate=rec.rate, band=tuple(cfg.band),
+                   filter_order=cfg.filter_order, window=cfg.window, step=cfg.step,
+                   pipeline=cfg.pipeline, classifier=make_classifier(cfg.pipeline),
+                   reference=np.eye(n), estimator=cfg.estimator)
+
+
+def _fit(model: MiModel, covs: np.ndarray, labels: np.ndarray) -> None:
+    model.reference = mean_riemann(covs)
+    model.classifier = make_classifier(model.pipeline)
+    model.classifier.fit(MiModel.recenter(covs, model.reference), labels)
+
+
+def train(recordings: Sequence[Recording], cfg: TrainingConfig | None = None,
+          cross_validate: bool = True) -> tuple[MiModel, dict[str, Any]]:
+    """Train a model on labelled recordings.
+
+    Returns
+    -------
+    model : MiModel
+        Fitted on all trials; ``model.provenance`` holds the data, settings and CV results.
+    report : dict
+        Cross-validation figures from :func:`score` (empty when ``cross_validate`` is False),
+        plus ``trials_per_class``.
+    """
+    cfg = cfg or TrainingConfig()
+    cfg.check()
+    if not recordings:
+        msg = 'No recordings to train on; give EEG files or bags.'
+        raise ClassifierError(msg)
+    rates = {rec.rate for rec in recordings}
+    if len(rates) > 1:
+        msg = (f'The recordings have different sampling rates {sorted(rates)} Hz; train on '
+               'recordings of one rate (resample the others first).')
+        raise ClassifierError(msg)
+    all_events = np.concatenate([rec.events[:, 1] for rec in recordings])
+    present = sorted(set(all_events.tolist()))
+    wanted = cfg.classes if cfg.classes is not None else present
+    model = _blank_model(cfg, recordings[0], sorted(wanted))
+    win = epoch_windows(model, recordings, cfg.tmin, cfg.tmax, cfg.train_step, wanted)
+    classes = _check_counts(win.trial_labels, cfg.min_trials)
+    if cfg.classes is not None and sorted(cfg.classes) != classes:
+        missing = sorted(set(cfg.classes) - set(classes))
+        msg = (f'The data have no trials of {[CLASS_NAMES[c] for c in missing]}; record them or '
+               'drop them from --classes.')
+        raise ClassifierError(msg)
+    model.classes = classes
+    report: dict[str, Any] = {}
+    if cross_validate:
+        report = cross_validate_windows(model, win, cfg.cv_folds, cfg.seed)
+    _fit(model, win.covs, win.labels)
+    model.provenance = {
+        'sources': [rec.source for rec in recordings],
+        'trials_per_class': {CLASS_NAMES[c]: int(np.sum(win.trial_labels == c)) for c in classes},
+        'n_windows': len(win.labels),
+        'config': asdict(cfg),
+        'cross_validation': {k: report[k] for k in ('accuracy', 'balanced_accuracy',
+                                                    'window_accuracy', 'confusion', 'folds')
+                             if k in report},
+    }
+    model.versions = library_versions()
+    return model, report
+
+
+def cross_validate_windows(model: MiModel, win: Windows, folds: int, seed: int) -> dict[str, Any]:
+    """Trial-grouped stratified cross-validation (windows of a trial stay in one fold)."""
+    n_folds = int(min(folds, np.bincount(win.trial_labels).max(initial=0),
+                      min(np.sum(win.trial_labels == c) for c in model.classes)))
+    if n_folds < 2:
+        msg = 'Cross-validation needs at least 2 trials per class; record more trials.'
+        raise ClassifierError(msg)
+    cv = StratifiedGroupKFold(n_splits=n_folds, shuffle=True, random_state=seed)
+    distances = np.zeros((len(win.labels), len(model.classes)))
+    fold_model = model.copy()
+    for train_idx, test_idx in cv.split(win.covs, win.labels, win.trials):
+        _fit(fold_model, win.covs[train_idx], win.labels[train_idx])
+        distances[test_idx] = decode_windows(fold_model, win.covs[test_idx])
+    report = score(model.classes, distances, win.labels, win.trials, win.trial_labels)
+    report['folds'] = n_folds
+    return report
+
+
+def evaluate(model: MiModel, recordings: Sequence[Recording], tmin: float = 0.5,
+             tmax: float = 2.5, recenter: str = 'fixed') -> dict[str, Any]:
+    """Score a model on labelled recordings with the online window grid (step = model step).
+
+    ``recenter='session'`` re-centres each recording on the Riemannian mean of all its windows
+    (unsupervised re-centering between sessions) instead of the training reference.
+    """
+    if recenter not in ('fixed', 'session'):
+        msg = f"Unknown re-centering {recenter!r}; choose 'fixed' or 'session'."
+        raise ClassifierError(msg)
+    dists, labels, trials, trial_labels = [], [], [], []
+    skipped = 0
+    for rec in recordings:
+        skipped += int(np.sum(~np.isin(rec.events[:, 1], model.classes)))
+        win = epoch_windows(model, [rec], tmin, tmax, model.step, model.classes,
+                            session_step=0.5 if recenter == 'session' else None)
+        if len(win.labels) == 0:
+            continue
+        ref = mean_riemann(win.session_covs[0]) if recenter == 'session' else None
+        dists.append(decode_windows(model, win.covs, ref))
+        labels.append(win.labels)
+        trials.append(win.trials + len(trial_labels))
+        trial_labels += win.trial_labels.tolist()
+    if not trial_labels:
+        msg = (f'No trials of the model classes {model.class_names} in the data; check the files '
+               'and the event map.')
+        raise ClassifierError(msg)
+    report = score(model.classes, np.concatenate(dists), np.concatenate(labels),
+                   np.concatenate(trials), np.array(trial_labels))
+    report['skipped_trials_other_classes'] = skipped
+    report['recenter'] = recenter
+    return report
