@@ -88,13 +88,16 @@ class Recorder:
             self._queue.append(('topic', topic, msgtype, list(offered_qos_profiles)))
         self._wake.set()
 
-    def push(self, topic: str, data: bytes | memoryview, timestamp_ns: int | None = None) -> bool:
+    def push(self, topic: str, data: bytes | memoryview, timestamp_ns: int | None = None,
+             publish_time_ns: int | None = None) -> bool:
         """Queue one message for writing; never blocks. False when dropped (or stopped).
 
         Args:
             topic: A topic passed to :meth:`add_topic` before.
             data: CDR bytes of the message.
-            timestamp_ns: Receive time (ns); default now (system clock).
+            timestamp_ns: Receive time (ns); default now (system clock). MCAP log_time.
+            publish_time_ns: Send time (ns) when the middleware gives it (DDS source
+                timestamp); MCAP publish_time, as rosbag2 Jazzy stores it.
         """
         if timestamp_ns is None:
             timestamp_ns = time.time_ns()
@@ -109,7 +112,7 @@ class Recorder:
                 return False
             self._queued_bytes += size
             self.max_queued_bytes = max(self.max_queued_bytes, self._queued_bytes)
-            self._queue.append(('msg', topic, timestamp_ns, data))
+            self._queue.append(('msg', topic, timestamp_ns, data, publish_time_ns))
         self._wake.set()
         return True
 
@@ -159,10 +162,10 @@ class Recorder:
                 while queue:
                     item = queue.popleft()
                     if item[0] == 'msg':
-                        _, topic, timestamp, data = item
+                        _, topic, timestamp, data, publish_time = item
                         with self._lock:
                             self._queued_bytes -= len(data)
-                        writer.write(topic, timestamp, data)
+                        writer.write(topic, timestamp, data, publish_time)
                         counters = self.counters[topic]
                         counters.written += 1
                         counters.bytes_written += len(data)
