@@ -9,6 +9,7 @@ from mindgrasp_bringup.launch_system.actions.action import Action
 from mindgrasp_bringup.launch_system.errors import LaunchError
 from mindgrasp_bringup.launch_system.substitutions import (
     SomeSubstitutions,
+    TextSubstitution,
     normalize,
     perform_substitutions,
 )
@@ -35,9 +36,8 @@ class DeclareLaunchArgument(Action):
         self.default_value = None if default_value is None else normalize(default_value)
         self.description = description
         self.choices = None if choices is None else [str(c) for c in choices]
-        if self.choices is not None and default_value is not None and isinstance(default_value,
-                                                                                    str) \
-                and default_value not in self.choices:
+        if (self.choices is not None and isinstance(default_value, str)
+                and default_value not in self.choices):
             msg = (f"launch argument '{name}': default {default_value!r} is not one of its "
                    f"choices {self.choices}; change the default or the choices.")
             raise LaunchError(msg)
@@ -47,7 +47,7 @@ class DeclareLaunchArgument(Action):
         if self.default_value is None:
             return None
         if context is None:
-            return ''.join(s.describe() if not hasattr(s, 'text') else s.text  # type: ignore
+            return ''.join(s.text if isinstance(s, TextSubstitution) else s.describe()
                            for s in self.default_value)
         return perform_substitutions(context, self.default_value)
 
