@@ -30,7 +30,7 @@ __all__ = ['CameraPlacer', 'DatasetConfig', 'ShapeDataset', 'collect_shape_datas
 class DatasetConfig:
     """Ranges of the random views (m, degrees)."""
 
-    distance: tuple[float, float] = (0.12, 0.40)     # camera to object centre
+    distance: tuple[float, float] = (0.10, 0.40)     # camera to object centre
     elevation_deg: tuple[float, float] = (20.0, 90.0)
     azimuth_jitter_deg: float = 25.0                   # around "seen from the base"
     roll_deg: float = 20.0

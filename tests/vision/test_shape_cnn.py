@@ -164,6 +164,6 @@ def test_data_set_is_seeded_balanced_and_labelled_from_the_scene():
     b = collect_shape_dataset(6, seed=11)
     np.testing.assert_array_equal(a.x, b.x)
     assert a.y.tolist() == [0, 1, 2, 0, 1, 2]
-    assert all(0.12 <= i['distance'] <= 0.40 for i in a.info)
+    assert all(0.10 <= i['distance'] <= 0.40 for i in a.info)
     c = collect_shape_dataset(6, seed=12)
     assert not np.array_equal(a.x, c.x)
