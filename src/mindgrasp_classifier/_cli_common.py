@@ -1,0 +1,65 @@
+"""Argument groups and printing shared by the train and evaluate commands."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from typing import Any
+
+from mindgrasp_classifier.data import Recording, load_inputs
+
+
+def add_data_arguments(parser: argparse.ArgumentParser) -> None:
+    """Input options: EDF files, EEGMMIDB through MNE, recorded run bags."""
+    g = parser.add_argument_group('data')
+    g.add_argument('--edf', nargs='+', default=[], metavar='FILE',
+                   help='EEG files with annotations (EDF/BDF/GDF); EEGMMIDB SxxxRyy.edf files are '
+                        'labelled automatically')
+    g.add_argument('--bag', nargs='+', default=[], metavar='RUN',
+                   help='recorded runs (rosbag2 folders or run directories) with /eeg/raw and '
+                        '/trainer/prompt')
+    g.add_argument('--eegbci', type=int, metavar='SUBJECT',
+                   help='EEGMMIDB subject loaded through MNE (MNE_DATASETS_EEGBCI_PATH)')
+    g.add_argument('--runs', type=int, nargs='+', default=[], metavar='RUN',
+                   help='EEGMMIDB runs for --eegbci (default 4 6 8 10)')
+    g.add_argument('--event-map', metavar='MAP',
+                   help='annotation to class for other files, e.g. T1=left_hand,T2=right_hand')
+    g.add_argument('--eeg-topic', default='/eeg/raw', help='EEG topic in bags (default /eeg/raw)')
+    g.add_argument('--prompt-topic', default='/trainer/prompt',
+                   help='prompt topic in bags (default /trainer/prompt)')
+    g.add_argument('--tmin', type=float, default=0.5, help='epoch start after the cue (s, 0.5)')
+    g.add_argument('--tmax', type=float, default=2.5, help='epoch end after the cue (s, 2.5)')
+
+
+def load_from_args(args: argparse.Namespace) -> list[Recording]:
+    """Recordings named by :func:`add_data_arguments` options."""
+    return load_inputs(edf=args.edf, bags=args.bag, event_map=args.event_map,
+                       eegbci_subject=args.eegbci, eegbci_runs=args.runs,
+                       eeg_topic=args.eeg_topic, prompt_topic=args.prompt_topic)
+
+
+def format_report(report: dict[str, Any], title: str) -> str:
+    """Human-readable accuracy, confusion matrix and certainty distribution."""
+    names = report['classes']
+    lines = [title,
+             f"  trials: {report['n_trials']} ({report.get('trials_per_class', {})}), "
+             f"windows: {report['n_windows']}",
+             f"  accuracy (per trial):        {100 * report['accuracy']:.1f} %  "
+             f"(chance {100 * report['chance']:.1f} %)",
+             f"  balanced accuracy:           {100 * report['balanced_accuracy']:.1f} %",
+             f"  window accuracy:             {100 * report['window_accuracy']:.1f} %",
+             '  confusion (rows true, columns predicted):']
+    width = max(len(n) for n in names) + 2
+    lines.append(' ' * (width + 4) + ''.join(f'{n[:12]:>13}' for n in names))
+    for name, row in zip(names, report['confusion'], strict=True):
+        lines.append(f'    {name:<{width}}' + ''.join(f'{v:>13d}' for v in row))
+    lines.append('  certainty per true class (windows): mean +- sd [q25 median q75]')
+    for name, st in report['certainty'].items():
+        lines.append(f"    {name:<{width}}{st['mean']:.3f} +- {st['std']:.3f} "
+                     f"[{st['q25']:.3f} {st['median']:.3f} {st['q75']:.3f}]")
+    return '\n'.join(lines)
+
+
+def print_json(obj: Any) -> None:
+    """The machine-readable result as the last line of output."""
+    print(json.dumps(obj, separators=(',', ':')))

@@ -1,0 +1,75 @@
+"""Train the MI classifier on EEG files or recorded runs and write a model file."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from mindgrasp_classifier._cli_common import (
+    add_data_arguments,
+    format_report,
+    load_from_args,
+    print_json,
+)
+from mindgrasp_classifier.errors import ClassifierError
+from mindgrasp_classifier.model import class_index, model_paths
+from mindgrasp_classifier.pipelines import PIPELINES
+from mindgrasp_classifier.training import TrainingConfig, train
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Options of ``mindgrasp train classifier``."""
+    add_data_arguments(parser)
+    parser.add_argument('-o', '--out', required=True, metavar='MODEL',
+                        help='model path (writes MODEL.json and MODEL.npz)')
+    g = parser.add_argument_group('model')
+    g.add_argument('--pipeline', choices=PIPELINES, default='mdm', help='classifier (mdm)')
+    g.add_argument('--channels', default='motor',
+                   help="'motor' (motor strip, default), 'all', or comma-separated names")
+    g.add_argument('--classes', default=None,
+                   help='classes to keep, e.g. left_hand,right_hand (default: all in the data)')
+    g.add_argument('--band', type=float, nargs=2, default=(8.0, 30.0), metavar=('LOW', 'HIGH'),
+                   help='band-pass (Hz, 8 30)')
+    g.add_argument('--filter-order', type=int, default=4, help='Butterworth order (4)')
+    g.add_argument('--window', type=float, default=1.0, help='window length (s, 1.0)')
+    g.add_argument('--step', type=float, default=1 / 16, help='online window step (s, 0.0625)')
+    g.add_argument('--train-step', type=float, default=1 / 16,
+                   help='step of training windows inside an epoch (s, 0.0625)')
+    g.add_argument('--estimator', default='oas', help='pyRiemann covariance estimator (oas)')
+    g.add_argument('--cv', type=int, default=5, help='cross-validation folds, 0 for none (5)')
+    g.add_argument('--min-trials', type=int, default=5, help='fewest trials per class (5)')
+    g.add_argument('--seed', type=int, default=0, help='seed of the fold shuffling (0)')
+    parser.add_argument('--json', action='store_true',
+                        help='print the cross-validation report as JSON on the last line')
+
+
+def main(args: argparse.Namespace) -> int:
+    """Run the training; returns the exit status."""
+    try:
+        classes = None
+        if args.classes:
+            classes = sorted(class_index(c) for c in args.classes.split(',') if c.strip())
+        channels = args.channels if args.channels in ('motor', 'all') else [
+            c.strip() for c in args.channels.split(',') if c.strip()]
+        cfg = TrainingConfig(
+            pipeline=args.pipeline, channels=channels, band=tuple(args.band),
+            filter_order=args.filter_order, window=args.window, step=args.step,
+            train_step=args.train_step, tmin=args.tmin, tmax=args.tmax,
+            estimator=args.estimator, classes=classes, cv_folds=max(args.cv, 2),
+            min_trials=args.min_trials, seed=args.seed)
+        recordings = load_from_args(args)
+        model, report = train(recordings, cfg, cross_validate=args.cv > 0)
+        path = model.save(args.out)
+    except ClassifierError as exc:
+        print(f'mindgrasp train classifier: {exc}', file=sys.stderr)
+        return 1
+    print(f'Trained {model.pipeline} on {len(recordings)} recording(s), '
+          f'{len(model.channels)} channels at {model.rate:g} Hz: {model.channels}')
+    if report:
+        print(format_report(report, f"Cross-validation ({report['folds']} folds, grouped by "
+                                    'trial):'))
+    print(f'Model written to {path} (+ {model_paths(path)[1].name}).')
+    if args.json:
+        print_json({**report, 'model': str(path), 'channels': model.channels,
+                    'pipeline': model.pipeline})
+    return 0
