@@ -1,0 +1,26 @@
+"""List the topics of the ROS 2 graph (like ``ros2 topic list``)."""
+
+from __future__ import annotations
+
+import argparse
+
+from mindgrasp_bringup.ros_cli import cli_node, wait_for_graph
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument('-t', '--show-types', action='store_true', help='also print types')
+    parser.add_argument('-c', '--count-topics', action='store_true', help='print the count')
+    parser.add_argument('--spin-time', type=float, default=1.0,
+                        help='seconds of unchanged discovery before answering (default 1)')
+
+
+def main(args: argparse.Namespace) -> int:
+    with cli_node() as node:
+        wait_for_graph(node, settle_s=args.spin_time, max_s=args.spin_time + 3)
+        topics = node.get_topic_names_and_types()
+    if args.count_topics:
+        print(len(topics))
+        return 0
+    for name, types in topics:
+        print(f'{name} [{", ".join(types)}]' if args.show_types else name)
+    return 0

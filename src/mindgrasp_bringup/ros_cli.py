@@ -1,0 +1,146 @@
+"""Shared helpers of the ``topic``, ``node`` and ``param`` commands (the ``ros2`` CLI's verbs).
+
+They work against any ROS 2 graph on the domain: endpoints come from DDS discovery and node
+names from ``ros_discovery_info`` (see :mod:`mindgrasp_ros.runtime.graph`).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import sys
+import time
+from collections.abc import Iterator
+from typing import Any
+
+import numpy as np
+import yaml
+
+__all__ = ['CliError', 'cli_node', 'find_topic_type', 'message_to_yaml', 'resolve_field',
+           'set_fields', 'wait_for_graph']
+
+
+class CliError(Exception):
+    """A command-line error with a message for the user."""
+
+
+@contextlib.contextmanager
+def cli_node(name: str = 'mindgrasp_cli') -> Iterator[Any]:
+    """An initialised context and a hidden-ish node for one CLI invocation."""
+    from mindgrasp_ros import rclpy
+
+    rclpy.init(args=[])
+    node = rclpy.node.Node(f'_{name}_{os.getpid()}', start_parameter_services=False,
+                           enable_rosout=False)
+    try:
+        yield node
+    finally:
+        node.destroy_node()
+        rclpy.try_shutdown()
+
+
+def wait_for_graph(node: Any, settle_s: float = 1.0, max_s: float = 3.0) -> None:
+    """Let discovery run until the set of topics stops changing (at most ``max_s``)."""
+    start = time.monotonic()
+    last: list = []
+    stable_since = time.monotonic()
+    while time.monotonic() - start < max_s:
+        now = node.get_topic_names_and_types() + [tuple(x) for x in
+                                                  node.get_node_names_and_namespaces()]
+        if now != last:
+            last, stable_since = now, time.monotonic()
+        elif time.monotonic() - stable_since >= settle_s:
+            return
+        time.sleep(0.1)
+
+
+def find_topic_type(node: Any, topic: str, timeout_s: float = 5.0) -> str:
+    """The type of ``topic`` as discovered on the graph; error when unknown."""
+    deadline = time.monotonic() + timeout_s
+    while True:
+        types = dict(node.get_topic_names_and_types())
+        if topic in types:
+            if len(types[topic]) > 1:
+                msg = (f"Topic '{topic}' has more than one type on the graph "
+                       f'({", ".join(types[topic])}); pass --type to choose.')
+                raise CliError(msg)
+            return types[topic][0]
+        if time.monotonic() >= deadline:
+            known = ', '.join(sorted(types)) or 'none'
+            msg = (f"Topic '{topic}' was not found on ROS_DOMAIN_ID="
+                   f'{os.environ.get("ROS_DOMAIN_ID", "0")} within {timeout_s:.0f} s. Known '
+                   f'topics: {known}. Check the name (mindgrasp topic list) and the domain.')
+            raise CliError(msg)
+        time.sleep(0.1)
+
+
+def to_plain(value: Any, truncate: int | None = 128) -> Any:
+    """Message -> nested dicts/lists of plain values (long arrays truncated like ros2)."""
+    if hasattr(value, '_fields'):
+        return {name: to_plain(getattr(value, name), truncate) for name in value._fields}
+    if isinstance(value, np.ndarray):
+        items = value.tolist()
+    elif isinstance(value, (list, tuple)):
+        items = [to_plain(v, truncate) for v in value]
+    elif isinstance(value, (bytes, bytearray)):
+        items = list(value)
+    else:
+        if isinstance(value, str) and truncate and len(value) > truncate:
+            return value[:truncate] + '...'
+        return value
+    if truncate and len(items) > truncate:
+        return [*items[:truncate], '...']
+    return items
+
+
+def message_to_yaml(msg: Any, truncate: int | None = 128) -> str:
+    """YAML text of a message, as ``ros2 topic echo`` prints it."""
+    plain = to_plain(msg, truncate)
+    if not isinstance(plain, dict):
+        return yaml.safe_dump(plain, default_flow_style=False).rstrip() + '\n'
+    return yaml.safe_dump(plain, sort_keys=False, default_flow_style=False, width=100)
+
+
+def resolve_field(msg: Any, path: str) -> Any:
+    """``--field header.stamp`` -> the nested value; a clear error for unknown names."""
+    value = msg
+    for part in path.split('.'):
+        fields = getattr(value, '_fields', ())
+        if part not in fields:
+            msg_ = (f"Field {part!r} of {path!r} does not exist; fields here: "
+                    f'{", ".join(fields) or "none (not a message)"}.')
+            raise CliError(msg_)
+        value = getattr(value, part)
+    return value
+
+
+def set_fields(msg: Any, values: dict[str, Any]) -> Any:
+    """Fill a message from a dict (YAML of ``topic pub``), recursively, naming bad fields."""
+    from mindgrasp_ros.typesupport import get_message_class
+
+    fields = msg.get_fields_and_field_types()
+    for key, value in values.items():
+        if key not in fields:
+            text = (f'{msg.__msgtype__} has no field {key!r}; its fields are: '
+                    f'{", ".join(fields)}.')
+            raise CliError(text)
+        current = getattr(msg, key)
+        if hasattr(current, '_fields') and isinstance(value, dict):
+            set_fields(current, value)
+        elif isinstance(current, list) and isinstance(value, list) and value and \
+                isinstance(value[0], dict):
+            sub = fields[key].removeprefix('sequence<').split(',')[0].rstrip('>').split('[')[0]
+            pkg, name = sub.split('/')
+            cls = get_message_class(f'{pkg}/msg/{name}')
+            setattr(msg, key, [set_fields(cls(), v) for v in value])
+        else:
+            try:
+                setattr(msg, key, value)
+            except (TypeError, ValueError) as exc:
+                raise CliError(f'Field {key!r}: {exc}') from None
+    return msg
+
+
+def print_error(exc: Exception) -> int:
+    print(f'mindgrasp: {exc}', file=sys.stderr)
+    return 1
