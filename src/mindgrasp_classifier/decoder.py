@@ -336,3 +336,32 @@ def _grid(first: int, stop: int, n_step: int) -> range:
     """Window ends in [first, stop) on the global grid (end + 1) % n_step == 0."""
     first += (-(first + 1)) % n_step
     return range(first, stop, n_step)
+
+
+class CueLabels:
+    """Labels for supervised adaptation from timed cues (trainer prompts).
+
+    A window is labelled with a cue's class when it lies inside ``[onset + tmin, onset + tmax]``
+    (the training epoch), so online updates use the same part of a trial as training did.
+
+    Parameters
+    ----------
+    tmin, tmax : float
+        Labelled interval after each cue onset (s).
+    """
+
+    def __init__(self, tmin: float = 0.5, tmax: float = 2.5) -> None:
+        self.tmin, self.tmax = tmin, tmax
+        self._cues: list[tuple[float, int]] = []
+
+    def add(self, onset: float, class_index: int) -> None:
+        """A cue of ``class_index`` at ``onset`` (s, any clock shared with the windows)."""
+        self._cues.append((float(onset), int(class_index)))
+        self._cues = self._cues[-8:]   # only recent cues matter
+
+    def label(self, start: float, end: float) -> int | None:
+        """Class of the window ``[start, end]`` (s), or ``None`` if it is outside every epoch."""
+        for onset, cls in reversed(self._cues):
+            if start >= onset + self.tmin - 1e-9 and end <= onset + self.tmax + 1e-9:
+                return cls
+        return None
