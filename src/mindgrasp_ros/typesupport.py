@@ -17,6 +17,7 @@ import functools
 import hashlib
 import json
 import keyword
+import os
 import threading
 from pathlib import Path
 from typing import Any
@@ -100,6 +101,23 @@ def _register_interface_dir(store: Typestore, package: str, folder: Path) -> Non
             _register_srv(store, package, path.stem, path.read_text(encoding='utf-8'))
 
 
+def interface_dir() -> Path:
+    """Folder of the ``mindgrasp_msgs`` interface package (``msg/``, ``srv/``, package.xml).
+
+    ``MINDGRASP_MSGS_DIR`` overrides; by default the folder next to this package in the source
+    tree (``src/mindgrasp_msgs``). It is deliberately not a Python package, so that with ROS 2
+    sourced ``import mindgrasp_msgs.msg`` finds the colcon-generated package, not this folder.
+    """
+    override = os.environ.get('MINDGRASP_MSGS_DIR')
+    folder = Path(override) if override else Path(__file__).resolve().parents[1] / 'mindgrasp_msgs'
+    if not (folder / 'msg').is_dir():
+        msg = (f'The mindgrasp_msgs interface folder {folder} has no msg/ directory; install '
+               'the project editable (pip install -e .) or set MINDGRASP_MSGS_DIR to '
+               'src/mindgrasp_msgs.')
+        raise MessageTypeError(msg)
+    return folder
+
+
 @functools.cache
 def typestore() -> Typestore:
     """The process-wide typestore: Jazzy common_interfaces, service types and mindgrasp_msgs.
@@ -108,15 +126,13 @@ def typestore() -> Typestore:
     ``typestore().deserialize_cdr(raw, 'sensor_msgs/msg/JointState')`` returns one of them.
     Bag tools use the same store to read and write rosbag2 files.
     """
-    import mindgrasp_msgs
-
     store = get_typestore(Stores.ROS2_JAZZY)
     # A copy of the types table: we replace the classes below, never the shared store's.
     store.types = dict(store.types)
     store.cache = {}
     for package in _EXTRA_SERVICE_FILES:
         _register_interface_dir(store, package, _DATA_DIR / package)
-    _register_interface_dir(store, 'mindgrasp_msgs', mindgrasp_msgs.INTERFACE_DIR)
+    _register_interface_dir(store, 'mindgrasp_msgs', interface_dir())
     for name in list(store.fielddefs):
         store.types[name] = _make_message_class(store, name)
     return store
