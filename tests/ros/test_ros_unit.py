@@ -280,3 +280,56 @@ def test_lockstep_is_deterministic_and_serves_services():
             runs.append(list(log.values))
     assert len(runs[0]) == 25 and runs[0] == runs[1]
     assert runs[0][0][0] == 10_000_000  # first tick at t = 10 ms of sim time
+
+
+def test_multithreaded_executor_respects_callback_groups(rclpy_ctx):
+    import threading
+    import time
+
+    rclpy = rclpy_ctx
+    node = rclpy.node.Node('mt')
+    active = {'n': 0, 'max_me': 0, 'max_re': 0}
+    lock = threading.Lock()
+
+    def work(key: str) -> None:
+        with lock:
+            active['n'] += 1
+            active[key] = max(active[key], active['n'])
+        time.sleep(0.05)
+        with lock:
+            active['n'] -= 1
+
+    me = rclpy.callback_groups.MutuallyExclusiveCallbackGroup()
+    for _ in range(3):
+        node.create_timer(0.01, lambda: work('max_me'), callback_group=me)
+    executor = rclpy.executors.MultiThreadedExecutor(num_threads=4)
+    executor.add_node(node)
+    end = time.monotonic() + 0.6
+    while time.monotonic() < end:
+        executor.spin_once(timeout_sec=0.05)
+    assert active['max_me'] == 1  # never two callbacks of one exclusive group at once
+    re = rclpy.callback_groups.ReentrantCallbackGroup()
+    for _ in range(3):
+        node.create_timer(0.01, lambda: work('max_re'), callback_group=re)
+    end = time.monotonic() + 0.6
+    while time.monotonic() < end:
+        executor.spin_once(timeout_sec=0.05)
+    executor.shutdown()
+    assert active['max_re'] >= 2  # a reentrant group runs callbacks in parallel
+
+
+def test_node_specific_remapping_and_log_level():
+    from mindgrasp_ros import rclpy
+
+    rclpy.init(args=['prog', '--ros-args', '-r', 'a:chatter:=/only_a', '-r', 'b:__ns:=/nsb',
+                     '--log-level', 'a:=warn'])
+    try:
+        a = rclpy.node.Node('a')
+        b = rclpy.node.Node('b')
+        assert a.resolve_topic_name('chatter') == '/only_a'
+        assert b.resolve_topic_name('chatter') == '/nsb/chatter'
+        assert b.get_namespace() == '/nsb'
+        assert a.get_logger().get_effective_level() == rclpy.logging.LoggingSeverity.WARN
+        assert not a.get_logger().info('hidden')
+    finally:
+        rclpy.shutdown()

@@ -124,7 +124,7 @@ def parse_ros_args(args: list[str]) -> RosArguments:
             i += 2
         elif arg == '--log-level':
             text = need_value(arg, i)
-            logger, _, level = text.rpartition(':')
+            logger, _, level = text.rpartition(':=')  # "level" or "logger_name:=level"
             out.log_levels.append((logger, level))
             i += 2
         elif arg in ('-e', '--enclave'):
@@ -136,7 +136,7 @@ def parse_ros_args(args: list[str]) -> RosArguments:
             i += 1
         else:
             msg = (f'Unknown ROS argument {arg!r}. Valid: -r from:=to, -p name:=value, '
-                   '--params-file FILE, --log-level [logger:]LEVEL, -e ENCLAVE.')
+                   '--params-file FILE, --log-level [logger:=]LEVEL, -e ENCLAVE.')
             raise RCLError(msg)
     return out
 
