@@ -87,7 +87,7 @@ class AdaptationConfig:
 
     mode: str = 'none'
     rate: float = 0.01
-    min_certainty: float = 0.3
+    min_certainty: float = 0.25
     recenter: str = 'fixed'
     recenter_rate: float = 0.005
 
