@@ -43,6 +43,9 @@ ARM_POSITION_GAIN = 0.8
 GROUND_RGBA = (0.78, 0.77, 0.74, 1.0)
 TRAINER_RGBA = (0.1, 0.85, 0.1, 0.35)
 ROBOTS = ('user', 'trainer')
+#: camera light: mostly ambient so the task colours stay saturated (original thresholds 0.7/0.3)
+_LIGHT = {'lightDirection': [0.4, -0.3, 1.0], 'lightAmbientCoeff': 0.55,
+          'lightDiffuseCoeff': 0.5, 'lightSpecularCoeff': 0.0}
 
 
 @dataclass
@@ -225,6 +228,8 @@ class Simulation:
         self._objects: list[tuple[ObjectSpec, int]] = []
         self._step_count = 0
         self._proj = None
+        self._rays: np.ndarray | None = None
+        self._ground_rgb = np.zeros(3, dtype=np.uint8)
         self.last_ik_error = 0.0
         self._scene: SceneSpec | None = None
         self.seed = int(seed)
@@ -234,11 +239,31 @@ class Simulation:
     def _make_ground(self) -> int:
         p = self._p
         col = p.createCollisionShape(pb.GEOM_PLANE)
-        vis = p.createVisualShape(pb.GEOM_BOX, halfExtents=[2.0, 2.0, 0.005],
-                                  visualFramePosition=[0, 0, -0.005], rgbaColor=GROUND_RGBA)
+        if self.gui:
+            vis = p.createVisualShape(pb.GEOM_BOX, halfExtents=[2.0, 2.0, 0.005],
+                                      visualFramePosition=[0, 0, -0.005], rgbaColor=GROUND_RGBA)
+        else:
+            # the camera sees the ground through render_camera's exact plane; a mesh covering the
+            # whole image would cost TinyRenderer ~0.3 us per pixel. A speck far below stops
+            # pybullet from drawing the collision plane instead.
+            vis = p.createVisualShape(pb.GEOM_BOX, halfExtents=[1e-4] * 3,
+                                      visualFramePosition=[0, 0, -50.0], rgbaColor=GROUND_RGBA)
         body = p.createMultiBody(0, col, vis, [0, 0, 0])
         p.changeDynamics(body, -1, lateralFriction=0.6, restitution=0.0)
         return body
+
+    def _ground_colour(self) -> np.ndarray:
+        """The ground's colour as TinyRenderer shades it under the camera light (rgb uint8)."""
+        k = self._kin
+        vis = k.createVisualShape(pb.GEOM_BOX, halfExtents=[0.5, 0.5, 0.005],
+                                  visualFramePosition=[0, 0, -0.005], rgbaColor=GROUND_RGBA)
+        body = k.createMultiBody(0, -1, vis, [10.0, 0, 0])
+        view = k.computeViewMatrix([10.0, 0, 1.0], [10.0, 0, 0], [1, 0, 0])
+        proj = k.computeProjectionMatrixFOV(20.0, 1.0, 0.1, 3.0)
+        rgba = k.getCameraImage(8, 8, view, proj, renderer=pb.ER_TINY_RENDERER, shadow=0,
+                                flags=pb.ER_NO_SEGMENTATION_MASK, **_LIGHT)[2]
+        k.removeBody(body)
+        return np.asarray(rgba, dtype=np.uint8).reshape(8, 8, 4)[4, 4, :3].copy()
 
     def _load_robot(self, p: BulletClient, ghost: bool) -> _Robot:
         flags = pb.URDF_USE_INERTIA_FROM_FILE
@@ -286,7 +311,10 @@ class Simulation:
         p.changeDynamics(body, -1, lateralFriction=spec.friction,
                          rollingFriction=spec.rolling_friction,
                          spinningFriction=spec.spinning_friction, restitution=0.0,
-                         linearDamping=0.04, angularDamping=0.04)
+                         linearDamping=0.04, angularDamping=0.04,
+                         # objects at rest sleep (most of the physics cost otherwise); a touch
+                         # of the hand wakes them
+                         activationState=pb.ACTIVATION_STATE_ENABLE_SLEEPING)
         return body
 
     # ------------------------------------------------------------------ scene and reset
@@ -542,13 +570,31 @@ class Simulation:
         hidden = self._hide_other_robots(robot)
         _, _, rgba, depth_buf, _ = p.getCameraImage(
             c.width, c.height, view, self._proj, renderer=pb.ER_TINY_RENDERER, shadow=0,
-            lightDirection=[0.4, -0.3, 1.0], lightAmbientCoeff=0.55, lightDiffuseCoeff=0.5,
-            lightSpecularCoeff=0.05, flags=pb.ER_NO_SEGMENTATION_MASK)
+            flags=pb.ER_NO_SEGMENTATION_MASK, **_LIGHT)
         self._unhide(hidden)
         rgb = np.asarray(rgba, dtype=np.uint8).reshape(c.height, c.width, 4)[:, :, :3].copy()
         d = np.asarray(depth_buf, dtype=np.float32).reshape(c.height, c.width)
         depth = (c.far * c.near / (c.far - (c.far - c.near) * d)).astype(np.float32)
+        if not self.gui:
+            self._draw_ground(rgb, depth, depth > c.far * 0.999, pos, rot)
         return rgb, depth
+
+    def _draw_ground(self, rgb: np.ndarray, depth: np.ndarray, empty: np.ndarray,
+                     pos: np.ndarray, rot: np.ndarray) -> None:
+        """Fill pixels that hit nothing with the ground plane z = 0 (exact ray-plane depth)."""
+        c = self.camera
+        if self._rays is None:
+            k, w, h = self.camera_intrinsics()
+            u, v = np.meshgrid(np.arange(w, dtype=float), np.arange(h, dtype=float))
+            self._rays = np.stack([(u - k[0, 2]) / k[0, 0], (v - k[1, 2]) / k[1, 1]], axis=-1)
+            self._ground_rgb = self._ground_colour()
+        # world z of the ray with optical-axis depth 1: r_z = R[2] . (x, y, 1)
+        rz = self._rays[..., 0] * rot[2, 0] + self._rays[..., 1] * rot[2, 1] + rot[2, 2]
+        with np.errstate(divide='ignore', invalid='ignore'):
+            t = -pos[2] / rz
+        hit = empty & (rz < 0) & (t <= c.far)
+        rgb[hit] = self._ground_rgb
+        depth[hit] = t[hit]
 
     def _hide_other_robots(self, robot: str) -> list[int]:
         # the trainer's ghost arm is seen by people, not by the user's camera: park it below

@@ -1,0 +1,102 @@
+"""Speed of the PyBullet simulation in fast mode (as fast as it can, as the node runs it).
+
+Prints, per camera setting, the real-time factor (simulated s per wall s) of the node's fast-mode
+work per simulated second (240 physics steps, joint states read at 100 Hz, the RGB-D camera
+rendered at its rate, the arm moving), plus the mean physics step time and render time.
+
+    .venv/bin/python benchmarks/sim.py [--seconds 10] [--node]
+
+``--node`` also runs ``python -m mindgrasp_sim.sim_node`` in fast mode as its own process and
+reports its real-time factor from the node's own statistics (ROS layer and DDS included).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import subprocess
+import sys
+import time
+
+import numpy as np
+
+from mindgrasp_sim.simulation import CameraConfig, Simulation
+
+SETTINGS = ((128, 128, 10.0), (640, 480, 30.0))
+
+
+def run_core(width: int, height: int, rate: float, seconds: float) -> dict[str, float]:
+    """Fast-mode loop on the ROS-free Simulation; returns the figures."""
+    sim = Simulation('set_locations', seed=0, camera=CameraConfig(width, height, rate))
+    steps = int(seconds * sim.physics_hz)
+    js_every = int(round(sim.physics_hz / 100.0))
+    cam_every = int(round(sim.physics_hz / rate))
+    step_t = render_t = 0.0
+    n_render = 0
+    rng = np.random.default_rng(0)
+    t0 = time.perf_counter()
+    for i in range(steps):
+        if i % 120 == 0:   # a controller changing its command twice a second
+            sim.set_joint_velocities(rng.uniform(-0.2, 0.2, 6))
+        a = time.perf_counter()
+        sim.step()
+        b = time.perf_counter()
+        step_t += b - a
+        if i % js_every == 0:
+            sim.joint_positions()
+            sim.joint_velocities()
+            sim.ee_pose()
+        if i % cam_every == 0:
+            sim.render_camera()
+            render_t += time.perf_counter() - b
+            n_render += 1
+    wall = time.perf_counter() - t0
+    sim.close()
+    return {'rtf': seconds / wall, 'step_ms': 1e3 * step_t / steps,
+            'render_ms': 1e3 * render_t / max(n_render, 1)}
+
+
+def run_node(width: int, height: int, rate: float, seconds: float) -> float | None:
+    """Sim node in fast mode as its own process; its reported real-time factor (or None)."""
+    env = dict(os.environ)
+    env.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
+    cmd = [sys.executable, '-m', 'mindgrasp_sim.sim_node', '--ros-args',
+           '-p', 'time_mode:=fast', '-p', f'sim_duration:={seconds}',
+           '-p', f'camera_width:={width}', '-p', f'camera_height:={height}',
+           '-p', f'camera_rate:={rate}']
+    out = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=600)
+    for line in (out.stdout + out.stderr).splitlines():
+        if 'real-time factor' in line:
+            try:
+                return float(line.rsplit('real-time factor', 1)[1].split()[0].strip(':=x '))
+            except (ValueError, IndexError):
+                return None
+    return None
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument('--seconds', type=float, default=10.0, help='simulated seconds per run')
+    parser.add_argument('--node', action='store_true', help='also benchmark the node process')
+    args = parser.parse_args()
+    load = os.getloadavg()[0] if hasattr(os, 'getloadavg') else float('nan')
+    print(f'fast mode, {args.seconds:.0f} simulated s per run, physics 240 Hz, '
+          f'{os.cpu_count()} CPUs, load average {load:.1f} at start')
+    header = '| camera | real-time factor | step time (ms) | render time (ms) |'
+    if args.node:
+        header += ' node RTF (DDS) |'
+    print(header)
+    print('|' + '|'.join(['---'] * (header.count('|') - 1)) + '|')
+    for w, h, r in SETTINGS:
+        res = run_core(w, h, r, args.seconds)
+        row = (f'| {w}x{h} @ {r:.0f} Hz | {res["rtf"]:.1f}x | {res["step_ms"]:.3f} | '
+               f'{res["render_ms"]:.2f} |')
+        if args.node:
+            rtf = run_node(w, h, r, args.seconds)
+            row += f' {rtf:.1f}x |' if rtf is not None else ' n/a |'
+        print(row, flush=True)
+    return 0
+
+
+if __name__ == '__main__':
+    raise SystemExit(main())

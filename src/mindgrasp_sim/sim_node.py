@@ -1,0 +1,446 @@
+"""PyBullet simulator node: the arm contract of a ros2_control forward velocity controller plus an
+RGB-D camera driver, served by :class:`~mindgrasp_sim.simulation.Simulation`.
+
+    python -m mindgrasp_sim.sim_node --ros-args -p scene:=random_locations -p seed:=3
+    python -m mindgrasp_sim.sim_node --ros-args -p time_mode:=fast -p sim_duration:=60.0
+    python -m mindgrasp_sim.sim_node --ros-args --params-file config/params/sim.yaml
+
+Subscribes ``/arm_controller/commands`` (std_msgs/Float64MultiArray, 6 joint velocities, rad/s;
+older than ``command_timeout`` s means zero), ``/gripper_controller/commands``
+(Float64MultiArray: [closure] 0 open .. 1 closed, or [thumb, left, right]) and ``/task/target``.
+Publishes ``/joint_states`` (6 arm joints), ``/gripper/joint_states`` (3 fingers),
+``/gripper/contacts`` (std_msgs/UInt8MultiArray, 1 = finger touches an object), ``/ee_pose``
+(geometry_msgs/PoseStamped, TCP in ``world``), ``/camera/color/image_raw`` (rgb8),
+``/camera/depth/image_raw`` (32FC1, m), ``/camera/color/camera_info``,
+``/camera/depth/camera_info``, ``/sim/objects`` (visualization_msgs/MarkerArray) and
+``/task/result`` (mindgrasp_msgs/GraspResult). With ``trainer_robot:=true`` the training robot
+has the same arm topics under ``/trainer_robot/``. Services ``/sim/reset`` (ResetSim),
+``/sim/load_scene`` (LoadScene) and, in lock-step mode, ``/sim/step`` (Step).
+
+Time modes (``time_mode``): ``realtime`` follows the node's clock (the wall clock, or /clock with
+``use_sim_time``); ``fast`` steps as fast as it can and publishes ``/clock`` (run the other nodes
+with ``use_sim_time:=true``); ``lockstep`` advances only on ``/sim/step`` and publishes ``/clock``.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import sys
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+from mindgrasp_ros.interfaces.geometry_msgs.msg import PoseStamped
+from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import GraspResult, TaskTarget
+from mindgrasp_ros.interfaces.mindgrasp_msgs.srv import LoadScene, ResetSim, Step
+from mindgrasp_ros.interfaces.rosgraph_msgs.msg import Clock
+from mindgrasp_ros.interfaces.sensor_msgs.msg import CameraInfo, Image, JointState
+from mindgrasp_ros.interfaces.std_msgs.msg import Float64MultiArray, Header, UInt8MultiArray
+from mindgrasp_ros.interfaces.visualization_msgs.msg import Marker, MarkerArray
+
+from mindgrasp_ros import rclpy
+from mindgrasp_sim.control import CommandGate, gripper_closure
+from mindgrasp_sim.errors import SimError
+from mindgrasp_sim.simulation import CameraConfig, Simulation
+from mindgrasp_sim.task import TaskMonitor
+
+TIME_MODES = ('realtime', 'fast', 'lockstep')
+_MARKER_TYPE = {'cube': 1, 'sphere': 2, 'cylinder': 3, 'mesh': 10}
+
+_PARAMS = (
+    ('scene', 'set_locations'), ('seed', 0), ('n_objects', -1), ('physics_hz', 240.0),
+    ('camera_width', 128), ('camera_height', 128), ('camera_rate', 10.0),
+    ('camera_fov_deg', 60.0), ('joint_state_rate', 100.0), ('objects_rate', 2.0),
+    ('time_mode', 'realtime'), ('command_timeout', 0.25), ('trainer_robot', False),
+    ('training_robot', False), ('gui', False), ('duration', 0.0), ('sim_duration', 0.0),
+    ('success_height', 0.22), ('frame_id', 'world'), ('max_catch_up', 0.25),
+)  # fmt: skip
+
+
+@dataclass
+class _RobotIO:
+    """Topics and command state of one simulated arm."""
+
+    name: str
+    prefix: str
+    gate: CommandGate
+    pubs: dict = field(default_factory=dict)
+    applied: np.ndarray = field(default_factory=lambda: np.zeros(6))
+
+
+def _check_params(p: dict) -> None:
+    if p['time_mode'] not in TIME_MODES:
+        msg = f"Parameter 'time_mode' is {p['time_mode']!r}; use one of {list(TIME_MODES)}."
+        raise SimError(msg)
+    for name in ('joint_state_rate', 'objects_rate', 'command_timeout', 'physics_hz'):
+        if not (isinstance(p[name], (int, float)) and p[name] > 0):
+            msg = f"Parameter '{name}' must be a positive number, got {p[name]!r}."
+            raise SimError(msg)
+    if p['joint_state_rate'] > p['physics_hz']:
+        msg = (f"Parameter 'joint_state_rate' ({p['joint_state_rate']} Hz) cannot exceed "
+               f"'physics_hz' ({p['physics_hz']} Hz); lower it or raise physics_hz.")
+        raise SimError(msg)
+
+
+class SimNode(rclpy.node.Node):
+    """Thin ROS layer over :class:`Simulation` (see the module docstring for the contract)."""
+
+    def __init__(self, **kwargs) -> None:
+        super().__init__('sim', **kwargs)
+        self.declare_parameters('', list(_PARAMS))
+        p = {name: self.get_parameter(name).value for name, _ in _PARAMS}
+        self.p = p
+        try:
+            _check_params(p)
+            gui = bool(p['gui'])
+            if gui and not os.environ.get('DISPLAY') and sys.platform.startswith('linux'):
+                self.get_logger().warning(
+                    'gui:=true needs a display (DISPLAY is not set); running headless instead.')
+                gui = False
+            self.sim = Simulation(
+                scene=p['scene'], seed=int(p['seed']),
+                camera=CameraConfig(int(p['camera_width']), int(p['camera_height']),
+                                    float(p['camera_rate']), float(p['camera_fov_deg'])),
+                physics_hz=float(p['physics_hz']),
+                trainer_robot=bool(p['trainer_robot'] or p['training_robot']), gui=gui,
+                n_objects=None if int(p['n_objects']) < 0 else int(p['n_objects']))
+        except SimError as err:
+            self.get_logger().error(str(err))
+            raise
+        self.mode = p['time_mode']
+        self.finished = False
+        self.monitor = TaskMonitor(success_height=float(p['success_height']))
+        self.monitor.new_trial(0.0)
+        self.desired = ''
+        self.total_steps = 0
+        self.js_every = self.sim.physics_hz / float(p['joint_state_rate'])
+        self.cam_every = self.sim.physics_hz / self.sim.camera.rate_hz
+        self.obj_every = self.sim.physics_hz / float(p['objects_rate'])
+        self.task_every = max(1, round(self.sim.physics_hz / 20.0))
+        self._next = {'js': 0.0, 'cam': 0.0, 'obj': 0.0}
+        self._collisions: list[str] = []
+        self._wall_start = time.monotonic()
+        self._last_bad_warning = -math.inf
+
+        reliable = rclpy.qos.QoSProfile(depth=10)
+        latched = rclpy.qos.QoSProfile(
+            depth=1, reliability=rclpy.qos.ReliabilityPolicy.RELIABLE,
+            durability=rclpy.qos.DurabilityPolicy.TRANSIENT_LOCAL)
+        sensor = rclpy.qos.qos_profile_sensor_data
+        self.robots: dict[str, _RobotIO] = {}
+        for name in self.sim._robots:
+            prefix = '' if name == 'user' else '/trainer_robot'
+            io = _RobotIO(name, prefix, CommandGate(float(p['command_timeout'])))
+            io.pubs['js'] = self.create_publisher(JointState, f'{prefix}/joint_states', reliable)
+            io.pubs['gripper'] = self.create_publisher(
+                JointState, f'{prefix}/gripper/joint_states', reliable)
+            io.pubs['contacts'] = self.create_publisher(
+                UInt8MultiArray, f'{prefix}/gripper/contacts', reliable)
+            io.pubs['ee'] = self.create_publisher(PoseStamped, f'{prefix}/ee_pose', reliable)
+            self.create_subscription(
+                Float64MultiArray, f'{prefix}/arm_controller/commands',
+                lambda msg, io=io: self.arm_command_callback(msg, io), reliable)
+            self.create_subscription(
+                Float64MultiArray, f'{prefix}/gripper_controller/commands',
+                lambda msg, io=io: self.gripper_command_callback(msg, io), reliable)
+            self.robots[name] = io
+        self.color_pub = self.create_publisher(Image, '/camera/color/image_raw', sensor)
+        self.depth_pub = self.create_publisher(Image, '/camera/depth/image_raw', sensor)
+        self.info_pub = self.create_publisher(CameraInfo, '/camera/color/camera_info', sensor)
+        self.depth_info_pub = self.create_publisher(CameraInfo, '/camera/depth/camera_info',
+                                                    sensor)
+        self.objects_pub = self.create_publisher(MarkerArray, '/sim/objects', latched)
+        self.result_pub = self.create_publisher(GraspResult, '/task/result', reliable)
+        self.clock_pub = None
+        if self.mode in ('fast', 'lockstep'):
+            self.clock_pub = self.create_publisher(
+                Clock, '/clock', rclpy.qos.QoSProfile(
+                    depth=1, reliability=rclpy.qos.ReliabilityPolicy.BEST_EFFORT))
+        self.create_subscription(TaskTarget, '/task/target', self.target_callback, latched)
+        self.create_service(ResetSim, '/sim/reset', self.reset_callback)
+        self.create_service(LoadScene, '/sim/load_scene', self.load_scene_callback)
+        self.create_service(Step, '/sim/step', self.step_callback)
+        self._t0 = self._clock_s() if self.mode == 'realtime' else 0.0
+        if self.mode == 'realtime':
+            self.create_timer(1.0 / float(p['joint_state_rate']), self.realtime_callback)
+        self.create_timer(0.5, self.duration_callback)
+        self._camera_info = self._make_camera_info()
+        self.publish_all()
+        robots = ' and the training robot' if 'trainer' in self.robots else ''
+        self.get_logger().info(
+            f"Simulating scene '{self.sim.scene.name}' ({len(self.sim.objects())} objects){robots}"
+            f' at {self.sim.physics_hz:.0f} Hz physics, camera {self.sim.camera.width}x'
+            f'{self.sim.camera.height} px at {self.sim.camera.rate_hz:g} Hz, {self.mode} mode.')
+
+    # ------------------------------------------------------------------ time
+    def _clock_s(self) -> float:
+        return self.get_clock().now().nanoseconds * 1e-9
+
+    def sim_now(self) -> float:
+        """Node time (s): start time plus simulated time since start (never goes back)."""
+        return self._t0 + self.total_steps * self.sim.dt
+
+    def _stamp(self) -> object:
+        return rclpy.time.Time(nanoseconds=round(self.sim_now() * 1e9)).to_msg()
+
+    def advance(self, n_steps: int) -> None:
+        """Step the physics ``n_steps`` times, publishing whatever falls due."""
+        sim = self.sim
+        for _ in range(int(n_steps)):
+            now = self.sim_now()
+            for io in self.robots.values():
+                v = io.gate.current(now)
+                if not np.array_equal(v, io.applied):
+                    sim.set_joint_velocities(v, robot=io.name)
+                    io.applied = v
+            sim.step()
+            self.total_steps += 1
+            k = self.total_steps
+            if k >= self._next['js']:
+                self._next['js'] += self.js_every
+                self.publish_states()
+            if k >= self._next['cam']:
+                self._next['cam'] += self.cam_every
+                self.publish_camera()
+            if k >= self._next['obj']:
+                self._next['obj'] += self.obj_every
+                self.publish_objects()
+            if k % self.task_every == 0:
+                self.check_task()
+        if self.clock_pub is not None:
+            self.clock_pub.publish(Clock(clock=self._stamp()))
+        limit = float(self.p['sim_duration'])
+        if limit > 0 and self.total_steps * sim.dt >= limit:
+            self.finished = True
+
+    def realtime_callback(self) -> None:
+        """Catch up with the node's clock (wall, or /clock with use_sim_time)."""
+        due = self._clock_s() - self.sim_now()
+        cap = float(self.p['max_catch_up'])
+        if due > cap:
+            # the machine is too slow (or the clock jumped): drop the lag instead of racing
+            self.get_logger().warning(
+                f'The simulation is {due:.2f} s behind its clock; skipping ahead. Lower '
+                'camera_width/height or camera_rate, or use time_mode:=fast.')
+            self._t0 += due - cap
+            due = cap
+        n = int(due * self.sim.physics_hz)
+        if n > 0:
+            self.advance(n)
+
+    def fast_iteration(self) -> None:
+        """One iteration of fast mode: the physics steps up to the next joint state."""
+        n = max(1, math.ceil(self._next['js'] - self.total_steps))
+        self.advance(n)
+
+    def duration_callback(self) -> None:
+        limit = float(self.p['duration'])
+        if limit > 0 and time.monotonic() - self._wall_start >= limit:
+            self.finished = True
+
+    # ------------------------------------------------------------------ commands
+    def _warn_bad(self, text: str) -> None:
+        now = time.monotonic()
+        if now - self._last_bad_warning > 1.0:    # at most one warning per second
+            self.get_logger().warning(text)
+            self._last_bad_warning = now
+
+    def arm_command_callback(self, msg: Float64MultiArray, io: _RobotIO) -> None:
+        """Joint velocities (rad/s); a bad command stops the arm and is reported."""
+        try:
+            io.gate.command(msg.data, self.sim_now())
+        except SimError as err:
+            io.gate.clear()
+            self._warn_bad(f'Rejected {io.prefix}/arm_controller/commands: {err} The arm holds '
+                           'still.')
+
+    def gripper_command_callback(self, msg: Float64MultiArray, io: _RobotIO) -> None:
+        """Gripper closure target(s)."""
+        try:
+            self.sim.set_gripper(gripper_closure(msg.data), robot=io.name)
+        except SimError as err:
+            self._warn_bad(f'Rejected {io.prefix}/gripper_controller/commands: {err}')
+
+    def target_callback(self, msg: TaskTarget) -> None:
+        self.desired = f'{msg.colour} {msg.shape}'.strip()
+
+    # ------------------------------------------------------------------ services
+    def _after_reset(self) -> None:
+        for io in self.robots.values():
+            io.gate.clear()
+            io.applied = np.zeros(6)
+        self.monitor.new_trial(self.sim.time)
+        self.publish_all()
+
+    def reset_callback(self, request: ResetSim.Request, response: ResetSim.Response
+                       ) -> ResetSim.Response:
+        try:
+            seed = None if int(request.seed) < 0 else int(request.seed)
+            self.sim.reset(new_random_draw=bool(request.new_random_draw), seed=seed)
+        except SimError as err:
+            response.success, response.message = False, str(err)
+            self.get_logger().error(f'/sim/reset failed: {err}')
+            return response
+        self._after_reset()
+        response.success = True
+        response.message = (f'Reset: robots home, {len(self.sim.objects())} objects of '
+                            f"'{self.sim.scene.name}' (layout seed {self.sim._layout_seed}).")
+        self.get_logger().info(response.message)
+        return response
+
+    def load_scene_callback(self, request: LoadScene.Request, response: LoadScene.Response
+                            ) -> LoadScene.Response:
+        try:
+            seed = None if int(request.seed) < 0 else int(request.seed)
+            self.sim.load_scene(request.scene, seed=seed)
+        except SimError as err:
+            response.success, response.message = False, str(err)
+            self.get_logger().error(f'/sim/load_scene failed: {err}')
+            return response
+        self._after_reset()
+        response.success = True
+        response.message = f"Loaded scene '{self.sim.scene.name}' with " \
+                           f'{len(self.sim.objects())} objects.'
+        self.get_logger().info(response.message)
+        return response
+
+    def step_callback(self, request: Step.Request, response: Step.Response) -> Step.Response:
+        if self.mode != 'lockstep':
+            self.get_logger().warning(
+                f'/sim/step is served in time_mode lockstep only (this node runs {self.mode}); '
+                'start the node with -p time_mode:=lockstep.')
+            response.success = False
+        else:
+            self.advance(int(request.steps))
+            response.success = True
+        response.sim_time = self._stamp()
+        return response
+
+    # ------------------------------------------------------------------ publishing
+    def _header(self, frame_id: str = '') -> Header:
+        return Header(stamp=self._stamp(), frame_id=frame_id)
+
+    def publish_all(self) -> None:
+        self.publish_states()
+        self.publish_camera()
+        self.publish_objects()
+        if self.clock_pub is not None:
+            self.clock_pub.publish(Clock(clock=self._stamp()))
+
+    def publish_states(self) -> None:
+        sim = self.sim
+        header = self._header()
+        for io in self.robots.values():
+            io.pubs['js'].publish(JointState(
+                header=header, name=list(sim.joint_names),
+                position=sim.joint_positions(io.name), velocity=sim.joint_velocities(io.name),
+                effort=sim.joint_efforts(io.name)))
+            state = sim.gripper_state(io.name)
+            io.pubs['gripper'].publish(JointState(
+                header=header, name=list(sim.finger_names), position=state['positions'],
+                velocity=np.zeros(3), effort=np.zeros(3)))
+            io.pubs['contacts'].publish(UInt8MultiArray(
+                data=state['contacts'].astype(np.uint8)))
+            pos, quat = sim.ee_pose(io.name)
+            pose = PoseStamped(header=self._header(self.p['frame_id']))
+            pose.pose.position.x, pose.pose.position.y, pose.pose.position.z = map(float, pos)
+            o = pose.pose.orientation
+            o.x, o.y, o.z, o.w = map(float, quat)
+            io.pubs['ee'].publish(pose)
+
+    def _make_camera_info(self) -> CameraInfo:
+        k, w, h = self.sim.camera_intrinsics()
+        p = np.zeros((3, 4))
+        p[:, :3] = k
+        return CameraInfo(height=h, width=w, distortion_model='plumb_bob', d=np.zeros(5),
+                          k=k.reshape(-1), r=np.eye(3).reshape(-1), p=p.reshape(-1))
+
+    def publish_camera(self) -> None:
+        rgb, depth = self.sim.render_camera()
+        h, w = depth.shape
+        header = self._header('camera_color_optical_frame')
+        self.color_pub.publish(Image(header=header, height=h, width=w, encoding='rgb8',
+                                     is_bigendian=0, step=w * 3, data=rgb.reshape(-1)))
+        self.depth_pub.publish(Image(header=header, height=h, width=w, encoding='32FC1',
+                                     is_bigendian=0, step=w * 4,
+                                     data=depth.astype('<f4').view(np.uint8).reshape(-1)))
+        info = self._camera_info
+        info.header = header
+        self.info_pub.publish(info)
+        self.depth_info_pub.publish(info)
+
+    def publish_objects(self) -> None:
+        markers = []
+        header = self._header(self.p['frame_id'])
+        for obj in self.sim.objects():
+            m = Marker(header=header, ns='objects', id=obj.id, type=_MARKER_TYPE[obj.shape],
+                       action=0, text=obj.label, frame_locked=False)
+            m.pose.position.x, m.pose.position.y, m.pose.position.z = map(float, obj.position)
+            o = m.pose.orientation
+            o.x, o.y, o.z, o.w = map(float, obj.orientation)
+            m.scale.x = m.scale.y = m.scale.z = float(obj.size)
+            r, g, b, a = self.sim._objects[obj.id][0].rgba
+            m.color.r, m.color.g, m.color.b, m.color.a = float(r), float(g), float(b), float(a)
+            markers.append(m)
+        self.objects_pub.publish(MarkerArray(markers=markers))
+
+    def check_task(self) -> None:
+        """Publish /task/result on a lift or a drop; report new arm collisions."""
+        event = self.monitor.update(self.sim)
+        if event is not None:
+            result = GraspResult(
+                header=self._header(self.p['frame_id']), trial=event.trial,
+                desired_object=self.desired, grasped_object=event.grasped_object,
+                success=event.success, duration=float(event.duration),
+                lift_height=float(event.lift_height), reason=event.reason)
+            self.result_pub.publish(result)
+            self.get_logger().info(
+                f'Trial {event.trial}: {event.grasped_object} {event.reason} '
+                f'(lift {event.lift_height:.3f} m, {event.duration:.1f} s).')
+        if self.total_steps % (self.task_every * 4) == 0:
+            collisions = self.sim.collisions()
+            new = sorted(set(collisions) - set(self._collisions))
+            if new:
+                self.get_logger().warning(f'Arm collision: {", ".join(new)}.')
+            self._collisions = collisions
+
+    # ------------------------------------------------------------------ lifecycle
+    def run(self) -> None:
+        """Spin until ``duration`` / ``sim_duration`` is over (or forever)."""
+        while rclpy.ok() and not self.finished:
+            if self.mode == 'fast':
+                self.fast_iteration()
+                rclpy.spin_once(self, timeout_sec=0.0)
+            else:
+                rclpy.spin_once(self, timeout_sec=0.05)
+        wall = time.monotonic() - self._wall_start
+        simulated = self.total_steps * self.sim.dt
+        self.get_logger().info(
+            f'Simulated {simulated:.2f} s in {wall:.2f} s wall time: real-time factor '
+            f'{simulated / max(wall, 1e-9):.2f}x.')
+
+    def destroy_node(self) -> None:
+        self.sim.close()
+        super().destroy_node()
+
+
+def main(args: list[str] | None = None) -> int:
+    rclpy.init(args=args)
+    try:
+        node = SimNode()
+    except SimError:
+        rclpy.try_shutdown()
+        return 2
+    try:
+        node.run()
+    except KeyboardInterrupt:
+        pass
+    finally:
+        node.destroy_node()
+        rclpy.try_shutdown()
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())
