@@ -29,8 +29,8 @@ def run_core(width: int, height: int, rate: float, seconds: float) -> dict[str, 
     """Fast-mode loop on the ROS-free Simulation; returns the figures."""
     sim = Simulation('set_locations', seed=0, camera=CameraConfig(width, height, rate))
     steps = int(seconds * sim.physics_hz)
-    js_every = int(round(sim.physics_hz / 100.0))
-    cam_every = int(round(sim.physics_hz / rate))
+    js_every = round(sim.physics_hz / 100.0)
+    cam_every = round(sim.physics_hz / rate)
     step_t = render_t = 0.0
     n_render = 0
     rng = np.random.default_rng(0)

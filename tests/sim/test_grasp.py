@@ -59,14 +59,14 @@ def test_task_monitor_reports_success_and_drop():
         obj = sim.objects()[0]
         quat = top_down_quat(math.atan2(obj.position[1], obj.position[0]))
         grasp = np.array([obj.position[0], obj.position[1], 0.028])
-        sim.set_joint_positions(sim.inverse_kinematics(grasp + [0, 0, 0.1], quat))
+        sim.set_joint_positions(sim.inverse_kinematics(grasp + np.array([0, 0, 0.1]), quat))
         move_tcp_line(sim, grasp, quat)
         sim.set_gripper(1.0)
         for _ in range(int(1.2 * sim.physics_hz) // 8):
             sim.step(8)
             events.append(monitor.update(sim))
         # lift to 0.15 m (below the success height), then open: a drop
-        move_tcp_line(sim, grasp + [0, 0, 0.15], quat)
+        move_tcp_line(sim, grasp + np.array([0, 0, 0.15]), quat)
         assert monitor.update(sim) is None
         sim.set_gripper(0.0)
         for _ in range(60):
