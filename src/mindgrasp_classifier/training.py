@@ -17,7 +17,15 @@ from sklearn.metrics import balanced_accuracy_score, confusion_matrix
 from sklearn.model_selection import StratifiedGroupKFold
 
 from mindgrasp_classifier.data import Recording
-from mindgrasp_classifier.decoder import decode_windows, filter_recording, window_covariances
+from mindgrasp_classifier.decoder import (
+    AdaptationConfig,
+    CueLabels,
+    MiDecoder,
+    Prediction,
+    decode_windows,
+    filter_recording,
+    window_covariances,
+)
 from mindgrasp_classifier.errors import ClassifierError
 from mindgrasp_classifier.model import CLASS_NAMES, MiModel, library_versions
 from mindgrasp_classifier.pipelines import PIPELINES, certainty, make_classifier
@@ -349,3 +357,66 @@ def evaluate(model: MiModel, recordings: Sequence[Recording], tmin: float = 0.5,
     report['skipped_trials_other_classes'] = skipped
     report['recenter'] = recenter
     return report
+
+
+def stream_recording(model: MiModel, rec: Recording, adaptation: AdaptationConfig | None = None,
+                     chunk: float = 1.0 / 32.0, supervised_labels: bool = False,
+                     tmin: float = 0.5, tmax: float = 2.5) -> tuple[np.ndarray, np.ndarray]:
+    """Stream a recording chunk by chunk through :class:`MiDecoder` (the online path).
+
+    With ``supervised_labels``, the recording's cues label the windows inside their epochs (as
+    trainer prompts do online) for supervised adaptation.
+
+    Returns
+    -------
+    ends : ndarray of int, shape (n_predictions,)
+        Last sample of each predicted window (recording index).
+    distances : ndarray, shape (n_predictions, n_classes)
+    """
+    dec = MiDecoder(model, rec.channels, rec.rate, adaptation)
+    cues = CueLabels(tmin, tmax)
+    onsets = {int(o): int(c) for o, c in rec.events}
+    n_chunk = max(1, round(chunk * rec.rate))
+    ends, dists = [], []
+    for k in range(0, rec.data.shape[0], n_chunk):
+        if supervised_labels:
+            for o in range(max(k - n_chunk, 0), k):
+                if o in onsets:
+                    cues.add(o / rec.rate, onsets[o])
+            # label of the windows that end inside this chunk
+            t_end = (k + n_chunk - 1) / rec.rate
+            dec.set_label(cues.label(t_end - model.window, t_end))
+        for res in dec.push(rec.data[k:k + n_chunk], k):
+            if isinstance(res, Prediction):
+                ends.append(res.sample_index)
+                dists.append(res.distances)
+    return np.array(ends, dtype=int), np.array(dists).reshape(len(ends), len(model.classes))
+
+
+def score_predictions(model: MiModel, recordings: Sequence[Recording],
+                      predictions: Sequence[tuple[np.ndarray, np.ndarray]], tmin: float = 0.5,
+                      tmax: float = 2.5) -> dict[str, Any]:
+    """Score online predictions (window ends, distances) per recording like :func:`evaluate`.
+
+    Only windows that lie wholly inside a cue epoch count, as offline.
+    """
+    n_window = window_samples(model.rate, model.window)
+    dists, labels, trials, trial_labels = [], [], [], []
+    for rec, (ends, dist) in zip(recordings, predictions, strict=True):
+        for onset, cls in rec.events:
+            if cls not in model.classes:
+                continue
+            lo = onset + round(tmin * rec.rate) + n_window - 1
+            hi = min(onset + round(tmax * rec.rate), rec.data.shape[0])
+            sel = (ends >= lo) & (ends < hi)
+            if not sel.any():
+                continue
+            dists.append(dist[sel])
+            labels += [int(cls)] * int(sel.sum())
+            trials += [len(trial_labels)] * int(sel.sum())
+            trial_labels.append(int(cls))
+    if not trial_labels:
+        msg = 'No predictions fell inside a cue epoch; check timing and the model classes.'
+        raise ClassifierError(msg)
+    return score(model.classes, np.concatenate(dists), np.array(labels), np.array(trials),
+                 np.array(trial_labels))
