@@ -1,0 +1,465 @@
+"""The MIndGrasp six-state controller (paper, section Finite State Machine), without ROS.
+
+States: 1 Object Search, 2 Center Object, 3 Initial Approach, 4 Final Approach, 5 Grasp Object,
+6 Return to Start. Transitions (paper; ``lock`` = all joints 0 for ``lock_duration`` first, applied
+to every change except into or out of state 2):
+
+====  ====  ==========================================================================  =====
+from  to    when                                                                        lock
+====  ====  ==========================================================================  =====
+1     2     both-hands MI with an object of interest in view (autonomous: object seen)  no
+2     3     object centred (or centring timed out) after a request from state 1 or 3    no
+2     4     object centred again after leaving state 4 to recentre                      no
+2     1     object of interest lost while centring                                      yes
+3     2     object of interest drifts out of the centre of the view                     no
+3     4     object fills enough of the image, is close in depth, or joint limit near    yes
+3     1     object of interest lost                                                     yes
+4     2     object off centre before the autonomous approach starts                     no
+4     5     gripper at the grasp pose (grasp policy)                                    yes
+4     6     object lost or out of reach (abort)                                         yes
+5     6     grasp checked by finger contact and lift, or failed after the retries       yes
+5     4     finger contact missing or the object slipped: retry (``grasp_retries``)     yes
+6     1     all joints back at the start position (or return timed out)                 yes
+====  ====  ==========================================================================  =====
+
+BCI input is used in states 1-3 only; its velocities scale with the certainty. Centring is
+proportional on the pixel error, joint 1 from x and joint 5 from y. A watchdog stops every joint
+when predictions (BCI mode) or joint states are older than ``watchdog_timeout``, when joint states
+hold NaN, or when no camera frames arrive; the output says why. Commands never drive a joint past
+its limits.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from mindgrasp_fsm.errors import FsmError
+from mindgrasp_fsm.grasp_policy import GraspPolicy, PolicyStep
+from mindgrasp_fsm.kinematics import ArmKinematics
+from mindgrasp_fsm.params import FsmParams
+from mindgrasp_fsm.types import (
+    FsmInputs,
+    FsmOutput,
+    GripperCommand,
+    MiClass,
+    ObjectObservation,
+    State,
+    VisionFrame,
+)
+
+_CLASS_WORDS = {0: 'left hand', 1: 'right hand', 2: 'both hands', 3: 'both feet'}
+
+
+def clamp_to_limits(q: np.ndarray, v: np.ndarray, params: FsmParams) -> np.ndarray:
+    """Joint velocities (6,) limited to ``max_joint_velocity`` and so that one control period
+    cannot carry a joint past ``limit -/+ joint_limit_margin``; pushing out of a limit is allowed."""
+    v = np.clip(np.asarray(v, dtype=float), -np.asarray(params.max_joint_velocity),
+                np.asarray(params.max_joint_velocity))
+    lo = np.asarray(params.joint_lower_limits) + params.joint_limit_margin
+    hi = np.asarray(params.joint_upper_limits) - params.joint_limit_margin
+    dt = params.control_period
+    up_room = np.maximum(hi - q, 0.0) / dt
+    down_room = np.maximum(q - lo, 0.0) / dt
+    return np.clip(v, -down_room, up_room)
+
+
+class GraspFsm:
+    """Six-state semi-autonomous grasp controller; call :meth:`tick` at the control rate.
+
+    Parameters
+    ----------
+    params : FsmParams
+        Gains and thresholds (``config/params/fsm.yaml``).
+    kinematics : ArmKinematics or None
+        Robot model for the autonomous final approach (camera pose and grasp IK). Without it the
+        controller aborts state 4 and returns to start.
+    """
+
+    def __init__(self, params: FsmParams | None = None,
+                 kinematics: ArmKinematics | None = None) -> None:
+        self.params = params or FsmParams()
+        self.kinematics = kinematics
+        self.policy = GraspPolicy(self.params, kinematics)
+        self.reset()
+
+    @classmethod
+    def from_params(cls, params: FsmParams | None = None) -> GraspFsm:
+        """Controller with the robot model named by ``params.robot_description`` (URDF)."""
+        from pathlib import Path
+
+        from mindgrasp_fsm.kinematics import UrdfKinematics
+        from mindgrasp_fsm.params import default_params_path
+
+        params = params or FsmParams()
+        urdf = Path(params.robot_description).expanduser()
+        if not urdf.is_absolute():
+            urdf = default_params_path().parents[2] / urdf
+        kinematics = UrdfKinematics(str(urdf), params.joint_names, params.tool_link,
+                                    params.camera_link)
+        return cls(params, kinematics)
+
+    # ---------------------------------------------------------------------------- lifecycle
+    def reset(self, time: float = 0.0) -> None:
+        """Back to Object Search, gripper open, no locks, all timers cleared."""
+        self.state = State.OBJECT_SEARCH
+        self.previous_state = State.OBJECT_SEARCH
+        self.reason = 'started'
+        self._clock = time            # active clock: wall/sim time minus time spent stopped
+        self._last_time: float | None = None
+        self._state_since = 0.0
+        self._lock_until: float | None = None
+        self._pending: tuple[State, str] | None = None
+        self._center_next = State.INITIAL_APPROACH
+        self._centred_since: float | None = None
+        self._last_seen: float | None = None
+        self._seen_since: float | None = None
+        self._ooi: ObjectObservation | None = None
+        self._ooi_label = ''
+        self._sweep = 0
+        self._sweep_dir = 1.0
+        self._attempt = 0
+        self._outcome = ''
+        self._gripper = GripperCommand(self.params.gripper_open_position, 0.0)
+        self._events: list[str] = []
+        self.policy = GraspPolicy(self.params, self.kinematics)
+
+    # ---------------------------------------------------------------------------- transitions
+    def _goto(self, new: State, reason: str) -> None:
+        """Change state; lock first unless the change is into or out of Center Object."""
+        if State.CENTER_OBJECT in (new, self.state):
+            self._enter(new, reason)
+            return
+        self._lock_until = self._clock + self.params.lock_duration
+        self._pending = (new, reason)
+        self._events.append(f'lock {int(self.state)}->{int(new)}: {reason}')
+
+    def _enter(self, new: State, reason: str) -> None:
+        self.previous_state = self.state
+        self.state = new
+        self.reason = reason
+        self._state_since = self._clock
+        self._centred_since = None
+        self._events.append(f'enter {int(new)} from {int(self.previous_state)}: {reason}')
+        if new == State.CENTER_OBJECT and self.previous_state == State.OBJECT_SEARCH:
+            self._outcome = ''        # a new object was selected: a new grasp begins
+        if new == State.OBJECT_SEARCH:
+            self._seen_since = None
+            self._attempt = 0
+        elif new == State.FINAL_APPROACH:
+            shape = self._ooi.shape if self._ooi is not None else 'unknown'
+            self.policy.begin_approach(self._clock, shape, self._attempt)
+            self._gripper = self.policy.gripper
+        elif new == State.GRASP_OBJECT:
+            self.policy.begin_grasp(self._clock)
+            self._gripper = self.policy.gripper
+        elif new == State.RETURN_TO_START:
+            self._gripper = self.policy.gripper if self._outcome == 'holding' else \
+                GripperCommand(self.params.gripper_open_position, 0.0)
+
+    # ---------------------------------------------------------------------------- outputs
+    def _output(self, v: np.ndarray, *, stopped: bool = False, reason: str | None = None,
+                phase: str = '') -> FsmOutput:
+        events, self._events = self._events, []
+        return FsmOutput(
+            joint_velocities=np.asarray(v, dtype=float), gripper=self._gripper, state=self.state,
+            previous_state=self.previous_state, locked=self._lock_until is not None,
+            stopped=stopped, reason=self.reason if reason is None else reason,
+            object_of_interest=self._ooi_label, phase=phase, grasp_attempts=self._attempt,
+            grasp_outcome=self._outcome, events=events)
+
+    def _stop(self, why: str) -> FsmOutput:
+        return self._output(np.zeros(6), stopped=True, reason=why)
+
+    # ---------------------------------------------------------------------------- main tick
+    def tick(self, inputs: FsmInputs) -> FsmOutput:
+        """Advance the controller to ``inputs.time`` (s) and return the commands of this tick."""
+        p = self.params
+        now = float(inputs.time)
+        if not math.isfinite(now):
+            msg = f'The controller time must be finite seconds, got {now}; pass the clock time.'
+            raise FsmError(msg)
+        dt = 0.0 if self._last_time is None else max(now - self._last_time, 0.0)
+        self._last_time = now
+
+        # --- watchdog: nothing moves on stale or broken inputs -------------------------------
+        why = self._watchdog(inputs, now)
+        if why:
+            return self._stop(why)    # the active clock does not advance while stopped
+        self._clock += dt
+        t = self._clock
+        assert inputs.joints is not None
+        q = np.asarray(inputs.joints.position, dtype=float)
+
+        self._observe(inputs.vision, t)
+
+        # --- lock between states ------------------------------------------------------------
+        if self._lock_until is not None:
+            if t < self._lock_until:
+                return self._output(np.zeros(6), reason=f'locked: {self._pending[1]}'
+                                    if self._pending else 'locked')
+            self._lock_until = None
+            assert self._pending is not None
+            new, reason = self._pending
+            self._pending = None
+            self._enter(new, reason)
+
+        handler = {
+            State.OBJECT_SEARCH: self._search,
+            State.CENTER_OBJECT: self._center,
+            State.INITIAL_APPROACH: self._initial_approach,
+            State.FINAL_APPROACH: self._final_approach,
+            State.GRASP_OBJECT: self._grasp,
+            State.RETURN_TO_START: self._return,
+        }[self.state]
+        v, phase = handler(t, q, inputs)
+        if self._lock_until is not None:   # a transition asked for a lock: stop this tick
+            v = np.zeros(6)
+        return self._output(clamp_to_limits(q, v, p), phase=phase)
+
+    def _watchdog(self, inputs: FsmInputs, now: float) -> str:
+        p = self.params
+        joints = inputs.joints
+        if joints is None:
+            return 'stopped: no joint states received yet'
+        age = now - joints.stamp
+        if age > p.watchdog_timeout:
+            return (f'stopped: joint states are {age:.2f} s old (limit {p.watchdog_timeout:.2f} s);'
+                    ' check the arm driver')
+        pos = np.asarray(joints.position, dtype=float)
+        if pos.shape != (6,):
+            return f'stopped: joint states hold {pos.size} positions, 6 expected'
+        if not np.all(np.isfinite(pos)) or not np.all(np.isfinite(np.asarray(joints.velocity))):
+            return 'stopped: joint states contain NaN or infinite values; check the arm driver'
+        if not p.autonomous:
+            pred = inputs.prediction
+            if pred is None:
+                return 'stopped: no MI prediction received yet'
+            age = now - pred.stamp
+            if age > p.watchdog_timeout:
+                return (f'stopped: the latest MI prediction is {age:.2f} s old (limit '
+                        f'{p.watchdog_timeout:.2f} s); check the classifier and EEG stream')
+        if inputs.vision is None:
+            return 'stopped: no camera images received yet; holding still'
+        age = now - inputs.vision.stamp
+        if age > p.camera_timeout:
+            return (f'stopped: no camera images for {age:.2f} s (limit {p.camera_timeout:.2f} s);'
+                    ' holding still')
+        return ''
+
+    def _observe(self, vision: VisionFrame | None, t: float) -> None:
+        ooi = vision.object_of_interest if vision is not None else None
+        if ooi is not None:
+            self._ooi = ooi
+            self._ooi_label = ooi.label
+            self._last_seen = t
+            self._seen_since = self._seen_since if self._seen_since is not None else t
+        else:
+            self._seen_since = None
+
+    def _visible(self, inputs: FsmInputs) -> ObjectObservation | None:
+        return inputs.vision.object_of_interest if inputs.vision is not None else None
+
+    def _errors(self, ooi: ObjectObservation, vision: VisionFrame) -> tuple[float, float]:
+        """Normalised centring errors (px error / image size), x right and y down positive."""
+        ex = (ooi.centre_x - vision.image_width / 2.0) / vision.image_width
+        ey = (ooi.centre_y - vision.image_height / 2.0) / vision.image_height
+        return ex, ey
+
+    def _centring(self, ooi: ObjectObservation, vision: VisionFrame, gain_scale: float
+                  ) -> np.ndarray:
+        p = self.params
+        ex, ey = self._errors(ooi, vision)
+        v = np.zeros(6)
+        v[0] = p.center_sign_joint1 * p.center_gain_joint1 * gain_scale * ex
+        v[4] = p.center_sign_joint5 * p.center_gain_joint5 * gain_scale * ey
+        return v
+
+    def _certainty(self, inputs: FsmInputs) -> tuple[int, float]:
+        pred = inputs.prediction
+        if pred is None or self.params.autonomous:
+            return -1, 0.0
+        cert = float(pred.certainty)
+        if not math.isfinite(cert):
+            cert = 0.0
+        return int(pred.class_index), min(max(cert, 0.0), self.params.certainty_cap)
+
+    def _lost(self, t: float) -> bool:
+        return self._last_seen is None or t - self._last_seen > self.params.object_lost_timeout
+
+    # ---------------------------------------------------------------------------- state 1
+    def _search(self, t: float, q: np.ndarray, inputs: FsmInputs) -> tuple[np.ndarray, str]:
+        p = self.params
+        v = np.zeros(6)
+        ooi = self._visible(inputs)
+        if p.autonomous:
+            if ooi is not None and self._seen_since is not None \
+                    and t - self._seen_since >= p.search_confirm_time:
+                self._center_next = State.INITIAL_APPROACH
+                self._goto(State.CENTER_OBJECT, f'{ooi.label} seen by the autonomous search')
+                return v, 'found'
+            if ooi is not None:
+                return v, 'confirming'
+            return self._sweep_step(q), f'sweep {self._sweep}'
+        cls, cert = self._certainty(inputs)
+        if cls == MiClass.LEFT_HAND:
+            v[0] = p.search_gain * cert
+        elif cls == MiClass.RIGHT_HAND:
+            v[0] = -p.search_gain * cert
+        elif cls == MiClass.BOTH_HANDS:
+            if ooi is not None:
+                self._center_next = State.INITIAL_APPROACH
+                self._goto(State.CENTER_OBJECT, f'both-hands MI selected the {ooi.label}')
+                return v, 'selected'
+            return v, 'both hands but no object in view'
+        return v, _CLASS_WORDS.get(cls, 'no class')
+
+    def _sweep_step(self, q: np.ndarray) -> np.ndarray:
+        """Autonomous search: turn left; at the joint-1 limit change the camera tilt and turn back."""
+        p = self.params
+        v = np.zeros(6)
+        tilts = p.autonomous_search_tilts or [0.0]
+        tilt = tilts[self._sweep % len(tilts)]
+        lo = p.joint_lower_limits[0] + p.joint_limit_margin + 0.05
+        hi = p.joint_upper_limits[0] - p.joint_limit_margin - 0.05
+        if (self._sweep_dir > 0 and q[0] >= hi) or (self._sweep_dir < 0 and q[0] <= lo):
+            self._sweep += 1
+            self._sweep_dir = -self._sweep_dir
+        v[0] = self._sweep_dir * p.autonomous_search_velocity
+        home = np.asarray(p.home_position)
+        # keep the other joints at home, joint 5 at this sweep's tilt
+        target = home.copy()
+        target[4] = home[4] + tilt
+        err = target - q
+        err[0] = 0.0
+        v[1:] = np.clip(p.return_gain * err[1:], -0.5, 0.5)
+        return v
+
+    # ---------------------------------------------------------------------------- state 2
+    def _center(self, t: float, q: np.ndarray, inputs: FsmInputs) -> tuple[np.ndarray, str]:
+        p = self.params
+        ooi = self._visible(inputs)
+        if ooi is None:
+            if self._lost(t):
+                self._goto(State.OBJECT_SEARCH, 'object of interest lost while centring')
+            return np.zeros(6), 'object not in this frame'
+        assert inputs.vision is not None
+        ex, ey = self._errors(ooi, inputs.vision)
+        v = self._centring(ooi, inputs.vision, 1.0)
+        if abs(ex) < p.center_tolerance and abs(ey) < p.center_tolerance:
+            self._centred_since = self._centred_since if self._centred_since is not None else t
+            if t - self._centred_since >= p.center_hold_time:
+                self._goto(self._center_next, f'{ooi.label} centred')
+                return np.zeros(6), 'centred'
+        else:
+            self._centred_since = None
+        if t - self._state_since > p.center_timeout:
+            self._goto(self._center_next, f'centring timed out after {p.center_timeout:.1f} s')
+            return np.zeros(6), 'timeout'
+        return v, f'error x {ex:+.3f} y {ey:+.3f}'
+
+    # ---------------------------------------------------------------------------- state 3
+    def _initial_approach(self, t: float, q: np.ndarray, inputs: FsmInputs
+                          ) -> tuple[np.ndarray, str]:
+        p = self.params
+        v = np.zeros(6)
+        ooi = self._visible(inputs)
+        if ooi is None:
+            if self._lost(t):
+                self._goto(State.OBJECT_SEARCH, 'object of interest lost during the approach')
+            return v, 'object not in this frame'
+        assert inputs.vision is not None
+        ex, ey = self._errors(ooi, inputs.vision)
+        if max(abs(ex), abs(ey)) > p.recenter_threshold:
+            self._center_next = State.INITIAL_APPROACH
+            self._goto(State.CENTER_OBJECT, f'{ooi.label} drifted off centre during the approach')
+            return v, 'recentre'
+        j = p.approach_joint - 1
+        near_limit = (p.approach_sign > 0 and q[j] >= p.joint_upper_limits[j] - 0.1) or \
+            (p.approach_sign < 0 and q[j] <= p.joint_lower_limits[j] + 0.1)
+        if ooi.pixel_fraction > p.final_approach_pixel_fraction:
+            self._goto(State.FINAL_APPROACH, f'{ooi.label} fills {100 * ooi.pixel_fraction:.1f} %'
+                       ' of the image')
+            return v, 'close'
+        if math.isfinite(ooi.distance) and ooi.distance < p.final_approach_distance:
+            self._goto(State.FINAL_APPROACH, f'{ooi.label} is {ooi.distance:.2f} m away')
+            return v, 'close'
+        if near_limit:
+            self._goto(State.FINAL_APPROACH, f'joint {p.approach_joint} near its limit')
+            return v, 'limit'
+        cls, cert = self._certainty(inputs)
+        if p.autonomous or cert <= p.certainty_threshold:
+            v += self._centring(ooi, inputs.vision, p.approach_center_gain)
+            v[j] = p.approach_sign * p.default_approach_velocity
+            return v, 'default approach'
+        if cls == MiClass.LEFT_HAND:
+            v[0] = p.turn_gain * cert
+            return v, 'turn left'
+        if cls == MiClass.RIGHT_HAND:
+            v[0] = -p.turn_gain * cert
+            return v, 'turn right'
+        if cls == MiClass.BOTH_FEET:
+            v[j] = -p.approach_sign * p.retreat_gain * cert
+            return v, 'back off'
+        v += self._centring(ooi, inputs.vision, p.approach_center_gain)
+        v[j] = p.approach_sign * p.approach_gain * cert
+        return v, 'approach'
+
+    # ---------------------------------------------------------------------------- states 4, 5
+    def _final_approach(self, t: float, q: np.ndarray, inputs: FsmInputs
+                        ) -> tuple[np.ndarray, str]:
+        p = self.params
+        ooi = self._visible(inputs)
+        if self.policy.phase in ('open', 'measure') and self._attempt == 0 and ooi is not None:
+            assert inputs.vision is not None
+            ex, ey = self._errors(ooi, inputs.vision)
+            if max(abs(ex), abs(ey)) > p.recenter_threshold:
+                self._center_next = State.FINAL_APPROACH
+                self._goto(State.CENTER_OBJECT, f'{ooi.label} off centre before the final approach')
+                return np.zeros(6), 'recentre'
+        step = self.policy.approach_step(t, q, inputs.vision, inputs.camera, inputs.gripper)
+        self._gripper = step.gripper
+        if step.event == 'at_grasp_pose':
+            self._goto(State.GRASP_OBJECT, step.reason)
+        elif step.event == 'abort':
+            self._outcome = 'failed'
+            self._goto(State.RETURN_TO_START, f'final approach aborted: {step.reason}')
+        return step.velocities, step.phase
+
+    def _grasp(self, t: float, q: np.ndarray, inputs: FsmInputs) -> tuple[np.ndarray, str]:
+        step: PolicyStep = self.policy.grasp_step(t, q, inputs.gripper)
+        self._gripper = step.gripper
+        if step.event == 'grasped':
+            self._outcome = 'holding'
+            self._goto(State.RETURN_TO_START, step.reason)
+        elif step.event == 'retry':
+            self._attempt += 1
+            self._goto(State.FINAL_APPROACH, f'retrying the grasp: {step.reason}')
+        elif step.event == 'failed':
+            self._outcome = 'failed'
+            self._goto(State.RETURN_TO_START, f'grasp failed: {step.reason}')
+        return step.velocities, step.phase
+
+    # ---------------------------------------------------------------------------- state 6
+    def _return(self, t: float, q: np.ndarray, inputs: FsmInputs) -> tuple[np.ndarray, str]:
+        p = self.params
+        err = np.asarray(p.home_position) - q
+        if np.max(np.abs(err)) < p.return_tolerance:
+            self._goto(State.OBJECT_SEARCH, 'returned to the start position')
+            return np.zeros(6), 'home'
+        if t - self._state_since > p.return_timeout:
+            self._goto(State.OBJECT_SEARCH, f'return timed out after {p.return_timeout:.1f} s')
+            return np.zeros(6), 'timeout'
+        v = p.return_gain * err
+        vmax = np.asarray(p.max_joint_velocity)
+        scale = float(np.max(np.abs(v) / vmax))
+        if scale > 1.0:
+            v = v / scale
+        return v, 'returning'
+
+    # ---------------------------------------------------------------------------- info
+    @property
+    def outcome(self) -> str:
+        """'' while no grasp has finished, 'holding' after a checked grasp, 'failed' otherwise."""
+        return self._outcome

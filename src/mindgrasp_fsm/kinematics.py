@@ -1,0 +1,231 @@
+"""Arm kinematics the grasp policy needs: camera pose (forward kinematics) and grasp IK.
+
+The controller sees the world only through the camera, depth and joint states; to turn a pixel and
+a depth into a point on the table it needs where the camera is (forward kinematics), and to put the
+gripper there it needs inverse kinematics. Both are properties of the robot model, not of the scene,
+so a real arm offers the same. :class:`ArmKinematics` is the interface; implementations wrap a
+URDF model or the simulator's kinematic solver.
+"""
+
+from __future__ import annotations
+
+from typing import Protocol
+
+import numpy as np
+
+
+class ArmKinematics(Protocol):
+    """What :class:`mindgrasp_fsm.grasp_policy.GraspPolicy` asks of a robot model."""
+
+    def camera_pose(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Camera optical frame (x right, y down, z forward) in the base frame at joints ``q``.
+
+        Returns ``(position (3,) m, rotation (3, 3))``; rotation columns are the optical axes.
+        """
+        ...
+
+    def tool_position(self, q: np.ndarray) -> np.ndarray:
+        """Grasp point between the fingertips in the base frame (m), shape (3,)."""
+        ...
+
+    def grasp_ik(self, position: np.ndarray, yaw: float, q_seed: np.ndarray) -> np.ndarray | None:
+        """Joints (6,) rad that put the grasp point at ``position`` (m, base frame) with the
+        gripper pointing straight down and the finger closing axis turned by ``yaw`` (rad) about
+        the vertical; ``None`` when no solution within 1 cm exists."""
+        ...
+
+
+def rotation_z(angle: float) -> np.ndarray:
+    """3x3 rotation about z by ``angle`` (rad)."""
+    c, s = np.cos(angle), np.sin(angle)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def wrap_angle(angle: float) -> float:
+    """Angle wrapped to [-pi, pi)."""
+    return float((angle + np.pi) % (2 * np.pi) - np.pi)
+
+
+def rotation_rpy(roll: float, pitch: float, yaw: float) -> np.ndarray:
+    """URDF fixed-axis roll-pitch-yaw to a 3x3 rotation (Rz(yaw) Ry(pitch) Rx(roll))."""
+    cr, sr, cp, sp, cy, sy = (np.cos(roll), np.sin(roll), np.cos(pitch), np.sin(pitch),
+                              np.cos(yaw), np.sin(yaw))
+    return np.array([
+        [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+        [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+        [-sp, cp * sr, cp * cr],
+    ])
+
+
+def _axis_angle(axis: np.ndarray, angle: float) -> np.ndarray:
+    x, y, z = axis
+    c, s = np.cos(angle), np.sin(angle)
+    C = 1 - c
+    return np.array([
+        [c + x * x * C, x * y * C - z * s, x * z * C + y * s],
+        [y * x * C + z * s, c + y * y * C, y * z * C - x * s],
+        [z * x * C - y * s, z * y * C + x * s, c + z * z * C],
+    ])
+
+
+def _transform(xyz: np.ndarray, rot: np.ndarray) -> np.ndarray:
+    t = np.eye(4)
+    t[:3, :3] = rot
+    t[:3, 3] = xyz
+    return t
+
+
+class UrdfKinematics:
+    """Forward and inverse kinematics of a serial arm read from its URDF (no simulator).
+
+    Parameters
+    ----------
+    urdf_path : str or Path
+        Robot description (e.g. ``config/robots/mindgrasp_arm.urdf``).
+    joint_names : sequence of str
+        The six arm joints, base to wrist.
+    tool_link, camera_link : str
+        Grasp point link (``tcp``) and camera optical frame link.
+    """
+
+    def __init__(self, urdf_path: str, joint_names: tuple[str, ...] | list[str],
+                 tool_link: str = 'tcp', camera_link: str = 'camera_color_optical_frame') -> None:
+        import xml.etree.ElementTree as ET
+
+        from mindgrasp_fsm.errors import FsmError
+
+        try:
+            root = ET.parse(str(urdf_path)).getroot()
+        except (OSError, ET.ParseError) as exc:
+            msg = f'Cannot read the robot description {urdf_path}: {exc}. Give a valid URDF file.'
+            raise FsmError(msg) from exc
+        joints = {}
+        for j in root.findall('joint'):
+            origin = j.find('origin')
+            xyz = np.array([float(v) for v in (origin.get('xyz', '0 0 0') if origin is not None
+                                               else '0 0 0').split()])
+            rpy = [float(v) for v in (origin.get('rpy', '0 0 0') if origin is not None
+                                      else '0 0 0').split()]
+            axis_el = j.find('axis')
+            axis = np.array([float(v) for v in (axis_el.get('xyz') if axis_el is not None
+                                                else '1 0 0').split()])
+            limit = j.find('limit')
+            joints[j.find('child').get('link')] = {
+                'name': j.get('name'), 'type': j.get('type'), 'parent': j.find('parent').get('link'),
+                'origin': _transform(xyz, rotation_rpy(*rpy)), 'axis': axis / np.linalg.norm(axis),
+                'lower': float(limit.get('lower', -np.pi)) if limit is not None else -np.pi,
+                'upper': float(limit.get('upper', np.pi)) if limit is not None else np.pi,
+            }
+        self.joint_names = list(joint_names)
+        self._chains = {}
+        for link in (tool_link, camera_link):
+            chain = []
+            cur = link
+            while cur in joints:
+                chain.append(joints[cur])
+                cur = joints[cur]['parent']
+            if not chain:
+                msg = f'The link {link!r} is not in {urdf_path}; name the tool/camera link there.'
+                raise FsmError(msg)
+            chain.reverse()
+            for name in joint_names:
+                if name not in [c['name'] for c in chain]:
+                    msg = (f'The joint {name!r} is not on the chain to {link!r} in {urdf_path}; '
+                           'check joint_names.')
+                    raise FsmError(msg)
+            self._chains[link] = chain
+        self.tool_link, self.camera_link = tool_link, camera_link
+        by_name = {c['name']: c for c in joints.values()}
+        self.lower = np.array([by_name[n]['lower'] for n in joint_names])
+        self.upper = np.array([by_name[n]['upper'] for n in joint_names])
+        self._index = {n: i for i, n in enumerate(joint_names)}
+
+    def link_pose(self, q: np.ndarray, link: str) -> np.ndarray:
+        """4x4 pose of ``link`` in the base frame at joints ``q`` (rad)."""
+        t = np.eye(4)
+        for joint in self._chains[link]:
+            t = t @ joint['origin']
+            if joint['type'] in ('revolute', 'continuous'):
+                angle = float(q[self._index[joint['name']]])
+                t = t @ _transform(np.zeros(3), _axis_angle(joint['axis'], angle))
+        return t
+
+    def camera_pose(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Camera optical frame: position (3,) m and rotation (3, 3) in the base frame."""
+        t = self.link_pose(q, self.camera_link)
+        return t[:3, 3].copy(), t[:3, :3].copy()
+
+    def tool_position(self, q: np.ndarray) -> np.ndarray:
+        """Grasp point (3,) m in the base frame."""
+        return self.link_pose(q, self.tool_link)[:3, 3].copy()
+
+    @staticmethod
+    def down_rotation(yaw: float) -> np.ndarray:
+        """Tool frame pointing down (z = -world z) with its x (closing) axis at ``yaw``."""
+        c, s = np.cos(yaw), np.sin(yaw)
+        return np.array([[c, s, 0.0], [s, -c, 0.0], [0.0, 0.0, -1.0]])
+
+    def _fk_jacobian(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Tool pose (4x4) and the geometric Jacobian (6, 6) [linear; angular] at ``q``."""
+        t = np.eye(4)
+        axes, origins = [], []
+        for joint in self._chains[self.tool_link]:
+            t = t @ joint['origin']
+            if joint['type'] in ('revolute', 'continuous') and joint['name'] in self._index:
+                axes.append((self._index[joint['name']], t[:3, :3] @ joint['axis'], t[:3, 3].copy()))
+                angle = float(q[self._index[joint['name']]])
+                t = t @ _transform(np.zeros(3), _axis_angle(joint['axis'], angle))
+        jac = np.zeros((6, 6))
+        p = t[:3, 3]
+        for i, z, o in axes:
+            jac[:3, i] = np.cross(z, p - o)
+            jac[3:, i] = z
+        return t, jac
+
+    def solve(self, position: np.ndarray, rotation: np.ndarray, q_seed: np.ndarray,
+              iterations: int = 100) -> tuple[np.ndarray, float, float]:
+        """Damped least squares on position + orientation, inside joint limits.
+
+        Returns ``(q, position error m, orientation error rad)``.
+        """
+        q = np.clip(np.asarray(q_seed, dtype=float).copy(), self.lower, self.upper)
+        lam = 0.01
+        w = np.array([1.0, 1.0, 1.0, 0.3, 0.3, 0.3])   # orientation weighs less (rad vs m)
+        for _ in range(iterations):
+            t, jac = self._fk_jacobian(q)
+            e = self._error(t, position, rotation)
+            if np.linalg.norm(e[:3]) < 2e-4 and np.linalg.norm(e[3:]) < 2e-3:
+                break
+            jw = jac * w[:, None]
+            step = jw.T @ np.linalg.solve(jw @ jw.T + lam ** 2 * np.eye(6), e * w)
+            n = np.linalg.norm(step)
+            if n > 0.3:
+                step *= 0.3 / n
+            q = np.clip(q + step, self.lower, self.upper)
+        t = self.link_pose(q, self.tool_link)
+        e = self._error(t, position, rotation)
+        return q, float(np.linalg.norm(e[:3])), float(np.linalg.norm(e[3:]))
+
+    @staticmethod
+    def _error(t: np.ndarray, position: np.ndarray, rotation: np.ndarray) -> np.ndarray:
+        dp = np.asarray(position) - t[:3, 3]
+        r = rotation @ t[:3, :3].T
+        # rotation vector of r (small-angle safe)
+        angle = np.arccos(np.clip((np.trace(r) - 1) / 2, -1.0, 1.0))
+        if angle < 1e-9:
+            dr = np.zeros(3)
+        else:
+            axis = np.array([r[2, 1] - r[1, 2], r[0, 2] - r[2, 0], r[1, 0] - r[0, 1]])
+            s = np.linalg.norm(axis)
+            dr = axis / s * angle if s > 1e-9 else np.zeros(3)
+        return np.concatenate([dp, dr])
+
+    def grasp_ik(self, position: np.ndarray, yaw: float, q_seed: np.ndarray) -> np.ndarray | None:
+        """Joints with the tool at ``position`` pointing down, closing axis at ``yaw``; if that
+        has no solution, at ``yaw + pi`` (the same grasp with the hand turned round). None when
+        neither is within 1 cm / 0.05 rad."""
+        for y in (yaw, yaw + np.pi):
+            q, ep, er = self.solve(position, self.down_rotation(y), q_seed)
+            if ep <= 0.01 and er <= 0.05:
+                return q
+        return None
