@@ -51,7 +51,7 @@ class TrainerNode(rclpy.node.Node):
     def __init__(self, **kwargs) -> None:
         super().__init__('trainer', **kwargs)
         self.declare_parameters('', [
-            *_PROTOCOL_PARAMS, ('rate', 50.0), ('robot_timeout', 10.0), ('reset_timeout', 5.0),
+            *_PROTOCOL_PARAMS, ('rate', 50.0), ('robot_timeout', 30.0), ('reset_timeout', 5.0),
             ('reset_new_random_draw', False), ('log_file', ''),
         ])  # fmt: skip
         params = {name: self.get_parameter(name).value for name, _ in _PROTOCOL_PARAMS}
@@ -66,6 +66,7 @@ class TrainerNode(rclpy.node.Node):
         self.trainer_pos: np.ndarray | None = None
         self.user_pos: np.ndarray | None = None
         self.fsm_state: int | None = None
+        self.grasp_latch = False
         self.joint_count: int | None = None
         self.reset_deadline: float | None = None  # wall time by which /sim/reset must answer
         self.reset_future = None
@@ -88,7 +89,7 @@ class TrainerNode(rclpy.node.Node):
         )
         self.create_subscription(PoseStamped, '/ee_pose', self.user_pose_callback, 10)
         fsm_qos = rclpy.qos.QoSProfile(
-            depth=1,
+            depth=10,
             reliability=rclpy.qos.ReliabilityPolicy.RELIABLE,
             durability=rclpy.qos.DurabilityPolicy.TRANSIENT_LOCAL,
         )
@@ -114,7 +115,17 @@ class TrainerNode(rclpy.node.Node):
         self.user_pos = _position(msg)
 
     def fsm_callback(self, msg: FsmState) -> None:
-        self.fsm_state = int(msg.state)
+        state = int(msg.state)
+        # latch an entry into the grasp state until the next tick sees it, however short it was
+        if state == self.protocol.grasp_state and self.fsm_state != state:
+            self.grasp_latch = True
+        self.fsm_state = state
+
+    def _fsm_for_tick(self) -> int | None:
+        if self.grasp_latch:
+            self.grasp_latch = False
+            return self.protocol.grasp_state
+        return self.fsm_state
 
     # ------------------------------------------------------------------ loop
     def _now(self) -> float:
@@ -158,11 +169,11 @@ class TrainerNode(rclpy.node.Node):
             if not self._ready():
                 return
             events = self.protocol.start(t)
-            step = self.protocol.update(t, self.trainer_pos[2], self.fsm_state)
+            step = self.protocol.update(t, self.trainer_pos[2], self._fsm_for_tick())
             step.events[:0] = events
         else:
             z = self.trainer_pos[2] if self.trainer_pos is not None else None
-            step = self.protocol.update(t, z, self.fsm_state)
+            step = self.protocol.update(t, z, self._fsm_for_tick())
         self._check_reset_timeout(t)
         self._check_stale_pose()
         if self.trainer_pos is not None and self.user_pos is not None:

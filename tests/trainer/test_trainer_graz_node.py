@@ -16,9 +16,10 @@ pytestmark = pytest.mark.slow
 FAST = {'fixation': 0.4, 'cue': 0.3, 'imagery': 0.5, 'rest_min': 0.2, 'rest_max': 0.4}
 
 
-def prompt_qos(rclpy):
+def prompt_qos(rclpy, depth: int = 10):
+    """Reliable, transient local; a collecting reader keeps 10 so a stalled test loses nothing."""
     return rclpy.qos.QoSProfile(
-        depth=1,
+        depth=depth,
         reliability=rclpy.qos.ReliabilityPolicy.RELIABLE,
         durability=rclpy.qos.DurabilityPolicy.TRANSIENT_LOCAL,
     )
@@ -80,8 +81,9 @@ def test_late_joiner_gets_the_last_prompt_and_the_display_shows_the_arrow(ros, s
     )
     cue = early[-1]
     assert [m.phase for m in early] == ['fixation', 'cue']
-    # a reader that joins now gets only the current phase (transient local, depth 1)
-    node.create_subscription(Prompt, '/trainer/prompt', late.append, prompt_qos(ros))
+    # a reader that joins now gets only the current phase (the writer keeps depth 1), even when
+    # it would keep 10
+    node.create_subscription(Prompt, '/trainer/prompt', late.append, prompt_qos(ros, 10))
     assert spin_until(node, lambda: late, 10.0)
     spin_until(node, lambda: False, 0.5)
     assert len(late) == 1

@@ -116,7 +116,7 @@ def test_trainer_prompts_moves_resets_and_measures(ros, spawn, spin_until):
     robot = StandInRobot(ros, node)
     prompts, distances = [], []  # prompts with the stand-in's joint positions on arrival
     tl = ros.qos.QoSProfile(
-        depth=1,
+        depth=10,
         reliability=ros.qos.ReliabilityPolicy.RELIABLE,
         durability=ros.qos.DurabilityPolicy.TRANSIENT_LOCAL,
     )
