@@ -120,6 +120,7 @@ class SimNode(rclpy.node.Node):
         self.task_every = max(1, round(self.sim.physics_hz / 20.0))
         self._next = {'js': 0.0, 'cam': 0.0, 'obj': 0.0}
         self._collisions: list[str] = []
+        self._last_state_step = -1
         self._wall_start = time.monotonic()
         self._last_bad_warning = -math.inf
 
@@ -196,7 +197,7 @@ class SimNode(rclpy.node.Node):
                     io.applied = v
             sim.step()
             self.total_steps += 1
-            k = self.total_steps
+            k = self.total_steps + 1e-6    # schedules are fractional step counts
             if k >= self._next['js']:
                 self._next['js'] += self.js_every
                 self.publish_states()
@@ -206,7 +207,7 @@ class SimNode(rclpy.node.Node):
             if k >= self._next['obj']:
                 self._next['obj'] += self.obj_every
                 self.publish_objects()
-            if k % self.task_every == 0:
+            if self.total_steps % self.task_every == 0:
                 self.check_task()
         if self.clock_pub is not None:
             self.clock_pub.publish(Clock(clock=self._stamp()))
@@ -313,6 +314,8 @@ class SimNode(rclpy.node.Node):
             response.success = False
         else:
             self.advance(int(request.steps))
+            if self._last_state_step != self.total_steps:
+                self.publish_states()    # the caller sees the state at the returned time
             response.success = True
         response.sim_time = self._stamp()
         return response
@@ -329,6 +332,7 @@ class SimNode(rclpy.node.Node):
             self.clock_pub.publish(Clock(clock=self._stamp()))
 
     def publish_states(self) -> None:
+        self._last_state_step = self.total_steps
         sim = self.sim
         header = self._header()
         for io in self.robots.values():
@@ -408,6 +412,8 @@ class SimNode(rclpy.node.Node):
     # ------------------------------------------------------------------ lifecycle
     def run(self) -> None:
         """Spin until ``duration`` / ``sim_duration`` is over (or forever)."""
+        self._wall_start = time.monotonic()
+        steps0 = self.total_steps
         while rclpy.ok() and not self.finished:
             if self.mode == 'fast':
                 self.fast_iteration()
@@ -415,7 +421,7 @@ class SimNode(rclpy.node.Node):
             else:
                 rclpy.spin_once(self, timeout_sec=0.05)
         wall = time.monotonic() - self._wall_start
-        simulated = self.total_steps * self.sim.dt
+        simulated = (self.total_steps - steps0) * self.sim.dt
         self.get_logger().info(
             f'Simulated {simulated:.2f} s in {wall:.2f} s wall time: real-time factor '
             f'{simulated / max(wall, 1e-9):.2f}x.')

@@ -492,15 +492,8 @@ class Simulation:
         """Gripper state: ``closure`` (commanded, 0..1), ``positions`` (3,) rad, ``contacts`` (3,)
         bool (finger touches any object), ``names`` (thumb, left, right)."""
         r = self._robot(robot)
-        contacts = []
-        bodies = [b for _, b in self._objects]
-        for j in self._finger_idx:
-            touching = False
-            for b in bodies:
-                if self._p.getContactPoints(r.body, b, j, -1):
-                    touching = True
-                    break
-            contacts.append(touching)
+        touching = self._finger_contacts(r.body)
+        contacts = [any(j in fingers for fingers in touching.values()) for j in self._finger_idx]
         return {'closure': r.closure, 'positions': self.finger_positions(robot),
                 'contacts': np.array(contacts, dtype=bool), 'names': FINGER_JOINTS}
 
@@ -519,14 +512,21 @@ class Simulation:
         body = self._objects[obj if isinstance(obj, int) else obj.id][1]
         return np.array(self._p.getBaseVelocity(body)[0])
 
+    def _finger_contacts(self, robot_body: int) -> dict[int, set[int]]:
+        """Object body -> finger joint indices touching it (one contact query)."""
+        objects = {b for _, b in self._objects}
+        out: dict[int, set[int]] = {}
+        for c in self._p.getContactPoints(bodyA=robot_body):
+            if c[2] in objects and c[3] in self._finger_links:
+                out.setdefault(c[2], set()).add(c[3])
+        return out
+
     def held_object(self, robot: str = 'user') -> SceneObject | None:
         """The object touched by >= 2 fingers and not touching the ground, else None."""
         r = self._robot(robot)
-        for obj in self.objects():
-            fingers = sum(bool(self._p.getContactPoints(r.body, obj.body, j, -1))
-                          for j in self._finger_idx)
-            if fingers >= 2 and not self._p.getContactPoints(obj.body, self._ground):
-                return obj
+        for body, fingers in self._finger_contacts(r.body).items():
+            if len(fingers) >= 2 and not self._p.getContactPoints(body, self._ground):
+                return next(o for o in self.objects() if o.body == body)
         return None
 
     def collisions(self, robot: str = 'user') -> list[str]:

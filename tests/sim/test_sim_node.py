@@ -1,0 +1,249 @@
+"""The simulator node as its own process, over real DDS: topics, commands, timeout, bad input,
+services, the training robot, and the three time modes."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pytest
+from sim_helpers import colour_mask
+
+pytestmark = pytest.mark.slow
+
+READY = 'Simulating scene'
+
+
+def spin_until(rclpy, node, predicate, timeout: float = 15.0) -> bool:
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if predicate():
+            return True
+        rclpy.spin_once(node, timeout_sec=0.02)
+    return predicate()
+
+
+def spin_for(rclpy, node, seconds: float) -> None:
+    spin_until(rclpy, node, lambda: False, seconds)
+
+
+class Probe:
+    """A test node that listens to the simulator's topics and talks to its inputs."""
+
+    def __init__(self, rclpy, prefix: str = '') -> None:
+        from mindgrasp_ros.interfaces.geometry_msgs.msg import PoseStamped
+        from mindgrasp_ros.interfaces.mindgrasp_msgs.srv import LoadScene, ResetSim, Step
+        from mindgrasp_ros.interfaces.rosgraph_msgs.msg import Clock
+        from mindgrasp_ros.interfaces.sensor_msgs.msg import CameraInfo, Image, JointState
+        from mindgrasp_ros.interfaces.std_msgs.msg import Float64MultiArray
+        from mindgrasp_ros.interfaces.visualization_msgs.msg import MarkerArray
+
+        self.rclpy = rclpy
+        self.node = rclpy.node.Node('sim_probe')
+        self.joints: list = []
+        self.images: list = []
+        self.depths: list = []
+        self.infos: list = []
+        self.poses: list = []
+        self.markers: list = []
+        self.clocks: list = []
+        n = self.node
+        sensor = rclpy.qos.qos_profile_sensor_data
+        latched = rclpy.qos.QoSProfile(
+            depth=1, reliability=rclpy.qos.ReliabilityPolicy.RELIABLE,
+            durability=rclpy.qos.DurabilityPolicy.TRANSIENT_LOCAL)
+        n.create_subscription(JointState, f'{prefix}/joint_states', self.joints.append, 100)
+        n.create_subscription(PoseStamped, f'{prefix}/ee_pose', self.poses.append, 100)
+        n.create_subscription(Image, '/camera/color/image_raw', self.images.append, sensor)
+        n.create_subscription(Image, '/camera/depth/image_raw', self.depths.append, sensor)
+        n.create_subscription(CameraInfo, '/camera/color/camera_info', self.infos.append, sensor)
+        n.create_subscription(MarkerArray, '/sim/objects', self.markers.append, latched)
+        n.create_subscription(Clock, '/clock', self.clocks.append, rclpy.qos.QoSProfile(
+            depth=10, reliability=rclpy.qos.ReliabilityPolicy.BEST_EFFORT))
+        self.cmd_pub = n.create_publisher(Float64MultiArray, f'{prefix}/arm_controller/commands',
+                                          10)
+        self.grip_pub = n.create_publisher(
+            Float64MultiArray, f'{prefix}/gripper_controller/commands', 10)
+        self.reset_cli = n.create_client(ResetSim, '/sim/reset')
+        self.load_cli = n.create_client(LoadScene, '/sim/load_scene')
+        self.step_cli = n.create_client(Step, '/sim/step')
+        self.Float64MultiArray, self.ResetSim, self.LoadScene, self.Step = (
+            Float64MultiArray, ResetSim, LoadScene, Step)
+
+    def q(self) -> np.ndarray:
+        return np.asarray(self.joints[-1].position, dtype=float)
+
+    def command(self, v) -> None:
+        self.cmd_pub.publish(self.Float64MultiArray(data=np.asarray(v, dtype=float)))
+
+    def call(self, client, request, timeout: float = 15.0):
+        assert client.wait_for_service(timeout_sec=timeout), 'service not available'
+        future = client.call_async(request)
+        assert spin_until(self.rclpy, self.node, future.done, timeout)
+        return future.result()
+
+    def drive(self, v, seconds: float, rate: float = 20.0) -> None:
+        """Publish the velocity command at ``rate`` Hz for ``seconds`` (wall)."""
+        end = time.monotonic() + seconds
+        while time.monotonic() < end:
+            self.command(v)
+            spin_for(self.rclpy, self.node, 1.0 / rate)
+
+
+def start(spawn_node, *params: str):
+    args = ['--ros-args', '-p', 'duration:=90.0']
+    for p in params:
+        args += ['-p', p]
+    proc = spawn_node('mindgrasp_sim.sim_node', *args)
+    assert proc.wait_for_output(READY, 40), proc.output()
+    return proc
+
+
+def test_realtime_node_serves_the_arm_and_camera_contract(rclpy_ctx, spawn_node):
+    proc = start(spawn_node)
+    probe = Probe(rclpy_ctx)
+    rclpy, node = rclpy_ctx, probe.node
+    assert spin_until(rclpy, node, lambda: len(probe.joints) > 150 and probe.images
+                      and probe.depths and probe.infos and probe.markers, 30), proc.output()
+    # joint states: 6 arm joints at 100 Hz (header stamps 10 ms apart), home pose
+    js = probe.joints[-1]
+    assert list(js.name) == [f'joint_{i}' for i in range(1, 7)]
+    stamps = np.array([m.header.stamp.sec + m.header.stamp.nanosec * 1e-9 for m in probe.joints])
+    assert np.median(np.diff(stamps)) == pytest.approx(0.01, abs=0.002)
+    np.testing.assert_allclose(probe.q(), [0, 0, 0, np.pi / 2, 1.2, 0], atol=0.003)
+    # camera: 128x128 rgb8 + 32FC1 metres + camera_info; the red cube straight ahead
+    img, depth, info = probe.images[-1], probe.depths[-1], probe.infos[-1]
+    assert (img.width, img.height, img.encoding) == (128, 128, 'rgb8')
+    assert depth.encoding == '32FC1' and info.width == 128
+    assert info.header.frame_id == img.header.frame_id == 'camera_color_optical_frame'
+    rgb = np.asarray(img.data, dtype=np.uint8).reshape(128, 128, 3)
+    d = np.asarray(depth.data, dtype=np.uint8).view('<f4').reshape(128, 128)
+    ys, xs = np.nonzero(colour_mask(rgb, 'red'))
+    assert len(xs) > 20 and 44 <= xs.mean() <= 84
+    assert 0.4 < float(np.median(d[ys, xs])) < 0.8
+    assert float(info.k[0]) == pytest.approx(64 / np.tan(np.radians(30)), rel=1e-6)
+    # the scene's objects, with labels
+    labels = [m.text for m in probe.markers[-1].markers]
+    assert labels[:3] == ['red cube', 'blue cylinder', 'yellow sphere'] and len(labels) == 9
+    assert probe.poses and probe.poses[-1].header.frame_id == 'world'
+
+    # a velocity command from outside moves joint 1 at the commanded rate
+    q0 = probe.q()[0]
+    probe.drive([0.3, 0, 0, 0, 0, 0], 1.5)
+    moving = probe.joints[-1]
+    assert moving.velocity[0] == pytest.approx(0.3, abs=0.03)
+    assert probe.q()[0] - q0 == pytest.approx(0.45, abs=0.15)
+    # silence: the command times out (0.25 s) and the arm stops
+    spin_for(rclpy, node, 0.8)
+    q_stop = probe.q()[0]
+    assert abs(probe.joints[-1].velocity[0]) < 0.01
+    spin_for(rclpy, node, 0.5)
+    assert probe.q()[0] == pytest.approx(q_stop, abs=0.002)
+
+    # bad commands: rejected with a warning, the arm holds still
+    probe.drive([0.3, 0, 0, 0, 0, 0], 0.3)
+    probe.command([0.3, 0.0, 0.0])
+    probe.command([0.3, 0, float('nan'), 0, 0, 0])
+    spin_for(rclpy, node, 0.4)
+    q_bad = probe.q()[0]
+    spin_for(rclpy, node, 0.4)
+    assert probe.q()[0] == pytest.approx(q_bad, abs=0.002)
+    out = proc.output()
+    assert 'Rejected /arm_controller/commands' in out and 'The arm holds still' in out
+
+    # the gripper closes on command
+    probe.grip_pub.publish(probe.Float64MultiArray(data=np.array([1.0])))
+    # reset: home, objects back
+    spin_for(rclpy, node, 0.5)
+    response = probe.call(probe.reset_cli, probe.ResetSim.Request(new_random_draw=False, seed=-1))
+    assert response.success, response.message
+    spin_for(rclpy, node, 0.3)
+    np.testing.assert_allclose(probe.q(), [0, 0, 0, np.pi / 2, 1.2, 0], atol=0.003)
+    # a new random draw needs a random scene: the error names the fix
+    response = probe.call(probe.reset_cli, probe.ResetSim.Request(new_random_draw=True, seed=-1))
+    assert not response.success and 'load a random scene' in response.message
+    # load another scene
+    n_before = len(probe.markers)
+    response = probe.call(probe.load_cli, probe.LoadScene.Request(scene='random_locations',
+                                                                  seed=4))
+    assert response.success, response.message
+    assert spin_until(rclpy, node, lambda: len(probe.markers) > n_before
+                      and len(probe.markers[-1].markers) == 3)
+    response = probe.call(probe.load_cli, probe.LoadScene.Request(scene='nowhere', seed=-1))
+    assert not response.success and 'Unknown scene' in response.message
+    assert not probe.clocks    # realtime mode does not own /clock
+    node.destroy_node()
+    proc.stop()
+
+
+def test_fast_mode_publishes_clock_and_ends_by_itself(rclpy_ctx, spawn_node):
+    proc = start(spawn_node, 'time_mode:=fast', 'sim_duration:=20.0')
+    probe = Probe(rclpy_ctx)
+    assert spin_until(rclpy_ctx, probe.node, lambda: len(probe.clocks) > 20, 30), proc.output()
+    wall0, clock0 = time.monotonic(), probe.clocks[-1].clock
+    spin_for(rclpy_ctx, probe.node, 1.0)
+    clock1 = probe.clocks[-1].clock
+    simulated = (clock1.sec - clock0.sec) + (clock1.nanosec - clock0.nanosec) * 1e-9
+    assert simulated > 1.2 * (time.monotonic() - wall0)    # faster than real time
+    assert proc.wait(120) == 0
+    assert 'real-time factor' in proc.output()
+
+
+def _lockstep_run(rclpy, spawn_node) -> tuple[np.ndarray, float]:
+    proc = start(spawn_node, 'time_mode:=lockstep', 'scene:=random_locations', 'seed:=2')
+    probe = Probe(rclpy)
+    sequence = [[0.4, 0.2, 0, 0, 0, 0], [0, 0, 0.3, -0.3, 0.5, 0], [-0.2, 0, 0, 0, 0, 1.0]]
+    traj = []
+    t = None
+    for v in sequence:
+        probe.command(v)
+        spin_for(rclpy, probe.node, 0.3)      # delivered before the steps (time stands still)
+        for _ in range(4):
+            response = probe.call(probe.step_cli, probe.Step.Request(steps=24))
+            assert response.success
+            t = response.sim_time.sec + response.sim_time.nanosec * 1e-9
+        last = (response.sim_time.sec, response.sim_time.nanosec)
+        assert spin_until(rclpy, probe.node, lambda last=last: probe.joints and (
+            probe.joints[-1].header.stamp.sec, probe.joints[-1].header.stamp.nanosec) == last, 5)
+        traj.append(probe.q())
+    probe.node.destroy_node()
+    proc.stop()
+    return np.array(traj), t
+
+
+def test_lockstep_mode_is_deterministic_across_runs(rclpy_ctx, spawn_node):
+    a, t_a = _lockstep_run(rclpy_ctx, spawn_node)
+    b, t_b = _lockstep_run(rclpy_ctx, spawn_node)
+    assert t_a == pytest.approx(3 * 4 * 24 / 240.0)   # time advances by the requested steps only
+    assert t_a == t_b
+    np.testing.assert_array_equal(a, b)
+    # the command timeout runs on simulated time: 0.4 rad/s acted for 0.25 s of the 0.4 s
+    assert a[0][0] == pytest.approx(0.4 * 0.25, abs=0.005)
+
+
+def test_training_robot_has_the_same_contract(rclpy_ctx, spawn_node):
+    proc = start(spawn_node, 'trainer_robot:=true')
+    probe = Probe(rclpy_ctx, prefix='/trainer_robot')
+    user = []
+    from mindgrasp_ros.interfaces.sensor_msgs.msg import JointState
+
+    probe.node.create_subscription(JointState, '/joint_states', user.append, 100)
+    assert spin_until(rclpy_ctx, probe.node, lambda: len(probe.joints) > 20 and probe.poses
+                      and user, 30), proc.output()
+    q0 = probe.q()
+    probe.drive([0, 0.3, 0, 0, 0, 0], 1.0)
+    assert probe.q()[1] - q0[1] > 0.15
+    # the user's arm did not move
+    np.testing.assert_allclose(np.asarray(user[-1].position)[1], 0.0, atol=0.003)
+    proc.stop()
+
+
+@pytest.mark.parametrize(('param', 'message'), [
+    ('time_mode:=bogus', "Parameter 'time_mode' is 'bogus'"),
+    ('scene:=no_such_scene', "Unknown scene 'no_such_scene'"),
+    ('camera_width:=0', 'Camera width must be an integer'),
+])
+def test_bad_parameters_exit_with_the_fix(spawn_node, param, message):
+    proc = spawn_node('mindgrasp_sim.sim_node', '--ros-args', '-p', param)
+    assert proc.wait(60) == 2
+    assert message in proc.output()
