@@ -281,6 +281,21 @@ def test_external_executable_resolves_on_path() -> None:
     assert spec.command()[1:] == ['--ros-args', '-r', '__node:=driver', '-r', 'a:=b']
 
 
+def test_package_slash_executable_runs_with_ros2_run(tmp_path: Path, monkeypatch) -> None:
+    fake_ros2 = tmp_path / 'ros2'
+    fake_ros2.write_text('#!/bin/sh\n')
+    fake_ros2.chmod(0o755)
+    description = LaunchDescription([Node(executable='ur_driver/ur_node', name='arm')])
+    monkeypatch.setenv('PATH', '/usr/bin:/bin')
+    with pytest.raises(LaunchError, match=r"'ur_driver/ur_node' is neither the Python module "
+                                          r"ur_driver.ur_node nor runnable with 'ros2 run'"):
+        plan(description)
+    monkeypatch.setenv('PATH', f'{tmp_path}:/usr/bin:/bin')
+    (spec,) = plan(description).processes
+    assert spec.command() == [str(fake_ros2), 'run', 'ur_driver', 'ur_node', '--ros-args', '-r',
+                              '__node:=arm']
+
+
 def test_recorder_is_first_and_gets_the_bag_and_topics() -> None:
     p = plan(LaunchDescription([ticker('a')]), 'record_topics:=/eeg/raw, /fsm/state',
              'record_regex:=^/camera/', record=True)

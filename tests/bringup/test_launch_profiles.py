@@ -40,8 +40,14 @@ def test_hardware_has_drivers_and_no_simulator() -> None:
     assert driver.program[0].endswith('/true') and driver.node_name == 'arm_driver'
     assert driver.arguments == ['--ip', '10.0.0.2', '--rate', '100']
     assert procs['eeg_acquisition'].parameters['stream_name'] == 'gNautilus'
-    procs = processes('hardware', 'eeg_stream:=a', 'arm_driver:=true', 'camera_driver:=true')
+    assert procs['classifier'].parameters['model'] == 'models/default_classifier.json'
+    procs = processes('hardware', 'eeg_stream:=a', 'arm_driver:=true', 'camera_driver:=true',
+                      'model:=models/alice.json')
     assert 'camera_driver' in procs
+    assert procs['classifier'].parameters['model'] == 'models/alice.json'
+    # package/executable: our module, else `ros2 run package executable`
+    procs = processes('hardware', 'eeg_stream:=a', 'arm_driver:=mindgrasp_sim/sim_node')
+    assert procs['arm_driver'].module == 'mindgrasp_sim.sim_node'
     with pytest.raises(LaunchError, match=r"needs these arguments, which were not given: "
                                           r"eeg_stream:=<value>.*; arm_driver:=<value>"):
         LaunchService('hardware').plan()
@@ -62,6 +68,8 @@ def test_replay_plays_the_bag_last_without_the_rerun_outputs() -> None:
     procs = processes('replay', 'bag:=b', 'clock:=true')
     assert procs['fsm'].parameters['use_sim_time'] is True and procs['bag_player'].parameters[
         'clock'] is True
+    assert processes('replay', 'bag:=b', 'model:=x.json')['classifier'].parameters[
+        'model'] == 'x.json'
     procs = processes('replay', 'bag:=b', 'vision:=true')
     assert 'vision' in procs and procs['bag_player'].parameters['exclude_regex'].endswith(
         '|vision/)')
@@ -71,13 +79,14 @@ def test_trainer_and_graz_end_with_their_prompter() -> None:
     procs = processes('trainer', 'trials:=8', 'amp:=lsl', 'eeg_stream:=amp')
     assert 'virtual_amp' not in procs and list(procs)[-1] == 'trainer'
     assert procs['trainer'].shutdown_on_exit and procs['trainer'].parameters['n_trials'] == 8
-    assert procs['sim'].parameters['training_robot'] is True
+    assert procs['sim'].parameters['trainer_robot'] is True
     procs = processes('trainer')
     assert procs['virtual_amp'].parameters['subject_mode'] == 'follow'
     procs = processes('graz')
     assert list(procs) == ['recorder', 'virtual_amp', 'eeg_acquisition', 'graz_prompter']
     assert procs['graz_prompter'].module == 'mindgrasp_trainer.graz_node'
-    assert 'classifier' in processes('graz', 'feedback:=true')
+    procs = processes('graz', 'feedback:=true', 'model:=m.json')
+    assert procs['classifier'].parameters['model'] == 'm.json'
 
 
 def test_a_profile_can_be_included_by_name() -> None:

@@ -16,6 +16,7 @@ from mindgrasp_bringup.launch_system import (
     Node,
     config_files,
 )
+from mindgrasp_bringup.launch_system.common import classifier_nodes
 
 
 def generate_launch_description() -> LaunchDescription:
@@ -36,6 +37,10 @@ def generate_launch_description() -> LaunchDescription:
                               description='virtual subject: noise (no imagery), follow (imagines '
                                           'what /trainer/prompt asks), pursue (imagines what '
                                           'brings the arm to /task/target)'),
+        DeclareLaunchArgument('model', default_value='',
+                              description='classifier model (.json written by mindgrasp train '
+                                          'classifier); empty: the one in '
+                                          'config/params/classifier.yaml'),
         # 1 simulator: arm, gripper, objects, RGB-D camera (the arm contract of ros2_control)
         Node(package='mindgrasp_sim', executable='sim_node', name='sim',
              parameters=[*config_files('sim', 'demo'), {'gui': gui, 'seed': seed}]),
@@ -48,8 +53,7 @@ def generate_launch_description() -> LaunchDescription:
         Node(package='mindgrasp_eeg', executable='acquisition_node', name='eeg_acquisition',
              parameters=[*config_files('eeg', 'demo'), {'stream_name': eeg_stream}]),
         # 4 classifier: /eeg/raw -> /bci/prediction
-        Node(package='mindgrasp_classifier', executable='classifier_node', name='classifier',
-             parameters=config_files('classifier', 'demo')),
+        *classifier_nodes(config_files('classifier', 'demo')),
         # 5 vision: camera -> /vision/detections, /vision/overlay
         Node(package='mindgrasp_vision', executable='vision_node', name='vision',
              parameters=config_files('vision', 'demo')),

@@ -10,6 +10,7 @@ The launch ends when the prompter has run all its trials (or after duration:=S).
 
 from mindgrasp_bringup.launch_system import (
     DeclareLaunchArgument,
+    GroupAction,
     IfCondition,
     LaunchConfiguration,
     LaunchConfigurationEquals,
@@ -18,6 +19,7 @@ from mindgrasp_bringup.launch_system import (
     Shutdown,
     config_files,
 )
+from mindgrasp_bringup.launch_system.common import classifier_nodes
 
 
 def generate_launch_description() -> LaunchDescription:
@@ -36,15 +38,18 @@ def generate_launch_description() -> LaunchDescription:
         DeclareLaunchArgument('feedback', default_value='false', choices=['true', 'false'],
                               description='run the classifier so the display shows a feedback '
                                           'bar (needs a trained model)'),
+        DeclareLaunchArgument('model', default_value='',
+                              description='classifier model for feedback:=true (.json written '
+                                          'by mindgrasp train classifier); empty: the one in '
+                                          'config/params/classifier.yaml'),
         Node(package='mindgrasp_eeg', executable='virtual_amp_node', name='virtual_amp',
              parameters=[*config_files('eeg'),
                          {'stream_name': eeg_stream, 'seed': seed, 'subject_mode': 'follow'}],
              condition=LaunchConfigurationEquals('amp', 'virtual')),
         Node(package='mindgrasp_eeg', executable='acquisition_node', name='eeg_acquisition',
              parameters=[*config_files('eeg'), {'stream_name': eeg_stream}]),
-        Node(package='mindgrasp_classifier', executable='classifier_node', name='classifier',
-             parameters=config_files('classifier'),
-             condition=IfCondition(LaunchConfiguration('feedback'))),
+        GroupAction(classifier_nodes(config_files('classifier')),
+                    condition=IfCondition(LaunchConfiguration('feedback'))),
         Node(package='mindgrasp_trainer', executable='graz_node', name='graz_prompter',
              parameters=[*config_files('trainer'),
                          {'n_trials': LaunchConfiguration('trials'), 'seed': seed}],

@@ -4,6 +4,8 @@ classifier, vision and the grasp controller.
     mindgrasp launch hardware eeg_stream:=gNautilus arm_driver:=my_arm_driver
     mindgrasp launch hardware eeg_stream:=gNautilus arm_driver:=/opt/arm/bin/driver \\
         arm_driver_args:="--ip 192.168.1.10" camera_driver:=my_camera_node
+    mindgrasp launch hardware eeg_stream:=gNautilus arm_driver:=my_ros_pkg/arm_node \\
+        model:=models/alice.json               # ros2 run my_ros_pkg arm_node; her classifier
 
 The arm driver must serve the arm contract of ros2_control's forward velocity controller:
 subscribe /arm_controller/commands and /gripper_controller/commands (std_msgs/Float64MultiArray,
@@ -21,6 +23,7 @@ from mindgrasp_bringup.launch_system import (
     SplitArguments,
     config_files,
 )
+from mindgrasp_bringup.launch_system.common import classifier_nodes
 
 
 def generate_launch_description() -> LaunchDescription:
@@ -29,11 +32,16 @@ def generate_launch_description() -> LaunchDescription:
                               description='LSL stream name of the amplifier (as its streaming '
                                           'software names it)'),
         DeclareLaunchArgument('arm_driver',
-                              description='arm driver: an executable on PATH, a path, or a '
-                                          'Python module (pkg.module) run with python -m'),
+                              description='arm driver: an executable on PATH, a path, a Python '
+                                          'module (pkg.module, run with python -m) or '
+                                          'package/executable (ros2 run)'),
         DeclareLaunchArgument('arm_driver_args', default_value='',
                               description='command-line arguments of the arm driver (shell '
                                           'quoting)'),
+        DeclareLaunchArgument('model', default_value='',
+                              description='classifier model (.json written by mindgrasp train '
+                                          'classifier); empty: the one in '
+                                          'config/params/classifier.yaml'),
         DeclareLaunchArgument('camera_driver', default_value='',
                               description='camera driver started like arm_driver (empty: the '
                                           'arm driver or another system publishes the camera)'),
@@ -47,8 +55,7 @@ def generate_launch_description() -> LaunchDescription:
         Node(package='mindgrasp_eeg', executable='acquisition_node', name='eeg_acquisition',
              parameters=[*config_files('eeg', 'hardware'),
                          {'stream_name': LaunchConfiguration('eeg_stream')}]),
-        Node(package='mindgrasp_classifier', executable='classifier_node', name='classifier',
-             parameters=config_files('classifier', 'hardware')),
+        *classifier_nodes(config_files('classifier', 'hardware')),
         Node(package='mindgrasp_vision', executable='vision_node', name='vision',
              parameters=config_files('vision', 'hardware')),
         Node(package='mindgrasp_fsm', executable='fsm_node', name='fsm',

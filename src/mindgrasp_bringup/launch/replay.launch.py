@@ -21,6 +21,7 @@ from mindgrasp_bringup.launch_system import (
     UnlessCondition,
     config_files,
 )
+from mindgrasp_bringup.launch_system.common import classifier_nodes
 
 RERUN = '^/(bci/prediction|fsm/|arm_controller/|gripper_controller/'
 
@@ -49,12 +50,15 @@ def generate_launch_description() -> LaunchDescription:
         DeclareLaunchArgument('vision', default_value='false', choices=['true', 'false'],
                               description='run the vision node again on the recorded camera '
                                           'images (false: play the recorded detections)'),
+        DeclareLaunchArgument('model', default_value='',
+                              description='classifier model (.json written by mindgrasp train '
+                                          'classifier); empty: the one in '
+                                          'config/params/classifier.yaml'),
         DeclareLaunchArgument('clock', default_value='false', choices=['true', 'false'],
                               description='the player publishes /clock from the bag and the '
                                           'nodes run on it (use_sim_time)'),
         SetParameter('use_sim_time', LaunchConfiguration('clock')),
-        Node(package='mindgrasp_classifier', executable='classifier_node', name='classifier',
-             parameters=config_files('classifier', 'replay')),
+        *classifier_nodes(config_files('classifier', 'replay')),
         Node(package='mindgrasp_vision', executable='vision_node', name='vision',
              parameters=config_files('vision', 'replay'), condition=IfCondition(vision)),
         Node(package='mindgrasp_fsm', executable='fsm_node', name='fsm',

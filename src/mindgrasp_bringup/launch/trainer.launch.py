@@ -17,6 +17,7 @@ from mindgrasp_bringup.launch_system import (
     Shutdown,
     config_files,
 )
+from mindgrasp_bringup.launch_system.common import classifier_nodes
 
 
 def generate_launch_description() -> LaunchDescription:
@@ -38,10 +39,14 @@ def generate_launch_description() -> LaunchDescription:
                               description='seed of the trial order, scene and virtual subject'),
         DeclareLaunchArgument('gui', default_value='false', choices=['true', 'false'],
                               description='open the PyBullet window (needs a display)'),
+        DeclareLaunchArgument('model', default_value='',
+                              description='classifier model (.json written by mindgrasp train '
+                                          'classifier); empty: the one in '
+                                          'config/params/classifier.yaml'),
         Node(package='mindgrasp_sim', executable='sim_node', name='sim',
              parameters=[*config_files('sim'),
                          {'gui': LaunchConfiguration('gui'), 'seed': seed,
-                          'training_robot': True}]),
+                          'trainer_robot': True}]),
         Node(package='mindgrasp_eeg', executable='virtual_amp_node', name='virtual_amp',
              parameters=[*config_files('eeg'),
                          {'stream_name': eeg_stream, 'seed': seed,
@@ -49,8 +54,7 @@ def generate_launch_description() -> LaunchDescription:
              condition=LaunchConfigurationEquals('amp', 'virtual')),
         Node(package='mindgrasp_eeg', executable='acquisition_node', name='eeg_acquisition',
              parameters=[*config_files('eeg'), {'stream_name': eeg_stream}]),
-        Node(package='mindgrasp_classifier', executable='classifier_node', name='classifier',
-             parameters=config_files('classifier')),
+        *classifier_nodes(config_files('classifier')),
         Node(package='mindgrasp_vision', executable='vision_node', name='vision',
              parameters=config_files('vision')),
         Node(package='mindgrasp_fsm', executable='fsm_node', name='fsm',

@@ -47,7 +47,9 @@ def resolve_program(package: str | None, executable: str) -> tuple[list[str], st
 
     ``package`` + ``executable`` is the module ``package.executable`` of our packages, run as
     ``python -m``; failing that, an executable of that name on PATH (an external driver).
-    Without a package, ``executable`` is a path, a program on PATH or a dotted module name.
+    Without a package, ``executable`` is a path, a program on PATH, a dotted module name, or
+    ``package/executable``: our module ``package.executable``, else ``ros2 run package executable``
+    (a ROS 2 driver, when ROS 2 is sourced).
     """
     if package:
         module = f'{package}.{executable}'
@@ -69,8 +71,20 @@ def resolve_program(package: str | None, executable: str) -> tuple[list[str], st
     found = shutil.which(executable)
     if found:
         return [found], None, None
-    if '.' in executable and find_module(executable):
+    if '.' in executable and '/' not in executable and find_module(executable):
         return [sys.executable, '-m', executable], executable, None
+    pkg, sep, exe = executable.partition('/')
+    if sep and pkg and exe and '/' not in exe:  # 'package/executable', as `ros2 run` takes it
+        module = f'{pkg}.{exe}'
+        if find_module(module):
+            return [sys.executable, '-m', module], module, None
+        ros2 = shutil.which('ros2')
+        if ros2:
+            return [ros2, 'run', pkg, exe], None, None
+        problem = (f"'{executable}' is neither the Python module {module} nor runnable with "
+                   f"'ros2 run' (ros2 is not on PATH): source your ROS 2 setup, or give the "
+                   f"driver's full path.")
+        return [executable], None, problem
     problem = (f"the executable '{executable}' was found neither on PATH nor as a Python "
                f"module: install it, give its full path, or fix the launch argument naming it.")
     return [executable], None, problem
