@@ -99,7 +99,7 @@ def build_loop(params: FsmParams | None = None, shape_model: str | None = None,
     note = cfg.shape_model
     try:
         classifier = cfg.load_classifier()
-    except Exception as exc:  # noqa: BLE001 - any load failure: run without shapes, say so
+    except Exception as exc:
         log.warning('Shape model %s not loaded (%s); the controller uses measured sizes only.',
                     cfg.shape_model, exc)
         classifier, note = None, f'none ({cfg.shape_model} not loaded)'

@@ -10,7 +10,7 @@ from  to    when                                                                
 1     2     both-hands MI with an object of interest in view (autonomous: object seen)  no
 2     3     object centred (or centring timed out) after a request from state 1 or 3    no
 2     4     object centred again after leaving state 4 to recentre                      no
-2     1     object of interest lost while centring                                      yes
+2     1     object of interest lost while centring                                      no
 3     2     object of interest drifts out of the centre of the view                     no
 3     4     object fills enough of the image, is close in depth, or joint limit near    yes
 3     1     object of interest lost                                                     yes
@@ -54,7 +54,8 @@ _CLASS_WORDS = {0: 'left hand', 1: 'right hand', 2: 'both hands', 3: 'both feet'
 
 def clamp_to_limits(q: np.ndarray, v: np.ndarray, params: FsmParams) -> np.ndarray:
     """Joint velocities (6,) limited to ``max_joint_velocity`` and so that one control period
-    cannot carry a joint past ``limit -/+ joint_limit_margin``; pushing out of a limit is allowed."""
+    cannot carry a joint past ``limit -/+ joint_limit_margin``; moving away from a limit is
+    allowed."""
     v = np.clip(np.asarray(v, dtype=float), -np.asarray(params.max_joint_velocity),
                 np.asarray(params.max_joint_velocity))
     lo = np.asarray(params.joint_lower_limits) + params.joint_limit_margin
@@ -125,6 +126,19 @@ class GraspFsm:
         self._events: list[str] = []
         self.policy = GraspPolicy(self.params, self.kinematics)
 
+    def force_state(self, state: State | int, reason: str = 'set by the caller',
+                    center_next: State | int | None = None, attempt: int = 0) -> None:
+        """Jump to ``state`` at once, without a lock, running its entry actions (tests, tools).
+
+        ``center_next``: where Center Object goes when centred; ``attempt``: grasp retries used.
+        """
+        self._lock_until = None
+        self._pending = None
+        if center_next is not None:
+            self._center_next = State(center_next)
+        self._attempt = int(attempt)
+        self._enter(State(state), reason)
+
     # ---------------------------------------------------------------------------- transitions
     def _goto(self, new: State, reason: str) -> None:
         """Change state; lock first unless the change is into or out of Center Object."""
@@ -162,6 +176,8 @@ class GraspFsm:
     def _output(self, v: np.ndarray, *, stopped: bool = False, reason: str | None = None,
                 phase: str = '') -> FsmOutput:
         events, self._events = self._events, []
+        if reason is None and self._pending is not None:
+            reason = f'locked: {self._pending[1]}'
         return FsmOutput(
             joint_velocities=np.asarray(v, dtype=float), gripper=self._gripper, state=self.state,
             previous_state=self.previous_state, locked=self._lock_until is not None,
@@ -197,8 +213,7 @@ class GraspFsm:
         # --- lock between states ------------------------------------------------------------
         if self._lock_until is not None:
             if t < self._lock_until:
-                return self._output(np.zeros(6), reason=f'locked: {self._pending[1]}'
-                                    if self._pending else 'locked')
+                return self._output(np.zeros(6))
             self._lock_until = None
             assert self._pending is not None
             new, reason = self._pending
@@ -286,7 +301,9 @@ class GraspFsm:
         return int(pred.class_index), min(max(cert, 0.0), self.params.certainty_cap)
 
     def _lost(self, t: float) -> bool:
-        return self._last_seen is None or t - self._last_seen > self.params.object_lost_timeout
+        seen = self._state_since if self._last_seen is None else max(self._last_seen,
+                                                                       self._state_since)
+        return t - seen > self.params.object_lost_timeout
 
     # ---------------------------------------------------------------------------- state 1
     def _search(self, t: float, q: np.ndarray, inputs: FsmInputs) -> tuple[np.ndarray, str]:
@@ -316,7 +333,7 @@ class GraspFsm:
         return v, _CLASS_WORDS.get(cls, 'no class')
 
     def _sweep_step(self, q: np.ndarray) -> np.ndarray:
-        """Autonomous search: turn left; at the joint-1 limit change the camera tilt and turn back."""
+        """Autonomous search: turn left; at a joint-1 limit change the camera tilt, turn back."""
         p = self.params
         v = np.zeros(6)
         tilts = p.autonomous_search_tilts or [0.0]

@@ -60,11 +60,11 @@ def rotation_rpy(roll: float, pitch: float, yaw: float) -> np.ndarray:
 def _axis_angle(axis: np.ndarray, angle: float) -> np.ndarray:
     x, y, z = axis
     c, s = np.cos(angle), np.sin(angle)
-    C = 1 - c
+    k = 1 - c
     return np.array([
-        [c + x * x * C, x * y * C - z * s, x * z * C + y * s],
-        [y * x * C + z * s, c + y * y * C, y * z * C - x * s],
-        [z * x * C - y * s, z * y * C + x * s, c + z * z * C],
+        [c + x * x * k, x * y * k - z * s, x * z * k + y * s],
+        [y * x * k + z * s, c + y * y * k, y * z * k - x * s],
+        [z * x * k - y * s, z * y * k + x * s, c + z * z * k],
     ])
 
 
@@ -111,7 +111,8 @@ class UrdfKinematics:
                                                 else '1 0 0').split()])
             limit = j.find('limit')
             joints[j.find('child').get('link')] = {
-                'name': j.get('name'), 'type': j.get('type'), 'parent': j.find('parent').get('link'),
+                'name': j.get('name'), 'type': j.get('type'),
+                'parent': j.find('parent').get('link'),
                 'origin': _transform(xyz, rotation_rpy(*rpy)), 'axis': axis / np.linalg.norm(axis),
                 'lower': float(limit.get('lower', -np.pi)) if limit is not None else -np.pi,
                 'upper': float(limit.get('upper', np.pi)) if limit is not None else np.pi,
@@ -168,11 +169,12 @@ class UrdfKinematics:
     def _fk_jacobian(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Tool pose (4x4) and the geometric Jacobian (6, 6) [linear; angular] at ``q``."""
         t = np.eye(4)
-        axes, origins = [], []
+        axes, _origins = [], []
         for joint in self._chains[self.tool_link]:
             t = t @ joint['origin']
             if joint['type'] in ('revolute', 'continuous') and joint['name'] in self._index:
-                axes.append((self._index[joint['name']], t[:3, :3] @ joint['axis'], t[:3, 3].copy()))
+                axes.append((self._index[joint['name']], t[:3, :3] @ joint['axis'],
+                             t[:3, 3].copy()))
                 angle = float(q[self._index[joint['name']]])
                 t = t @ _transform(np.zeros(3), _axis_angle(joint['axis'], angle))
         jac = np.zeros((6, 6))

@@ -1,0 +1,386 @@
+"""GraspFsm on synthetic inputs: every transition of the paper, locks, watchdog, BCI scaling."""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pytest
+
+from mindgrasp_fsm.grasp_fsm import GraspFsm, clamp_to_limits
+from mindgrasp_fsm.params import FsmParams
+from mindgrasp_fsm.types import FsmInputs, GripperState, JointStateIn, MiClass, State
+
+from .conftest import HOME, inputs, observation, run
+
+CENTRED = observation(64, 64, 0.01, 0.8)
+OFF_RIGHT = observation(64 + 0.3 * 128, 64, 0.01, 0.8)
+BIG = observation(64, 64, 0.2, 0.5)
+NEAR = observation(64, 64, 0.05, 0.3)
+HOLDING = GripperState(opening=0.6, force=float('nan'), stamp=0.0, contact=True)
+EMPTY = GripperState(opening=0.0, force=float('nan'), stamp=0.0, contact=False)
+
+
+def _near_limit_q() -> np.ndarray:
+    q = HOME.copy()
+    q[1] = FsmParams().joint_upper_limits[1] - 0.05
+    return q
+
+
+def _settle(fsm: GraspFsm, t: float, **kwargs: object) -> tuple[list, float]:
+    """Tick until the lock (if any) is over: 0.7 s at the fixture's 0.5 s lock."""
+    return run(fsm, t, 0.7, **kwargs)
+
+
+# (name, start state, Center-Object continuation, autonomous, inputs, seconds, end state, locked)
+TRANSITIONS = [
+    ('1->2 both hands selects the object', State.OBJECT_SEARCH, None, False,
+     {'cls': MiClass.BOTH_HANDS, 'obs': CENTRED}, 0.04, State.CENTER_OBJECT, False),
+    ('1->2 autonomous search sees an object', State.OBJECT_SEARCH, None, True,
+     {'cls': None, 'obs': CENTRED}, 0.4, State.CENTER_OBJECT, False),
+    ('2->3 centred after selection', State.CENTER_OBJECT, State.INITIAL_APPROACH, False,
+     {'cls': MiClass.BOTH_HANDS, 'obs': CENTRED}, 0.4, State.INITIAL_APPROACH, False),
+    ('2->4 centred again during the final approach', State.CENTER_OBJECT, State.FINAL_APPROACH,
+     False, {'cls': MiClass.BOTH_HANDS, 'obs': CENTRED}, 0.4, State.FINAL_APPROACH, False),
+    ('2->1 object lost while centring', State.CENTER_OBJECT, State.INITIAL_APPROACH, False,
+     {'cls': MiClass.BOTH_HANDS, 'obs': None}, 1.6, State.OBJECT_SEARCH, False),
+    ('3->2 object drifts off centre', State.INITIAL_APPROACH, None, False,
+     {'cls': MiClass.BOTH_HANDS, 'obs': OFF_RIGHT}, 0.04, State.CENTER_OBJECT, False),
+    ('3->4 object fills the image', State.INITIAL_APPROACH, None, False,
+     {'cls': MiClass.BOTH_HANDS, 'obs': BIG}, 0.04, State.INITIAL_APPROACH, True),
+    ('3->4 object near in depth', State.INITIAL_APPROACH, None, False,
+     {'cls': MiClass.BOTH_HANDS, 'obs': NEAR}, 0.04, State.INITIAL_APPROACH, True),
+    ('3->4 approach joint near its limit', State.INITIAL_APPROACH, None, False,
+     {'cls': MiClass.BOTH_HANDS, 'obs': CENTRED, 'q': _near_limit_q()}, 0.04,
+     State.INITIAL_APPROACH, True),
+    ('3->1 object lost during the approach', State.INITIAL_APPROACH, None, False,
+     {'cls': MiClass.BOTH_HANDS, 'obs': None}, 1.6, State.INITIAL_APPROACH, True),
+    ('4->2 off centre before the autonomous approach', State.FINAL_APPROACH, None, False,
+     {'cls': MiClass.BOTH_HANDS, 'obs': OFF_RIGHT}, 0.04, State.CENTER_OBJECT, False),
+    ('6->1 back at the start position', State.RETURN_TO_START, None, False,
+     {'cls': MiClass.BOTH_HANDS, 'obs': None}, 0.04, State.RETURN_TO_START, True),
+]
+AFTER_LOCK = {
+    '3->4 object fills the image': State.FINAL_APPROACH,
+    '3->4 object near in depth': State.FINAL_APPROACH,
+    '3->4 approach joint near its limit': State.FINAL_APPROACH,
+    '3->1 object lost during the approach': State.OBJECT_SEARCH,
+    '6->1 back at the start position': State.OBJECT_SEARCH,
+}
+
+
+@pytest.mark.parametrize(('name', 'start', 'center_next', 'autonomous', 'kw', 'seconds', 'end',
+                          'locked'), TRANSITIONS, ids=[t[0] for t in TRANSITIONS])
+def test_transition(params: FsmParams, name: str, start: State, center_next: State | None,
+                    autonomous: bool, kw: dict, seconds: float, end: State, locked: bool) -> None:
+    params.autonomous = autonomous
+    fsm = GraspFsm.from_params(params)
+    fsm.force_state(start, center_next=center_next)
+    outs, t = run(fsm, 0.0, seconds, **kw)
+    assert outs[-1].state == end, outs[-1].reason
+    assert outs[-1].locked == locked
+    if locked:
+        # the lock: every joint stopped, state unchanged, then the new state
+        assert all(np.all(o.joint_velocities == 0) for o in outs if o.locked)
+        outs, _ = _settle(fsm, t, **kw)
+        assert outs[-1].state == AFTER_LOCK[name]
+        assert outs[-1].previous_state == start
+        assert not outs[-1].locked
+
+
+def test_both_hands_without_object_stays_in_search(fsm: GraspFsm) -> None:
+    outs, _ = run(fsm, 0.0, 0.5, cls=MiClass.BOTH_HANDS, obs=None)
+    assert outs[-1].state == State.OBJECT_SEARCH
+    assert np.all(outs[-1].joint_velocities == 0)
+
+
+@pytest.mark.parametrize(('cls', 'sign'), [(MiClass.LEFT_HAND, 1.0), (MiClass.RIGHT_HAND, -1.0),
+                                           (MiClass.BOTH_FEET, 0.0)])
+@pytest.mark.parametrize('cert', [0.4, 1.0])
+def test_search_turns_joint1_scaled_by_certainty(fsm: GraspFsm, cls: int, sign: float,
+                                                 cert: float) -> None:
+    out = fsm.tick(inputs(0.0, cls=cls, cert=cert, obs=None))
+    expected = np.zeros(6)
+    expected[0] = sign * fsm.params.search_gain * cert
+    np.testing.assert_allclose(out.joint_velocities, expected)
+
+
+def test_initial_approach_classes(fsm: GraspFsm) -> None:
+    p = fsm.params
+    fsm.force_state(State.INITIAL_APPROACH)
+    out = fsm.tick(inputs(0.0, cls=MiClass.BOTH_HANDS, cert=1.0, obs=CENTRED))
+    assert out.joint_velocities[1] == pytest.approx(p.approach_gain * 1.0)
+    out = fsm.tick(inputs(0.02, cls=MiClass.BOTH_HANDS, cert=1.5, obs=CENTRED))
+    assert out.joint_velocities[1] == pytest.approx(p.approach_gain * 1.5)
+    out = fsm.tick(inputs(0.04, cls=MiClass.BOTH_FEET, cert=1.0, obs=CENTRED))
+    assert out.joint_velocities[1] == pytest.approx(-p.retreat_gain)
+    out = fsm.tick(inputs(0.06, cls=MiClass.LEFT_HAND, cert=1.0, obs=CENTRED))
+    assert out.joint_velocities[1] == 0 and out.joint_velocities[0] == pytest.approx(p.turn_gain)
+    out = fsm.tick(inputs(0.08, cls=MiClass.RIGHT_HAND, cert=1.0, obs=CENTRED))
+    assert out.joint_velocities[0] == pytest.approx(-p.turn_gain)
+    # no class above the certainty threshold: the slow default approach
+    out = fsm.tick(inputs(0.10, cls=MiClass.BOTH_FEET, cert=0.2, obs=CENTRED))
+    assert out.joint_velocities[1] == pytest.approx(p.default_approach_velocity)
+    assert out.state == State.INITIAL_APPROACH
+
+
+def test_centring_is_proportional_on_joints_1_and_5(fsm: GraspFsm) -> None:
+    p = fsm.params
+    fsm.force_state(State.CENTER_OBJECT, center_next=State.INITIAL_APPROACH)
+    obs = observation(64 + 12.8, 64 - 6.4)
+    out = fsm.tick(inputs(0.0, obs=obs))
+    assert out.joint_velocities[0] == pytest.approx(p.center_sign_joint1 * p.center_gain_joint1
+                                                    * 0.1)
+    assert out.joint_velocities[4] == pytest.approx(p.center_sign_joint5 * p.center_gain_joint5
+                                                    * -0.05)
+    assert np.all(out.joint_velocities[[1, 2, 3, 5]] == 0)
+
+
+def test_bci_ignored_in_autonomous_states(fsm: GraspFsm) -> None:
+    fsm.force_state(State.RETURN_TO_START)
+    q = HOME + np.array([0.3, 0.0, 0.0, 0.0, 0.0, 0.0])
+    a = fsm.tick(inputs(0.0, q=q, cls=MiClass.LEFT_HAND))
+    b = fsm.tick(inputs(0.02, q=q, cls=MiClass.RIGHT_HAND))
+    np.testing.assert_allclose(a.joint_velocities, b.joint_velocities)
+    assert a.joint_velocities[0] < 0   # back towards home
+
+
+def test_center_timeout_goes_on(params: FsmParams) -> None:
+    params.center_timeout = 0.5
+    fsm = GraspFsm.from_params(params)
+    fsm.force_state(State.CENTER_OBJECT, center_next=State.INITIAL_APPROACH)
+    obs = observation(64 + 0.1 * 128, 64)
+    outs, _ = run(fsm, 0.0, 0.6, obs=obs)
+    assert outs[-1].state == State.INITIAL_APPROACH
+    assert 'timed out' in outs[-1].reason
+
+
+def test_return_timeout(params: FsmParams) -> None:
+    params.return_timeout = 0.3
+    fsm = GraspFsm.from_params(params)
+    fsm.force_state(State.RETURN_TO_START)
+    q = HOME + 0.5
+    outs, t = run(fsm, 0.0, 0.4, q=q)
+    assert outs[-1].locked and 'timed out' in outs[-1].reason
+    outs, _ = _settle(fsm, t, q=q)
+    assert outs[-1].state == State.OBJECT_SEARCH
+
+
+# ------------------------------------------------------------------------- state 5 transitions
+def _grasp_fsm(params: FsmParams, attempt: int = 0) -> GraspFsm:
+    fsm = GraspFsm.from_params(params)
+    fsm.force_state(State.FINAL_APPROACH, attempt=attempt)
+    fsm.policy.object_position = np.array([0.45, 0.0, 0.025])
+    fsm.policy.shape = 'cube'
+    fsm.force_state(State.GRASP_OBJECT, attempt=attempt)
+    return fsm
+
+
+def _grasp_pose() -> np.ndarray:
+    fsm = GraspFsm.from_params(FsmParams())
+    q = fsm.kinematics.grasp_ik(np.array([0.45, 0.0, 0.025]), np.pi, HOME)
+    assert q is not None
+    return q
+
+
+def _drive(fsm: GraspFsm, q: np.ndarray, gripper: GripperState, seconds: float,
+           t0: float = 0.0) -> tuple[list, np.ndarray, float]:
+    """Closed loop on a kinematic arm (q integrates the commanded velocities)."""
+    outs = []
+    t = t0
+    dt = 0.02
+    while t < t0 + seconds:
+        g = GripperState(gripper.opening, gripper.force, t, gripper.contact)
+        out = fsm.tick(inputs(t, q=q, obs=None, gripper=g))
+        q = q + out.joint_velocities * dt
+        outs.append(out)
+        t += dt
+    return outs, q, t
+
+
+def test_5_to_6_checked_grasp(params: FsmParams) -> None:
+    fsm = _grasp_fsm(params)
+    outs, _q, _ = _drive(fsm, _grasp_pose(), HOLDING, 8.0)
+    states = [o.state for o in outs]
+    assert State.RETURN_TO_START in states
+    phases = {o.phase for o in outs}
+    assert {'close', 'lift', 'check_lift', 'hold'} <= phases
+    assert fsm.outcome == 'holding'
+    assert outs[0].gripper.position == params.gripper_closed_position
+    # during the return the hand stays closed on the object
+    assert all(o.gripper.position == params.gripper_closed_position for o in outs)
+
+
+def test_5_to_4_retry_when_the_fingers_close_on_nothing(params: FsmParams) -> None:
+    fsm = _grasp_fsm(params)
+    outs, _, _ = _drive(fsm, _grasp_pose(), EMPTY, 8.0)
+    entered = [o for o in outs if o.state == State.FINAL_APPROACH]
+    assert entered, [o.reason for o in outs[-3:]]
+    assert entered[0].previous_state == State.GRASP_OBJECT
+    assert entered[0].grasp_attempts == 1
+    assert 'retrying' in entered[0].reason and 'closed on nothing' in entered[0].reason
+    # opened before retreating
+    assert any(o.phase == 'retreat' and o.gripper.position == 0.0 for o in outs)
+
+
+def test_5_to_6_fails_after_the_retries(params: FsmParams) -> None:
+    fsm = _grasp_fsm(params, attempt=params.grasp_retries)
+    outs, _, _ = _drive(fsm, _grasp_pose(), EMPTY, 8.0)
+    returning = [o for o in outs if o.state == State.RETURN_TO_START]
+    assert returning and 'grasp failed' in returning[0].reason
+    assert returning[0].previous_state == State.GRASP_OBJECT
+    assert fsm.outcome == 'failed'
+    assert all(o.state != State.FINAL_APPROACH for o in outs)
+
+
+def test_slip_after_lift_retries(params: FsmParams) -> None:
+    fsm = _grasp_fsm(params)
+    q = _grasp_pose()
+    outs, q, t = _drive(fsm, q, HOLDING, 1.2)
+    assert outs[-1].phase == 'lift'
+    outs, _, _ = _drive(fsm, q, EMPTY, 6.0, t0=t)
+    entered = [o for o in outs if o.state == State.FINAL_APPROACH]
+    assert entered and 'slipped' in entered[0].reason
+
+
+def test_4_to_6_abort_when_out_of_reach(fsm: GraspFsm) -> None:
+    fsm.force_state(State.FINAL_APPROACH)
+    # an object seen far beyond the arm's reach (2.5 m along the optical axis)
+    far = observation(64, 64, 0.001, 2.5)
+    outs, _t = run(fsm, 0.0, 1.5, obs=far, gripper=GripperState(1.0, 0.0, 0.0))
+    locked = [o for o in outs if o.locked]
+    assert locked and 'aborted' in locked[0].reason and 'reach' in locked[0].reason
+    returning = [o for o in outs if o.state == State.RETURN_TO_START]
+    assert returning and returning[0].previous_state == State.FINAL_APPROACH
+
+
+# ------------------------------------------------------------------------- locks, watchdog
+def test_no_lock_into_and_out_of_center(fsm: GraspFsm) -> None:
+    out = fsm.tick(inputs(0.0, cls=MiClass.BOTH_HANDS, obs=CENTRED))
+    assert out.state == State.CENTER_OBJECT and not out.locked
+
+
+def test_lock_holds_all_joints_for_lock_duration(fsm: GraspFsm) -> None:
+    fsm.force_state(State.INITIAL_APPROACH)
+    outs, _ = run(fsm, 0.0, 0.8, cls=MiClass.LEFT_HAND, obs=BIG)
+    locked = [o for o in outs if o.locked]
+    assert len(locked) == pytest.approx(0.5 / 0.02, abs=2)
+    assert all(o.state == State.INITIAL_APPROACH for o in locked)
+    assert all(np.all(o.joint_velocities == 0) for o in locked)
+    assert outs[-1].state == State.FINAL_APPROACH
+
+
+@pytest.mark.parametrize(('kw', 'match'), [
+    ({'joints': 'stale'}, r'joint states are 0\.50 s old'),
+    ({'joints': 'nan'}, r'NaN'),
+    ({'joints': None}, r'no joint states'),
+    ({'prediction': 'stale'}, r'MI prediction is 0\.50 s old'),
+    ({'prediction': None}, r'no MI prediction'),
+    ({'vision': 'stale'}, r'no camera images for 0\.80 s'),
+    ({'vision': None}, r'no camera images received'),
+])
+def test_watchdog_stops_every_joint(fsm: GraspFsm, kw: dict, match: str) -> None:
+    fsm.tick(inputs(0.0, cls=MiClass.LEFT_HAND, obs=None))
+    good = inputs(1.0, cls=MiClass.LEFT_HAND, obs=None)
+    assert fsm.tick(good).joint_velocities[0] > 0
+    t = 1.02
+    bad = inputs(t, cls=MiClass.LEFT_HAND, obs=None)
+    if 'joints' in kw:
+        if kw['joints'] == 'stale':
+            bad.joints = JointStateIn(HOME, np.zeros(6), t - 0.5)
+        elif kw['joints'] == 'nan':
+            q = HOME.copy()
+            q[2] = np.nan
+            bad.joints = JointStateIn(q, np.zeros(6), t)
+        else:
+            bad.joints = None
+    if 'prediction' in kw:
+        bad.prediction = (None if kw['prediction'] is None
+                          else type(good.prediction)(MiClass.LEFT_HAND, 1.0, t - 0.5))
+    if 'vision' in kw:
+        bad.vision = None if kw['vision'] is None else type(good.vision)(t - 0.8, 128, 128)
+    out = fsm.tick(bad)
+    assert out.stopped
+    assert np.all(out.joint_velocities == 0)
+    assert re.search(match, out.reason), out.reason
+    # recovers when the inputs are good again
+    assert not fsm.tick(inputs(t + 0.02, cls=MiClass.LEFT_HAND, obs=None)).stopped
+
+
+def test_autonomous_mode_needs_no_predictions(params: FsmParams) -> None:
+    params.autonomous = True
+    fsm = GraspFsm.from_params(params)
+    out = fsm.tick(inputs(0.0, cls=None, obs=None))
+    assert not out.stopped
+    assert out.joint_velocities[0] == pytest.approx(params.autonomous_search_velocity)
+
+
+def test_watchdog_freezes_the_lock_timer(fsm: GraspFsm) -> None:
+    fsm.force_state(State.INITIAL_APPROACH)
+    fsm.tick(inputs(0.0, obs=BIG))              # lock begins
+    stale = inputs(0.3, obs=BIG)
+    stale.prediction = None
+    for k in range(50):                          # 1 s without predictions
+        stale.time = 0.3 + 0.02 * k
+        stale.joints = JointStateIn(HOME, np.zeros(6), stale.time)
+        stale.vision = inputs(stale.time, obs=BIG).vision
+        assert fsm.tick(stale).stopped
+    out = fsm.tick(inputs(1.4, obs=BIG))
+    assert out.locked and out.state == State.INITIAL_APPROACH
+
+
+def test_gripper_is_kept_while_stopped(params: FsmParams) -> None:
+    fsm = _grasp_fsm(params)
+    out = fsm.tick(inputs(0.0, q=_grasp_pose(), obs=None, gripper=HOLDING))
+    closed = out.gripper
+    stale = inputs(0.02, q=_grasp_pose(), obs=None, gripper=HOLDING)
+    stale.joints = None
+    out = fsm.tick(stale)
+    assert out.stopped and out.gripper == closed
+
+
+def test_bad_time_raises(fsm: GraspFsm) -> None:
+    from mindgrasp_fsm.errors import FsmError
+
+    with pytest.raises(FsmError, match='finite seconds'):
+        fsm.tick(FsmInputs(time=float('nan')))
+
+
+# ------------------------------------------------------------------------- joint limits
+def test_clamp_stops_at_the_limits() -> None:
+    p = FsmParams()
+    hi = np.asarray(p.joint_upper_limits)
+    lo = np.asarray(p.joint_lower_limits)
+    q = hi - p.joint_limit_margin
+    v = clamp_to_limits(q, np.full(6, 0.5), p)
+    np.testing.assert_array_equal(v, np.zeros(6))
+    v = clamp_to_limits(q, np.full(6, -0.5), p)          # moving away from a limit is fine
+    np.testing.assert_allclose(v, np.full(6, -0.5))
+    v = clamp_to_limits(lo + 0.001, np.full(6, -5.0), p)
+    assert np.all(v >= 0)
+    # one period from the limit: the step lands exactly on the margin
+    q = hi - p.joint_limit_margin - 0.004
+    v = clamp_to_limits(q, np.full(6, 1.0), p)
+    np.testing.assert_allclose(q + v * p.control_period, hi - p.joint_limit_margin)
+
+
+def test_never_commands_beyond_limits_or_speed(params: FsmParams) -> None:
+    rng = np.random.default_rng(3)
+    lo = np.asarray(params.joint_lower_limits)
+    hi = np.asarray(params.joint_upper_limits)
+    vmax = np.asarray(params.max_joint_velocity)
+    for state in State:
+        fsm = GraspFsm.from_params(params)
+        fsm.force_state(state)
+        for k in range(40):
+            q = rng.uniform(lo - 0.1, hi + 0.1)
+            obs = observation(*rng.uniform(0, 128, 2), rng.uniform(0, 0.3), rng.uniform(0.1, 1))
+            out = fsm.tick(inputs(0.02 * k, q=q, cls=int(rng.integers(4)),
+                                  cert=rng.uniform(0, 5), obs=obs,
+                                  gripper=GripperState(0.5, 1.0, 0.02 * k, True)))
+            v = out.joint_velocities
+            assert np.all(np.abs(v) <= vmax + 1e-12)
+            nxt = q + v * params.control_period
+            over = (nxt > hi - params.joint_limit_margin + 1e-9) & (v > 0)
+            under = (nxt < lo + params.joint_limit_margin - 1e-9) & (v < 0)
+            assert not np.any(over | under), (state, q, v)
