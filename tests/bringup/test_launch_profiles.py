@@ -40,7 +40,13 @@ def test_hardware_has_drivers_and_no_simulator() -> None:
     assert driver.program[0].endswith('/true') and driver.node_name == 'arm_driver'
     assert driver.arguments == ['--ip', '10.0.0.2', '--rate', '100']
     assert procs['eeg_acquisition'].parameters['stream_name'] == 'gNautilus'
-    assert procs['classifier'].parameters['model'] == 'models/default_classifier.json'
+    from mindgrasp_bringup.launch_system import config_files
+    from mindgrasp_bringup.launch_system.params import load_parameter_file
+
+    file_model = {}
+    for f in config_files('classifier'):
+        file_model.update(load_parameter_file(f).get('classifier', {}))
+    assert procs['classifier'].parameters.get('model') == file_model.get('model')
     procs = processes('hardware', 'eeg_stream:=a', 'arm_driver:=true', 'camera_driver:=true',
                       'model:=models/alice.json')
     assert 'camera_driver' in procs
