@@ -134,13 +134,15 @@ QoSProfile, ReliabilityPolicy = rclpy.qos.QoSProfile, rclpy.qos.ReliabilityPolic
 rclpy.init()
 node = rclpy.node.Node('bag_test_probe')
 qos = QoSProfile(depth=200, reliability=ReliabilityPolicy.RELIABLE)
+best_effort = QoSProfile(depth=200, reliability=ReliabilityPolicy.BEST_EFFORT)  # /clock
 subs = []
 for spec in sys.argv[1:]:
     topic, msgtype = spec.split('=')
     def cb(data, info, topic=topic):
         t = info.get('source_timestamp') or time.time_ns()
         print(topic, t, hashlib.sha1(bytes(data)).hexdigest(), flush=True)
-    subs.append(node.create_subscription(msgtype, topic, cb, qos, raw=True))
+    subs.append(node.create_subscription(msgtype, topic, cb,
+                                         best_effort if topic == '/clock' else qos, raw=True))
 print('ready', flush=True)
 try:
     rclpy.spin(node)

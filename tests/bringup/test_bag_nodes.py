@@ -148,12 +148,13 @@ def test_bag_play_cli_republishes_identical_bytes_with_original_timing(recorded)
     prefix, bag, _ = recorded
     out_prefix = f'/bagplay_{uuid.uuid4().hex[:8]}'
     probe, probe_out = _start([sys.executable, '-c', PROBE, f'{out_prefix}/eeg={EEG}',
-                               f'{prefix}/chatter={STRING}'])
+                               f'{prefix}/chatter={STRING}', '/clock=rosgraph_msgs/msg/Clock'])
     try:
         assert probe_out.wait_for('ready', 20), probe_out.lines
         play = subprocess.run(
             [sys.executable, '-m', 'mindgrasp_bringup', 'bag', 'play', str(bag),
-             '--remap', f'{prefix}/eeg:={out_prefix}/eeg', '--priority', '20', '--delay', '1.0'],
+             '--remap', f'{prefix}/eeg:={out_prefix}/eeg', '--priority', '20', '--delay', '1.0',
+             '--clock', '20'],
             capture_output=True, text=True, env=_env(), timeout=120)
         assert play.returncode == 0, play.stdout + play.stderr
         time.sleep(0.5)
@@ -176,6 +177,8 @@ def test_bag_play_cli_republishes_identical_bytes_with_original_timing(recorded)
     sent = np.array([int(r[1]) for r in got_eeg], dtype=np.int64)
     errors = np.abs((sent - sent[0]) - (np.array(stamps) - stamps[0])) / 1e6
     assert errors.max() < 5.0, errors
+    # --clock 20: /clock at ~20 Hz during the ~2 s of playback.
+    assert 20 <= sum(1 for r in rows if r[0] == '/clock') <= 60
 
 
 def test_bag_play_missing_bag_is_a_clear_error(tmp_path):
@@ -184,3 +187,36 @@ def test_bag_play_missing_bag_is_a_clear_error(tmp_path):
                          timeout=60)
     assert out.returncode == 1
     assert 'does not exist; pass the path of a bag directory' in out.stderr
+
+
+def test_recorder_node_full_disk_stops_recording_and_keeps_running(tmp_path):
+    mount = tmp_path / 'tiny'
+    mount.mkdir()
+    result = subprocess.run(['mount', '-t', 'tmpfs', '-o', 'size=40k', 'tmpfs', str(mount)],
+                            capture_output=True, text=True)
+    if result.returncode != 0:
+        pytest.skip(f'cannot mount a small tmpfs to fill (needs root): {result.stderr.strip()}')
+    prefix = f'/bagfull_{uuid.uuid4().hex[:8]}'
+    recorder = publisher = None
+    try:
+        # Through the CLI this time: `mindgrasp bag record`.
+        recorder, rec_out = _start([
+            sys.executable, '-m', 'mindgrasp_bringup', 'bag', 'record', '-o', str(mount / 'bag'),
+            '-e', f'^{prefix}/', '--flush-interval', '0.2', '--duration', '60'])
+        assert rec_out.wait_for('Recording to', 20), rec_out.lines
+        publisher, pub_out = _start([sys.executable, '-c', PUBLISHER, str(HERE), prefix, '30'])
+        assert rec_out.wait_for('Recording stopped', 60), rec_out.lines + pub_out.lines
+        assert any('disk is full' in line for line in rec_out.lines), rec_out.lines
+        assert pub_out.wait_for('done', 60), pub_out.lines
+        assert recorder.poll() is None            # the node keeps running after the error
+        assert _stop(recorder) == 1               # ... and reports the failure when it ends
+        with BagReader(mount / 'bag') as reader:
+            got = [d for topic, _, d in reader.messages() if topic == f'{prefix}/eeg']
+        assert got, 'nothing written before the disk filled up was kept'
+        for k, data in enumerate(got):
+            assert data[:len(eeg_chunk(25 * k))] == eeg_chunk(25 * k)
+    finally:
+        for proc in (publisher, recorder):
+            if proc is not None and proc.poll() is None:
+                _stop(proc)
+        subprocess.run(['umount', '-l', str(mount)], check=False)
