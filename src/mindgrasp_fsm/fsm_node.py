@@ -1,0 +1,221 @@
+"""The ``fsm`` node: the six-state MIndGrasp controller on ROS topics.
+
+Run: ``python -m mindgrasp_fsm.fsm_node --ros-args --params-file config/params/fsm.yaml``
+
+Subscribes ``/bci/prediction`` (mindgrasp_msgs/MIPrediction), ``/vision/detections``
+(DetectionArray), ``/joint_states``, ``/gripper/joint_states`` + ``/gripper/contacts`` (finger
+angles and contact flags), ``/camera/color/camera_info``. Publishes ``/arm_controller/commands``
+(std_msgs/Float64MultiArray, 6 joint velocities in rad/s), ``/gripper_controller/commands``
+(``[closure]``, 0 open .. 1 closed) and ``/fsm/state`` (FsmState, transient local). Parameters:
+every field of :class:`mindgrasp_fsm.params.FsmParams`, plus ``control_rate`` (Hz) and
+``duration`` (s; > 0 ends the node after that time, for launch tests).
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+
+import numpy as np
+from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import DetectionArray, FsmState, MIPrediction
+from mindgrasp_ros.interfaces.sensor_msgs.msg import CameraInfo, JointState
+from mindgrasp_ros.interfaces.std_msgs.msg import Float64MultiArray, UInt8MultiArray
+
+from mindgrasp_fsm.conversions import gripper_from_fingers, vision_frame_from_msg
+from mindgrasp_fsm.errors import FsmError
+from mindgrasp_fsm.grasp_fsm import GraspFsm
+from mindgrasp_fsm.params import FsmParams
+from mindgrasp_fsm.types import (
+    STATE_NAMES,
+    CameraModel,
+    FsmInputs,
+    FsmOutput,
+    JointStateIn,
+    Prediction,
+)
+from mindgrasp_ros import rclpy
+
+_RELIABLE = 10
+
+
+def _seconds(stamp: object) -> float:
+    return int(stamp.sec) + int(stamp.nanosec) * 1e-9
+
+
+class FsmNode(rclpy.node.Node):
+    """Thin ROS wrapper round :class:`GraspFsm` (parameters: config/params/fsm.yaml)."""
+
+    def __init__(self, **kwargs: object) -> None:
+        super().__init__('fsm', **kwargs)
+        defaults = FsmParams().to_dict()
+        self.declare_parameters('', [*defaults.items(), ('control_rate', 50.0),
+                                     ('duration', 0.0)])
+        values = {name: self.get_parameter(name).value for name in defaults}
+        self.params = FsmParams.from_dict(values)      # FsmError ends the node with the reason
+        rate = float(self.get_parameter('control_rate').value)
+        if not rate > 0:
+            msg = f"The parameter 'control_rate' must be > 0 Hz, got {rate}; use e.g. 50.0."
+            raise FsmError(msg)
+        self.params.control_period = 1.0 / rate
+        self.fsm = GraspFsm.from_params(self.params)
+        self.inputs = FsmInputs(time=0.0)
+        self._fingers: np.ndarray | None = None
+        self._finger_stamp = 0.0
+        self._contacts: np.ndarray | None = None
+        self._errors: dict[str, float] = {}
+        self._last_state_msg: tuple | None = None
+        self._last_state_pub = -1e9
+        self.done = False
+        self.ticks = 0
+
+        self.arm_pub = self.create_publisher(Float64MultiArray, '/arm_controller/commands',
+                                             _RELIABLE)
+        self.gripper_pub = self.create_publisher(Float64MultiArray,
+                                                 '/gripper_controller/commands', _RELIABLE)
+        latched = rclpy.qos.QoSProfile(
+            depth=1, reliability=rclpy.qos.ReliabilityPolicy.RELIABLE,
+            durability=rclpy.qos.DurabilityPolicy.TRANSIENT_LOCAL)
+        self.state_pub = self.create_publisher(FsmState, '/fsm/state', latched)
+        self.create_subscription(MIPrediction, '/bci/prediction', self.prediction_callback,
+                                 _RELIABLE)
+        self.create_subscription(DetectionArray, '/vision/detections', self.detections_callback,
+                                 _RELIABLE)
+        self.create_subscription(JointState, '/joint_states', self.joint_state_callback, _RELIABLE)
+        self.create_subscription(JointState, '/gripper/joint_states', self.finger_callback,
+                                 _RELIABLE)
+        self.create_subscription(UInt8MultiArray, '/gripper/contacts', self.contacts_callback,
+                                 _RELIABLE)
+        self.create_subscription(CameraInfo, '/camera/color/camera_info', self.info_callback,
+                                 rclpy.qos.qos_profile_sensor_data)
+        self.create_timer(self.params.control_period, self.control_callback)
+        self._start = self._now()
+        self._duration = float(self.get_parameter('duration').value)
+        mode = 'autonomous' if self.params.autonomous else 'BCI'
+        self.get_logger().info(f'Grasp controller ready ({mode} mode, {rate:.0f} Hz, lock '
+                               f'{self.params.lock_duration:.1f} s, watchdog '
+                               f'{self.params.watchdog_timeout:.2f} s).')
+
+    # ------------------------------------------------------------------ helpers
+    def _now(self) -> float:
+        return self.get_clock().now().nanoseconds * 1e-9
+
+    def _stamp_or_now(self, header: object) -> float:
+        t = _seconds(header.stamp)
+        return t if t > 0 else self._now()   # unstamped messages: time of receipt
+
+    def _error(self, key: str, text: str) -> None:
+        now = time.monotonic()
+        if now - self._errors.get(key, -1e9) >= 5.0:   # the same problem at most every 5 s
+            self._errors[key] = now
+            self.get_logger().error(text)
+
+    # ------------------------------------------------------------------ callbacks
+    def prediction_callback(self, msg: MIPrediction) -> None:
+        self.inputs.prediction = Prediction(int(msg.class_index), float(msg.certainty),
+                                            self._stamp_or_now(msg.header))
+
+    def detections_callback(self, msg: DetectionArray) -> None:
+        if msg.image_width == 0 or msg.image_height == 0:
+            self._error('detections', 'Received /vision/detections with a zero image size; '
+                        'the vision node must fill image_width and image_height.')
+            return
+        self.inputs.vision = vision_frame_from_msg(msg, self._stamp_or_now(msg.header))
+
+    def joint_state_callback(self, msg: JointState) -> None:
+        names = list(msg.name)
+        try:
+            idx = [names.index(n) for n in self.params.joint_names]
+        except ValueError:
+            self._error('joints', f'/joint_states names {names} lack one of the controller '
+                        f'joints {self.params.joint_names}; set joint_names to match the arm.')
+            return
+        pos = np.asarray(msg.position, dtype=float)
+        vel = np.asarray(msg.velocity, dtype=float)
+        if pos.size != len(names):
+            self._error('joints', f'/joint_states has {len(names)} names but {pos.size} '
+                        'positions; the arm driver must send one position per joint.')
+            return
+        v = vel[idx] if vel.size == len(names) else np.zeros(len(idx))
+        # NaN positions are passed on: the controller's watchdog stops the arm and says why
+        self.inputs.joints = JointStateIn(pos[idx], v, self._stamp_or_now(msg.header))
+
+    def finger_callback(self, msg: JointState) -> None:
+        self._fingers = np.asarray(msg.position, dtype=float)
+        self._finger_stamp = self._stamp_or_now(msg.header)
+        self._update_gripper()
+
+    def contacts_callback(self, msg: UInt8MultiArray) -> None:
+        self._contacts = np.asarray(msg.data, dtype=bool)
+        self._update_gripper()
+
+    def _update_gripper(self) -> None:
+        if self._fingers is None or self._fingers.size == 0:
+            return
+        contacts = self._contacts if self._contacts is not None and \
+            self._contacts.size == self._fingers.size else None
+        self.inputs.gripper = gripper_from_fingers(self._fingers, self._finger_stamp, contacts)
+
+    def info_callback(self, msg: CameraInfo) -> None:
+        k = np.asarray(msg.k, dtype=float)
+        if k.size != 9 or k[0] <= 0 or k[4] <= 0 or msg.width == 0:
+            self._error('camera_info', f'camera_info K {k.tolist()} is not a pinhole matrix '
+                        '(9 values, fx, fy > 0); check the camera driver.')
+            return
+        self.inputs.camera = CameraModel.from_k(int(msg.width), int(msg.height), k)
+
+    def control_callback(self) -> None:
+        now = self._now()
+        if self._duration > 0 and now - self._start >= self._duration:
+            self.arm_pub.publish(Float64MultiArray(data=np.zeros(6)))
+            self.done = True
+            return
+        self.inputs.time = now
+        out = self.fsm.tick(self.inputs)
+        self.ticks += 1
+        self.arm_pub.publish(Float64MultiArray(data=np.asarray(out.joint_velocities, float)))
+        self.gripper_pub.publish(Float64MultiArray(data=np.array([out.gripper.position])))
+        self._publish_state(out, now)
+        for event in out.events:
+            self.get_logger().info(f'State: {event}')
+
+    def _publish_state(self, out: FsmOutput, now: float) -> None:
+        key = (int(out.state), out.locked, out.stopped, out.reason, out.object_of_interest)
+        if key == self._last_state_msg and now - self._last_state_pub < 1.0:
+            return
+        if out.stopped and (self._last_state_msg is None or not self._last_state_msg[2]):
+            self.get_logger().warning(out.reason)
+        self._last_state_msg, self._last_state_pub = key, now
+        msg = FsmState(state=int(out.state), state_name=STATE_NAMES[out.state],
+                       previous_state=int(out.previous_state),
+                       object_of_interest=out.object_of_interest, locked=bool(out.locked),
+                       stopped=bool(out.stopped), reason=out.reason)
+        msg.header.stamp = self.get_clock().now().to_msg()
+        self.state_pub.publish(msg)
+
+
+def main(args: list[str] | None = None) -> int:
+    """Run the controller until Ctrl-C or the ``duration`` parameter; arm stopped on exit."""
+    rclpy.init(args=args if args is not None else sys.argv)
+    try:
+        node = FsmNode()
+    except FsmError as exc:
+        print(f'fsm: {exc}', file=sys.stderr)
+        rclpy.shutdown()
+        return 2
+    try:
+        while rclpy.ok() and not node.done:
+            rclpy.spin_once(node, timeout_sec=0.1)
+    except KeyboardInterrupt:
+        pass
+    finally:
+        if rclpy.ok():
+            node.arm_pub.publish(Float64MultiArray(data=np.zeros(6)))
+        node.get_logger().info(f'Controller ran {node.ticks} ticks.')
+        node.destroy_node()
+        if rclpy.ok():
+            rclpy.shutdown()
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())

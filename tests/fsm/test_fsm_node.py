@@ -1,0 +1,76 @@
+"""The fsm node in its own process, over real DDS: commands, state topic, watchdog."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pytest
+from tests.conftest import spin_until
+
+pytestmark = pytest.mark.slow
+
+HOME = [0.0, 0.0, 0.0, np.pi / 2, 1.2, 0.0]
+
+
+def test_fsm_node_turns_on_left_hand_and_stops_when_predictions_end(rclpy_ctx, spawn_node
+                                                                    ) -> None:
+    rclpy = rclpy_ctx
+    from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import DetectionArray, FsmState, MIPrediction
+    from mindgrasp_ros.interfaces.sensor_msgs.msg import JointState
+    from mindgrasp_ros.interfaces.std_msgs.msg import Float64MultiArray
+
+    proc = spawn_node('mindgrasp_fsm.fsm_node', '--ros-args', '-p', 'duration:=60.0',
+                      '-p', 'lock_duration:=0.5', '-p', 'search_gain:=0.4')
+    assert proc.wait_for_output('Grasp controller ready', 30.0), proc.output()
+
+    node = rclpy.node.Node('fsm_test_driver')
+    commands: list[np.ndarray] = []
+    states: list[object] = []
+    node.create_subscription(Float64MultiArray, '/arm_controller/commands',
+                             lambda m: commands.append(np.array(m.data)), 10)
+    latched = rclpy.qos.QoSProfile(depth=1, reliability=rclpy.qos.ReliabilityPolicy.RELIABLE,
+                                   durability=rclpy.qos.DurabilityPolicy.TRANSIENT_LOCAL)
+    node.create_subscription(FsmState, '/fsm/state', states.append, latched)
+    js_pub = node.create_publisher(JointState, '/joint_states', 10)
+    det_pub = node.create_publisher(DetectionArray, '/vision/detections', 10)
+    pred_pub = node.create_publisher(MIPrediction, '/bci/prediction', 10)
+
+    # nothing published yet: the controller holds still and says why
+    assert spin_until(node, lambda: any(s.stopped for s in states), 20.0), proc.output()
+    assert 'no joint states' in next(s for s in states if s.stopped).reason
+
+    send_predictions = [True]
+
+    def publish() -> None:
+        stamp = node.get_clock().now().to_msg()
+        js = JointState(name=[f'joint_{i}' for i in range(1, 7)], position=np.array(HOME),
+                        velocity=np.zeros(6))
+        js.header.stamp = stamp
+        js_pub.publish(js)
+        det = DetectionArray(image_width=128, image_height=128, object_of_interest=-1)
+        det.header.stamp = stamp
+        det_pub.publish(det)
+        if send_predictions[0]:
+            pred = MIPrediction(class_index=MIPrediction.LEFT_HAND, certainty=1.0)
+            pred.header.stamp = stamp
+            pred_pub.publish(pred)
+
+    node.create_timer(0.05, publish)
+    # left-hand imagery in Object Search turns joint 1 left at search_gain * certainty
+    assert spin_until(node, lambda: bool(commands) and abs(commands[-1][0] - 0.4) < 1e-9, 20.0), \
+        (commands[-3:], proc.output())
+    assert np.all(commands[-1][1:] == 0)
+    assert states[-1].state == FsmState.OBJECT_SEARCH and not states[-1].stopped
+
+    # predictions stop: within the 0.3 s watchdog every joint is commanded to 0, state says why
+    send_predictions[0] = False
+    t0 = time.monotonic()
+    assert spin_until(node, lambda: states[-1].stopped, 10.0), proc.output()
+    assert 'MI prediction' in states[-1].reason
+    n = len(commands)
+    spin_until(node, lambda: len(commands) > n + 5, 5.0)
+    assert all(np.all(c == 0) for c in commands[n:])
+    assert time.monotonic() - t0 < 5.0
+    node.destroy_node()
+    assert proc.stop() in (0, -2, 130), proc.output()
