@@ -14,6 +14,7 @@ from pathlib import Path
 
 import pytest
 from conftest_bag import EEG, IMAGE, STRING, eeg_chunk, image, string
+from rosbags.rosbag2 import Reader as RosbagsReader
 
 from mindgrasp_bringup.bag import BagReader, BagWriter, Recorder
 from mindgrasp_bringup.cli import main as cli_main
@@ -120,6 +121,11 @@ def test_sigkill_during_recording_leaves_a_readable_bag(tmp_path, capsys):
     out = capsys.readouterr().out
     assert f'Messages:          {len(got)}' in out
     assert 'rebuilt' in out and (bag / 'metadata.yaml').exists()
+    # --fix finishes the file, so tools without a recovery path (rosbags) read it too.
+    assert cli_main(['bag', 'info', '--fix', str(bag)]) == 0
+    assert 'rewritten with its summary' in capsys.readouterr().out
+    with RosbagsReader(bag) as reader:
+        assert [bytes(d) for _, _, d in reader.messages()] == got
 
 
 @pytest.fixture

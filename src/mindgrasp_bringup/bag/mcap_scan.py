@@ -11,6 +11,7 @@ incomplete or corrupt record, so everything before it is recovered.
 from __future__ import annotations
 
 import io
+import os
 import struct
 from collections import defaultdict
 from collections.abc import Iterator
@@ -24,7 +25,8 @@ from mcap.stream_reader import StreamReader
 
 from .errors import BagError
 
-__all__ = ['ChannelInfo', 'McapContents', 'iter_mcap_messages', 'read_mcap_contents']
+__all__ = ['ChannelInfo', 'McapContents', 'is_finished', 'iter_mcap_messages', 'read_mcap_contents',
+           'recover_mcap']
 
 MAGIC = b'\x89MCAP0\r\n'
 _RECORD_HEADER = struct.Struct('<BQ')
@@ -188,3 +190,51 @@ def iter_mcap_messages(path: Path) -> Iterator[tuple[ChannelInfo, int, bytes]]:
                 channel = channels.get(record.channel_id)
                 if channel is not None:
                     yield channel, record.log_time, bytes(record.data)
+
+
+def is_finished(path: Path) -> bool:
+    """True when an MCAP file ends with its closing magic (its writer finished it)."""
+    try:
+        size = Path(path).stat().st_size
+        with Path(path).open('rb') as f:
+            return _is_finished(f, size)
+    except OSError:
+        return False
+
+
+def recover_mcap(path: Path) -> int:
+    """Rewrite an unfinished MCAP file as a finished one (summary, footer); returns messages kept.
+
+    Every complete record is copied (schemas, channels, messages with both times); the cut-off
+    tail, which no reader can use, is left out. The new file replaces the old one atomically, so
+    other tools (rosbags, ros2 bag, Foxglove) can open the bag afterwards.
+    """
+    from mcap.writer import CompressionType
+    from mcap.writer import Writer as McapWriter
+
+    path = Path(path)
+    tmp = path.with_name(path.name + '.recovering')
+    contents = McapContents(path)
+    count = 0
+    with path.open('rb') as f, tmp.open('wb') as out:
+        size = path.stat().st_size
+        _check_magic(path, f.read(8))
+        writer = McapWriter(out, compression=CompressionType.NONE)
+        writer.start(profile='ros2', library='mindgrasp-ros bag recovery (mcap python)')
+        schema_ids: dict[int, int] = {}
+        channel_ids: dict[int, int] = {}
+        for record in _records(path, f, size, contents):
+            if isinstance(record, Schema) and record.id not in schema_ids:
+                schema_ids[record.id] = writer.register_schema(record.name, record.encoding,
+                                                               record.data)
+            elif isinstance(record, Channel) and record.id not in channel_ids:
+                channel_ids[record.id] = writer.register_channel(
+                    record.topic, record.message_encoding, schema_ids.get(record.schema_id, 0),
+                    dict(record.metadata))
+            elif isinstance(record, Message) and record.channel_id in channel_ids:
+                writer.add_message(channel_ids[record.channel_id], record.log_time,
+                                   record.data, record.publish_time, record.sequence)
+                count += 1
+        writer.finish()
+    os.replace(tmp, path)
+    return count

@@ -18,7 +18,7 @@ from rosbags.rosbag2 import Reader
 from rosbags.rosbag2.errors import ReaderError
 
 from .errors import BagError
-from .mcap_scan import iter_mcap_messages, read_mcap_contents
+from .mcap_scan import is_finished, iter_mcap_messages, read_mcap_contents
 from .metadata import METADATA_FILE, load_metadata, mcap_files, rebuild_metadata
 from .qos import parse_offered_qos
 
@@ -88,14 +88,14 @@ class BagReader:
                            'file); pass the directory that `mindgrasp bag record` or '
                            '`ros2 bag record` created.')
                 raise BagError(msg)
-            unfinished = [p for p in self.files if not _finished(p)]
+            unfinished = [p for p in self.files if not is_finished(p)]
             if has_metadata and not unfinished:
                 self._open_rosbags(self.path)
             else:
                 self._open_scan(self.files, unfinished, has_metadata)
         elif self.path.suffix == '.mcap':
             self.files = [self.path]
-            if _finished(self.path):
+            if is_finished(self.path):
                 self._open_rosbags(self.path)
             else:
                 self._open_scan(self.files, self.files, False)
@@ -230,19 +230,6 @@ class BagReader:
     def __exit__(self, exc_type: type[BaseException] | None, exc: BaseException | None,
                  tb: TracebackType | None) -> None:
         self.close()
-
-
-def _finished(path: Path) -> bool:
-    """True when an MCAP file ends with its closing magic (writer finished it)."""
-    try:
-        size = path.stat().st_size
-        with path.open('rb') as f:
-            if size < 16:
-                return False
-            f.seek(size - 8)
-            return f.read(8) == b'\x89MCAP0\r\n'
-    except OSError:
-        return False
 
 
 def _rosbags_qos(qos: Any) -> dict[str, Any]:
