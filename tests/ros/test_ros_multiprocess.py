@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from conftest import spin_until
+from mindgrasp_testing import spin_until
 
 pytestmark = pytest.mark.slow
 

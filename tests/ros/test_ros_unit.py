@@ -7,11 +7,11 @@ import numpy as np
 import pytest
 from rosbags.typesys import Stores, get_typestore
 
-from conftest import spin_until
 from mindgrasp_ros import typesupport
 from mindgrasp_ros.runtime.arguments import ParamsFileError, parse_ros_args
 from mindgrasp_ros.runtime.exceptions import InvalidNameError
 from mindgrasp_ros.runtime.names import expand_topic_name, validate_topic_name
+from mindgrasp_testing import spin_until
 
 # every message type the MIndGrasp graph puts on the wire
 GRAPH_TYPES = [
