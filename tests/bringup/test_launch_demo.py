@@ -26,13 +26,15 @@ def test_demo_runs_headless_ends_cleanly_and_records_the_session(tmp_path: Path)
         pytest.skip(f'the demo needs node modules that are not written yet: {missing}')
     run_dir = tmp_path / 'run'
     stream = f'mg-demo-test-{uuid.uuid4().hex[:8]}'  # LSL names are host-wide
-    result = run_launch('demo', 'duration:=30', f'eeg_stream:={stream}', '--run-dir',
-                        str(run_dir), timeout=240)
+    # generous stop timeout: this machine may be loaded by other test runs
+    result = run_launch('demo', 'duration:=30', f'eeg_stream:={stream}', 'target_colour:=blue',
+                        '--sigint-timeout', '20', '--run-dir', str(run_dir), timeout=300)
     assert result.returncode == 0, result.stderr[-4000:]
     summary = yaml.safe_load((run_dir / 'summary.yaml').read_text())
     assert summary['stop_reason'] == 'duration of 30 s reached'
     assert {p['label'] for p in summary['processes']} == {
-        'recorder', 'sim', 'virtual_amp', 'eeg_acquisition', 'classifier', 'vision', 'fsm'}
+        'recorder', 'task', 'sim', 'virtual_amp', 'eeg_acquisition', 'classifier', 'vision',
+        'fsm'}
     for label in ('sim', 'eeg_acquisition', 'classifier', 'vision', 'fsm'):
         assert (run_dir / 'logs' / f'{label}.log').stat().st_size > 0, label
     from mindgrasp_bringup.bag.reader import BagReader
@@ -40,5 +42,6 @@ def test_demo_runs_headless_ends_cleanly_and_records_the_session(tmp_path: Path)
     with BagReader(run_dir / 'bag') as reader:
         reader.open()
         counts = {name: info.message_count for name, info in reader.topics.items()}
-    for topic in ('/eeg/raw', '/joint_states', '/camera/color/image_raw'):
+    for topic in ('/eeg/raw', '/joint_states', '/camera/color/image_raw', '/task/target',
+                  '/bci/prediction', '/vision/detections', '/fsm/state'):
         assert counts.get(topic, 0) > 0, (topic, counts)

@@ -20,8 +20,10 @@ def test_mine_and_the_helpers_profiles_exist() -> None:
 
 def test_demo_starts_every_node_after_the_recorder() -> None:
     procs = processes('demo', 'seed:=4', 'eeg_stream:=amp-x')
-    assert list(procs) == ['recorder', 'sim', 'virtual_amp', 'eeg_acquisition', 'classifier',
-                           'vision', 'fsm']
+    assert list(procs) == ['recorder', 'task', 'sim', 'virtual_amp', 'eeg_acquisition',
+                           'classifier', 'vision', 'fsm']
+    assert 'colour: red, shape: cube}' in ' '.join(procs['task'].program)
+    assert 'task' not in processes('demo', 'target_colour:=')
     assert procs['recorder'].daemon
     assert procs['sim'].module == 'mindgrasp_sim.sim_node'
     assert procs['sim'].parameters['seed'] == 4 and procs['sim'].parameters['gui'] is False

@@ -2,16 +2,23 @@
 acquisition, MI classifier, vision and the grasp controller, recorded to the run directory.
 
     mindgrasp launch demo                          # until Ctrl-C; runs/<UTC time>_demo/
-    mindgrasp launch demo duration:=120 gui:=true subject:=follow seed:=3
+    mindgrasp launch demo duration:=120 gui:=true target_colour:=blue target_shape:=sphere
     mindgrasp launch demo --show-args
+
+The task: grasp the target object; it is published (latched) on /task/target, where the virtual
+subject (subject:=pursue) reads what to imagine and the simulator which grasp counts as success.
 
 Parameters: config/params/<package>.yaml of each package, then config/params/demo.yaml (the demo's
 own settings), then the launch arguments below (later entries win).
 """
 
+import sys
+
 from mindgrasp_bringup.launch_system import (
     DeclareLaunchArgument,
+    ExecuteProcess,
     LaunchConfiguration,
+    LaunchConfigurationNotEquals,
     LaunchDescription,
     Node,
     config_files,
@@ -41,6 +48,23 @@ def generate_launch_description() -> LaunchDescription:
                               description='classifier model (.json written by mindgrasp train '
                                           'classifier); empty: the one in '
                                           'config/params/classifier.yaml'),
+        DeclareLaunchArgument('target_colour', default_value='red',
+                              choices=['red', 'yellow', 'blue', ''],
+                              description="colour of the object to grasp ('': no task)"),
+        DeclareLaunchArgument('target_shape', default_value='cube',
+                              choices=['cube', 'cylinder', 'sphere'],
+                              description='shape of the object to grasp'),
+        # 0 the task: which object to grasp (latched, so late joiners get it too)
+        ExecuteProcess(
+            name='task', output='log',
+            cmd=[sys.executable, '-m', 'mindgrasp_bringup', 'topic', 'pub', '/task/target',
+                 'mindgrasp_msgs/msg/TaskTarget',
+                 ['{trial: 1, object_id: -1, scene: demo, colour: ',
+                  LaunchConfiguration('target_colour'), ', shape: ',
+                  LaunchConfiguration('target_shape'), '}'],
+                 '--qos-durability', 'transient_local', '--rate', '0.1',
+                 '--wait-matching-subscriptions', '0'],
+            condition=LaunchConfigurationNotEquals('target_colour', '')),
         # 1 simulator: arm, gripper, objects, RGB-D camera (the arm contract of ros2_control)
         Node(package='mindgrasp_sim', executable='sim_node', name='sim',
              parameters=[*config_files('sim', 'demo'), {'gui': gui, 'seed': seed}]),
