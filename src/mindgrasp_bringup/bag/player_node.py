@@ -17,9 +17,11 @@ from mindgrasp_bringup.bag.player import Player, PlayStats, parse_remaps, type_p
 from mindgrasp_bringup.bag.qos import adapted_qos
 from mindgrasp_bringup.bag.reader import BagReader, TopicInfo
 from mindgrasp_bringup.bag.ros_glue import message_class, qos_profile
+from mindgrasp_bringup.bag.typestore import typestore
 from mindgrasp_ros import rclpy
 
 CLOCK_TYPE = 'rosgraph_msgs/msg/Clock'
+TIME_TYPE = 'builtin_interfaces/msg/Time'
 
 
 class PlayerNode(rclpy.node.Node):
@@ -74,8 +76,11 @@ class PlayerNode(rclpy.node.Node):
         except (ImportError, AttributeError, ValueError):
             return f'its message type {info.type} is unknown to the client layer'
         qos = adapted_qos(info.offered_qos_profiles)
-        self.publishers_[info.name] = self.create_publisher(
-            msg_class, self.remap.get(info.name, info.name), qos_profile(rclpy, qos), raw=True)
+        out = self.remap.get(info.name, info.name)
+        if out in self.publishers_:   # two bag topics remapped onto one: one publisher
+            return None
+        self.publishers_[out] = self.create_publisher(msg_class, out, qos_profile(rclpy, qos),
+                                                      raw=True)
         return None
 
     def start(self) -> None:
@@ -85,23 +90,22 @@ class PlayerNode(rclpy.node.Node):
     def _play(self) -> None:
         if self.delay > 0 and self.stop_event.wait(self.delay):
             return
-        ts = rclpy_clock_type()
-        publishers = self.publishers_
+        store = typestore()
+        clock_class, time_class = store.types[CLOCK_TYPE], store.types[TIME_TYPE]
+        publishers = self.publishers_   # keyed by output topic, as the player reports them
 
         def publish(topic: str, data: bytes) -> None:
             publishers[topic].publish(data)
 
         def publish_clock(ns: int) -> None:
             sec, nanosec = divmod(ns, 1_000_000_000)
-            self.clock_publisher.publish(ts.serialize_cdr(  # type: ignore[union-attr]
-                ts.types[CLOCK_TYPE](ts.types['builtin_interfaces/msg/Time'](sec, nanosec)),
-                CLOCK_TYPE))
+            msg = clock_class(clock=time_class(sec=sec, nanosec=nanosec))
+            self.clock_publisher.publish(  # type: ignore[union-attr]
+                bytes(store.serialize_cdr(msg, CLOCK_TYPE)))
 
-        # The player reports output topics; publishers are keyed by bag topic.
-        inverse = {self.player.output_topic(t): t for t in publishers}
         try:
             self.stats = self.player.run(
-                lambda out, data: publish(inverse[out], data),
+                publish,
                 publish_clock=publish_clock if self.clock_publisher is not None else None,
                 clock_hz=self.clock_frequency, stop=self.stop_event, priority=self.priority)
             for note in self.stats.notes:
@@ -109,13 +113,6 @@ class PlayerNode(rclpy.node.Node):
         except BagError as exc:
             self.error = str(exc)
             self.get_logger().error(self.error)
-
-
-def rclpy_clock_type() -> Any:
-    """The type store used to serialise /clock messages."""
-    from mindgrasp_bringup.bag.typestore import typestore
-
-    return typestore()
 
 
 def main(args: list[str] | None = None) -> int:
