@@ -1,0 +1,53 @@
+"""The simulator alone: arm, three-finger gripper, objects and the eye-in-hand RGB-D camera, with
+the arm contract of a ros2_control forward velocity controller (drive it from outside).
+
+    mindgrasp launch sim                                   # set locations, real time
+    mindgrasp launch sim scene:=random_locations seed:=3 camera:=640x480@30
+    mindgrasp launch sim time_mode:=fast                   # + /clock; others on use_sim_time
+    mindgrasp launch sim trainer_robot:=true gui:=true duration:=60
+    mindgrasp topic hz /joint_states                       # in another shell
+
+Parameters: config/params/sim.yaml, then the launch arguments below.
+"""
+
+from mindgrasp_bringup.launch_system import (
+    DeclareLaunchArgument,
+    LaunchConfiguration,
+    LaunchDescription,
+    Node,
+    PythonExpression,
+    config_files,
+)
+
+
+def generate_launch_description() -> LaunchDescription:
+    camera = LaunchConfiguration('camera')
+    # "WxH@R" -> width, height, rate
+    width = PythonExpression(["int('", camera, "'.split('x')[0])"])
+    height = PythonExpression(["int('", camera, "'.split('x')[1].split('@')[0])"])
+    rate = PythonExpression(["float('", camera, "'.split('@')[1])"])
+    return LaunchDescription([
+        DeclareLaunchArgument('scene', default_value='set_locations',
+                              description='scene name in config/scenes/ or a scene YAML path'),
+        DeclareLaunchArgument('seed', default_value='0',
+                              description='layout seed of random scenes'),
+        DeclareLaunchArgument('time_mode', default_value='realtime',
+                              choices=['realtime', 'fast', 'lockstep'],
+                              description='realtime (wall clock), fast (as fast as possible, '
+                                          'publishes /clock) or lockstep (advances on /sim/step)'),
+        DeclareLaunchArgument('camera', default_value='128x128@10',
+                              description='camera resolution and rate, WIDTHxHEIGHT@HZ'),
+        DeclareLaunchArgument('trainer_robot', default_value='false', choices=['true', 'false'],
+                              description='also simulate the green training robot '
+                                          '(/trainer_robot/...)'),
+        DeclareLaunchArgument('gui', default_value='false', choices=['true', 'false'],
+                              description='open the PyBullet window (needs a display)'),
+        Node(package='mindgrasp_sim', executable='sim_node', name='sim',
+             parameters=[*config_files('sim'),
+                         {'scene': LaunchConfiguration('scene'),
+                          'seed': LaunchConfiguration('seed'),
+                          'time_mode': LaunchConfiguration('time_mode'),
+                          'camera_width': width, 'camera_height': height, 'camera_rate': rate,
+                          'trainer_robot': LaunchConfiguration('trainer_robot'),
+                          'gui': LaunchConfiguration('gui')}]),
+    ])

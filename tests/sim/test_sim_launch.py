@@ -1,0 +1,43 @@
+"""The ``sim`` launch profile: what it starts, resolved without starting anything, and a short
+real launch that records the simulator's topics."""
+
+from __future__ import annotations
+
+import pytest
+
+from mindgrasp_bringup.launch_system import LaunchService
+
+
+def sim_process(*args: str):
+    plan = LaunchService('sim', list(args)).plan(strict=True)
+    procs = {spec.label: spec for spec in plan.processes}
+    return procs['sim']
+
+
+def test_sim_profile_defaults_follow_the_parameter_file():
+    sim = sim_process('record:=false')
+    assert sim.module == 'mindgrasp_sim.sim_node'
+    p = sim.parameters
+    assert (p['camera_width'], p['camera_height'], p['camera_rate']) == (128, 128, 10.0)
+    assert p['scene'] == 'set_locations' and p['time_mode'] == 'realtime'
+    assert p['physics_hz'] == 240.0 and p['command_timeout'] == 0.25
+    assert p['trainer_robot'] is False and p['gui'] is False
+
+
+def test_sim_profile_arguments():
+    p = sim_process('record:=false', 'camera:=640x480@30', 'scene:=random_locations', 'seed:=7',
+                    'time_mode:=fast', 'trainer_robot:=true').parameters
+    assert (p['camera_width'], p['camera_height'], p['camera_rate']) == (640, 480, 30.0)
+    assert p['scene'] == 'random_locations' and p['seed'] == 7
+    assert p['time_mode'] == 'fast' and p['trainer_robot'] is True
+
+
+@pytest.mark.slow
+def test_sim_launch_runs_and_records(tmp_path):
+    run_dir = tmp_path / 'run'
+    service = LaunchService('sim', ['duration:=12', 'time_mode:=fast'], run_dir=run_dir)
+    assert service.run() == 0
+    metadata = (run_dir / 'bag' / 'metadata.yaml').read_text()
+    for topic in ('/joint_states', '/camera/color/image_raw', '/camera/depth/image_raw',
+                  '/camera/color/camera_info', '/ee_pose', '/sim/objects', '/clock'):
+        assert f'name: {topic}\n' in metadata, topic
