@@ -220,3 +220,13 @@ def test_recorder_node_full_disk_stops_recording_and_keeps_running(tmp_path):
             if proc is not None and proc.poll() is None:
                 _stop(proc)
         subprocess.run(['umount', '-l', str(mount)], check=False)
+
+
+def test_bag_record_bad_options_are_clear_errors(tmp_path):
+    for extra, message in ((['-e', '('], 'The topic regular expression is not valid'),
+                           (['--compression', 'zstd', '--max-queue-mb', '0'],
+                            'max_queue_bytes must be positive')):
+        out = subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', 'bag', 'record',
+                              '-o', str(tmp_path / uuid.uuid4().hex), *extra],
+                             capture_output=True, text=True, env=_env(), timeout=60)
+        assert out.returncode == 1 and message in out.stderr, out.stderr

@@ -41,8 +41,13 @@ class RecorderNode(rclpy.node.Node):
             'duration', 'include_ros_topics')}
         output = value['output'] or time.strftime('rosbag2_%Y_%m_%d-%H_%M_%S')
         self.topics = [t for t in (value['topics'] or []) if t]
-        self.include = re.compile(value['regex']) if value['regex'] else None
-        self.exclude = re.compile(value['exclude_regex']) if value['exclude_regex'] else None
+        try:
+            self.include = re.compile(value['regex']) if value['regex'] else None
+            self.exclude = re.compile(value['exclude_regex']) if value['exclude_regex'] else None
+        except re.error as exc:
+            msg = (f'The topic regular expression is not valid ({exc}); fix the regex or '
+                   'exclude_regex parameter.')
+            raise BagError(msg) from None
         self.include_ros_topics = bool(value['include_ros_topics'])
         writer = BagWriter(output, chunk_size=int(value['chunk_size']),
                            compression=str(value['compression']),
