@@ -32,9 +32,10 @@ def _options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--dry-run', action='store_true',
                         help='print the processes and their command lines, start nothing')
     parser.add_argument('--list', action='store_true', help='list the profiles and exit')
-    parser.add_argument('--sigint-timeout', type=float, default=5.0, metavar='S',
+    parser.add_argument('--sigint-timeout', type=float, default=10.0, metavar='S',
                         help='seconds a node gets to stop after SIGINT before SIGTERM '
-                             '(default 5)')
+                             '(default 10: Python nodes may take seconds to leave DDS on a '
+                             'loaded machine)')
     parser.add_argument('--sigterm-timeout', type=float, default=5.0, metavar='S',
                         help='seconds after SIGTERM before SIGKILL (default 5)')
 

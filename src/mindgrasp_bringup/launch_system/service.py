@@ -129,7 +129,7 @@ class LaunchService:
     def __init__(self, description: str | Path | LaunchDescription,
                  launch_arguments: Sequence[str] | Mapping[str, Any] = (), *,
                  run_dir: str | Path | None = None, runs_root: str | Path | None = None,
-                 composed: bool = False, sigint_timeout: float = 5.0,
+                 composed: bool = False, sigint_timeout: float = 10.0,
                  sigterm_timeout: float = 5.0, printer: Printer | None = None,
                  argv: Sequence[str] | None = None) -> None:
         if isinstance(description, LaunchDescription):

@@ -124,7 +124,7 @@ class Supervisor:
     """
 
     def __init__(self, processes: Sequence[tuple[ProcessSpec, list[str]]], log_dir: Path, *,
-                 sigint_timeout: float = 5.0, sigterm_timeout: float = 5.0,
+                 sigint_timeout: float = 10.0, sigterm_timeout: float = 5.0,
                  duration: float | None = None, printer: Printer | None = None,
                  env: dict[str, str] | None = None) -> None:
         self.log_dir = Path(log_dir)
