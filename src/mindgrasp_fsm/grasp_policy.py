@@ -153,6 +153,8 @@ class GraspPolicy:
             return None
         assert self.kinematics is not None
         obs = vision.object_of_interest
+        if obs.shape in ('cube', 'cylinder', 'sphere'):
+            self.shape = obs.shape     # the depth CNN classifies while the arm holds still
         if (camera.width, camera.height) != (vision.image_width, vision.image_height):
             camera = camera.scaled_to(vision.image_width, vision.image_height)
         cam_pos, cam_rot = self.kinematics.camera_pose(q)

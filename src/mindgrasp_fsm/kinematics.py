@@ -180,7 +180,10 @@ class UrdfKinematics:
         jac = np.zeros((6, 6))
         p = t[:3, 3]
         for i, z, o in axes:
-            jac[:3, i] = np.cross(z, p - o)
+            r = p - o
+            # z x r written out: np.cross is slow for single 3-vectors
+            jac[:3, i] = (z[1] * r[2] - z[2] * r[1], z[2] * r[0] - z[0] * r[2],
+                          z[0] * r[1] - z[1] * r[0])
             jac[3:, i] = z
         return t, jac
 

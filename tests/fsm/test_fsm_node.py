@@ -6,7 +6,8 @@ import time
 
 import numpy as np
 import pytest
-from tests.conftest import spin_until
+
+from mindgrasp_testing import spin_until
 
 pytestmark = pytest.mark.slow
 
@@ -74,3 +75,28 @@ def test_fsm_node_turns_on_left_hand_and_stops_when_predictions_end(rclpy_ctx, s
     assert time.monotonic() - t0 < 5.0
     node.destroy_node()
     assert proc.stop() in (0, -2, 130), proc.output()
+
+
+def test_node_graph_sim_vision_fsm_selects_and_approaches(rclpy_ctx, spawn_node) -> None:
+    """sim_node + vision_node + fsm_node (autonomous), each its own process: the controller sees
+    the red cube ahead through the real camera topics, centres it and starts the approach."""
+    rclpy = rclpy_ctx
+    from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import FsmState
+
+    sim = spawn_node('mindgrasp_sim.sim_node', '--ros-args', '-p', 'scene:=set_locations')
+    vision = spawn_node('mindgrasp_vision.vision_node', '--ros-args', '-p', 'shape_model:=none')
+    fsm = spawn_node('mindgrasp_fsm.fsm_node', '--ros-args', '-p', 'autonomous:=true',
+                     '-p', 'duration:=120.0')
+    node = rclpy.node.Node('fsm_graph_observer')
+    states: list[object] = []
+    latched = rclpy.qos.QoSProfile(depth=1, reliability=rclpy.qos.ReliabilityPolicy.RELIABLE,
+                                   durability=rclpy.qos.DurabilityPolicy.TRANSIENT_LOCAL)
+    node.create_subscription(FsmState, '/fsm/state', states.append, latched)
+    ok = spin_until(node, lambda: any(s.state == FsmState.INITIAL_APPROACH for s in states),
+                    90.0)
+    assert ok, ([(s.state, s.reason) for s in states[-5:]], fsm.output()[-2000:],
+                vision.output()[-1000:], sim.output()[-1000:])
+    entered = next(s for s in states if s.state == FsmState.INITIAL_APPROACH)
+    assert entered.object_of_interest.startswith('red')
+    assert entered.previous_state == FsmState.CENTER_OBJECT
+    node.destroy_node()
