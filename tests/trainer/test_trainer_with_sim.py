@@ -1,0 +1,76 @@
+"""End to end: the trainer node drives the PyBullet training robot of the real simulator node
+(two processes over DDS): class directions on the robot's joints, the 0.1 m reset through
+/sim/reset, and the distance between the two end-effectors."""
+
+from __future__ import annotations
+
+import importlib.util
+import itertools
+
+import numpy as np
+import pytest
+
+pytestmark = [
+    pytest.mark.slow,
+    pytest.mark.skipif(importlib.util.find_spec('mindgrasp_sim.sim_node') is None,
+                       reason='the simulator node (mindgrasp_sim.sim_node) is not installed'),
+]  # fmt: skip
+
+
+def test_trainer_drives_the_simulated_training_robot(ros, spawn, spin_until):
+    from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import Prompt
+    from mindgrasp_ros.interfaces.sensor_msgs.msg import JointState
+    from mindgrasp_ros.interfaces.std_msgs.msg import Float64
+
+    node = ros.node.Node('trainer_sim_observer')
+    state = {'q': None}
+    prompts, distances = [], []
+    tl = ros.qos.QoSProfile(
+        depth=10,
+        reliability=ros.qos.ReliabilityPolicy.RELIABLE,
+        durability=ros.qos.DurabilityPolicy.TRANSIENT_LOCAL,
+    )
+    node.create_subscription(JointState, '/trainer_robot/joint_states',
+                             lambda m: state.update(q=np.array(m.position, float)), 10)
+    node.create_subscription(Prompt, '/trainer/prompt',
+                             lambda m: prompts.append((m, state['q'])), tl)
+    node.create_subscription(Float64, '/trainer/ee_distance', lambda m: distances.append(m.data),
+                             10)  # fmt: skip
+    sim = spawn('mindgrasp_sim.sim_node', trainer_robot=True, camera_rate=1.0, duration=90.0)
+    # left, right and an approach long enough to take the end-effector below 0.1 m (joint 2 must
+    # turn about 1 rad; it is commanded 2.25 rad, so that a simulator running slower than real time
+    # on a loaded machine still gets there)
+    trainer = spawn('mindgrasp_trainer.trainer_node', n_trials=3, classes='[0, 1, 2]', seed=0,
+                    balanced=True, approach_speed=0.45, turn_speed=0.3, move_duration=5.0,
+                    start_delay=1.0,
+                    robot_timeout=60.0)  # fmt: skip
+    ok = spin_until(node, lambda: prompts and prompts[-1][0].phase == 'end', 90.0)
+    out = trainer.stdout.read() if trainer.poll() is not None else ''
+    assert ok, f'prompts: {[(m.trial, m.phase) for m, _ in prompts]}\n{out}'
+    assert trainer.wait(10) == 0
+    out = trainer.stdout.read()
+    assert sim.poll() is None, 'the simulator died'
+
+    moves = [(m, q) for m, q in prompts if m.phase == 'move']
+    assert sorted(m.class_index for m, _ in moves) == [0, 1, 2]
+    for (a, qa), (b, qb) in itertools.pairwise(prompts):
+        if a.phase != 'move':
+            continue
+        if a.class_index in (0, 1):  # joint 1 turns at 0.3 rad/s for 5 s, left +, right -
+            assert b.phase == 'wait'
+            sign = 1 if a.class_index == 0 else -1
+            # at most 1.5 rad; less when the loaded machine keeps the simulator below real time
+            assert 0.5 < sign * (qb - qa)[0] < 1.6, f'dq {qb - qa}'
+            assert abs((qb - qa)[1]) < 0.02
+        else:  # approach: joint 2 forward until the end-effector went below 0.1 m
+            assert b.phase == 'rest', f'no 0.1 m reset: dq {qb - qa}, min distance {min(distances)}'
+            assert 'Resetting both robots: training end-effector at 0.0' in out
+    # the reset brought the training robot home: at the next prompt (after settle_time) its joints
+    # are at the simulator's home pose again
+    from mindgrasp_sim.simulation import HOME_POSE
+
+    i_rest = next(i for i, (m, _) in enumerate(prompts) if m.phase == 'rest' and m.trial > 0)
+    np.testing.assert_allclose(prompts[i_rest + 1][1], HOME_POSE, atol=0.05)
+    # distance: 0 at home (the robots coincide), growing as the training robot moves
+    assert distances and min(distances) < 0.01 and max(distances) > 0.1
+    node.destroy_node()
