@@ -67,6 +67,7 @@ def class_info_accuracy(mode: str) -> float:
     from pyriemann.estimation import Covariances
     from sklearn.model_selection import cross_val_score
     from sklearn.pipeline import make_pipeline
+    from threadpoolctl import threadpool_limits
 
     subject = VirtualSubject(mode, accuracy=1.0, reaction_delay=0.0, seed=3)
     gen = SyntheticEEG(seed=4)
@@ -81,7 +82,8 @@ def class_info_accuracy(mode: str) -> float:
         gen.generate(int(1.5 * FS), subject.intent(trial * 4.0 + 2.5))
         y.append(cls)
     pipe = make_pipeline(Covariances('oas'), MDM())
-    return float(cross_val_score(pipe, np.array(epochs) * 1e6, np.array(y), cv=4).mean())
+    with threadpool_limits(1):            # BLAS threads oversubscribe a shared 2-core machine
+        return float(cross_val_score(pipe, np.array(epochs) * 1e6, np.array(y), cv=4).mean())
 
 
 @pytest.mark.slow
