@@ -91,7 +91,7 @@ def test_task_monitor_reports_success_and_drop():
 def test_random_locations_are_graspable():
     results = []
     with Simulation('random_locations', seed=0) as sim:
-        for seed in (11, 12, 13, 14):
+        for seed in (11, 12):
             sim.reset(seed=seed)
             for obj in sim.objects():
                 sim.reset()

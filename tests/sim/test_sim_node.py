@@ -177,7 +177,7 @@ def test_realtime_node_serves_the_arm_and_camera_contract(rclpy_ctx, spawn_node)
 
 
 def test_fast_mode_publishes_clock_and_ends_by_itself(rclpy_ctx, spawn_node):
-    proc = start(spawn_node, 'time_mode:=fast', 'sim_duration:=20.0')
+    proc = start(spawn_node, 'time_mode:=fast', 'sim_duration:=10.0')
     probe = Probe(rclpy_ctx)
     assert spin_until(rclpy_ctx, probe.node, lambda: len(probe.clocks) > 20, 30), proc.output()
     wall0, clock0 = time.monotonic(), probe.clocks[-1].clock
