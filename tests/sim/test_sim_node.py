@@ -247,3 +247,11 @@ def test_bad_parameters_exit_with_the_fix(spawn_node, param, message):
     proc = spawn_node('mindgrasp_sim.sim_node', '--ros-args', '-p', param)
     assert proc.wait(60) == 2
     assert message in proc.output()
+
+
+def test_gui_without_a_display_runs_headless_with_a_warning(spawn_node):
+    proc = spawn_node('mindgrasp_sim.sim_node', '--ros-args', '-p', 'gui:=true', '-p',
+                      'duration:=1.0', env={'DISPLAY': ''})
+    assert proc.wait(60) == 0
+    out = proc.output()
+    assert 'gui:=true needs a display' in out and 'running headless' in out

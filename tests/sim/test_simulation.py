@@ -313,3 +313,14 @@ def test_bad_construction_arguments():
         Simulation(scene='no_such_scene')
     with pytest.raises(SimError, match='no random section'), Simulation('set_locations') as s:
         s.reset(new_random_draw=True)
+
+
+def test_collisions_with_the_ground_and_itself_are_reported(sim):
+    assert sim.collisions() == []
+    sim.set_joint_positions(np.array([0, 1.2, 1.2, 0, 0, 0]))   # wrist driven into the ground
+    sim.step(5)
+    assert any(c.endswith('- ground') for c in sim.collisions())
+    sim.reset()
+    sim.set_joint_positions(np.array([0.7, -0.41, 2.59, 2.5, 0.89, 0.92]))   # folded onto itself
+    sim.step(1)
+    assert 'link_2 - link_4' in sim.collisions()
