@@ -38,7 +38,7 @@ DEFAULT_MODEL = Path(__file__).resolve().parents[2] / 'models' / 'default_classi
 
 PARAMETERS = [
     ('model', str(DEFAULT_MODEL)), ('classes', list(CLASS_NAMES)),
-    ('adaptation', 'none'), ('adaptation_rate', 0.01), ('min_certainty', 0.25),
+    ('adaptation', 'none'), ('adaptation_rate', 0.005), ('min_certainty', 0.5),
     ('recenter', 'fixed'), ('recenter_rate', 0.005), ('label_tmin', 0.5), ('label_tmax', 2.5),
     ('flat_threshold', 1e-8), ('status_period', 1.0), ('frame_id', 'eeg'), ('duration', 0.0),
 ]

@@ -83,11 +83,17 @@ class AdaptationConfig:
         (a cumulative mean at first, then exponential forgetting at ``recenter_rate``).
     recenter_rate : float
         Smallest weight (0..1) of a new window in the running reference.
+
+    Notes
+    -----
+    Unsupervised mean updates need ``recenter='adaptive'`` when the session has drifted: without
+    re-centering, drifted windows are confidently assigned to one class, whose mean then absorbs
+    everything (see ``benchmarks/classifier.py``, section adaptation).
     """
 
     mode: str = 'none'
-    rate: float = 0.01
-    min_certainty: float = 0.25
+    rate: float = 0.005
+    min_certainty: float = 0.5
     recenter: str = 'fixed'
     recenter_rate: float = 0.005
 
