@@ -31,7 +31,9 @@ def set_locations_loop():
     except Exception:
         classifier = None
     sim = Simulation(scene='set_locations', seed=0)
-    loop = LockstepLoop(sim, cfg.build_pipeline(classifier), GraspFsm.from_params(FsmParams()))
+    # a shorter lock than the default keeps the test quick; the behaviour is the same
+    loop = LockstepLoop(sim, cfg.build_pipeline(classifier),
+                        GraspFsm.from_params(FsmParams(lock_duration=0.5)))
     yield loop
     sim.close()
 
@@ -55,7 +57,7 @@ def test_oracle_bci_grasps_the_desired_object(set_locations_loop: LockstepLoop, 
                                                         ('sphere', 0.45, 120.0)])
 def test_autonomous_grasp_succeeds_for_each_shape(shape: str, radius: float, angle: float
                                                   ) -> None:
-    loop, _ = build_loop(FsmParams())
+    loop, _ = build_loop(FsmParams(lock_duration=0.5))
     try:
         spec = TrialSpec(0, shape, 'yellow', radius, angle, 0.05, 20.0)
         loop.sim.load_scene(spec.scene())
