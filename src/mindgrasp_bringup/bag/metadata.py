@@ -3,6 +3,10 @@
 A bag whose writer was killed has MCAP files without a summary section and no metadata.yaml;
 :func:`rebuild_metadata` recovers both the topic list and the counts from the files themselves
 (their summary when present, else a scan of every complete record).
+
+Written here rather than by ``rosbags.rosbag2.Writer``: rosbags writes metadata.yaml only from its
+own writer's state when that writer closes, while ours must describe split MCAP files written by
+the ``mcap`` library and bags rebuilt from files. The layout follows rosbag2 Jazzy (version 9).
 """
 
 from __future__ import annotations

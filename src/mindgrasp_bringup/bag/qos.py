@@ -4,6 +4,8 @@ A profile is a dict ``{history: 'keep_last', depth: 10, reliability: 'reliable',
 'volatile', deadline: {sec, nsec}, lifespan: {sec, nsec}, liveliness: 'automatic',
 liveliness_lease_duration: {sec, nsec}, avoid_ros_namespace_conventions: False}``. metadata.yaml
 holds the list itself; MCAP channel metadata holds the same list as a YAML string.
+(``rosbags.rosbag2.metadata.dump_qos_v9`` produces the same dicts but only from rosbags ``Qos``
+tuples; the recorder gets rclpy ``QoSProfile`` objects from the graph, hence these helpers.)
 """
 
 from __future__ import annotations
