@@ -57,7 +57,7 @@ class RecorderNode(rclpy.node.Node):
         self.recorder = Recorder(writer, max_queue_bytes=int(value['max_queue_mb']) << 20,
                                  on_error=self._on_error)
         self.recorder.start()
-        self._subscriptions: dict[str, Any] = {}
+        self._topic_subscriptions: dict[str, Any] = {}
         self._refused: set[str] = set()
         self.finished = False
         self.get_logger().info(f'Recording to {writer.path} (MCAP, compression '
@@ -84,7 +84,8 @@ class RecorderNode(rclpy.node.Node):
         if self.recorder.error is not None:
             return
         for topic, types in self.get_topic_names_and_types():
-            if topic in self._subscriptions or topic in self._refused or not self._wanted(topic):
+            known = topic in self._topic_subscriptions or topic in self._refused
+            if known or not self._wanted(topic):
                 continue
             msgtype = types[0]
             if len(types) > 1:
@@ -101,7 +102,7 @@ class RecorderNode(rclpy.node.Node):
                        for i in self.get_publishers_info_by_topic(topic)]
             qos = adapted_qos(offered, default_depth=100)
             self.recorder.add_topic(topic, msgtype, offered)
-            self._subscriptions[topic] = self.create_subscription(
+            self._topic_subscriptions[topic] = self.create_subscription(
                 msg_class, topic, self._make_callback(topic), qos_profile(rclpy, qos), raw=True)
             self.get_logger().info(f'Subscribed to {topic} ({msgtype}, {qos["reliability"]}, '
                                    f'{qos["durability"]}).')
