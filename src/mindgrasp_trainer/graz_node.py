@@ -58,7 +58,7 @@ class GrazNode(rclpy.node.Node):
             ('n_trials', 40), ('classes', [0, 1, 2, 3]), ('seed', 0),
             ('fixation', 2.0), ('cue', 1.25), ('imagery', 2.75),
             ('rest_min', 1.5), ('rest_max', 2.5), ('max_repeat', 0),
-            ('start_delay', 1.0), ('duration', 0.0), ('rate', 200.0),
+            ('start_delay', 5.0), ('duration', 0.0), ('rate', 200.0),
             ('display_rate', 10.0), ('display_width', 480), ('display_height', 360),
             ('feedback', 'move'), ('max_certainty', 1.0),
         ])  # fmt: skip

@@ -36,7 +36,7 @@ _PROTOCOL_PARAMS = (
     ('n_trials', 40), ('classes', [0, 1, 2, 3]), ('seed', 0), ('balanced', True),
     ('move_duration', 2.0), ('wait_duration', 2.0), ('turn_speed', 0.2), ('approach_speed', 0.05),
     ('turn_joint', 0), ('approach_joint', 1), ('n_joints', 6), ('reset_height', 0.1),
-    ('grasp_state', 5), ('settle_time', 1.0), ('start_delay', 1.0), ('duration', 0.0),
+    ('grasp_state', 5), ('settle_time', 1.0), ('start_delay', 5.0), ('duration', 0.0),
 )  # fmt: skip
 
 
