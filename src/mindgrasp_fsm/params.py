@@ -49,9 +49,10 @@ class FsmParams:
     certainty_cap: float = 2.0          # certainty is unbounded (Eq. 1); velocities scale to this
     # --- state 1: object search ----------------------------------------------------------------
     search_gain: float = 0.3            # rad/s of joint 1 per unit certainty (left +, right -)
-    autonomous_search_velocity: float = 0.5  # rad/s of joint 1 (turn left)
-    autonomous_search_tilts: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.3, 0.3])
-    # rad added to joint 5 of home for each sweep of the autonomous search
+    autonomous_search_velocity: float = 0.8  # rad/s of joint 1 (turn left)
+    # rad added to joint 5 of home for each sweep of the autonomous search (0.15: the view spans
+    # 0.15-0.75 m from the base)
+    autonomous_search_tilts: list[float] = field(default_factory=lambda: [0.15, 0.15, 0.3, 0.0])
     search_confirm_time: float = 0.2    # s an object must be seen before it is taken
     # --- state 2: center object ----------------------------------------------------------------
     center_gain_joint1: float = 1.5     # rad/s per unit normalised x error (error / width)
@@ -78,7 +79,7 @@ class FsmParams:
     joint_tolerance: float = 0.01       # rad, IK target reached
     cartesian_speed: float = 0.12       # m/s of the tool along straight segments
     settle_time: float = 0.3            # s still before a depth measurement
-    refine_max_correction: float = 0.08  # m; larger top-view corrections are rejected
+    refine_max_correction: float = 0.15  # m; larger top-view corrections are rejected
     max_refinements: int = 2            # top-view re-measurements before descending
     table_height: float = 0.0           # m, z of the surface the objects stand on
     min_reach: float = 0.12             # m, objects closer to the base axis are not grasped
