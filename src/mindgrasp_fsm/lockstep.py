@@ -179,7 +179,7 @@ class LockstepLoop:
             reason = f'not held at the end ({fsm.outcome or "no grasp"}): {fsm.reason}'
         return TrialOutcome(
             success=success, duration=sim.time - t0, time_to_grasp=time_to_grasp,
-            lift_height=lift, attempts=fsm.policy.attempt + 1 if len(states) > 3 else 0,
+            lift_height=lift, attempts=states.count(int(State.GRASP_OBJECT)),
             reason=reason, grasped_object=held.label if held is not None else '',
             detected_shape=detected_shape, states=states, vision_times=vision_times,
             wall_time=time.perf_counter() - wall0)
