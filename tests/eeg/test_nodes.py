@@ -137,3 +137,83 @@ def test_acquisition_node_rejects_wrong_layout(spawn_node, stream_name, lsl_sour
     assert missing.wait(30) == 1
     out = missing.output()
     assert f"No LSL stream with name='{stream_name}_nope'" in out and stream_name in out
+
+
+def test_pursue_mode_reads_task_scene_arm_and_fsm(spawn_node, listener, stream_name) -> None:
+    from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import FsmState, TaskTarget
+    from mindgrasp_ros.interfaces.sensor_msgs.msg import JointState
+    from mindgrasp_ros.interfaces.visualization_msgs.msg import Marker, MarkerArray
+
+    rclpy = listener.rclpy
+    node = listener.node
+    latched = rclpy.qos.QoSProfile(depth=10, reliability=rclpy.qos.ReliabilityPolicy.RELIABLE,
+                                   durability=rclpy.qos.DurabilityPolicy.TRANSIENT_LOCAL)
+    pub_target = node.create_publisher(TaskTarget, '/task/target', latched)
+    pub_fsm = node.create_publisher(FsmState, '/fsm/state', latched)
+    pub_objects = node.create_publisher(MarkerArray, '/sim/objects', 10)
+    pub_joints = node.create_publisher(JointState, '/joint_states', 10)
+    pub_target.publish(TaskTarget(trial=1, object_id=4, colour='blue', shape='cylinder'))
+    pub_fsm.publish(FsmState(state=1, state_name='OBJECT_SEARCH'))
+    amp = spawn_node('mindgrasp_eeg.virtual_amp_node', '--ros-args', '-p',
+                     f'stream_name:={stream_name}', '-p', 'subject_mode:=pursue', '-p',
+                     'accuracy:=1.0', '-p', 'reaction_delay:=0.0')
+
+    def scene(yaw: float) -> None:
+        red = Marker(id=1, type=1, text='red cube')
+        red.pose.position.x = 0.5
+        blue = Marker(id=4, type=3, ns='objects')         # colour from RGBA, shape from type
+        blue.color.b, blue.color.a = 1.0, 1.0
+        blue.pose.position.y = 0.5                        # +90 deg: to the left
+        pub_objects.publish(MarkerArray(markers=[red, blue]))
+        pub_joints.publish(JointState(name=[f'joint_{k}' for k in range(1, 7)],
+                                      position=np.array([yaw, 0, 0, 0, 0, 0], dtype=float)))
+
+    def saw(name: str) -> bool:
+        scene(0.0 if name == 'left_hand' else 2.5)
+        return name in listener.intents
+
+    assert listener.spin(30, lambda: saw('left_hand')), (listener.intents, amp.output())
+    assert listener.spin(10, lambda: saw('right_hand')), listener.intents   # overshot to 143 deg
+    pub_fsm.publish(FsmState(state=3, state_name='INITIAL_APPROACH',
+                             object_of_interest='red cube'))
+    assert listener.spin(10, lambda: scene(1.57) or 'both_feet' in listener.intents)
+
+
+def test_virtual_amp_paced_by_sim_clock(spawn_node, listener, stream_name) -> None:
+    import pylsl
+    from mindgrasp_ros.interfaces.rosgraph_msgs.msg import Clock
+
+    rclpy = listener.rclpy
+    clock_qos = rclpy.qos.QoSProfile(depth=1, reliability=rclpy.qos.ReliabilityPolicy.BEST_EFFORT)
+    pub_clock = listener.node.create_publisher(Clock, '/clock', clock_qos)
+
+    def tick(t: float) -> None:
+        msg = Clock()
+        msg.clock.sec, msg.clock.nanosec = int(t), round((t % 1) * 1e9) % 1_000_000_000
+        pub_clock.publish(msg)
+
+    tick(100.0)
+    spawn_node('mindgrasp_eeg.virtual_amp_node', '--ros-args', '-p',
+               f'stream_name:={stream_name}', '-p', 'use_sim_time:=true')
+    found = pylsl.resolve_byprop('name', stream_name, timeout=30)
+    assert found
+    inlet = pylsl.StreamInlet(found[0])
+    inlet.open_stream(timeout=10)
+    t, got = 100.0, 0
+    for _ in range(100):                  # hold simulated time: no samples beyond the first
+        tick(t)
+        listener.spin(0.01)
+    inlet.pull_chunk(timeout=0.5, max_samples=10000)
+    for _ in range(100):                  # 2 s of simulated time in ~1-2 s of wall time
+        t += 0.02
+        tick(t)
+        listener.spin(0.01)
+    deadline = time.monotonic() + 5
+    while time.monotonic() < deadline and got < 500:
+        _d, ts = inlet.pull_chunk(timeout=0.2, max_samples=10000)
+        got += len(ts)
+    tick(t)
+    listener.spin(0.5)
+    _d, ts = inlet.pull_chunk(timeout=0.2, max_samples=10000)
+    got += len(ts)
+    assert 480 <= got <= 510, got         # 250 Hz of simulated time, nothing more
