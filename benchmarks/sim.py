@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import re
 import subprocess
 import sys
 import time
@@ -65,13 +66,8 @@ def run_node(width: int, height: int, rate: float, seconds: float) -> float | No
            '-p', f'camera_width:={width}', '-p', f'camera_height:={height}',
            '-p', f'camera_rate:={rate}']
     out = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=600)
-    for line in (out.stdout + out.stderr).splitlines():
-        if 'real-time factor' in line:
-            try:
-                return float(line.rsplit('real-time factor', 1)[1].split()[0].strip(':=x '))
-            except (ValueError, IndexError):
-                return None
-    return None
+    found = re.search(r'real-time factor ([0-9.]+)x', out.stdout + out.stderr)
+    return float(found.group(1)) if found else None
 
 
 def main() -> int:
