@@ -389,8 +389,9 @@ class ColourDetector:
         """Split same-coloured components that contain objects at different depths.
 
         The component's pixels away from depth jumps ("cores") are labelled; cores whose median
-        depths differ by less than ``depth_edge`` belong to one object (faces of one cube), others
-        become separate objects; the jump pixels then go to the nearest object.
+        depths differ by less than ``depth_edge`` belong to one object (faces of one cube), other
+        groups become separate objects if each holds at least ``min_split_fraction`` of the
+        component; the remaining pixels (jumps, small parts) then go to the nearest object.
         """
         cores = cv2.bitwise_and(mask, cv2.bitwise_not(edges))
         m, core_labels, core_stats, _ = cv2.connectedComponentsWithStats(cores, connectivity=4)
