@@ -4,7 +4,10 @@ Prints, per camera setting, the real-time factor (simulated s per wall s) of the
 work per simulated second (240 physics steps, joint states read at 100 Hz, the RGB-D camera
 rendered at its rate, the arm moving), plus the mean physics step time and render time.
 
-    .venv/bin/python benchmarks/sim.py [--seconds 10] [--node]
+    .venv/bin/python benchmarks/sim.py [--seconds 10] [--node] [--grasps 40]
+
+``--grasps N`` also grasps every object of N random-locations layouts with the scripted top-down
+grasp (cube yaw unknown to the grasp) and prints the success rate per shape.
 
 ``--node`` also runs ``python -m mindgrasp_sim.sim_node`` in fast mode as its own process and
 reports its real-time factor from the node's own statistics (ROS layer and DDS included).
@@ -70,10 +73,31 @@ def run_node(width: int, height: int, rate: float, seconds: float) -> float | No
     return float(found.group(1)) if found else None
 
 
+def run_grasps(n_layouts: int) -> dict[str, list[bool]]:
+    """Scripted grasp of each object of ``n_layouts`` random layouts; success per shape."""
+    import math
+
+    from mindgrasp_sim import scripted
+
+    # a controller does not know the cube's yaw: grasp along the bearing from the base
+    scripted.grasp_yaw = lambda obj: math.atan2(obj.position[1], obj.position[0])
+    results: dict[str, list[bool]] = {}
+    with Simulation('random_locations', seed=0) as sim:
+        for seed in range(n_layouts):
+            sim.reset(seed=seed)
+            for obj in sim.objects():
+                sim.reset()
+                out = scripted.grasp_object_at(sim, obj)
+                results.setdefault(obj.shape, []).append(out.success)
+    return results
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument('--seconds', type=float, default=10.0, help='simulated seconds per run')
     parser.add_argument('--node', action='store_true', help='also benchmark the node process')
+    parser.add_argument('--grasps', type=int, default=0,
+                        help='also run scripted grasps on this many random layouts')
     args = parser.parse_args()
     load = os.getloadavg()[0] if hasattr(os, 'getloadavg') else float('nan')
     print(f'fast mode, {args.seconds:.0f} simulated s per run, physics 240 Hz, '
@@ -91,6 +115,13 @@ def main() -> int:
             rtf = run_node(w, h, r, args.seconds)
             row += f' {rtf:.1f}x |' if rtf is not None else ' n/a |'
         print(row, flush=True)
+    if args.grasps:
+        print(f'\nscripted top-down grasps, {args.grasps} random layouts '
+              '(radius 0.2-0.7 m, 4-6 cm)')
+        print('| shape | lifted > 0.22 m |')
+        print('|---|---|')
+        for shape, ok in run_grasps(args.grasps).items():
+            print(f'| {shape} | {sum(ok)}/{len(ok)} ({100 * sum(ok) / len(ok):.0f} %) |')
     return 0
 
 
