@@ -255,8 +255,8 @@ class TrainerNode(rclpy.node.Node):
         self.command_pub.publish(Float64MultiArray(data=np.zeros(self.protocol.n_joints)))
         if code != 0 or not self.protocol.trials:
             return
-        summary = self.protocol.summary()
-        self.get_logger().info('Trainer session summary: ' + json.dumps(summary))
+        summary = json.dumps(_rounded(self.protocol.summary()))
+        self.get_logger().info(f'Trainer session summary (distances in m): {summary}')
         if self.log_file:
             self._write_log(self.log_file)
 
@@ -277,6 +277,15 @@ class TrainerNode(rclpy.node.Node):
             )
             return
         self.get_logger().info(f'Trial log written to {path}.')
+
+
+def _rounded(value: object) -> object:
+    """Floats to 4 decimals (0.1 mm), recursively, for a readable log line."""
+    if isinstance(value, float):
+        return round(value, 4) if math.isfinite(value) else None
+    if isinstance(value, dict):
+        return {k: _rounded(v) for k, v in value.items()}
+    return value
 
 
 def _fmt(x: float) -> str:
