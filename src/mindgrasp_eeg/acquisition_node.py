@@ -28,7 +28,7 @@ PARAMETERS = [
     ('stream_name', 'MIndGrasp-VirtualAmp'), ('stream_type', ''), ('source_id', ''),
     ('n_channels', 32), ('sample_rate', 250.0), ('channel_names', list(NAUTILUS_32)),
     ('check_channel_names', True), ('adapt_to_stream', False), ('stream_unit', 'auto'),
-    ('chunk_period', 1.0 / 32.0), ('max_buflen', 1.0), ('resolve_timeout', 10.0),
+    ('chunk_period', 1.0 / 32.0), ('max_buflen', 1.0), ('resolve_timeout', 30.0),
     ('lost_timeout', 0.5), ('nan_policy', 'replace'), ('dejitter', True), ('clocksync', True),
     ('quality_window', 1.0), ('flat_threshold', 1e-7), ('rail_threshold', 0.1),
     ('status_period', 1.0), ('frame_id', 'eeg'), ('duration', 0.0),

@@ -1,7 +1,8 @@
 """EEG only: the acquisition node against any LSL EEG stream (optionally with a virtual amplifier).
 
     mindgrasp launch eeg eeg_stream:=MyAmp                 # a real amplifier's LSL stream
-    mindgrasp launch eeg eeg_stream:=eegmmidb              # e.g. `mindgrasp eeg play eegbci:1:4 --name eegmmidb`
+    mindgrasp eeg play eegbci:1:4 --name eegmmidb &        # any LSL EEG source, e.g. EEGMMIDB
+    mindgrasp launch eeg eeg_stream:=eegmmidb
     mindgrasp launch eeg virtual_amp:=true subject:=noise  # with the virtual amplifier
     mindgrasp launch eeg --show-args
 

@@ -1,0 +1,40 @@
+"""`mindgrasp launch eeg eeg_stream:=NAME` records an EEGMMIDB file played by the LSL player."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from mindgrasp_eeg.export import read_session
+from mindgrasp_eeg.player import load_recording
+
+from .test_player import eegbci_file
+
+
+@pytest.mark.slow
+def test_launch_eeg_records_a_played_dataset(tmp_path: Path, stream_name: str) -> None:
+    path = eegbci_file(8)
+    player = subprocess.Popen([sys.executable, '-m', 'mindgrasp_bringup', 'eeg', 'play', path,
+                               '--name', stream_name, '--duration', '60'],
+                              stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+    try:
+        assert player.stdout is not None and 'Playing' in player.stdout.readline()
+        run = subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', 'launch', 'eeg',
+                              f'eeg_stream:={stream_name}', '--duration', '12', '--run-dir',
+                              str(tmp_path / 'run')], capture_output=True, text=True, timeout=120)
+    finally:
+        player.kill()
+        player.wait()
+    assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
+    assert 'adopting the stream' in run.stdout + run.stderr  # 64 ch @ 160 Hz, not 32 @ 250
+    session = read_session(tmp_path / 'run')
+    assert session.sample_rate == 160.0 and len(session.channel_names) == 64
+    assert session.channel_names[:3] == ['FC5', 'FC3', 'FC1']
+    assert len(session.data) > 3 * 160 and session.n_missing == 0
+    rec = load_recording(path)
+    k0 = int(np.argmin(np.abs(rec.data[:20000] - session.data[0]).sum(axis=1)))
+    np.testing.assert_allclose(session.data, rec.data[k0:k0 + len(session.data)], atol=1e-9)
