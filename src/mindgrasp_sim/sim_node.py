@@ -51,7 +51,8 @@ _MARKER_TYPE = {'cube': 1, 'sphere': 2, 'cylinder': 3, 'mesh': 10}
 _PARAMS = (
     ('scene', 'set_locations'), ('seed', 0), ('n_objects', -1), ('physics_hz', 240.0),
     ('camera_width', 128), ('camera_height', 128), ('camera_rate', 10.0),
-    ('camera_fov_deg', 60.0), ('joint_state_rate', 100.0), ('objects_rate', 2.0),
+    ('camera_fov_deg', 60.0), ('camera_renderer', 'tiny'), ('joint_state_rate', 100.0),
+    ('objects_rate', 2.0),
     ('time_mode', 'realtime'), ('command_timeout', 0.25), ('trainer_robot', False),
     ('training_robot', False), ('gui', False), ('duration', 0.0), ('sim_duration', 0.0),
     ('success_height', 0.22), ('frame_id', 'world'), ('max_catch_up', 0.25),
@@ -101,7 +102,8 @@ class SimNode(rclpy.node.Node):
             self.sim = Simulation(
                 scene=p['scene'], seed=int(p['seed']),
                 camera=CameraConfig(int(p['camera_width']), int(p['camera_height']),
-                                    float(p['camera_rate']), float(p['camera_fov_deg'])),
+                                    float(p['camera_rate']), float(p['camera_fov_deg']),
+                                    renderer=str(p['camera_renderer'])),
                 physics_hz=float(p['physics_hz']),
                 trainer_robot=bool(p['trainer_robot'] or p['training_robot']), gui=gui,
                 n_objects=None if int(p['n_objects']) < 0 else int(p['n_objects']))

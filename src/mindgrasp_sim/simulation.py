@@ -53,7 +53,9 @@ class CameraConfig:
     """Eye-in-hand RGB-D camera settings.
 
     width, height: image size (px); rate_hz: publishing rate (Hz, used by the node);
-    fov_deg: vertical field of view (deg); near, far: clipping planes (m).
+    fov_deg: vertical field of view (deg); near, far: clipping planes (m); renderer: 'tiny'
+    (PyBullet's CPU TinyRenderer, the default) or 'egl' (OpenGL through the EGL plugin: fast with a
+    GPU, slow with a software driver; falls back to 'tiny' where EGL is missing).
     """
 
     width: int = 128
@@ -62,6 +64,8 @@ class CameraConfig:
     fov_deg: float = 60.0
     near: float = 0.01
     far: float = 3.0
+    renderer: str = 'tiny'
+
 
     def __post_init__(self) -> None:
         for name in ('width', 'height'):
@@ -76,6 +80,9 @@ class CameraConfig:
             raise SimError(msg)
         if not 5.0 <= self.fov_deg <= 150.0:
             msg = f'Camera fov_deg must be in 5..150 degrees, got {self.fov_deg!r}.'
+            raise SimError(msg)
+        if self.renderer not in ('tiny', 'egl'):
+            msg = f"Camera renderer must be 'tiny' or 'egl', got {self.renderer!r}."
             raise SimError(msg)
         if not 0 < self.near < self.far:
             msg = f'Camera clipping planes must satisfy 0 < near < far, got near={self.near!r}, ' \
@@ -203,6 +210,11 @@ class Simulation:
         if self.gui:
             p.configureDebugVisualizer(pb.COV_ENABLE_GUI, 0)
             p.resetDebugVisualizerCamera(1.4, 30, -35, [0.2, 0, 0.2])
+        self._renderer = pb.ER_TINY_RENDERER
+        if self.camera.renderer == 'egl':
+            self._renderer = self._load_egl()
+        # the camera draws the ground itself unless a GPU renderer or a window shows it
+        self._ground_visual = self.gui or self._renderer != pb.ER_TINY_RENDERER
         self._ground = self._make_ground()
         self._robots: dict[str, _Robot] = {}
         self._robots['user'] = self._load_robot(p, ghost=False)
@@ -236,10 +248,24 @@ class Simulation:
         self.load_scene(scene, seed=seed)
 
     # ------------------------------------------------------------------ world building
+    def _load_egl(self) -> int:
+        import pkgutil
+        import warnings
+
+        loader = pkgutil.get_loader('eglRenderer')
+        if loader is not None and self._p.loadPlugin(loader.get_filename(),
+                                                     '_eglRendererPlugin') >= 0:
+            return pb.ER_BULLET_HARDWARE_OPENGL
+        warnings.warn('The EGL renderer plugin could not be loaded (no EGL on this machine); '
+                      "rendering with TinyRenderer instead. Use camera renderer 'tiny'.",
+                      stacklevel=3)
+        self.camera.renderer = 'tiny'
+        return pb.ER_TINY_RENDERER
+
     def _make_ground(self) -> int:
         p = self._p
         col = p.createCollisionShape(pb.GEOM_PLANE)
-        if self.gui:
+        if self._ground_visual:
             vis = p.createVisualShape(pb.GEOM_BOX, halfExtents=[2.0, 2.0, 0.005],
                                       visualFramePosition=[0, 0, -0.005], rgbaColor=GROUND_RGBA)
         else:
@@ -569,13 +595,13 @@ class Simulation:
             self._proj = p.computeProjectionMatrixFOV(c.fov_deg, c.width / c.height, c.near, c.far)
         hidden = self._hide_other_robots(robot)
         _, _, rgba, depth_buf, _ = p.getCameraImage(
-            c.width, c.height, view, self._proj, renderer=pb.ER_TINY_RENDERER, shadow=0,
+            c.width, c.height, view, self._proj, renderer=self._renderer, shadow=0,
             flags=pb.ER_NO_SEGMENTATION_MASK, **_LIGHT)
         self._unhide(hidden)
         rgb = np.asarray(rgba, dtype=np.uint8).reshape(c.height, c.width, 4)[:, :, :3].copy()
         d = np.asarray(depth_buf, dtype=np.float32).reshape(c.height, c.width)
         depth = (c.far * c.near / (c.far - (c.far - c.near) * d)).astype(np.float32)
-        if not self.gui:
+        if not self._ground_visual:
             self._draw_ground(rgb, depth, depth > c.far * 0.999, pos, rot)
         return rgb, depth
 

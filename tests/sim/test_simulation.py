@@ -324,3 +324,22 @@ def test_collisions_with_the_ground_and_itself_are_reported(sim):
     sim.set_joint_positions(np.array([0.7, -0.41, 2.59, 2.5, 0.89, 0.92]))   # folded onto itself
     sim.step(1)
     assert 'link_2 - link_4' in sim.collisions()
+
+
+def test_egl_renderer_sees_the_same_scene():
+    # EGL (OpenGL) where the plugin loads, else a warning and TinyRenderer
+    import warnings
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter('always')
+        s = Simulation('set_locations', camera=CameraConfig(64, 64, renderer='egl'))
+    try:
+        if caught:
+            assert 'EGL renderer plugin could not be loaded' in str(caught[0].message)
+            assert s.camera.renderer == 'tiny'
+        rgb, depth = s.render_camera()
+        ys, xs = np.nonzero(colour_mask(rgb, 'red'))
+        assert len(xs) > 5 and 22 <= xs.mean() <= 42
+        assert 0.5 < float(np.median(depth[ys, xs])) < 0.7
+    finally:
+        s.close()
