@@ -333,3 +333,17 @@ def test_node_specific_remapping_and_log_level():
         assert not a.get_logger().info('hidden')
     finally:
         rclpy.shutdown()
+
+
+def test_lost_messages_are_counted(rclpy_ctx):
+    from mindgrasp_ros.interfaces.std_msgs.msg import String
+
+    node = rclpy_ctx.node.Node('lossy')
+    got = []
+    sub = node.create_subscription(String, '/burst', lambda m: got.append(m.data), 5)
+    pub = node.create_publisher(String, '/burst', 50)
+    for i in range(20):
+        pub.publish(String(data=str(i)))
+    spin_until(node, lambda: len(got) >= 5, timeout=5)
+    assert got == ['15', '16', '17', '18', '19']  # KEEP_LAST 5 keeps the newest
+    assert sub.messages_lost == 15

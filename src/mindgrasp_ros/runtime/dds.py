@@ -21,7 +21,7 @@ from typing import Any
 
 from cyclonedds import idl
 from cyclonedds._clayer import ddspy_take, ddspy_write
-from cyclonedds.core import InstanceState, Policy, Qos, SampleState, ViewState
+from cyclonedds.core import InstanceState, Listener, Policy, Qos, SampleState, ViewState
 from cyclonedds.domain import Domain, DomainParticipant
 from cyclonedds.idl import types as t
 from cyclonedds.pub import DataWriter, Publisher
@@ -44,6 +44,11 @@ __all__ = ['DdsParticipant', 'dds_type_name', 'ros_type_name_from_dds']
 
 _ANY_STATE = SampleState.Any | ViewState.Any | InstanceState.Any
 _MAX_AUTO_PARTICIPANT_INDEX = 100
+# Best-effort 640x480 images arrive as ~640 UDP fragments each: the kernel's default receive
+# buffer (rmem_default, ~208 kB) overflows and frames are lost. Ask for 4 MB (capped by
+# net.core.rmem_max; 'default' minimum, so a smaller cap is not an error).
+_SOCKET_BUFFERS = ('<Internal><SocketReceiveBufferSize min="default" max="4MB"/>'
+                   '</Internal>')
 
 
 class DdsError(RosError):
@@ -184,6 +189,7 @@ def _discovery_config(domain_id: int) -> str | None:
             '<CycloneDDS><Domain id="any"><General><Interfaces>'
             '<NetworkInterface address="127.0.0.1"/></Interfaces>'
             '<AllowMulticast>false</AllowMulticast></General>'
+            f'{_SOCKET_BUFFERS}'
             '<Discovery><ParticipantIndex>auto</ParticipantIndex>'
             f'<MaxAutoParticipantIndex>{_MAX_AUTO_PARTICIPANT_INDEX}</MaxAutoParticipantIndex>'
             f'<Peers>{peer_xml}</Peers></Discovery></Domain></CycloneDDS>')
@@ -195,10 +201,10 @@ def _discovery_config(domain_id: int) -> str | None:
                 '</Domain></CycloneDDS>')
     if scope in ('SUBNET', 'SYSTEM_DEFAULT'):
         if not peers:
-            return None
+            return f'<CycloneDDS><Domain id="any">{_SOCKET_BUFFERS}</Domain></CycloneDDS>'
         peer_xml = ''.join(f'<Peer address="{p}"/>' for p in peers)
-        return (f'<CycloneDDS><Domain id="any"><Discovery><Peers>{peer_xml}</Peers>'
-                '</Discovery></Domain></CycloneDDS>')
+        return (f'<CycloneDDS><Domain id="any">{_SOCKET_BUFFERS}<Discovery><Peers>{peer_xml}'
+                '</Peers></Discovery></Domain></CycloneDDS>')
     msg = (f'ROS_AUTOMATIC_DISCOVERY_RANGE={scope!r} is not valid; use LOCALHOST, SUBNET, OFF '
            'or SYSTEM_DEFAULT.')
     raise DdsError(msg)
@@ -222,10 +228,19 @@ def domain_id_from_env() -> int:
 # --------------------------------------------------------------------------- participant
 
 class DdsReader:
-    """A raw-CDR DataReader (executors attach their own ReadConditions to it)."""
+    """A raw-CDR DataReader (executors attach their own ReadConditions to it).
 
-    def __init__(self, reader: DataReader) -> None:
-        self.reader = reader
+    ``lost`` counts samples DDS reports lost or rejected (a full history or resource limit);
+    the listener fires only on such events, so the data path stays free of Python callbacks.
+    """
+
+    def __init__(self) -> None:
+        self.reader: DataReader | None = None
+        self.lost = 0
+        self.listener = Listener(on_sample_lost=self._on_lost, on_sample_rejected=self._on_lost)
+
+    def _on_lost(self, _reader: object, status: Any) -> None:
+        self.lost += max(0, int(status.total_count_change))
 
     def take(self, n: int = 64) -> list[tuple[bytes, Any]]:
         """Up to n valid samples as (CDR bytes incl. header, SampleInfo)."""
@@ -320,9 +335,12 @@ class DdsParticipant:
                      else idl_struct(ros_type))
         user_data = f'typehash={type_hash or rihs01(ros_type)};'.encode()
         with self._lock:
-            reader = DataReader(self.subscriber, self._topic(dds_topic, data_type),
-                                qos=to_dds_qos(qos, user_data, ignore_local=ignore_local))
-        return DdsReader(reader)
+            wrapper = DdsReader()
+            wrapper.reader = DataReader(
+                self.subscriber, self._topic(dds_topic, data_type),
+                qos=to_dds_qos(qos, user_data, ignore_local=ignore_local),
+                listener=wrapper.listener)
+        return wrapper
 
     def delete_reader(self, reader: DdsReader) -> None:
         with self._lock:

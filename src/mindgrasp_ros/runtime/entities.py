@@ -175,6 +175,7 @@ class Subscription(Entity):
         maxlen = None if qos.history == HistoryPolicy.KEEP_ALL else max(1, qos.depth)
         self._queue: deque[_Delivery] = deque(maxlen=maxlen)
         self._reader: DdsReader | None = None
+        self._local_lost = 0
         self.malformed_count = 0
         ctx = node.context
         if ctx.dds is not None:
@@ -191,8 +192,17 @@ class Subscription(Entity):
         return self._reader.guid if self._reader else _local_gid(self)
 
     def _enqueue(self, delivery: _Delivery) -> None:
+        if self._queue.maxlen is not None and len(self._queue) == self._queue.maxlen:
+            self._local_lost += 1  # KEEP_LAST: the oldest undelivered message is dropped
         self._queue.append(delivery)
         self.node.wake_executor()
+
+    @property
+    def messages_lost(self) -> int:
+        """Messages that never reached the callback: DDS-reported losses plus in-process
+        queue overflows (not in rclpy, which reports these through event callbacks)."""
+        remote = self._reader.lost if self._reader is not None else 0
+        return remote + self._local_lost
 
     def take(self) -> list[tuple[Any, MessageInfo]]:
         """Everything that has arrived: (message or bytes, info) pairs, oldest first."""
