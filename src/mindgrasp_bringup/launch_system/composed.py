@@ -27,7 +27,7 @@ CONTAINER_LABEL = 'composed'
 
 def composable(spec: ProcessSpec) -> bool:
     """Whether a process can be loaded as a component."""
-    return spec.is_node and spec.module is not None and not spec.daemon and not spec.arguments
+    return spec.composable and not spec.daemon and not spec.arguments
 
 
 def compose(processes: list[ProcessSpec], commands: list[list[str]], run_dir: Path,

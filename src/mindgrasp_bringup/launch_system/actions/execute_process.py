@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import shlex
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -86,11 +85,6 @@ class ProcessSpec:
         for src, dst in self.remappings:
             ros += ['-r', f'{src}:={dst}']
         return [*cmd, '--ros-args', *ros] if ros else cmd
-
-    def shell_line(self, params_file: str | Path | None = None) -> str:
-        """The command as one shell-quoted line (for logs and the run directory)."""
-        cmd = self.command(params_file)
-        return cmd[0] if self.shell else shlex.join(cmd)
 
 
 def resolve_list(context: LaunchContext, values: Iterable[SomeSubstitutions] | None) -> list[str]:
