@@ -96,7 +96,12 @@ class Component:
 
 def run_composed(components: Sequence[Component], *, num_threads: int | None = None,
                  duration_s: float = 0.0) -> int:
-    """Create every component in this process and spin them with a MultiThreadedExecutor."""
+    """Create every component in this process and spin them with a MultiThreadedExecutor.
+
+    Ends on Ctrl-C, after ``duration_s`` (> 0), or when a node says it is finished through a
+    ``done`` attribute (the convention of our nodes' ``duration`` parameter), as a launch ends
+    when one of its processes ends. Returns 1 when a node reports an ``error``, else 0.
+    """
     import time
 
     from mindgrasp_ros import rclpy
@@ -113,6 +118,8 @@ def run_composed(components: Sequence[Component], *, num_threads: int | None = N
         deadline = time.monotonic() + duration_s if duration_s > 0 else None
         while rclpy.ok() and (deadline is None or time.monotonic() < deadline):
             executor.spin_once(timeout_sec=0.1)
+            if any(getattr(node, 'done', False) for node in nodes):
+                break
     except KeyboardInterrupt:
         pass
     finally:
@@ -120,7 +127,10 @@ def run_composed(components: Sequence[Component], *, num_threads: int | None = N
         for node in reversed(nodes):
             node.destroy_node()
         rclpy.try_shutdown()
-    return 0
+    failed = [n.get_name() for n in nodes if getattr(n, 'error', None) is not None]
+    for name in failed:
+        print(f'[{name}] ERROR: {next(n.error for n in nodes if n.get_name() == name)}')
+    return 1 if failed else 0
 
 
 class LockstepRunner:
