@@ -49,6 +49,7 @@ class VisionConfig:
     lost_frames: int = 10
     shape_model: str = DEFAULT_SHAPE_MODEL
     shape_min_fraction: float = 0.04
+    shape_max_fraction: float = 0.35
     classify_states: list[int] = field(default_factory=lambda: [4])
     prediction_timeout: float = 1.0
     sync_tolerance: float = 0.02
@@ -109,4 +110,5 @@ class VisionConfig:
     def build_pipeline(self, classifier: object | None = None) -> VisionPipeline:
         """A :class:`VisionPipeline` with these parameters (and a loaded classifier, if any)."""
         return VisionPipeline(self.build_detector(), self.build_ranker(), classifier,
-                              shape_min_fraction=float(self.shape_min_fraction))
+                              shape_min_fraction=float(self.shape_min_fraction),
+                              shape_max_fraction=float(self.shape_max_fraction))

@@ -67,19 +67,27 @@ class VisionPipeline:
     shape_min_fraction : float
         Classify automatically once the object of interest fills at least this fraction of the
         image (the view just before the final approach); values > 1 disable it.
+    shape_max_fraction : float
+        Never classify an object that fills more than this fraction of the image (closer than
+        the training views, or between the fingers), even on request.
     """
 
     def __init__(self, detector: ColourDetector | None = None,
                  ranker: ObjectOfInterestRanker | None = None, classifier: object | None = None,
-                 shape_min_fraction: float = 0.04) -> None:
+                 shape_min_fraction: float = 0.04, shape_max_fraction: float = 0.35) -> None:
         if shape_min_fraction < 0:
             msg = (f"'shape_min_fraction' must be >= 0, got {shape_min_fraction}; use a value "
                    '> 1 to classify only on request.')
+            raise VisionError(msg)
+        if not 0 < shape_max_fraction <= 1:
+            msg = (f"'shape_max_fraction' must be in (0, 1], got {shape_max_fraction}; the "
+                   'training views fill up to about 0.3 of the image.')
             raise VisionError(msg)
         self.detector = detector or ColourDetector()
         self.ranker = ranker or ObjectOfInterestRanker()
         self.classifier = classifier
         self.shape_min_fraction = float(shape_min_fraction)
+        self.shape_max_fraction = float(shape_max_fraction)
         self.reset()
 
     def reset(self) -> None:
@@ -123,8 +131,9 @@ class VisionPipeline:
             # a new object of interest: its shape is not known yet
             self._shape_track = self.ranker.track_id
             self._proba_sum, self._proba_n = None, 0
-        want = classify or target.pixel_fraction >= self.shape_min_fraction
-        if self.classifier is not None and depth is not None and want and not target.truncated:
+        want = (classify or target.pixel_fraction >= self.shape_min_fraction) \
+            and target.pixel_fraction <= self.shape_max_fraction and not target.truncated
+        if self.classifier is not None and depth is not None and want:
             from mindgrasp_vision.shape_cnn import preprocess_depth
 
             try:

@@ -162,6 +162,7 @@ class VisionNode(rclpy.node.Node):
         self.cfg = cfg
         self.pipeline.detector, self.pipeline.ranker = detector, ranker
         self.pipeline.shape_min_fraction = float(cfg.shape_min_fraction)
+        self.pipeline.shape_max_fraction = float(cfg.shape_max_fraction)
         return SetParametersResult(successful=True)
 
     def duration_callback(self) -> None:

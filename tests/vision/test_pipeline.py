@@ -70,6 +70,9 @@ def test_shape_is_classified_when_large_or_requested_and_averaged(view, detector
     pipe.reset()
     assert pipe.process(rgb, depth).classified
     assert not pipe.process(rgb, None).classified
+    # too close (fills more than shape_max_fraction): not even on request
+    pipe.shape_max_fraction = 0.001
+    assert not pipe.process(rgb, depth, classify=True).classified
 
 
 def test_config_builds_the_pipeline_and_rejects_unknown_parameters():
@@ -82,3 +85,13 @@ def test_config_builds_the_pipeline_and_rejects_unknown_parameters():
         VisionConfig.from_mapping({'hysterisis': 0.2})
     with pytest.raises(VisionError, match='does not exist; train one'):
         VisionConfig(shape_model='/nonexistent/model').load_classifier()
+
+
+def test_parameter_file_matches_the_defaults():
+    import yaml
+
+    from mindgrasp_vision.config import resolve_model_path
+
+    path = resolve_model_path('config/params/vision.yaml')
+    params = yaml.safe_load(path.read_text())['vision']['ros__parameters']
+    assert VisionConfig.from_mapping(params) == VisionConfig()
