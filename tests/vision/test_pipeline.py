@@ -88,10 +88,10 @@ def test_config_builds_the_pipeline_and_rejects_unknown_parameters():
 
 
 def test_parameter_file_matches_the_defaults():
+    from pathlib import Path
+
     import yaml
 
-    from mindgrasp_vision.config import resolve_model_path
-
-    path = resolve_model_path('config/params/vision.yaml')
+    path = Path(__file__).resolve().parents[2] / 'config' / 'params' / 'vision.yaml'
     params = yaml.safe_load(path.read_text())['vision']['ros__parameters']
     assert VisionConfig.from_mapping(params) == VisionConfig()

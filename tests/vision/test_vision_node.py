@@ -3,16 +3,16 @@
 from __future__ import annotations
 
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
 
-from mindgrasp_vision.config import resolve_model_path
 from mindgrasp_vision.ros_conversions import image_from_rgb
 
 pytestmark = pytest.mark.slow
 
-PARAMS = str(resolve_model_path('config/params/vision.yaml'))
+PARAMS = str(Path(__file__).resolve().parents[2] / 'config' / 'params' / 'vision.yaml')
 
 
 def _spin_until(rclpy, node, predicate, timeout: float) -> bool:
