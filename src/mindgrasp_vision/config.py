@@ -53,6 +53,7 @@ class VisionConfig:
     classify_states: list[int] = field(default_factory=lambda: [4])
     prediction_timeout: float = 1.0
     sync_tolerance: float = 0.02
+    image_timeout: float = 2.0
     expected_width: int = 0
     expected_height: int = 0
     publish_overlay: bool = True

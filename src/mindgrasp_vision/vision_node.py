@@ -85,14 +85,15 @@ class VisionNode(rclpy.node.Node):
         self.frames = 0
         self._start = time.monotonic()
         self.done = False
-        if self.cfg.duration > 0:
-            self.create_timer(0.1, self.duration_callback)
+        self._last_image = time.monotonic()
+        self.create_timer(0.5, self.watch_callback)
         self.get_logger().info(
             f'Vision ready: colours {self.cfg.colour_names}, shape model '
             f'{"none" if classifier is None else self.cfg.shape_model}.')
 
     # ------------------------------------------------------------------ callbacks
     def color_callback(self, msg: Image) -> None:
+        self._last_image = time.monotonic()
         try:
             rgb = rgb_from_image(msg)
             self._check_size(rgb.shape[1], rgb.shape[0], '/camera/color/image_raw')
@@ -165,8 +166,13 @@ class VisionNode(rclpy.node.Node):
         self.pipeline.shape_max_fraction = float(cfg.shape_max_fraction)
         return SetParametersResult(successful=True)
 
-    def duration_callback(self) -> None:
-        if time.monotonic() - self._start >= self.cfg.duration:
+    def watch_callback(self) -> None:
+        now = time.monotonic()
+        if 0 < self.cfg.image_timeout < now - self._last_image:
+            self._error('no_image', f'No camera image on /camera/color/image_raw for '
+                        f'{now - self._last_image:.1f} s; check that the camera driver or the '
+                        'simulator is running and publishing rgb8 images.')
+        if self.cfg.duration > 0 and now - self._start >= self.cfg.duration:
             self.done = True
 
     # ------------------------------------------------------------------ work

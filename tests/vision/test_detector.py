@@ -141,3 +141,15 @@ def test_bad_parameters():
         ColourRange.from_sequence([1, 2])
     with pytest.raises(VisionError, match=r'not a valid pinhole matrix'):
         CameraIntrinsics.from_k([0.0] * 9)
+
+
+def test_640x480_frame_gives_the_same_objects():
+    from mindgrasp_sim.simulation import CameraConfig, Simulation
+
+    with Simulation(scene='set_locations', seed=0,
+                    camera=CameraConfig(width=640, height=480)) as big:
+        rgb, depth = big.render_camera()
+        k, _, _ = big.camera_intrinsics()
+    dets = ColourDetector(intrinsics=CameraIntrinsics.from_k(k.ravel())).detect(rgb, depth)
+    assert [d.colour for d in sorted(dets, key=lambda d: d.centre[0])] == ['blue', 'red', 'yellow']
+    assert all(d.pixel_count > 500 and 0.4 < d.distance < 0.8 for d in dets)

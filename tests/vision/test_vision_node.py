@@ -142,8 +142,10 @@ def test_bad_images_are_reported_by_name(rclpy_ctx, spawn_node, sim, view):
     rgb, depth = view([{'shape': 'cube', 'colour': 'blue', 'position': [0.45, 0.0]}],
                       (0.45, 0.0, 0.025), distance=0.3, elevation_deg=50)
     proc = spawn_node('mindgrasp_vision.vision_node', '--ros-args', '-p', 'shape_model:=none',
-                      '-p', 'duration:=60.0')
+                      '-p', 'duration:=60.0', '-p', 'image_timeout:=1.0')
     assert proc.wait_for_output('Vision ready', 60.0), proc.output()
+    # no camera yet: reported
+    assert proc.wait_for_output('No camera image on /camera/color/image_raw', 10.0)
     cam = Camera(rclpy_ctx)
     # a mono8 image: nothing is published, the log names the encoding and the fix
     cam.stream(rgb, None, k, lambda: "encoding 'mono8'" in proc.output(), timeout=8.0,
