@@ -52,6 +52,8 @@ from .quality import QualityMonitor
 
 NAN_POLICIES = ('replace', 'drop', 'keep')
 OK, WARN, ERROR = 0, 1, 2
+#: seconds a newly opened stream has to deliver its first sample before it counts as lost
+FIRST_SAMPLE_GRACE = 5.0
 
 
 def ros_stamp_ns(t_lsl: float, lsl_now: float, ros_now_ns: int) -> int:
@@ -102,7 +104,8 @@ class EEGAcquisition:
     resolve_timeout : float
         Seconds to wait for the stream at :meth:`connect`.
     lost_timeout : float
-        No samples for this long (s) means the stream is lost; reconnection starts.
+        No samples for this long (s) means the stream is lost; reconnection starts. Right after
+        (re)connecting the first sample may take up to :data:`FIRST_SAMPLE_GRACE` seconds.
     nan_policy : {'replace', 'drop', 'keep'}
         Non-finite values: replaced by the channel's last finite value, samples dropped, or kept.
     dejitter, clocksync : bool
@@ -149,6 +152,7 @@ class EEGAcquisition:
         self._last_ts: float | None = None       # timestamp of the last accepted sample
         self._next_index = 0                     # index the next sample would get without gaps
         self._last_data_at = 0.0                 # local_clock() when samples last arrived
+        self._got_data = False                   # a sample arrived since (re)connecting
         self._last_finite: np.ndarray | None = None
         self.lost = False
         self._lost_reason = ''
@@ -181,6 +185,7 @@ class EEGAcquisition:
             raise
         self._inlet = inlet
         self._last_data_at = pylsl.local_clock()
+        self._got_data = False
         return desc
 
     def _clocksync_for(self, info: pylsl.StreamInfo) -> bool:
@@ -277,6 +282,7 @@ class EEGAcquisition:
         self._reconnect_error = ''
         self.counters['reconnects'] += 1
         self._last_data_at = pylsl.local_clock()
+        self._got_data = False
 
     # -- data ----------------------------------------------------------------------------------
     def poll(self) -> list[Chunk]:
@@ -298,11 +304,16 @@ class EEGAcquisition:
             return []
         now = pylsl.local_clock()
         if len(ts) == 0:
-            if now - self._last_data_at > self.lost_timeout:
-                self._lost_reason = f'no samples for more than {self.lost_timeout:g} s'
+            # a freshly opened stream gets FIRST_SAMPLE_GRACE to send its first sample (an
+            # amplifier app may create its outlet well before it starts streaming)
+            limit = self.lost_timeout if self._got_data else max(self.lost_timeout,
+                                                                  FIRST_SAMPLE_GRACE)
+            if now - self._last_data_at > limit:
+                self._lost_reason = f'no samples for more than {limit:g} s'
                 self._mark_lost()
             return []
         self._last_data_at = now
+        self._got_data = True
         return self._process(np.asarray(raw, dtype=np.float64) * self.scale,
                              np.asarray(ts, dtype=np.float64), now)
 

@@ -63,14 +63,6 @@ class VirtualAmpNode(rclpy.node.Node):
             p['subject_mode'], accuracy=p['accuracy'], reaction_delay=p['reaction_delay'],
             lapse_rate=p['lapse_rate'], seed=p['seed'], active_phases=p['active_phases'],
             decision_period=p['decision_period'], heading_tolerance=p['heading_tolerance'])
-        outlet = EEGOutlet(p['stream_name'], list(p['channel_names']), p['sample_rate'],
-                           stream_type=p['stream_type'], source_id=p['source_id'],
-                           unit=p['unit'])
-        self.markers = MarkerOutlet(f'{p["stream_name"]}-markers',
-                                    f'{p["source_id"] or p["stream_name"]}-markers')
-        sim_time = bool(self.get_parameter('use_sim_time').value)
-        self.amp = VirtualAmplifier(gen, self.subject, outlet, realtime_stamps=not sim_time,
-                                    block=p['block'])
         latched = rclpy.qos.QoSProfile(depth=10,
                                        reliability=rclpy.qos.ReliabilityPolicy.RELIABLE,
                                        durability=rclpy.qos.DurabilityPolicy.TRANSIENT_LOCAL)
@@ -79,11 +71,20 @@ class VirtualAmpNode(rclpy.node.Node):
             self.create_subscription(Prompt, '/trainer/prompt', self.prompt_callback, latched)
         elif mode == 'pursue':
             self.create_subscription(TaskTarget, '/task/target', self.target_callback, latched)
-            self.create_subscription(MarkerArray, '/sim/objects', self.objects_callback, 10)
+            self.create_subscription(MarkerArray, '/sim/objects', self.objects_callback, latched)
             self.create_subscription(JointState, '/joint_states', self.joints_callback,
                                      rclpy.qos.qos_profile_sensor_data)
             self.create_subscription(FsmState, '/fsm/state', self.fsm_callback, latched)
         self.pub_intent = self.create_publisher(String, '/virtual_subject/intent', latched)
+        # the outlets last, so streaming starts soon after the stream becomes visible
+        outlet = EEGOutlet(p['stream_name'], list(p['channel_names']), p['sample_rate'],
+                           stream_type=p['stream_type'], source_id=p['source_id'],
+                           unit=p['unit'])
+        self.markers = MarkerOutlet(f'{p["stream_name"]}-markers',
+                                    f'{p["source_id"] or p["stream_name"]}-markers')
+        sim_time = bool(self.get_parameter('use_sim_time').value)
+        self.amp = VirtualAmplifier(gen, self.subject, outlet, realtime_stamps=not sim_time,
+                                    block=p['block'])
         self._last_intent: object = 'unset'
         self.create_timer(p['push_period'], self.push_callback)
         self._start = self.now_s()

@@ -150,7 +150,7 @@ def test_pursue_mode_reads_task_scene_arm_and_fsm(spawn_node, listener, stream_n
                                    durability=rclpy.qos.DurabilityPolicy.TRANSIENT_LOCAL)
     pub_target = node.create_publisher(TaskTarget, '/task/target', latched)
     pub_fsm = node.create_publisher(FsmState, '/fsm/state', latched)
-    pub_objects = node.create_publisher(MarkerArray, '/sim/objects', 10)
+    pub_objects = node.create_publisher(MarkerArray, '/sim/objects', latched)
     pub_joints = node.create_publisher(JointState, '/joint_states', 10)
     pub_target.publish(TaskTarget(trial=1, object_id=4, colour='blue', shape='cylinder'))
     pub_fsm.publish(FsmState(state=1, state_name='OBJECT_SEARCH'))
