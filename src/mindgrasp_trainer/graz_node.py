@@ -17,6 +17,7 @@ import sys
 import time
 
 from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import MIPrediction, Prompt
+from mindgrasp_ros.interfaces.rcl_interfaces.msg import SetParametersResult
 from mindgrasp_ros.interfaces.sensor_msgs.msg import Image
 
 from mindgrasp_ros import rclpy
@@ -33,6 +34,42 @@ def prompt_qos() -> rclpy.qos.QoSProfile:
         reliability=rclpy.qos.ReliabilityPolicy.RELIABLE,
         durability=rclpy.qos.DurabilityPolicy.TRANSIENT_LOCAL,
     )
+
+
+def check_rate(name: str, value: float, allow_zero: bool = False) -> float:
+    """Validate a timer rate parameter (Hz)."""
+    value = float(value)
+    if not (value > 0 or (allow_zero and value == 0)) or value > 10000:
+        zero = ' (0 turns it off)' if allow_zero else ''
+        msg = (
+            f"The rate '{name}' must be a positive number of Hz up to 10000{zero}; "
+            f'{value} is invalid.'
+        )
+        raise TrainerError(msg)
+    return value
+
+
+def fixed_parameters_callback(live: dict) -> object:
+    """An on-set-parameters callback: names in ``live`` map to a validator that applies the new
+    value; every other parameter is fixed for the session and the change is refused."""
+
+    def callback(params: list) -> SetParametersResult:
+        for param in params:
+            if param.name == 'use_sim_time':
+                continue
+            if param.name not in live:
+                return SetParametersResult(
+                    successful=False,
+                    reason=f"'{param.name}' is fixed once the session is planned; restart the "
+                    f'node to change it (live: {", ".join(sorted(live)) or "none"}).',
+                )
+            try:
+                live[param.name](param.value)
+            except TrainerError as err:
+                return SetParametersResult(successful=False, reason=str(err))
+        return SetParametersResult(successful=True)
+
+    return callback
 
 
 def to_msg(event: PromptEvent, stamp) -> Prompt:
@@ -76,6 +113,10 @@ class GrazNode(rclpy.node.Node):
             self.protocol = GrazProtocol(**p)
             self.sequencer = PromptSequencer(self.protocol.schedule())
             render_display(None, **self.display)  # validates the display parameters
+            rate = check_rate('rate', self.get_parameter('rate').value)
+            display_rate = check_rate(
+                'display_rate', self.get_parameter('display_rate').value, allow_zero=True
+            )
         except TrainerError as err:
             self.get_logger().error(str(err))
             raise
@@ -86,17 +127,24 @@ class GrazNode(rclpy.node.Node):
 
         self.prompt_pub = self.create_publisher(Prompt, '/trainer/prompt', prompt_qos())
         self.create_subscription(MIPrediction, '/bci/prediction', self.prediction_callback, 10)
-        self.create_timer(1.0 / float(self.get_parameter('rate').value), self.tick_callback)
-        display_rate = float(self.get_parameter('display_rate').value)
+        self.create_timer(1.0 / rate, self.tick_callback)
         if display_rate > 0:
             self.display_pub = self.create_publisher(
                 Image, '/trainer/display', rclpy.qos.qos_profile_sensor_data
             )
             self.create_timer(1.0 / display_rate, self.display_callback)
+        self.add_on_set_parameters_callback(fixed_parameters_callback({
+            'feedback': lambda v: self._set_display('feedback', str(v)),
+            'max_certainty': lambda v: self._set_display('max_certainty', float(v)),
+        }))  # fmt: skip
         self.get_logger().info(
             f'Graz-BCI session: {self.n_trials} trials, classes {list(self.protocol.classes)}, '
             f'seed {self.protocol.seed}, {self.protocol.total_duration():.1f} s planned.'
         )
+
+    def _set_display(self, key: str, value: object) -> None:
+        render_display(None, **(self.display | {key: value}))  # raises TrainerError if invalid
+        self.display[key] = value
 
     def prediction_callback(self, msg: MIPrediction) -> None:
         self.prediction = (int(msg.class_index), float(msg.certainty))

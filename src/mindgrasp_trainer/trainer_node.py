@@ -28,7 +28,13 @@ from mindgrasp_ros.interfaces.sensor_msgs.msg import JointState
 from mindgrasp_ros.interfaces.std_msgs.msg import Float64, Float64MultiArray
 
 from mindgrasp_ros import rclpy
-from mindgrasp_trainer.graz_node import prompt_qos, spin_until_finished, to_msg
+from mindgrasp_trainer.graz_node import (
+    check_rate,
+    fixed_parameters_callback,
+    prompt_qos,
+    spin_until_finished,
+    to_msg,
+)
 from mindgrasp_trainer.protocol import CLASS_NAMES, TrainerError
 from mindgrasp_trainer.trainer import TrainerProtocol, ee_distance
 
@@ -57,6 +63,7 @@ class TrainerNode(rclpy.node.Node):
         params = {name: self.get_parameter(name).value for name, _ in _PROTOCOL_PARAMS}
         try:
             self.protocol = TrainerProtocol(**params)
+            rate = check_rate('rate', self.get_parameter('rate').value)
         except TrainerError as err:
             self.get_logger().error(str(err))
             raise
@@ -95,13 +102,23 @@ class TrainerNode(rclpy.node.Node):
         )
         self.create_subscription(FsmState, '/fsm/state', self.fsm_callback, fsm_qos)
         self.reset_client = self.create_client(ResetSim, '/sim/reset')
-        self.create_timer(1.0 / float(self.get_parameter('rate').value), self.tick_callback)
+        self.create_timer(1.0 / rate, self.tick_callback)
+        self.add_on_set_parameters_callback(fixed_parameters_callback({
+            'reset_timeout': self._set_reset_timeout,
+        }))  # fmt: skip
         self.get_logger().info(
             f'MIndGrasp Trainer: {self.protocol.n_trials} trials of '
             f'{self.protocol.move_duration} s move + {self.protocol.wait_duration} s wait, '
             f'seed {self.protocol.seed}; waiting for '
             '/trainer_robot/joint_states and /trainer_robot/ee_pose.'
         )
+
+    def _set_reset_timeout(self, value: object) -> None:
+        value = float(value)
+        if not (math.isfinite(value) and value > 0):
+            msg = f"'reset_timeout' must be a positive number of seconds; {value} is invalid."
+            raise TrainerError(msg)
+        self.reset_timeout = value
 
     # ------------------------------------------------------------------ inputs
     def joint_states_callback(self, msg: JointState) -> None:

@@ -137,3 +137,54 @@ def test_bad_parameters_end_the_node_with_the_reason(ros, spawn, params, match):
     assert proc.wait(30) == 2
     out = proc.stdout.read()
     assert match in out, out
+
+
+def test_live_display_parameters_and_fixed_protocol_parameters(ros, spawn, spin_until):
+    from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import MIPrediction, Prompt
+    from mindgrasp_ros.interfaces.rcl_interfaces.srv import SetParameters
+    from mindgrasp_ros.interfaces.sensor_msgs.msg import Image
+
+    from mindgrasp_trainer.display import BAR_COLOUR
+
+    node = ros.node.Node('graz_param_client')
+    frames = []
+    node.create_subscription(Image, '/trainer/display', frames.append,
+                             ros.qos.qos_profile_sensor_data)  # fmt: skip
+    pred_pub = node.create_publisher(MIPrediction, '/bci/prediction', 10)
+    client = node.create_client(SetParameters, '/graz_prompter/set_parameters')
+    # a long fixation: the feedback bar shows only when 'feedback' is 'always'
+    spawn('mindgrasp_trainer.graz_node', start_delay=0.5, fixation=60.0, display_rate=20.0,
+          display_width=160, display_height=120, duration=60.0)  # fmt: skip
+    assert client.wait_for_service(timeout_sec=30.0)
+    prompts = []
+    node.create_subscription(Prompt, '/trainer/prompt', prompts.append, prompt_qos(ros))
+    assert spin_until(node, lambda: prompts and prompts[-1].phase == 'fixation', 30.0)
+
+    def set_param(name, value):
+        req = SetParameters.Request(
+            parameters=[ros.parameter.Parameter(name, value=value).to_parameter_msg()]
+        )
+        future = client.call_async(req)
+        assert spin_until(node, future.done, 10.0)
+        return future.result().results[0]
+
+    def bar_pixels() -> int:
+        """Green pixels of the newest frame after 1 s of predictions (right hand, 0.9)."""
+        for _ in range(20):  # repeated: the first ones may go out before discovery matched
+            pred_pub.publish(MIPrediction(class_index=1, certainty=0.9))
+            spin_until(node, lambda: False, 0.05)
+        n = len(frames)
+        assert spin_until(node, lambda: len(frames) > n + 1, 10.0)
+        rgb = np.asarray(frames[-1].data, np.uint8).reshape(120, 160, 3)
+        return int(np.all(rgb == BAR_COLOUR, axis=-1).sum())
+
+    assert set_param('feedback', 'always').successful
+    assert bar_pixels() > 100  # the prediction arrived and is drawn
+    assert set_param('feedback', 'move').successful
+    assert bar_pixels() == 0  # 'move': no feedback during the fixation
+    bad = set_param('feedback', 'loud')
+    assert not bad.successful and "'feedback' is 'loud'" in bad.reason
+    fixed = set_param('n_trials', 8)
+    assert not fixed.successful
+    assert "'n_trials' is fixed once the session is planned; restart the node" in fixed.reason
+    node.destroy_node()
