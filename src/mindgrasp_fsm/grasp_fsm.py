@@ -8,9 +8,9 @@ to every change except into or out of state 2):
 from  to    when                                                                        lock
 ====  ====  ==========================================================================  =====
 1     2     both-hands MI with an object of interest in view (autonomous: object seen)  no
-2     3     object centred (or centring timed out) after a request from state 1 or 3    no
+2     3     object centred (or centring timed out near it) after state 1 or 3           no
 2     4     object centred again after leaving state 4 to recentre                      no
-2     1     object of interest lost while centring                                      no
+2     1     object lost, or it cannot be centred (joint limit, timeout far off centre)  no
 3     2     object of interest drifts out of the centre of the view                     no
 3     4     object fills enough of the image, is close in depth, or joint limit near    yes
 3     1     object of interest lost                                                     yes
@@ -120,6 +120,7 @@ class GraspFsm:
         self._ooi_label = ''
         self._sweep = 0
         self._sweep_dir = 1.0
+        self._ignore_from: float | None = None
         self._attempt = 0
         self._outcome = ''
         self._gripper = GripperCommand(self.params.gripper_open_position, 0.0)
@@ -311,6 +312,11 @@ class GraspFsm:
         v = np.zeros(6)
         ooi = self._visible(inputs)
         if p.autonomous:
+            if self._ignore_from is not None:
+                if abs(q[0] - self._ignore_from) < p.search_ignore_angle:
+                    return self._sweep_step(q), 'turning away from an object out of reach'
+                self._ignore_from = None
+                self._seen_since = None
             if ooi is not None and self._seen_since is not None \
                     and t - self._seen_since >= p.search_confirm_time:
                 self._center_next = State.INITIAL_APPROACH
@@ -371,10 +377,39 @@ class GraspFsm:
                 return np.zeros(6), 'centred'
         else:
             self._centred_since = None
+        blocked = self._blocked_joint(q, v)
+        if blocked:
+            # the object lies beyond a joint limit this way round: search the other way
+            self._give_up_on_object(q, v, f'joint {blocked} is at its limit, the {ooi.label} '
+                                    'cannot be centred; searching the other way')
+            return np.zeros(6), 'limit'
         if t - self._state_since > p.center_timeout:
-            self._goto(self._center_next, f'centring timed out after {p.center_timeout:.1f} s')
+            if max(abs(ex), abs(ey)) <= p.recenter_threshold:
+                self._goto(self._center_next, f'centring timed out after {p.center_timeout:.1f} s'
+                           ' (object near the centre)')
+            else:
+                self._give_up_on_object(q, v, f'the {ooi.label} could not be centred in '
+                                        f'{p.center_timeout:.1f} s; searching again')
             return np.zeros(6), 'timeout'
         return v, f'error x {ex:+.3f} y {ey:+.3f}'
+
+    def _blocked_joint(self, q: np.ndarray, v: np.ndarray) -> int:
+        """Joint number (1 or 5) whose centring command pushes into its limit, else 0."""
+        p = self.params
+        for j in (0, 4):
+            near_hi = q[j] >= p.joint_upper_limits[j] - p.joint_limit_margin - 0.03
+            near_lo = q[j] <= p.joint_lower_limits[j] + p.joint_limit_margin + 0.03
+            if (near_hi and v[j] > 1e-3) or (near_lo and v[j] < -1e-3):
+                return j + 1
+        return 0
+
+    def _give_up_on_object(self, q: np.ndarray, v: np.ndarray, reason: str) -> None:
+        """Back to Object Search; the autonomous sweep turns away from the object it could not
+        centre and ignores objects until joint 1 has turned ``search_ignore_angle``."""
+        if abs(v[0]) > 1e-3:
+            self._sweep_dir = -float(np.sign(v[0]))
+        self._ignore_from = float(q[0])
+        self._goto(State.OBJECT_SEARCH, reason)
 
     # ---------------------------------------------------------------------------- state 3
     def _initial_approach(self, t: float, q: np.ndarray, inputs: FsmInputs

@@ -46,13 +46,16 @@ class PolicyStep:
 
 def estimate_object_position(obs_centre: tuple[float, float], distance: float, bbox_width: float,
                              camera: CameraModel, cam_pos: np.ndarray, cam_rot: np.ndarray,
-                             size: float, table_height: float) -> np.ndarray:
+                             size: float, table_height: float) -> tuple[np.ndarray, np.ndarray]:
     """Object centre (m, base frame) from its centre pixel, depth and the camera pose.
 
     ``distance`` is the depth (m, along the optical axis) of the object's visible surface; when
     it is NaN the pinhole size relation ``depth = fx * size / bbox_width`` stands in, as the paper
     did. The visible surface lies ``size / 2`` in front of the centre along the viewing ray; the
     height is set from the table and the object size (objects rest on the table).
+
+    Returns ``(centre, surface)``: the estimated centre and the measured surface point (m, base
+    frame); seen from above, the surface point's height is the object's top.
     """
     u, v = obs_centre
     depth = float(distance)
@@ -60,12 +63,13 @@ def estimate_object_position(obs_centre: tuple[float, float], distance: float, b
         depth = camera.fx * size / max(float(bbox_width), 1.0)
     p_cam = camera.backproject(u, v, depth)
     p = cam_pos + cam_rot @ p_cam
+    surface = p.copy()
     ray = p - cam_pos
     norm = float(np.linalg.norm(ray))
     if norm > 1e-9:
         p = p + ray / norm * (size / 2.0)
     p[2] = table_height + size / 2.0
-    return p
+    return p, surface
 
 
 class GraspPolicy:
@@ -77,6 +81,7 @@ class GraspPolicy:
         self.phase = ''
         self.shape = 'unknown'
         self.object_position: np.ndarray | None = None   # m, base frame (object centre)
+        self.object_height: float | None = None          # m, measured from above
         self.attempt = 0
         self._t0 = 0.0
         self._q_target: np.ndarray | None = None
@@ -127,22 +132,28 @@ class GraspPolicy:
             return self._zeros(), False, True
         v, reached = self._track(q, q_set)
         if s >= 1.0:
-            close = float(np.linalg.norm(self.kinematics.tool_position(q) - p1)) < 0.006
+            close = float(np.linalg.norm(self.kinematics.tool_position(q) - p1)) < 0.004
             if reached or close:
                 return v, True, False
         if t - t0 > duration + self.params.segment_timeout:
             return self._zeros(), False, True
         return v, False, False
 
+    def _height(self) -> float:
+        """Object height (m): measured from above when available, else the shape's size."""
+        if self.object_height is not None:
+            return self.object_height
+        return self.params.shape_value(self.shape, 'size')
+
     def _grasp_z(self) -> float:
-        size = self.params.shape_value(self.shape, 'size')
+        """Grasp-point height (m): a fraction of the object height, but high enough that the
+        fingertips, which reach ``min_tcp_height`` below the grasp point, clear the table."""
         frac = self.params.shape_value(self.shape, 'grasp_height_fraction')
-        return self.params.table_height + size * frac
+        return self.params.table_height + max(self._height() * frac, self.params.min_tcp_height)
 
     def _pregrasp_point(self) -> np.ndarray:
         assert self.object_position is not None
-        size = self.params.shape_value(self.shape, 'size')
-        top = self.params.table_height + size
+        top = self.params.table_height + self._height()
         p = self.object_position.copy()
         p[2] = top + self.params.shape_value(self.shape, 'approach_height')
         return p
@@ -158,9 +169,17 @@ class GraspPolicy:
         if (camera.width, camera.height) != (vision.image_width, vision.image_height):
             camera = camera.scaled_to(vision.image_width, vision.image_height)
         cam_pos, cam_rot = self.kinematics.camera_pose(q)
-        size = self.params.shape_value(self.shape, 'size')
-        return estimate_object_position((obs.centre_x, obs.centre_y), obs.distance, obs.bbox[2],
-                                        camera, cam_pos, cam_rot, size, self.params.table_height)
+        size = self._height()
+        centre, surface = estimate_object_position(
+            (obs.centre_x, obs.centre_y), obs.distance, obs.bbox[2], camera, cam_pos, cam_rot,
+            size, self.params.table_height)
+        if cam_rot[2, 2] < -0.95:
+            # looking straight down: the median depth is the top face (a sphere's cap a little
+            # lower); keep a plausible height of a table-top object
+            height = float(surface[2]) - self.params.table_height
+            self.object_height = min(max(height, 0.02), 0.2)
+            centre[2] = self.params.table_height + self.object_height / 2
+        return centre
 
     def _plan_pregrasp(self, q: np.ndarray) -> str:
         """Set the joint target above the object; returns '' or why it is not reachable."""
@@ -188,6 +207,7 @@ class GraspPolicy:
         self.phase = 'open'
         self._t0 = t
         self._refinements = 0
+        self.object_height = None
         self._lost_since = None
         self._gripper = GripperCommand(self.params.gripper_open_position,
                                        self.params.shape_value(self.shape, 'close_force'))

@@ -54,6 +54,7 @@ class FsmParams:
     # 0.15-0.75 m from the base)
     autonomous_search_tilts: list[float] = field(default_factory=lambda: [0.15, 0.15, 0.3, 0.0])
     search_confirm_time: float = 0.2    # s an object must be seen before it is taken
+    search_ignore_angle: float = 1.0    # rad joint 1 turns away from an object it could not centre
     # --- state 2: center object ----------------------------------------------------------------
     center_gain_joint1: float = 1.5     # rad/s per unit normalised x error (error / width)
     center_gain_joint5: float = 1.5     # rad/s per unit normalised y error (error / height)
@@ -85,6 +86,7 @@ class FsmParams:
     min_reach: float = 0.12             # m, objects closer to the base axis are not grasped
     max_reach: float = 0.85             # m
     segment_timeout: float = 8.0        # s for one motion segment
+    min_tcp_height: float = 0.035       # m above the table: the fingertips reach 0.025 m below
     # per shape: pre-grasp height above the object top, grasp height as a fraction of the
     # object height from the table, object size (m) used for the depth-surface correction,
     # wrist yaw offset (rad) relative to the approach direction, closing force (N)
@@ -99,7 +101,7 @@ class FsmParams:
     cylinder_wrist_yaw: float = 0.0
     cylinder_close_force: float = 40.0
     sphere_approach_height: float = 0.10
-    sphere_grasp_height_fraction: float = 0.45
+    sphere_grasp_height_fraction: float = 0.55
     sphere_size: float = 0.05
     sphere_wrist_yaw: float = 0.0
     sphere_close_force: float = 30.0

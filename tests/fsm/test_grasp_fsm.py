@@ -384,3 +384,32 @@ def test_never_commands_beyond_limits_or_speed(params: FsmParams) -> None:
             over = (nxt > hi - params.joint_limit_margin + 1e-9) & (v > 0)
             under = (nxt < lo + params.joint_limit_margin - 1e-9) & (v < 0)
             assert not np.any(over | under), (state, q, v)
+
+
+def test_object_beyond_the_joint1_limit_is_searched_the_other_way(params: FsmParams) -> None:
+    params.autonomous = True
+    fsm = GraspFsm.from_params(params)
+    fsm.force_state(State.CENTER_OBJECT, center_next=State.INITIAL_APPROACH)
+    q = HOME.copy()
+    q[0] = params.joint_upper_limits[0] - params.joint_limit_margin - 0.01
+    left = observation(20, 64)          # left of centre: centring would turn joint 1 further up
+    out = fsm.tick(inputs(0.0, q=q, cls=None, obs=left))
+    assert out.state == State.OBJECT_SEARCH and 'joint 1 is at its limit' in out.reason
+    # the sweep now turns right and ignores the object it could not reach this way round
+    out = fsm.tick(inputs(0.5, q=q, cls=None, obs=left))
+    assert out.state == State.OBJECT_SEARCH
+    assert out.joint_velocities[0] == pytest.approx(-params.autonomous_search_velocity)
+    q[0] -= params.search_ignore_angle + 0.1
+    for k in range(20):
+        out = fsm.tick(inputs(1.0 + 0.02 * k, q=q, cls=None, obs=left))
+    assert out.state == State.CENTER_OBJECT
+
+
+def test_centring_timeout_far_off_centre_searches_again(params: FsmParams) -> None:
+    params.center_timeout = 0.3
+    params.center_gain_joint1 = 0.0     # a centring that gets nowhere
+    fsm = GraspFsm.from_params(params)
+    fsm.force_state(State.CENTER_OBJECT, center_next=State.INITIAL_APPROACH)
+    outs, _ = run(fsm, 0.0, 0.5, cls=MiClass.BOTH_FEET, obs=observation(64 + 0.3 * 128, 64))
+    assert outs[-1].state == State.OBJECT_SEARCH
+    assert 'could not be centred' in outs[-1].reason
