@@ -14,6 +14,7 @@ The algorithms are :class:`mindgrasp_vision.pipeline.VisionPipeline`.
 from __future__ import annotations
 
 import sys
+import threading
 import time
 
 from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import (
@@ -77,7 +78,7 @@ class VisionNode(rclpy.node.Node):
         self._pending = None      # (stamp ns, rgb, header) waiting for its depth image
         self._depth = None        # (stamp ns, depth)
         self._seen_depth = False
-        self._mi = None           # (class index, receipt time s)
+        self._mi = None           # (class index, receipt ROS time s)
         self._fsm_state = 0
         self._classify_next = False
         self._last = None         # (rgb, depth, header) of the last processed frame
@@ -85,7 +86,9 @@ class VisionNode(rclpy.node.Node):
         self.frames = 0
         self._start = time.monotonic()
         self.done = False
-        self._last_image = time.monotonic()
+        self._last_image: float | None = None   # ROS time (s); set on the first watch tick
+        # callbacks may run on several threads (composition uses a MultiThreadedExecutor)
+        self._lock = threading.RLock()
         self.create_timer(0.5, self.watch_callback)
         self.get_logger().info(
             f'Vision ready: colours {self.cfg.colour_names}, shape model '
@@ -93,18 +96,19 @@ class VisionNode(rclpy.node.Node):
 
     # ------------------------------------------------------------------ callbacks
     def color_callback(self, msg: Image) -> None:
-        self._last_image = time.monotonic()
+        self._last_image: float | None = None   # ROS time (s); set on the first watch tick
         try:
             rgb = rgb_from_image(msg)
             self._check_size(rgb.shape[1], rgb.shape[0], '/camera/color/image_raw')
         except VisionError as exc:
             self._error('color', str(exc))
             return
-        if self._pending is not None:
-            # its depth image never came: process the older frame without depth
-            self._process(*self._pending[1:], None)
-        self._pending = (_stamp_ns(msg.header), rgb, msg.header)
-        self._try_process()
+        with self._lock:
+            if self._pending is not None:
+                # its depth image never came: process the older frame without depth
+                self._process(*self._pending[1:], None)
+            self._pending = (_stamp_ns(msg.header), rgb, msg.header)
+            self._try_process()
 
     def depth_callback(self, msg: Image) -> None:
         try:
@@ -113,9 +117,10 @@ class VisionNode(rclpy.node.Node):
         except VisionError as exc:
             self._error('depth', str(exc))
             return
-        self._seen_depth = True
-        self._depth = (_stamp_ns(msg.header), depth)
-        self._try_process()
+        with self._lock:
+            self._seen_depth = True
+            self._depth = (_stamp_ns(msg.header), depth)
+            self._try_process()
 
     def info_callback(self, msg: CameraInfo) -> None:
         try:
@@ -124,7 +129,7 @@ class VisionNode(rclpy.node.Node):
             self._error('camera_info', str(exc))
 
     def prediction_callback(self, msg: MIPrediction) -> None:
-        self._mi = (int(msg.class_index), time.monotonic())
+        self._mi = (int(msg.class_index), self._now())
 
     def state_callback(self, msg: FsmState) -> None:
         if msg.state == FsmState.RETURN_TO_START and self._fsm_state != msg.state:
@@ -140,7 +145,8 @@ class VisionNode(rclpy.node.Node):
             response.success = False
             response.message = 'No shape model loaded; set the shape_model parameter.'
             return response
-        result = self._process(*self._last, classify=True)
+        with self._lock:
+            result = self._process(*self._last, classify=True)
         target = None if result is None else result.target
         if target is None or target.shape == 'unknown':
             response.success, response.message = False, 'No object of interest to classify.'
@@ -159,23 +165,31 @@ class VisionNode(rclpy.node.Node):
             detector, ranker = cfg.build_detector(), cfg.build_ranker()
         except (VisionError, TypeError, ValueError) as exc:
             return SetParametersResult(successful=False, reason=str(exc))
-        detector.intrinsics = self.pipeline.detector.intrinsics
-        self.cfg = cfg
-        self.pipeline.detector, self.pipeline.ranker = detector, ranker
-        self.pipeline.shape_min_fraction = float(cfg.shape_min_fraction)
-        self.pipeline.shape_max_fraction = float(cfg.shape_max_fraction)
+        with self._lock:
+            detector.intrinsics = self.pipeline.detector.intrinsics
+            self.cfg = cfg
+            self.pipeline.detector, self.pipeline.ranker = detector, ranker
+            self.pipeline.shape_min_fraction = float(cfg.shape_min_fraction)
+            self.pipeline.shape_max_fraction = float(cfg.shape_max_fraction)
         return SetParametersResult(successful=True)
 
     def watch_callback(self) -> None:
-        now = time.monotonic()
-        if 0 < self.cfg.image_timeout < now - self._last_image:
+        now = self._now()
+        if self._last_image is None or now < self._last_image:  # start, or sim time reset
+            self._last_image = now
+        silent = now - self._last_image
+        if 0 < self.cfg.image_timeout < silent:
             self._error('no_image', f'No camera image on /camera/color/image_raw for '
-                        f'{now - self._last_image:.1f} s; check that the camera driver or the '
-                        'simulator is running and publishing rgb8 images.')
-        if self.cfg.duration > 0 and now - self._start >= self.cfg.duration:
+                        f'{silent:.1f} s; check that the camera driver or the simulator is '
+                        'running and publishing rgb8 images.')
+        if self.cfg.duration > 0 and time.monotonic() - self._start >= self.cfg.duration:
             self.done = True
 
     # ------------------------------------------------------------------ work
+    def _now(self) -> float:
+        """ROS time (s): simulated time under use_sim_time, so timeouts scale with the sim."""
+        return self.get_clock().now().nanoseconds * 1e-9
+
     def _check_size(self, width: int, height: int, topic: str) -> None:
         ew, eh = int(self.cfg.expected_width), int(self.cfg.expected_height)
         if (ew and width != ew) or (eh and height != eh):
@@ -205,7 +219,7 @@ class VisionNode(rclpy.node.Node):
                         'depth registered to the colour camera.')
             depth = None
         mi = None
-        if self._mi is not None and time.monotonic() - self._mi[1] <= self.cfg.prediction_timeout:
+        if self._mi is not None and self._now() - self._mi[1] <= self.cfg.prediction_timeout:
             mi = self._mi[0]
         classify = (classify or self._classify_next
                     or self._fsm_state in list(self.cfg.classify_states))
