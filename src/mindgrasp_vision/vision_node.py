@@ -80,8 +80,7 @@ class VisionNode(rclpy.node.Node):
         self._seen_depth = False
         self._mi = None           # (class index, receipt ROS time s)
         self._fsm_state = 0
-        self._classify_next = False
-        self._last = None         # (rgb, depth, header) of the last processed frame
+        self._last = None         # (rgb, header, depth) of the last processed frame
         self._errors: dict[str, float] = {}
         self.frames = 0
         self._start = time.monotonic()
@@ -96,7 +95,7 @@ class VisionNode(rclpy.node.Node):
 
     # ------------------------------------------------------------------ callbacks
     def color_callback(self, msg: Image) -> None:
-        self._last_image: float | None = None   # ROS time (s); set on the first watch tick
+        self._last_image = self._now()
         try:
             rgb = rgb_from_image(msg)
             self._check_size(rgb.shape[1], rgb.shape[0], '/camera/color/image_raw')
@@ -221,8 +220,7 @@ class VisionNode(rclpy.node.Node):
         mi = None
         if self._mi is not None and self._now() - self._mi[1] <= self.cfg.prediction_timeout:
             mi = self._mi[0]
-        classify = (classify or self._classify_next
-                    or self._fsm_state in list(self.cfg.classify_states))
+        classify = classify or self._fsm_state in list(self.cfg.classify_states)
         try:
             result = self.pipeline.process(rgb, depth, mi, classify=classify)
         except VisionError as exc:
