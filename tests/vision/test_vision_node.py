@@ -47,6 +47,7 @@ class Camera:
             durability=rclpy.qos.DurabilityPolicy.TRANSIENT_LOCAL)
         self.state = self.node.create_publisher(FsmState, '/fsm/state', state_qos)
         self.detections: list = []
+        self.stamps: set = set()
         self.overlays: list = []
         self.node.create_subscription(DetectionArray, '/vision/detections',
                                       self.detections.append, 10)
@@ -68,6 +69,7 @@ class Camera:
                 data=np.frombuffer(depth.astype('<f4').tobytes(), np.uint8)))
         msg = image_from_rgb(image_cls, rgb, header)
         msg.encoding = encoding
+        self.stamps.add((header.stamp.sec, header.stamp.nanosec))
         self.color.publish(msg)
         return header.stamp
 
@@ -111,6 +113,8 @@ def test_detections_overlay_focus_shift_and_shape(rclpy_ctx, spawn_node, sim, vi
         proc.output()
     msg = cam.detections[-1]
     assert (msg.image_width, msg.image_height) == (128, 128)
+    assert msg.header.frame_id == 'camera_color_optical_frame'   # the image's header
+    assert (msg.header.stamp.sec, msg.header.stamp.nanosec) in cam.stamps
     assert sorted(d.colour for d in msg.detections) == ['blue', 'red', 'yellow']
     assert _target(msg).colour == 'yellow' and _target(msg).is_object_of_interest
     assert all(0.3 < d.distance < 0.5 for d in msg.detections)
