@@ -21,6 +21,7 @@ from pathlib import Path
 import numpy as np
 from mindgrasp_ros.interfaces.diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import EEGChunk, MIPrediction, Prompt
+from threadpoolctl import threadpool_limits
 
 from mindgrasp_classifier.decoder import (
     AdaptationConfig,
@@ -41,6 +42,7 @@ PARAMETERS = [
     ('adaptation', 'none'), ('adaptation_rate', 0.005), ('min_certainty', 0.5),
     ('recenter', 'fixed'), ('recenter_rate', 0.005), ('label_tmin', 0.5), ('label_tmax', 2.5),
     ('flat_threshold', 1e-8), ('status_period', 1.0), ('frame_id', 'eeg'), ('duration', 0.0),
+    ('blas_threads', 1),
 ]
 
 
@@ -51,6 +53,9 @@ class ClassifierNode(rclpy.node.Node):
         super().__init__('classifier', **kwargs)
         self.declare_parameters('', PARAMETERS)
         self.p = {name: self.get_parameter(name).value for name, _ in PARAMETERS}
+        if self.p['blas_threads'] > 0:
+            # small matrices: multi-threaded BLAS only adds latency, worst on a busy machine
+            threadpool_limits(limits=int(self.p['blas_threads']))
         self.model = MiModel.load(self.p['model'])
         if self.p['classes']:
             check_classes(self.model, self.p['classes'])

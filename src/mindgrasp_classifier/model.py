@@ -22,6 +22,7 @@ from pyriemann.geometry.covariance import covariances
 
 from mindgrasp_classifier.errors import ClassifierError
 from mindgrasp_classifier.pipelines import _DistanceClassifier, classifier_from_arrays
+from mindgrasp_classifier.preprocessing import oas_covariances
 
 #: MIndGrasp class names by class index (MIPrediction constants).
 CLASS_NAMES: tuple[str, ...] = ('left_hand', 'right_hand', 'both_hands', 'both_feet')
@@ -120,8 +121,12 @@ class MiModel:
     def covariances(self, windows: np.ndarray) -> np.ndarray:
         """Shrinkage covariances of filtered windows, shape (n, n_channels, n_channels).
 
-        ``windows`` has shape (n_windows, n_channels, n_samples), in microvolts.
+        ``windows`` has shape (n_windows, n_channels, n_samples), in microvolts. OAS uses the
+        vectorised :func:`~mindgrasp_classifier.preprocessing.oas_covariances` (equal to
+        pyRiemann's); other estimators go through pyRiemann ``covariances``.
         """
+        if self.estimator == 'oas':
+            return oas_covariances(windows)
         return covariances(windows, estimator=self.estimator)
 
     @staticmethod

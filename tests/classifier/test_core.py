@@ -242,3 +242,14 @@ def test_too_few_trials_error():
         train([rec], TrainingConfig(channels='all'))
     with pytest.raises(ClassifierError, match='at least two classes'):
         train([make_recording(classes=(2,), trials_per_class=6)], TrainingConfig(channels='all'))
+
+
+def test_oas_equals_pyriemann():
+    from pyriemann.estimation import Covariances
+
+    from mindgrasp_classifier.preprocessing import oas_covariances
+
+    rng = np.random.RandomState(1234)
+    x = rng.randn(6, 8, 100) * 5.0 + 2.0
+    np.testing.assert_allclose(oas_covariances(x), Covariances(estimator='oas').transform(x),
+                               rtol=1e-10, atol=1e-12)
