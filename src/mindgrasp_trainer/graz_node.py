@@ -14,7 +14,6 @@ the last trial, or after ``duration`` seconds when that is > 0.
 from __future__ import annotations
 
 import sys
-import time
 
 from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import MIPrediction, Prompt
 from mindgrasp_ros.interfaces.rcl_interfaces.msg import SetParametersResult
@@ -123,7 +122,7 @@ class GrazNode(rclpy.node.Node):
         self.n_trials = len(self.protocol.class_order())
         self.prediction: tuple[int, float] | None = None
         self.t0_ns: int | None = None
-        self.finished = False
+        self.done = rclpy.task.Future()  # result set when the session has ended
 
         self.prompt_pub = self.create_publisher(Prompt, '/trainer/prompt', prompt_qos())
         self.create_subscription(MIPrediction, '/bci/prediction', self.prediction_callback, 10)
@@ -141,6 +140,10 @@ class GrazNode(rclpy.node.Node):
             f'Graz-BCI session: {self.n_trials} trials, classes {list(self.protocol.classes)}, '
             f'seed {self.protocol.seed}, {self.protocol.total_duration():.1f} s planned.'
         )
+
+    @property
+    def finished(self) -> bool:
+        return self.done.done()
 
     def _set_display(self, key: str, value: object) -> None:
         render_display(None, **(self.display | {key: value}))  # raises TrainerError if invalid
@@ -171,7 +174,7 @@ class GrazNode(rclpy.node.Node):
                 )
             elif event.phase == 'end':
                 self.get_logger().info(f'Graz-BCI session ended after {elapsed:.1f} s.')
-                self.finished = True
+                self.done.set_result(0)
 
     def display_callback(self) -> None:
         frame = render_display(self.sequencer.current, self.prediction, **self.display)
@@ -185,12 +188,14 @@ class GrazNode(rclpy.node.Node):
 
 
 def spin_until_finished(node: rclpy.node.Node, linger: float = 0.5) -> None:
-    """Spin until ``node.finished``, then ``linger`` s more so reliable readers get the end."""
-    while rclpy.ok() and not node.finished:
-        rclpy.spin_once(node, timeout_sec=0.1)
-    deadline = time.monotonic() + linger  # wall time: /clock may have stopped
-    while rclpy.ok() and time.monotonic() < deadline:
-        rclpy.spin_once(node, timeout_sec=0.05)
+    """Spin until ``node.done`` completes, then ``linger`` s more so reliable readers get the end.
+
+    One executor for the whole run (``rclpy.spin_once`` in a loop adds and removes the node each
+    call, which costs a quarter of a core).
+    """
+    rclpy.spin_until_future_complete(node, node.done)
+    if rclpy.ok():
+        rclpy.spin_until_future_complete(node, rclpy.task.Future(), timeout_sec=linger)
 
 
 def main(args: list[str] | None = None) -> int:

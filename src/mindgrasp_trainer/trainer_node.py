@@ -80,8 +80,7 @@ class TrainerNode(rclpy.node.Node):
         self.created = time.monotonic()
         self.trainer_pose_time = math.inf  # wall time of the last training robot pose
         self.stale_warned = 0.0
-        self.finished = False
-        self.exit_code = 0
+        self.done = rclpy.task.Future()  # result: exit code, set when the session has ended
 
         self.prompt_pub = self.create_publisher(Prompt, '/trainer/prompt', prompt_qos())
         self.command_pub = self.create_publisher(
@@ -112,6 +111,14 @@ class TrainerNode(rclpy.node.Node):
             f'seed {self.protocol.seed}; waiting for '
             '/trainer_robot/joint_states and /trainer_robot/ee_pose.'
         )
+
+    @property
+    def finished(self) -> bool:
+        return self.done.done()
+
+    @property
+    def exit_code(self) -> int:
+        return self.done.result() if self.done.done() else 0
 
     def _set_reset_timeout(self, value: object) -> None:
         value = float(value)
@@ -267,8 +274,9 @@ class TrainerNode(rclpy.node.Node):
             self.protocol.reset_finished(t, success=False)
 
     def _finish(self, code: int) -> None:
-        self.finished = True
-        self.exit_code = code
+        if self.done.done():
+            return
+        self.done.set_result(code)
         self.command_pub.publish(Float64MultiArray(data=np.zeros(self.protocol.n_joints)))
         if code != 0 or not self.protocol.trials:
             return
