@@ -76,3 +76,54 @@ def test_same_seed_same_prompts_in_lockstep():
         runs.append([(m.phase, m.class_index, m.trial, m.header.stamp.sec,
                       m.header.stamp.nanosec) for m in run_graz(runner)])  # fmt: skip
     assert runs[0] == runs[1]
+
+
+def run_trainer_with_sim() -> tuple[list, dict]:
+    """Simulator (training robot) and trainer composed in lock-step; returns prompts, summary."""
+    composition = pytest.importorskip('mindgrasp_ros.composition')
+    sim_node = pytest.importorskip('mindgrasp_sim.sim_node')
+    from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import Prompt
+
+    from mindgrasp_ros import rclpy
+    from mindgrasp_trainer.trainer_node import TrainerNode
+
+    got = []
+
+    class Listener(rclpy.node.Node):
+        def __init__(self) -> None:
+            super().__init__('prompt_listener')
+            qos = rclpy.qos.QoSProfile(
+                depth=10,
+                reliability=rclpy.qos.ReliabilityPolicy.RELIABLE,
+                durability=rclpy.qos.DurabilityPolicy.TRANSIENT_LOCAL,
+            )
+            self.create_subscription(Prompt, '/trainer/prompt', got.append, qos)
+
+    runner = composition.LockstepRunner(start_time_s=100.0)
+    runner.add(Listener)
+    runner.add(sim_node.SimNode, ros_args=['-p', 'trainer_robot:=true', '-p', 'camera_rate:=1.0'])
+    trainer = runner.add(TrainerNode, ros_args=[
+        '-p', 'n_trials:=3', '-p', 'classes:=[0, 2]', '-p', 'seed:=1', '-p', 'start_delay:=0.5',
+        '-p', 'approach_speed:=0.6', '-p', 'settle_time:=0.5',
+    ])  # fmt: skip
+    for _ in range(3000):
+        if trainer.finished:
+            break
+        runner.step(0.01)
+    assert trainer.finished and trainer.exit_code == 0
+    prompts = [(m.phase, m.trial, m.class_index, m.header.stamp.sec, m.header.stamp.nanosec)
+               for m in got]  # fmt: skip
+    return prompts, trainer.protocol.summary()
+
+
+@pytest.mark.slow
+def test_trainer_and_simulator_in_lockstep_are_deterministic():
+    a_prompts, a_summary = run_trainer_with_sim()
+    # the approach (both hands, 0.6 rad/s) takes the training end-effector below 0.1 m: the
+    # reset goes through the simulator's /sim/reset service in the same process
+    assert a_summary['n_resets'] >= 1
+    assert [p[0] for p in a_prompts].count('rest') == 1 + a_summary['n_resets']
+    assert a_prompts[-1][0] == 'end'
+    b_prompts, b_summary = run_trainer_with_sim()
+    assert a_prompts == b_prompts
+    assert a_summary == b_summary
