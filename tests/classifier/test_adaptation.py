@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from classifier_synth import CHANNELS, make_recording
 
 from mindgrasp_classifier.decoder import AdaptationConfig, CueLabels
 from mindgrasp_classifier.errors import ClassifierError
@@ -15,6 +14,8 @@ from mindgrasp_classifier.training import (
     stream_recording,
     train,
 )
+
+from .classifier_synth import CHANNELS, make_recording
 
 
 @pytest.fixture(scope='module')

@@ -7,7 +7,6 @@ import json
 
 import numpy as np
 import pytest
-from classifier_synth import CHANNELS, RATE, make_recording
 from pyriemann.classification import MDM, FgMDM
 from pyriemann.datasets import make_matrices
 from scipy import signal
@@ -37,6 +36,8 @@ from mindgrasp_classifier.training import (
     stream_recording,
     train,
 )
+
+from .classifier_synth import CHANNELS, RATE, make_recording
 
 
 @pytest.fixture(scope='module')
