@@ -1,7 +1,8 @@
 """Speed of the PyBullet simulation in fast mode (as fast as it can, as the node runs it).
 
-Prints, per camera setting, the real-time factor (simulated s per wall s) of the node's fast-mode
-work per simulated second (240 physics steps, joint states read at 100 Hz, the RGB-D camera
+Prints, per camera setting, the real-time factor (simulated s per wall s, and per CPU s of this
+process, which a busy shared machine distorts less) of the node's fast-mode work per simulated
+second (240 physics steps, joint states read at 100 Hz, the RGB-D camera
 rendered at its rate, the arm moving), plus the mean physics step time and render time.
 
     .venv/bin/python benchmarks/sim.py [--seconds 10] [--node] [--grasps 40]
@@ -38,7 +39,7 @@ def run_core(width: int, height: int, rate: float, seconds: float) -> dict[str, 
     step_t = render_t = 0.0
     n_render = 0
     rng = np.random.default_rng(0)
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     for i in range(steps):
         if i % 120 == 0:   # a controller changing its command twice a second
             sim.set_joint_velocities(rng.uniform(-0.2, 0.2, 6))
@@ -54,14 +55,15 @@ def run_core(width: int, height: int, rate: float, seconds: float) -> dict[str, 
             sim.render_camera()
             render_t += time.perf_counter() - b
             n_render += 1
-    wall = time.perf_counter() - t0
+    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     sim.close()
-    return {'rtf': seconds / wall, 'step_ms': 1e3 * step_t / steps,
+    return {'rtf': seconds / wall, 'rtf_cpu': seconds / cpu, 'step_ms': 1e3 * step_t / steps,
             'render_ms': 1e3 * render_t / max(n_render, 1)}
 
 
-def run_node(width: int, height: int, rate: float, seconds: float) -> float | None:
-    """Sim node in fast mode as its own process; its reported real-time factor (or None)."""
+def run_node(width: int, height: int, rate: float, seconds: float
+             ) -> tuple[float, float] | None:
+    """Sim node in fast mode as its own process; its reported real-time factors (wall, CPU)."""
     env = dict(os.environ)
     env.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
     cmd = [sys.executable, '-m', 'mindgrasp_sim.sim_node', '--ros-args',
@@ -69,8 +71,9 @@ def run_node(width: int, height: int, rate: float, seconds: float) -> float | No
            '-p', f'camera_width:={width}', '-p', f'camera_height:={height}',
            '-p', f'camera_rate:={rate}']
     out = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=600)
-    found = re.search(r'real-time factor ([0-9.]+)x', out.stdout + out.stderr)
-    return float(found.group(1)) if found else None
+    found = re.search(r'real-time factor ([0-9.]+)x \(([0-9.]+)x per CPU',
+                      out.stdout + out.stderr)
+    return (float(found.group(1)), float(found.group(2))) if found else None
 
 
 def run_grasps(n_layouts: int) -> dict[str, list[bool]]:
@@ -102,18 +105,19 @@ def main() -> int:
     load = os.getloadavg()[0] if hasattr(os, 'getloadavg') else float('nan')
     print(f'fast mode, {args.seconds:.0f} simulated s per run, physics 240 Hz, '
           f'{os.cpu_count()} CPUs, load average {load:.1f} at start')
-    header = '| camera | real-time factor | step time (ms) | render time (ms) |'
+    header = ('| camera | real-time factor (wall) | per CPU second | step time (ms) | '
+              'render time (ms) |')
     if args.node:
-        header += ' node RTF (DDS) |'
+        header += ' node process (DDS), wall / CPU |'
     print(header)
     print('|' + '|'.join(['---'] * (header.count('|') - 1)) + '|')
     for w, h, r in SETTINGS:
         res = run_core(w, h, r, args.seconds)
-        row = (f'| {w}x{h} @ {r:.0f} Hz | {res["rtf"]:.1f}x | {res["step_ms"]:.3f} | '
-               f'{res["render_ms"]:.2f} |')
+        row = (f'| {w}x{h} @ {r:.0f} Hz | {res["rtf"]:.1f}x | {res["rtf_cpu"]:.1f}x | '
+               f'{res["step_ms"]:.3f} | {res["render_ms"]:.2f} |')
         if args.node:
             rtf = run_node(w, h, r, args.seconds)
-            row += f' {rtf:.1f}x |' if rtf is not None else ' n/a |'
+            row += f' {rtf[0]:.1f}x / {rtf[1]:.1f}x |' if rtf is not None else ' n/a |'
         print(row, flush=True)
     if args.grasps:
         print(f'\nscripted top-down grasps, {args.grasps} random layouts '

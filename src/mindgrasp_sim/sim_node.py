@@ -31,6 +31,7 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
+from mindgrasp_ros.interfaces.builtin_interfaces.msg import Time as TimeMsg
 from mindgrasp_ros.interfaces.geometry_msgs.msg import PoseStamped
 from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import GraspResult, TaskTarget
 from mindgrasp_ros.interfaces.mindgrasp_msgs.srv import LoadScene, ResetSim, Step
@@ -165,10 +166,10 @@ class SimNode(rclpy.node.Node):
         self.create_service(LoadScene, '/sim/load_scene', self.load_scene_callback)
         self.create_service(Step, '/sim/step', self.step_callback)
         self._t0 = self._clock_s() if self.mode == 'realtime' else 0.0
+        self._set_t0(self._t0)
         if self.mode == 'realtime':
             self.create_timer(1.0 / float(p['joint_state_rate']), self.realtime_callback)
         self.create_timer(0.5, self.duration_callback)
-        self._camera_info = self._make_camera_info()
         self.publish_all()
         robots = ' and the training robot' if 'trainer' in self.robots else ''
         self.get_logger().info(
@@ -180,12 +181,23 @@ class SimNode(rclpy.node.Node):
     def _clock_s(self) -> float:
         return self.get_clock().now().nanoseconds * 1e-9
 
+    def _set_t0(self, t0: float) -> None:
+        self._t0 = t0
+        self._t0_ns = round(t0 * 1e9)
+        self._dt_ns = round(self.sim.dt * 1e9)
+        self._stamp_cache: tuple[int, TimeMsg | None] = (-1, None)
+
     def sim_now(self) -> float:
         """Node time (s): start time plus simulated time since start (never goes back)."""
         return self._t0 + self.total_steps * self.sim.dt
 
-    def _stamp(self) -> object:
-        return rclpy.time.Time(nanoseconds=round(self.sim_now() * 1e9)).to_msg()
+    def _stamp(self) -> TimeMsg:
+        # integer nanoseconds: start time plus whole physics steps (no float drift)
+        if self._stamp_cache[0] != self.total_steps:
+            ns = self._t0_ns + self.total_steps * self._dt_ns
+            self._stamp_cache = (self.total_steps, TimeMsg(sec=ns // 1_000_000_000,
+                                                           nanosec=ns % 1_000_000_000))
+        return self._stamp_cache[1]
 
     def advance(self, n_steps: int) -> None:
         """Step the physics ``n_steps`` times, publishing whatever falls due."""
@@ -226,7 +238,7 @@ class SimNode(rclpy.node.Node):
             self.get_logger().warning(
                 f'The simulation is {due:.2f} s behind its clock; skipping ahead. Lower '
                 'camera_width/height or camera_rate, or use time_mode:=fast.')
-            self._t0 += due - cap
+            self._set_t0(self._t0 + due - cap)
             due = cap
         n = int(due * self.sim.physics_hz)
         if n > 0:
@@ -337,6 +349,7 @@ class SimNode(rclpy.node.Node):
         self._last_state_step = self.total_steps
         sim = self.sim
         header = self._header()
+        world = self._header(self.p['frame_id'])
         for io in self.robots.values():
             io.pubs['js'].publish(JointState(
                 header=header, name=list(sim.joint_names),
@@ -349,18 +362,19 @@ class SimNode(rclpy.node.Node):
             io.pubs['contacts'].publish(UInt8MultiArray(
                 data=state['contacts'].astype(np.uint8)))
             pos, quat = sim.ee_pose(io.name)
-            pose = PoseStamped(header=self._header(self.p['frame_id']))
+            pose = PoseStamped(header=world)
             pose.pose.position.x, pose.pose.position.y, pose.pose.position.z = map(float, pos)
             o = pose.pose.orientation
             o.x, o.y, o.z, o.w = map(float, quat)
             io.pubs['ee'].publish(pose)
 
-    def _make_camera_info(self) -> CameraInfo:
+    def _camera_info(self, header: Header) -> CameraInfo:
         k, w, h = self.sim.camera_intrinsics()
         p = np.zeros((3, 4))
         p[:, :3] = k
-        return CameraInfo(height=h, width=w, distortion_model='plumb_bob', d=np.zeros(5),
-                          k=k.reshape(-1), r=np.eye(3).reshape(-1), p=p.reshape(-1))
+        return CameraInfo(header=header, height=h, width=w, distortion_model='plumb_bob',
+                          d=np.zeros(5), k=k.reshape(-1), r=np.eye(3).reshape(-1),
+                          p=p.reshape(-1))
 
     def publish_camera(self) -> None:
         rgb, depth = self.sim.render_camera()
@@ -371,10 +385,8 @@ class SimNode(rclpy.node.Node):
         self.depth_pub.publish(Image(header=header, height=h, width=w, encoding='32FC1',
                                      is_bigendian=0, step=w * 4,
                                      data=depth.astype('<f4').view(np.uint8).reshape(-1)))
-        info = self._camera_info
-        info.header = header
-        self.info_pub.publish(info)
-        self.depth_info_pub.publish(info)
+        self.info_pub.publish(self._camera_info(header))
+        self.depth_info_pub.publish(self._camera_info(header))
 
     def publish_objects(self) -> None:
         markers = []
@@ -415,18 +427,25 @@ class SimNode(rclpy.node.Node):
     def run(self) -> None:
         """Spin until ``duration`` / ``sim_duration`` is over (or forever)."""
         self._wall_start = time.monotonic()
+        cpu0 = time.process_time()
         steps0 = self.total_steps
+        last_spin = 0.0
         while rclpy.ok() and not self.finished:
             if self.mode == 'fast':
                 self.fast_iteration()
-                rclpy.spin_once(self, timeout_sec=0.0)
+                now = time.monotonic()
+                if now - last_spin > 0.002:    # take commands and requests every 2 ms (wall)
+                    rclpy.spin_once(self, timeout_sec=0.0)
+                    last_spin = now
             else:
                 rclpy.spin_once(self, timeout_sec=0.05)
         wall = time.monotonic() - self._wall_start
         simulated = (self.total_steps - steps0) * self.sim.dt
+        cpu = time.process_time() - cpu0
         self.get_logger().info(
             f'Simulated {simulated:.2f} s in {wall:.2f} s wall time: real-time factor '
-            f'{simulated / max(wall, 1e-9):.2f}x.')
+            f'{simulated / max(wall, 1e-9):.2f}x ({simulated / max(cpu, 1e-9):.2f}x per CPU '
+            'second of this process).')
 
     def destroy_node(self) -> None:
         self.sim.close()

@@ -608,19 +608,23 @@ class Simulation:
     def _draw_ground(self, rgb: np.ndarray, depth: np.ndarray, empty: np.ndarray,
                      pos: np.ndarray, rot: np.ndarray) -> None:
         """Fill pixels that hit nothing with the ground plane z = 0 (exact ray-plane depth)."""
-        c = self.camera
         if self._rays is None:
             k, w, h = self.camera_intrinsics()
             u, v = np.meshgrid(np.arange(w, dtype=float), np.arange(h, dtype=float))
-            self._rays = np.stack([(u - k[0, 2]) / k[0, 0], (v - k[1, 2]) / k[1, 1]], axis=-1)
+            self._rays = np.stack([(u - k[0, 2]) / k[0, 0], (v - k[1, 2]) / k[1, 1],
+                                   np.ones_like(u)], axis=-1)   # (H, W, 3), optical z = 1
             self._ground_rgb = self._ground_colour()
-        # world z of the ray with optical-axis depth 1: r_z = R[2] . (x, y, 1)
-        rz = self._rays[..., 0] * rot[2, 0] + self._rays[..., 1] * rot[2, 1] + rot[2, 2]
-        with np.errstate(divide='ignore', invalid='ignore'):
-            t = -pos[2] / rz
-        hit = empty & (rz < 0) & (t <= c.far)
-        rgb[hit] = self._ground_rgb
-        depth[hit] = t[hit]
+        idx = np.flatnonzero(empty)
+        if idx.size == 0:
+            return
+        # world z component of each empty pixel's ray (optical-axis depth 1), then depth to z = 0
+        rz = self._rays.reshape(-1, 3)[idx] @ rot[2]
+        down = rz < -1e-9
+        idx, t = idx[down], -pos[2] / rz[down]
+        keep = t <= self.camera.far
+        idx, t = idx[keep], t[keep]
+        rgb.reshape(-1, 3)[idx] = self._ground_rgb
+        depth.reshape(-1)[idx] = t
 
     def _hide_other_robots(self, robot: str) -> list[int]:
         # the trainer's ghost arm is seen by people, not by the user's camera: park it below
