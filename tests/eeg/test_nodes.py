@@ -122,7 +122,7 @@ def test_loss_reported_and_reconnected(spawn_node, listener, stream_name) -> Non
     assert listener.spin(20, lambda: len(listener.chunks) > n_before + 20), acq.output()
     assert listener.spin(3, lambda: level_of(listener.status[-1]) == 0)
     values = dict((kv.key, kv.value) for kv in listener.status[-1].status[0].values)
-    assert values['reconnects'] == '1' and int(values['dropped']) > 0
+    assert int(values['reconnects']) >= 1 and int(values['dropped']) > 0
     assert 'is lost' in acq.output()
 
 
