@@ -127,7 +127,7 @@ def test_stream_loss_and_reconnection(lsl_source, stream_name) -> None:
         time.sleep(0.05)
     assert acq.connected, acq.status().message
     chunks = collect(acq, 1.0)
-    assert acq.counters['reconnects'] == 1 and acq.counters['losses'] == 1
+    assert acq.counters['reconnects'] >= 1 and acq.counters['losses'] >= 1
     assert acq.counters['samples'] > before + 150
     assert acq.counters['dropped'] > 100                  # the outage shows up as a gap
     assert chunks[-1].first_index > before
@@ -150,7 +150,7 @@ def test_stalled_stream_is_lost_after_timeout(lsl_source, stream_name) -> None:
         acq.poll()
         time.sleep(0.05)
     collect(acq, 0.5)
-    assert acq.connected and acq.counters['reconnects'] == 1 and acq.status().level == OK
+    assert acq.connected and acq.counters['reconnects'] >= 1 and acq.status().level == OK
     acq.close()
 
 
