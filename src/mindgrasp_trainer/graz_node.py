@@ -7,7 +7,8 @@ Run::
 
 Publishes ``/trainer/prompt`` (mindgrasp_msgs/Prompt, reliable, transient local, depth 1: a late
 joiner gets the current phase) and ``/trainer/display`` (sensor_msgs/Image rgb8, when
-``display_rate`` > 0); subscribes ``/bci/prediction`` for the feedback bar. Ends by itself after
+``display_rate`` > 0); subscribes ``/bci/prediction`` for the feedback bar (hidden when the last
+prediction is older than ``prediction_timeout`` s). Ends by itself after
 the last trial, or after ``duration`` seconds when that is > 0.
 """
 
@@ -16,73 +17,19 @@ from __future__ import annotations
 import sys
 
 from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import MIPrediction, Prompt
-from mindgrasp_ros.interfaces.rcl_interfaces.msg import SetParametersResult
 from mindgrasp_ros.interfaces.sensor_msgs.msg import Image
 
 from mindgrasp_ros import rclpy
 from mindgrasp_trainer.display import render_display
 from mindgrasp_trainer.graz import GrazProtocol, PromptSequencer
-from mindgrasp_trainer.protocol import PromptEvent, TrainerError
-
-
-def prompt_qos() -> rclpy.qos.QoSProfile:
-    """QoS of /trainer/prompt: reliable, transient local, keep last 1 (DESIGN.md topic table)."""
-    return rclpy.qos.QoSProfile(
-        depth=1,
-        history=rclpy.qos.HistoryPolicy.KEEP_LAST,
-        reliability=rclpy.qos.ReliabilityPolicy.RELIABLE,
-        durability=rclpy.qos.DurabilityPolicy.TRANSIENT_LOCAL,
-    )
-
-
-def check_rate(name: str, value: float, allow_zero: bool = False) -> float:
-    """Validate a timer rate parameter (Hz)."""
-    value = float(value)
-    if not (value > 0 or (allow_zero and value == 0)) or value > 10000:
-        zero = ' (0 turns it off)' if allow_zero else ''
-        msg = (
-            f"The rate '{name}' must be a positive number of Hz up to 10000{zero}; "
-            f'{value} is invalid.'
-        )
-        raise TrainerError(msg)
-    return value
-
-
-def fixed_parameters_callback(live: dict) -> object:
-    """An on-set-parameters callback: names in ``live`` map to a validator that applies the new
-    value; every other parameter is fixed for the session and the change is refused."""
-
-    def callback(params: list) -> SetParametersResult:
-        for param in params:
-            if param.name == 'use_sim_time':
-                continue
-            if param.name not in live:
-                return SetParametersResult(
-                    successful=False,
-                    reason=f"'{param.name}' is fixed once the session is planned; restart the "
-                    f'node to change it (live: {", ".join(sorted(live)) or "none"}).',
-                )
-            try:
-                live[param.name](param.value)
-            except TrainerError as err:
-                return SetParametersResult(successful=False, reason=str(err))
-        return SetParametersResult(successful=True)
-
-    return callback
-
-
-def to_msg(event: PromptEvent, stamp) -> Prompt:
-    """A mindgrasp_msgs/Prompt for ``event``, stamped with the phase onset ``stamp``."""
-    msg = Prompt(
-        paradigm=event.paradigm,
-        class_index=event.class_index,
-        class_name=event.class_name,
-        phase=event.phase,
-        trial=event.trial,
-        duration=event.duration,
-    )
-    msg.header.stamp = stamp
-    return msg
+from mindgrasp_trainer.protocol import TrainerError
+from mindgrasp_trainer.ros_common import (
+    check_rate,
+    fixed_parameters_callback,
+    prompt_qos,
+    spin_until_finished,
+    to_msg,
+)
 
 
 class GrazNode(rclpy.node.Node):
@@ -96,7 +43,7 @@ class GrazNode(rclpy.node.Node):
             ('rest_min', 1.5), ('rest_max', 2.5), ('max_repeat', 0),
             ('start_delay', 5.0), ('duration', 0.0), ('rate', 200.0),
             ('display_rate', 10.0), ('display_width', 480), ('display_height', 360),
-            ('feedback', 'move'), ('max_certainty', 1.0),
+            ('feedback', 'move'), ('max_certainty', 1.0), ('prediction_timeout', 1.0),
         ])  # fmt: skip
         p = {name: self.get_parameter(name).value for name in (
             'n_trials', 'classes', 'seed', 'fixation', 'cue', 'imagery', 'rest_min', 'rest_max',
@@ -121,6 +68,9 @@ class GrazNode(rclpy.node.Node):
             raise
         self.n_trials = len(self.protocol.class_order())
         self.prediction: tuple[int, float] | None = None
+        self.prediction_ns = 0  # ROS time of the latest prediction's arrival
+        timeout = float(self.get_parameter('prediction_timeout').value)
+        self.prediction_timeout_ns = int(timeout * 1e9)
         self.t0_ns: int | None = None
         self.done = rclpy.task.Future()  # result set when the session has ended
 
@@ -151,6 +101,7 @@ class GrazNode(rclpy.node.Node):
 
     def prediction_callback(self, msg: MIPrediction) -> None:
         self.prediction = (int(msg.class_index), float(msg.certainty))
+        self.prediction_ns = self.get_clock().now().nanoseconds
 
     def tick_callback(self) -> None:
         if self.finished:
@@ -177,7 +128,10 @@ class GrazNode(rclpy.node.Node):
                 self.done.set_result(0)
 
     def display_callback(self) -> None:
-        frame = render_display(self.sequencer.current, self.prediction, **self.display)
+        # a classifier that went quiet shows no bar rather than a stale one
+        age_ns = self.get_clock().now().nanoseconds - self.prediction_ns
+        prediction = self.prediction if age_ns <= self.prediction_timeout_ns else None
+        frame = render_display(self.sequencer.current, prediction, **self.display)
         msg = Image(
             height=frame.shape[0], width=frame.shape[1], encoding='rgb8',
             is_bigendian=0, step=frame.shape[1] * 3, data=frame.reshape(-1),
@@ -185,17 +139,6 @@ class GrazNode(rclpy.node.Node):
         msg.header.stamp = self.get_clock().now().to_msg()
         msg.header.frame_id = 'trainer_display'
         self.display_pub.publish(msg)
-
-
-def spin_until_finished(node: rclpy.node.Node, linger: float = 0.5) -> None:
-    """Spin until ``node.done`` completes, then ``linger`` s more so reliable readers get the end.
-
-    One executor for the whole run (``rclpy.spin_once`` in a loop adds and removes the node each
-    call, which costs a quarter of a core).
-    """
-    rclpy.spin_until_future_complete(node, node.done)
-    if rclpy.ok():
-        rclpy.spin_until_future_complete(node, rclpy.task.Future(), timeout_sec=linger)
 
 
 def main(args: list[str] | None = None) -> int:

@@ -28,14 +28,14 @@ from mindgrasp_ros.interfaces.sensor_msgs.msg import JointState
 from mindgrasp_ros.interfaces.std_msgs.msg import Float64, Float64MultiArray
 
 from mindgrasp_ros import rclpy
-from mindgrasp_trainer.graz_node import (
+from mindgrasp_trainer.protocol import CLASS_NAMES, TrainerError
+from mindgrasp_trainer.ros_common import (
     check_rate,
     fixed_parameters_callback,
     prompt_qos,
     spin_until_finished,
     to_msg,
 )
-from mindgrasp_trainer.protocol import CLASS_NAMES, TrainerError
 from mindgrasp_trainer.trainer import TrainerProtocol, ee_distance
 
 _PROTOCOL_PARAMS = (

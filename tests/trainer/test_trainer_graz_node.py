@@ -180,6 +180,10 @@ def test_live_display_parameters_and_fixed_protocol_parameters(ros, spawn, spin_
 
     assert set_param('feedback', 'always').successful
     assert bar_pixels() > 100  # the prediction arrived and is drawn
+    # a classifier that goes quiet: the bar disappears after prediction_timeout (1 s)
+    spin_until(node, lambda: False, 1.5)
+    rgb = np.asarray(frames[-1].data, np.uint8).reshape(120, 160, 3)
+    assert not np.all(rgb == BAR_COLOUR, axis=-1).any()
     assert set_param('feedback', 'move').successful
     assert bar_pixels() == 0  # 'move': no feedback during the fixation
     bad = set_param('feedback', 'loud')

@@ -1,0 +1,90 @@
+"""ROS plumbing shared by the trainer nodes: prompt QoS and message, rate and parameter checks,
+spinning until a session ends. Imports the client layer; the protocols themselves do not.
+"""
+
+from __future__ import annotations
+
+from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import Prompt
+from mindgrasp_ros.interfaces.rcl_interfaces.msg import SetParametersResult
+
+from mindgrasp_ros import rclpy
+from mindgrasp_trainer.protocol import PromptEvent, TrainerError
+
+__all__ = [
+    'check_rate',
+    'fixed_parameters_callback',
+    'prompt_qos',
+    'spin_until_finished',
+    'to_msg',
+]
+
+
+def prompt_qos() -> rclpy.qos.QoSProfile:
+    """QoS of /trainer/prompt: reliable, transient local, keep last 1 (DESIGN.md topic table)."""
+    return rclpy.qos.QoSProfile(
+        depth=1,
+        history=rclpy.qos.HistoryPolicy.KEEP_LAST,
+        reliability=rclpy.qos.ReliabilityPolicy.RELIABLE,
+        durability=rclpy.qos.DurabilityPolicy.TRANSIENT_LOCAL,
+    )
+
+
+def check_rate(name: str, value: float, allow_zero: bool = False) -> float:
+    """Validate a timer rate parameter (Hz)."""
+    value = float(value)
+    if not (value > 0 or (allow_zero and value == 0)) or value > 10000:
+        zero = ' (0 turns it off)' if allow_zero else ''
+        msg = (
+            f"The rate '{name}' must be a positive number of Hz up to 10000{zero}; "
+            f'{value} is invalid.'
+        )
+        raise TrainerError(msg)
+    return value
+
+
+def fixed_parameters_callback(live: dict) -> object:
+    """An on-set-parameters callback: names in ``live`` map to a validator that applies the new
+    value; every other parameter is fixed for the session and the change is refused."""
+
+    def callback(params: list) -> SetParametersResult:
+        for param in params:
+            if param.name == 'use_sim_time':
+                continue
+            if param.name not in live:
+                return SetParametersResult(
+                    successful=False,
+                    reason=f"'{param.name}' is fixed once the session is planned; restart the "
+                    f'node to change it (live: {", ".join(sorted(live)) or "none"}).',
+                )
+            try:
+                live[param.name](param.value)
+            except TrainerError as err:
+                return SetParametersResult(successful=False, reason=str(err))
+        return SetParametersResult(successful=True)
+
+    return callback
+
+
+def to_msg(event: PromptEvent, stamp) -> Prompt:
+    """A mindgrasp_msgs/Prompt for ``event``, stamped with the phase onset ``stamp``."""
+    msg = Prompt(
+        paradigm=event.paradigm,
+        class_index=event.class_index,
+        class_name=event.class_name,
+        phase=event.phase,
+        trial=event.trial,
+        duration=event.duration,
+    )
+    msg.header.stamp = stamp
+    return msg
+
+
+def spin_until_finished(node: rclpy.node.Node, linger: float = 0.5) -> None:
+    """Spin until ``node.done`` completes, then ``linger`` s more so reliable readers get the end.
+
+    One executor for the whole run (``rclpy.spin_once`` in a loop adds and removes the node each
+    call, which costs a quarter of a core).
+    """
+    rclpy.spin_until_future_complete(node, node.done)
+    if rclpy.ok():
+        rclpy.spin_until_future_complete(node, rclpy.task.Future(), timeout_sec=linger)
