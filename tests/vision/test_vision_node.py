@@ -165,3 +165,18 @@ def test_bad_images_are_reported_by_name(rclpy_ctx, spawn_node, sim, view):
     # paper did
     assert 0.15 < cam.detections[-1].detections[0].distance < 0.5
     assert proc.stop() == 0
+
+
+def test_images_of_an_unexpected_size_are_rejected(rclpy_ctx, spawn_node, sim, view):
+    k, _, _ = sim.camera_intrinsics()
+    rgb, depth = view([{'shape': 'cube', 'colour': 'red', 'position': [0.45, 0.0]}],
+                      (0.45, 0.0, 0.025), distance=0.3, elevation_deg=50)
+    proc = spawn_node('mindgrasp_vision.vision_node', '--ros-args', '-p', 'shape_model:=none',
+                      '-p', 'expected_width:=640', '-p', 'expected_height:=480',
+                      '-p', 'duration:=30.0')
+    assert proc.wait_for_output('Vision ready', 60.0), proc.output()
+    cam = Camera(rclpy_ctx)
+    text = 'The image on /camera/color/image_raw is 128x128 px, expected 640x480 px'
+    assert cam.stream(rgb, depth, k, lambda: text in proc.output(), timeout=10.0)
+    assert cam.detections == []
+    assert proc.stop() == 0
