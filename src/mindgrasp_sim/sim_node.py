@@ -125,7 +125,7 @@ class SimNode(rclpy.node.Node):
         self._collisions: list[str] = []
         self._last_state_step = -1
         self._wall_start = time.monotonic()
-        self._last_bad_warning = -math.inf
+        self._last_warning: dict[str, float] = {}
 
         reliable = rclpy.qos.QoSProfile(depth=10)
         latched = rclpy.qos.QoSProfile(
@@ -169,6 +169,10 @@ class SimNode(rclpy.node.Node):
         self._set_t0(self._t0)
         if self.mode == 'realtime':
             self.create_timer(1.0 / float(p['joint_state_rate']), self.realtime_callback)
+        elif self.mode == 'fast':
+            # always ready; each call steps for ~2 ms of wall time, then lets the executor take
+            # commands and requests (works under main() and in a composed process alike)
+            self.create_timer(0.0, self.fast_callback)
         self.create_timer(0.5, self.duration_callback)
         self.publish_all()
         robots = ' and the training robot' if 'trainer' in self.robots else ''
@@ -235,9 +239,9 @@ class SimNode(rclpy.node.Node):
         cap = float(self.p['max_catch_up'])
         if due > cap:
             # the machine is too slow (or the clock jumped): drop the lag instead of racing
-            self.get_logger().warning(
-                f'The simulation is {due:.2f} s behind its clock; skipping ahead. Lower '
-                'camera_width/height or camera_rate, or use time_mode:=fast.')
+            self._warn_throttled(
+                'behind', 5.0, f'The simulation is {due:.2f} s behind its clock; skipping '
+                'ahead. Lower camera_width/height or camera_rate, or use time_mode:=fast.')
             self._set_t0(self._t0 + due - cap)
             due = cap
         n = int(due * self.sim.physics_hz)
@@ -249,17 +253,27 @@ class SimNode(rclpy.node.Node):
         n = max(1, math.ceil(self._next['js'] - self.total_steps))
         self.advance(n)
 
+    def fast_callback(self) -> None:
+        """Fast mode: step as fast as possible for about 2 ms of wall time."""
+        end = time.monotonic() + 0.002
+        while not self.finished and time.monotonic() < end:
+            self.fast_iteration()
+
     def duration_callback(self) -> None:
         limit = float(self.p['duration'])
         if limit > 0 and time.monotonic() - self._wall_start >= limit:
             self.finished = True
 
     # ------------------------------------------------------------------ commands
-    def _warn_bad(self, text: str) -> None:
+    def _warn_throttled(self, key: str, period: float, text: str) -> None:
+        """Log ``text`` at most once per ``period`` wall seconds per ``key``."""
         now = time.monotonic()
-        if now - self._last_bad_warning > 1.0:    # at most one warning per second
+        if now - self._last_warning.get(key, -math.inf) > period:
             self.get_logger().warning(text)
-            self._last_bad_warning = now
+            self._last_warning[key] = now
+
+    def _warn_bad(self, text: str) -> None:
+        self._warn_throttled('bad', 1.0, text)
 
     def arm_command_callback(self, msg: Float64MultiArray, io: _RobotIO) -> None:
         """Joint velocities (rad/s); a bad command stops the arm and is reported."""
@@ -429,16 +443,8 @@ class SimNode(rclpy.node.Node):
         self._wall_start = time.monotonic()
         cpu0 = time.process_time()
         steps0 = self.total_steps
-        last_spin = 0.0
         while rclpy.ok() and not self.finished:
-            if self.mode == 'fast':
-                self.fast_iteration()
-                now = time.monotonic()
-                if now - last_spin > 0.002:    # take commands and requests every 2 ms (wall)
-                    rclpy.spin_once(self, timeout_sec=0.0)
-                    last_spin = now
-            else:
-                rclpy.spin_once(self, timeout_sec=0.05)
+            rclpy.spin_once(self, timeout_sec=0.05)
         wall = time.monotonic() - self._wall_start
         simulated = (self.total_steps - steps0) * self.sim.dt
         cpu = time.process_time() - cpu0
