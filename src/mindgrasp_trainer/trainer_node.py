@@ -64,11 +64,17 @@ class TrainerNode(rclpy.node.Node):
         try:
             self.protocol = TrainerProtocol(**params)
             rate = check_rate('rate', self.get_parameter('rate').value)
+            self._set_reset_timeout(self.get_parameter('reset_timeout').value)
+            self.robot_timeout = float(self.get_parameter('robot_timeout').value)
+            if not (math.isfinite(self.robot_timeout) and self.robot_timeout >= 0):
+                msg = (
+                    f"'robot_timeout' must be 0 (wait forever) or a positive number of seconds; "
+                    f'{self.robot_timeout} is invalid.'
+                )
+                raise TrainerError(msg)
         except TrainerError as err:
             self.get_logger().error(str(err))
             raise
-        self.robot_timeout = float(self.get_parameter('robot_timeout').value)
-        self.reset_timeout = float(self.get_parameter('reset_timeout').value)
         self.log_file = str(self.get_parameter('log_file').value)
         self.trainer_pos: np.ndarray | None = None
         self.user_pos: np.ndarray | None = None

@@ -199,7 +199,17 @@ def test_trainer_without_training_robot_exits_with_the_fix(ros, spawn):
     assert 'mindgrasp launch trainer' in out
 
 
-def test_trainer_bad_parameter(ros, spawn):
-    proc = spawn('mindgrasp_trainer.trainer_node', turn_joint=9)
+@pytest.mark.parametrize(
+    ('params', 'match'),
+    [
+        ({'turn_joint': 9}, "'turn_joint' is 9, outside the 6 joints"),
+        ({'reset_timeout': 0.0}, "'reset_timeout' must be a positive number of seconds"),
+        ({'robot_timeout': -1.0}, "'robot_timeout' must be 0 (wait forever) or a positive"),
+        ({'rate': 0.0}, "The rate 'rate' must be a positive number of Hz"),
+    ],
+)
+def test_trainer_bad_parameter(ros, spawn, params, match):
+    proc = spawn('mindgrasp_trainer.trainer_node', **params)
     assert proc.wait(30) == 2
-    assert "'turn_joint' is 9, outside the 6 joints" in proc.stdout.read()
+    out = proc.stdout.read()
+    assert match in out, out
