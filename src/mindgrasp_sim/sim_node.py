@@ -13,9 +13,10 @@ Publishes ``/joint_states`` (6 arm joints), ``/gripper/joint_states`` (3 fingers
 (geometry_msgs/PoseStamped, TCP in ``world``), ``/camera/color/image_raw`` (rgb8),
 ``/camera/depth/image_raw`` (32FC1, m), ``/camera/color/camera_info``,
 ``/camera/depth/camera_info``, ``/sim/objects`` (visualization_msgs/MarkerArray) and
-``/task/result`` (mindgrasp_msgs/GraspResult). With ``trainer_robot:=true`` the training robot
-has the same arm topics under ``/trainer_robot/``. Services ``/sim/reset`` (ResetSim),
-``/sim/load_scene`` (LoadScene) and, in lock-step mode, ``/sim/step`` (Step).
+``/task/result`` (mindgrasp_msgs/GraspResult). With ``trainer_robot:=true`` (alias
+``training_robot``) the training robot has the same arm topics under ``/trainer_robot/``.
+Services ``/sim/reset`` (ResetSim), ``/sim/load_scene`` (LoadScene) and, in lock-step mode,
+``/sim/step`` (Step).
 
 Time modes (``time_mode``): ``realtime`` follows the node's clock (the wall clock, or /clock with
 ``use_sim_time``); ``fast`` steps as fast as it can and publishes ``/clock`` (run the other nodes
@@ -133,7 +134,7 @@ class SimNode(rclpy.node.Node):
             durability=rclpy.qos.DurabilityPolicy.TRANSIENT_LOCAL)
         sensor = rclpy.qos.qos_profile_sensor_data
         self.robots: dict[str, _RobotIO] = {}
-        for name in self.sim._robots:
+        for name in self.sim.robots:
             prefix = '' if name == 'user' else '/trainer_robot'
             io = _RobotIO(name, prefix, CommandGate(float(p['command_timeout'])))
             io.pubs['js'] = self.create_publisher(JointState, f'{prefix}/joint_states', reliable)
@@ -314,7 +315,7 @@ class SimNode(rclpy.node.Node):
         self._after_reset()
         response.success = True
         response.message = (f'Reset: robots home, {len(self.sim.objects())} objects of '
-                            f"'{self.sim.scene.name}' (layout seed {self.sim._layout_seed}).")
+                            f"'{self.sim.scene.name}' (layout seed {self.sim.layout_seed}).")
         self.get_logger().info(response.message)
         return response
 
@@ -412,7 +413,7 @@ class SimNode(rclpy.node.Node):
             o = m.pose.orientation
             o.x, o.y, o.z, o.w = map(float, obj.orientation)
             m.scale.x = m.scale.y = m.scale.z = float(obj.size)
-            r, g, b, a = self.sim._objects[obj.id][0].rgba
+            r, g, b, a = obj.rgba
             m.color.r, m.color.g, m.color.b, m.color.a = float(r), float(g), float(b), float(a)
             markers.append(m)
         self.objects_pub.publish(MarkerArray(markers=markers))

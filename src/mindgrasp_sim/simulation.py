@@ -102,6 +102,7 @@ class SceneObject:
     position: np.ndarray
     orientation: np.ndarray
     body: int = field(default=-1, repr=False)
+    rgba: tuple[float, float, float, float] = field(default=(1.0, 1.0, 1.0, 1.0), repr=False)
 
     @property
     def label(self) -> str:
@@ -389,6 +390,16 @@ class Simulation:
 
     # ------------------------------------------------------------------ time and commands
     @property
+    def robots(self) -> tuple[str, ...]:
+        """Names of the simulated arms: ``('user',)`` or ``('user', 'trainer')``."""
+        return tuple(self._robots)
+
+    @property
+    def layout_seed(self) -> int:
+        """Seed of the current object layout (random scenes)."""
+        return self._layout_seed
+
+    @property
     def time(self) -> float:
         """Simulated time since the last reset (s)."""
         return self._step_count * self.dt
@@ -530,7 +541,7 @@ class Simulation:
             pos, orn = self._p.getBasePositionAndOrientation(body)
             out.append(SceneObject(id=i, shape=spec.shape, colour=spec.colour, size=spec.size,
                                    mass=spec.mass, position=np.array(pos),
-                                   orientation=np.array(orn), body=body))
+                                   orientation=np.array(orn), body=body, rgba=spec.rgba))
         return out
 
     def object_velocity(self, obj: SceneObject | int) -> np.ndarray:
