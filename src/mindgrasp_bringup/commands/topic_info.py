@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import time
 
 from mindgrasp_bringup.ros_cli import CliError, cli_node, find_topic_type, print_error
 
@@ -34,8 +35,16 @@ def main(args: argparse.Namespace) -> int:
     try:
         with cli_node('info') as node:
             typename = find_topic_type(node, args.topic)
-            pubs = node.get_publishers_info_by_topic(args.topic)
-            subs = node.get_subscriptions_info_by_topic(args.topic)
+            # endpoints are discovered before ros_discovery_info names their nodes: wait a
+            # little for the names (a non-ROS DDS endpoint stays _NODE_NAME_UNKNOWN_)
+            deadline = time.monotonic() + 3.0
+            while True:
+                pubs = node.get_publishers_info_by_topic(args.topic)
+                subs = node.get_subscriptions_info_by_topic(args.topic)
+                unknown = any(i.node_name == '_NODE_NAME_UNKNOWN_' for i in pubs + subs)
+                if not unknown or time.monotonic() > deadline:
+                    break
+                time.sleep(0.1)
     except CliError as exc:
         return print_error(exc)
     print(f'Type: {typename}\n')
