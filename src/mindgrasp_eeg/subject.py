@@ -159,6 +159,7 @@ class VirtualSubject:
         self._trial_key: tuple[int, int] | None = None
         self._trial_choice: int | None = None
         self._next_decision = -math.inf
+        self._last_t = -math.inf
         # pursue inputs
         self.objects: list[SceneObject] = []
         self.target_id, self.target_colour, self.target_shape = -1, '', ''
@@ -207,7 +208,15 @@ class VirtualSubject:
 
     # -- output --------------------------------------------------------------------------------
     def intent(self, t: float) -> int | None:
-        """Class imagined at time ``t`` (s), None for rest. Call with non-decreasing ``t``."""
+        """Class imagined at time ``t`` (s), None for rest.
+
+        Call with non-decreasing ``t``; if time goes backwards (a simulation reset), pending
+        decisions are dropped and the subject decides afresh.
+        """
+        if t < self._last_t:
+            self._next_decision = -math.inf
+            self._schedule = [(min(te, t), c) for te, c in self._schedule[-1:]]
+        self._last_t = t
         if self.mode == 'pursue' and t >= self._next_decision:
             self._next_decision = t + self.decision_period
             right = self.competent_class()

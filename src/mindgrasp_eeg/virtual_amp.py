@@ -37,13 +37,19 @@ class VirtualAmplifier:
         Stamp samples on the amplifier's own sample clock (real-time pacing) instead of push time.
     block : int
         Largest block generated with one imagery decision (samples).
+    max_catch_up : float or None
+        When the pacing clock jumps (simulated time starting, a reset going backwards, a jump
+        ahead of more than this many seconds), re-anchor instead of generating the whole gap at
+        once. None (real-time pacing) always catches up, as an amplifier delivers its backlog.
     """
 
     def __init__(self, generator: SyntheticEEG, subject: VirtualSubject,
                  outlet: EEGOutlet | None = None, *, realtime_stamps: bool = True,
-                 block: int = 8) -> None:
+                 block: int = 8, max_catch_up: float | None = None) -> None:
         self.generator, self.subject, self.outlet = generator, subject, outlet
         self.realtime_stamps, self.block = realtime_stamps, max(1, int(block))
+        self.max_catch_up = max_catch_up
+        self.n_skipped = 0                       # samples skipped by re-anchoring
         self.t_start: float | None = None        # pacing clock at the first step (s)
         self.lsl_start = 0.0
         self.current_class: int | None = None
@@ -65,6 +71,13 @@ class VirtualAmplifier:
             self.lsl_start = pylsl.local_clock()
         fs = self.generator.sample_rate
         due = math.floor((now - self.t_start) * fs + 1e-9) + 1   # sample 0 is due at t_start
+        if self.max_catch_up is not None and (
+                due < self.n_samples - fs * self.max_catch_up
+                or due - self.n_samples > fs * self.max_catch_up):
+            # the clock jumped: continue from now as if the gap had not happened
+            self.n_skipped += max(0, due - self.n_samples)
+            self.t_start = now - self.n_samples / fs
+            due = self.n_samples + 1
         out = []
         while self.n_samples < due:
             k = self.n_samples

@@ -84,7 +84,8 @@ class VirtualAmpNode(rclpy.node.Node):
                                     f'{p["source_id"] or p["stream_name"]}-markers')
         sim_time = bool(self.get_parameter('use_sim_time').value)
         self.amp = VirtualAmplifier(gen, self.subject, outlet, realtime_stamps=not sim_time,
-                                    block=p['block'])
+                                    block=p['block'], max_catch_up=1.0 if sim_time else None)
+        self.sim_time = sim_time
         self._last_intent: object = 'unset'
         self.create_timer(p['push_period'], self.push_callback)
         self._start = self.now_s()
@@ -124,6 +125,8 @@ class VirtualAmpNode(rclpy.node.Node):
     def push_callback(self) -> None:
         """Generate and push every sample due by now; report imagery changes."""
         now = self.now_s()
+        if self.sim_time and now <= 0.0:
+            return                                   # no /clock yet
         self.amp.step(now)
         if self.amp.current_class != self._last_intent:
             self._last_intent = self.amp.current_class

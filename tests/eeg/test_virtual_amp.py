@@ -27,6 +27,17 @@ def test_paced_by_the_given_clock() -> None:
     assert len(amp.step(102.0)) == 0                     # nothing new is due
 
 
+def test_clock_jumps_re_anchor_in_simulated_time() -> None:
+    amp = VirtualAmplifier(SyntheticEEG(seed=0), VirtualSubject('noise'), None,
+                           realtime_stamps=False, max_catch_up=1.0)
+    amp.step(0.0)
+    assert len(amp.step(0.5)) == 125
+    assert len(amp.step(100.0)) == 1                     # a jump ahead: no 100 s burst
+    assert len(amp.step(100.2)) == 50
+    assert len(amp.step(3.0)) == 1 and len(amp.step(3.1)) == 25   # a reset back in time
+    assert amp.n_skipped > 20000
+
+
 def test_same_seed_same_stream_whatever_the_pacing() -> None:
     a = VirtualAmplifier(SyntheticEEG(seed=3), VirtualSubject('noise'), None)
     b = VirtualAmplifier(SyntheticEEG(seed=3), VirtualSubject('noise'), None)
