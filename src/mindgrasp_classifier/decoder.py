@@ -149,8 +149,18 @@ def filter_recording(model: MiModel, data: np.ndarray, channels: Sequence[str],
         Filtered EEG in microvolts.
     """
     idx = check_stream(model, channels, rate)
-    filt = CausalBandpass(design_bandpass(*model.band, model.rate, model.filter_order), len(idx))
-    return filt.process(np.asarray(data, dtype=float)[:, idx] * SCALE_V_TO_UV)
+    sos = design_bandpass(*model.band, model.rate, model.filter_order)
+    x = np.asarray(data, dtype=float)[:, idx] * SCALE_V_TO_UV
+    finite = np.isfinite(x).all(axis=1)
+    if finite.all():
+        return CausalBandpass(sos, len(idx)).process(x)
+    # Lost samples (NaN rows): each finite segment is filtered from a fresh state, as the online
+    # decoder restarts after a gap; NaN rows stay NaN and no window covers them.
+    out = np.full_like(x, np.nan)
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], finite.astype(int), [0]])))
+    for start, stop in zip(edges[::2], edges[1::2], strict=True):
+        out[start:stop] = CausalBandpass(sos, len(idx)).process(x[start:stop])
+    return out
 
 
 def window_covariances(model: MiModel, filtered: np.ndarray, ends: np.ndarray) -> np.ndarray:
