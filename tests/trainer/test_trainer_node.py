@@ -47,7 +47,7 @@ def expected_resets(seed: int) -> list[tuple[int, str]]:
 class StandInRobot:
     """Integrates the commanded joint velocities; the end-effector sinks 2 m per rad of joint 2."""
 
-    def __init__(self, ros, node) -> None:
+    def __init__(self, ros, node, reset_service: bool = True) -> None:
         from mindgrasp_ros.interfaces.geometry_msgs.msg import PoseStamped
         from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import FsmState
         from mindgrasp_ros.interfaces.mindgrasp_msgs.srv import ResetSim
@@ -71,7 +71,8 @@ class StandInRobot:
         node.create_subscription(
             Float64MultiArray, '/trainer_robot/arm_controller/commands', self.command_callback, 10
         )
-        node.create_service(ResetSim, '/sim/reset', self.reset_callback)
+        if reset_service:
+            node.create_service(ResetSim, '/sim/reset', self.reset_callback)
         node.create_timer(0.02, self.timer_callback)
         self.PoseStamped, self.JointState, self.FsmState = PoseStamped, JointState, FsmState
 
@@ -187,6 +188,32 @@ def test_trainer_prompts_moves_resets_and_measures(ros, spawn, spin_until, tmp_p
     assert [int(r['trial']) for r in rows if r['aborted']] == [trial for trial, _ in resets]
     assert all(float(r['mean_ee_distance_m']) >= 0 for r in rows)
     assert robot.commands > 100
+    node.destroy_node()
+
+
+def test_missing_reset_service_is_reported_and_the_session_goes_on(ros, spawn, spin_until):
+    from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import Prompt
+
+    node = ros.node.Node('trainer_stand_in_no_reset')
+    StandInRobot(ros, node, reset_service=False)
+    prompts = []
+    tl = ros.qos.QoSProfile(
+        depth=10,
+        reliability=ros.qos.ReliabilityPolicy.RELIABLE,
+        durability=ros.qos.DurabilityPolicy.TRANSIENT_LOCAL,
+    )
+    node.create_subscription(Prompt, '/trainer/prompt', prompts.append, tl)
+    # seed 0 starts with both hands: the end-effector goes below 0.1 m in trial 1 and stays there
+    assert TrainerProtocol(n_trials=2, seed=0).order[0] == 2
+    proc = spawn('mindgrasp_trainer.trainer_node', seed=0, **(PARAMS | {'n_trials': 2}))
+    assert spin_until(node, lambda: prompts and prompts[-1].phase == 'end', 60.0)
+    assert proc.wait(10) == 0
+    out = proc.stdout.read()
+    assert 'The reset service /sim/reset is not available, so the robots stay where they are' in out
+    # both trials end in a reset attempt: the robot is still low when trial 2 starts
+    assert [(m.phase, m.trial) for m in prompts if m.trial > 0] == [
+        ('move', 1), ('rest', 1), ('move', 2), ('rest', 2), ('end', 2)
+    ]
     node.destroy_node()
 
 
