@@ -35,7 +35,7 @@ def test_sim_profile_arguments():
 @pytest.mark.slow
 def test_sim_launch_runs_and_records(tmp_path):
     run_dir = tmp_path / 'run'
-    service = LaunchService('sim', ['duration:=12', 'time_mode:=fast'], run_dir=run_dir)
+    service = LaunchService('sim', ['duration:=6', 'time_mode:=fast'], run_dir=run_dir)
     assert service.run() == 0
     metadata = (run_dir / 'bag' / 'metadata.yaml').read_text()
     for topic in ('/joint_states', '/camera/color/image_raw', '/camera/depth/image_raw',
