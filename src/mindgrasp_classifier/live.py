@@ -1,0 +1,193 @@
+"""``evaluate classifier --live``: the online path end to end, scored against the cues.
+
+Each recording is streamed in real time over LSL by the EEG package's dataset player, received by
+the acquisition node (``mindgrasp_eeg.acquisition_node``, its own process) and decoded by the
+classifier node (``mindgrasp_classifier.classifier_node``, its own process); this process listens
+to ``/eeg/raw`` and ``/bci/prediction`` over DDS, maps each prediction stamp back to the stream
+sample it ends on, and scores the predictions on the same epoch windows as the offline
+evaluation. Use a ``ROS_DOMAIN_ID`` of your own: the nodes run on the current one.
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+import uuid
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from mindgrasp_classifier.data import Recording
+from mindgrasp_classifier.errors import ClassifierError
+from mindgrasp_classifier.model import MiModel
+from mindgrasp_classifier.training import score_predictions
+
+
+class _Proc:
+    """A node process with its output in a log file."""
+
+    def __init__(self, args: list[str], log: Path) -> None:
+        self.log_path = log
+        self._log = log.open('wb')
+        env = dict(os.environ, PYTHONUNBUFFERED='1')
+        self.proc = subprocess.Popen([sys.executable, '-u', *args], stdout=self._log,
+                                     stderr=subprocess.STDOUT, env=env, start_new_session=True)
+
+    def output(self) -> str:
+        self._log.flush()
+        return self.log_path.read_text(errors='replace')
+
+    def wait_for(self, text: str, timeout: float) -> bool:
+        end = time.monotonic() + timeout
+        while time.monotonic() < end:
+            if text in self.output():
+                return True
+            if self.proc.poll() is not None:
+                break
+            time.sleep(0.05)
+        return text in self.output()
+
+    def stop(self) -> None:
+        import signal
+
+        for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGKILL):
+            if self.proc.poll() is not None:
+                break
+            self.proc.send_signal(sig)
+            try:
+                self.proc.wait(5)
+            except subprocess.TimeoutExpired:
+                continue
+        self._log.close()
+
+
+def _stamp(msg: Any) -> float:
+    return msg.header.stamp.sec + 1e-9 * msg.header.stamp.nanosec
+
+
+def stream_live(model_path: str, rec: Recording, workdir: Path,
+                timeout_margin: float = 20.0) -> tuple[np.ndarray, np.ndarray]:
+    """Play one recording through LSL -> acquisition node -> classifier node in real time.
+
+    Returns
+    -------
+    ends : ndarray of int, shape (n_predictions,)
+        Recording sample index of each predicted window's last sample.
+    distances : ndarray, shape (n_predictions, n_classes)
+    """
+    from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import EEGChunk, MIPrediction
+
+    from mindgrasp_eeg.player import DatasetPlayer
+    from mindgrasp_eeg.player import Recording as PlayerRecording
+    from mindgrasp_ros import rclpy
+
+    name = f'mindgrasp-eval-{uuid.uuid4().hex[:8]}'
+    data = np.where(np.isfinite(rec.data), rec.data, 0.0)   # the player streams numbers only
+    player = DatasetPlayer(PlayerRecording(data, rec.rate, list(rec.channels), [], rec.source),
+                           name, block=max(1, round(rec.rate / 64)))
+    procs: list[_Proc] = []
+    rclpy.init(args=[])
+    try:
+        node = rclpy.node.Node(f'classifier_live_eval_{uuid.uuid4().hex[:6]}')
+        executor = rclpy.executors.SingleThreadedExecutor()
+        executor.add_node(node)
+        chunks: list[tuple[float, int, int]] = []
+        preds: list[tuple[float, np.ndarray]] = []
+        sensor = rclpy.qos.QoSProfile(depth=100,
+                                      reliability=rclpy.qos.ReliabilityPolicy.BEST_EFFORT)
+        node.create_subscription(
+            EEGChunk, '/eeg/raw',
+            lambda m: chunks.append((_stamp(m), int(m.first_sample_index), int(m.n_samples))),
+            sensor)
+        node.create_subscription(
+            MIPrediction, '/bci/prediction',
+            lambda m: preds.append((_stamp(m), np.asarray(m.distances, dtype=float))), 100)
+        acq = _Proc(['-m', 'mindgrasp_eeg.acquisition_node', '--ros-args',
+                     '-r', f'__node:=eeg_acquisition_{name[-8:]}',
+                     '-p', f'stream_name:={name}', '-p', f'n_channels:={len(rec.channels)}',
+                     '-p', f'sample_rate:={rec.rate}', '-p', 'check_channel_names:=false',
+                     '-p', 'adapt_to_stream:=true', '-p', 'resolve_timeout:=30.0'],
+                    workdir / 'acquisition.log')
+        procs.append(acq)
+        if not acq.wait_for('Connected to', 60):
+            msg = f'The acquisition node did not connect to the player:\n{acq.output()[-2000:]}'
+            raise ClassifierError(msg)
+        clf = _Proc(['-m', 'mindgrasp_classifier.classifier_node', '--ros-args',
+                     '-r', f'__node:=classifier_{name[-8:]}', '-p', f'model:={model_path}',
+                     '-p', 'classes:=[]'], workdir / 'classifier.log')
+        procs.append(clf)
+        if not clf.wait_for('Loaded', 60):
+            msg = f'The classifier node did not start:\n{clf.output()[-2000:]}'
+            raise ClassifierError(msg)
+        pub_ready = time.monotonic() + 30
+        while time.monotonic() < pub_ready and not (
+                node.count_publishers('/bci/prediction') and node.count_publishers('/eeg/raw')):
+            executor.spin_once(timeout_sec=0.05)
+        time.sleep(1.0)                              # let discovery settle on both sides
+        thread = threading.Thread(target=player.run, kwargs={'period': 0.005}, daemon=True)
+        thread.start()
+        end = time.monotonic() + rec.data.shape[0] / rec.rate + timeout_margin
+        n_expected = rec.data.shape[0]
+        while time.monotonic() < end:
+            executor.spin_once(timeout_sec=0.02)
+            if not thread.is_alive() and chunks and \
+                    chunks[-1][1] + chunks[-1][2] >= n_expected and \
+                    preds and preds[-1][0] >= chunks[-1][0]:
+                break
+            if clf.proc.poll() is not None:
+                msg = f'The classifier node stopped:\n{clf.output()[-2000:]}'
+                raise ClassifierError(msg)
+        for _ in range(20):
+            executor.spin_once(timeout_sec=0.02)
+        node.destroy_node()
+    finally:
+        player.close()
+        for p in reversed(procs):
+            p.stop()
+        rclpy.try_shutdown()
+    return _map_predictions(chunks, preds, rec.rate)
+
+
+def _map_predictions(chunks: list[tuple[float, int, int]], preds: list[tuple[float, np.ndarray]],
+                     rate: float) -> tuple[np.ndarray, np.ndarray]:
+    """Sample index of each prediction: stamp = chunk stamp + (index - first) / rate."""
+    if not chunks or not preds:
+        msg = ('No EEG chunks or predictions arrived; check that DDS works on this ROS_DOMAIN_ID '
+               'and look at the node logs.')
+        raise ClassifierError(msg)
+    chunks = sorted(chunks)
+    stamps = np.array([c[0] for c in chunks])
+    ends, dists = [], []
+    for t, d in preds:
+        i = int(np.searchsorted(stamps, t + 0.5 / rate, side='right')) - 1
+        if i < 0:
+            continue
+        s, first, _n = chunks[i]
+        ends.append(first + round((t - s) * rate))
+        dists.append(d)
+    return np.array(ends, dtype=int), np.array(dists)
+
+
+def evaluate_live(model_path: str, recordings: Sequence[Recording], tmin: float = 0.5,
+                  tmax: float = 2.5, speed: float = 1.0) -> dict[str, Any]:
+    """Stream each recording through the live node chain and score the predictions."""
+    if speed != 1.0:
+        msg = (f'--live plays in real time only (speed 1.0, got {speed}): prediction stamps are '
+               'mapped back to samples through the real-time stream clock.')
+        raise ClassifierError(msg)
+    model = MiModel.load(model_path)
+    results = []
+    with tempfile.TemporaryDirectory(prefix='mindgrasp-live-') as tmp:
+        for i, rec in enumerate(recordings):
+            work = Path(tmp) / f'rec{i}'
+            work.mkdir()
+            results.append(stream_live(str(Path(model_path).resolve()), rec, work))
+    report = score_predictions(model, recordings, results, tmin, tmax)
+    report['n_predictions'] = int(sum(len(e) for e, _ in results))
+    return report

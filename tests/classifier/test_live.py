@@ -1,0 +1,39 @@
+"""``evaluate classifier --live``: LSL player -> acquisition node -> classifier node vs offline."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from mindgrasp_classifier.training import TrainingConfig, train
+
+from .classifier_synth import make_recording
+from .test_data_cli import write_run_bag
+
+pytestmark = pytest.mark.slow
+
+
+def test_live_agrees_with_offline(tmp_path):
+    model, _ = train([make_recording(trials_per_class=6, seed=0)], TrainingConfig(channels='all'),
+                     cross_validate=False)
+    path = model.save(tmp_path / 'm')
+    rec = make_recording(trials_per_class=2, seed=21)
+    # extra sensor noise, so that the model makes mistakes and agreement is not trivial
+    rec.data = rec.data + np.random.RandomState(5).randn(*rec.data.shape) * 10e-6
+    bag = write_run_bag(tmp_path / 'run', rec, drop=())
+    env = dict(os.environ)
+    out = subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', 'evaluate', 'classifier',
+                          '--model', str(path), '--bag', str(bag), '--live', '--json'],
+                         capture_output=True, text=True, timeout=400, env=env)
+    assert out.returncode == 0, out.stdout[-3000:] + out.stderr[-3000:]
+    report = json.loads(out.stdout.strip().splitlines()[-1])
+    live = report['live']
+    assert live['n_windows'] >= report['n_windows'] - 2
+    assert 0.1 < report['window_accuracy'] < 0.99
+    assert abs(live['window_accuracy'] - report['window_accuracy']) <= 0.02
+    assert 'live - offline window accuracy' in out.stdout
