@@ -68,6 +68,7 @@ class Executor:
         self._guard: DdsGuardCondition | None = None
         self._conditions: dict[int, tuple[Any, ReadCondition]] = {}
         self._pending: list[Work] = []
+        self._waiting = False
         dds = self._context.dds
         if dds is not None:
             self._waitset = WaitSet(dds.participant)
@@ -88,7 +89,7 @@ class Executor:
             self._nodes.append(node)
             node.executor = self
             self._generation = -1
-        self.wake()
+        self._wake_if_waiting()
         return True
 
     def remove_node(self, node: Any) -> None:
@@ -98,7 +99,13 @@ class Executor:
                 if node.executor is self:
                     node.executor = None
                 self._generation = -1
-        self.wake()
+        self._wake_if_waiting()
+
+    def _wake_if_waiting(self) -> None:
+        # Only a wait in another thread needs waking to see the change. Waking always would
+        # make rclpy.spin_once(node) (add, spin, remove) return at once every time: a busy loop.
+        if self._waiting:
+            self.wake()
 
     def get_nodes(self) -> list[Any]:
         with self._lock:
@@ -184,6 +191,13 @@ class Executor:
             if self._woken:
                 self._woken = False
                 return
+            self._waiting = True
+        try:
+            self._wait_blocking(timeout)
+        finally:
+            self._waiting = False
+
+    def _wait_blocking(self, timeout: float) -> None:
         if self._waitset is not None and self._context.dds is not None:
             self._waitset.wait(int(timeout * 1e9))
             if self._guard is not None and self._guard.read():
