@@ -347,3 +347,16 @@ def test_lost_messages_are_counted(rclpy_ctx):
     spin_until(node, lambda: len(got) >= 5, timeout=5)
     assert got == ['15', '16', '17', '18', '19']  # KEEP_LAST 5 keeps the newest
     assert sub.messages_lost == 15
+
+
+def test_spin_once_waits_for_its_timeout_when_idle(rclpy_ctx):
+    """rclpy.spin_once(node) adds and removes the node each call; that must not wake it."""
+    import time
+
+    node = rclpy_ctx.node.Node('idle')
+    node.create_timer(5.0, lambda: None)
+    start, calls = time.monotonic(), 0
+    while time.monotonic() - start < 1.0:
+        rclpy_ctx.spin_once(node, timeout_sec=0.1)
+        calls += 1
+    assert calls <= 15  # ~10 at 0.1 s each; a busy loop makes thousands
