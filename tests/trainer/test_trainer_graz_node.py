@@ -39,9 +39,9 @@ def test_prompts_arrive_in_order_with_the_schedule_timing(ros, spawn, spin_until
         lambda m: got.append((m, node.get_clock().now().nanoseconds * 1e-9)), prompt_qos(ros),
     )  # fmt: skip
     # Start delay covers process start-up and discovery, so the listener sees the whole session.
-    proc = spawn('mindgrasp_trainer.graz_node', n_trials=4, seed=3, start_delay=3.0,
+    proc = spawn('mindgrasp_trainer.graz_node', n_trials=4, seed=3, start_delay=2.0,
                  display_rate=0.0, **FAST)  # fmt: skip
-    expected = GrazProtocol(n_trials=4, seed=3, start_delay=3.0, **FAST).schedule()
+    expected = GrazProtocol(n_trials=4, seed=3, start_delay=2.0, **FAST).schedule()
     assert spin_until(node, lambda: got and got[-1][0].phase == 'end', 40.0), (
         f'prompts received: {[m.phase for m, _ in got]}; node output:\n{proc.stdout.read()}'
     )
@@ -115,7 +115,7 @@ def test_duration_ends_the_session(ros, spawn, spin_until):
     got = []
     node.create_subscription(Prompt, '/trainer/prompt', got.append, prompt_qos(ros))
     t0 = time.monotonic()
-    proc = spawn('mindgrasp_trainer.graz_node', n_trials=400, duration=4.0, start_delay=1.0,
+    proc = spawn('mindgrasp_trainer.graz_node', n_trials=400, duration=2.5, start_delay=0.5,
                  display_rate=0.0, **FAST)  # fmt: skip
     assert proc.wait(40) == 0
     assert time.monotonic() - t0 < 30

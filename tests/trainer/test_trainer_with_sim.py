@@ -42,7 +42,7 @@ def test_trainer_drives_the_simulated_training_robot(ros, spawn, spin_until):
     # on a loaded machine still gets there)
     trainer = spawn('mindgrasp_trainer.trainer_node', n_trials=3, classes='[0, 1, 2]', seed=0,
                     balanced=True, approach_speed=0.45, turn_speed=0.3, move_duration=5.0,
-                    start_delay=1.0,
+                    wait_duration=0.5, start_delay=0.5,
                     robot_timeout=60.0)  # fmt: skip
     ok = spin_until(node, lambda: prompts and prompts[-1][0].phase == 'end', 90.0)
     out = trainer.stdout.read() if trainer.poll() is not None else ''
