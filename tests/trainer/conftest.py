@@ -37,8 +37,12 @@ def ros():
 
 
 @pytest.fixture
-def spawn() -> Iterator[Callable[..., subprocess.Popen]]:
-    """Start ``python -m module --ros-args -p k:=v ...``; every process is stopped at teardown."""
+def spawn(tmp_path) -> Iterator[Callable[..., subprocess.Popen]]:
+    """Start ``python -m module --ros-args -p k:=v ...``; every process is stopped at teardown.
+
+    The output (stdout and stderr) goes to a file, so a chatty node never blocks on a full pipe;
+    ``proc.output()`` returns all of it so far.
+    """
     procs: list[subprocess.Popen] = []
 
     def start(module: str, **params: object) -> subprocess.Popen:
@@ -47,9 +51,11 @@ def spawn() -> Iterator[Callable[..., subprocess.Popen]]:
             if isinstance(value, bool):
                 value = str(value).lower()
             args += ['-p', f'{name}:={value}']
-        proc = subprocess.Popen(
-            args, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, env=os.environ.copy()
-        )
+        log = tmp_path / f'{module.rsplit(".", 1)[-1]}_{len(procs)}.log'
+        with open(log, 'w', encoding='utf-8') as f:
+            env = os.environ | {'PYTHONUNBUFFERED': '1'}  # the log is complete at any time
+            proc = subprocess.Popen(args, stdout=f, stderr=subprocess.STDOUT, env=env)
+        proc.output = lambda: log.read_text(encoding='utf-8', errors='replace')
         procs.append(proc)
         return proc
 
@@ -62,8 +68,6 @@ def spawn() -> Iterator[Callable[..., subprocess.Popen]]:
             except subprocess.TimeoutExpired:
                 proc.kill()
                 proc.wait(5)
-        if proc.stdout is not None:
-            proc.stdout.close()
 
 
 def _spin_until(rclpy, node, condition: Callable[[], bool], timeout: float) -> bool:

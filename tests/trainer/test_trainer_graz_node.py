@@ -43,7 +43,7 @@ def test_prompts_arrive_in_order_with_the_schedule_timing(ros, spawn, spin_until
                  display_rate=0.0, **FAST)  # fmt: skip
     expected = GrazProtocol(n_trials=4, seed=3, start_delay=2.0, **FAST).schedule()
     assert spin_until(node, lambda: got and got[-1][0].phase == 'end', 40.0), (
-        f'prompts received: {[m.phase for m, _ in got]}; node output:\n{proc.stdout.read()}'
+        f'prompts received: {[m.phase for m, _ in got]}; node output:\n{proc.output()}'
     )
     assert proc.wait(10) == 0
     msgs = [m for m, _ in got]
@@ -81,7 +81,7 @@ def test_late_joiner_gets_the_last_prompt_and_the_display_shows_the_arrow(ros, s
                  fixation=0.5, cue=6.0, display_rate=20.0, display_width=160,
                  display_height=120)  # fmt: skip
     assert spin_until(node, lambda: any(m.phase == 'cue' for m in early), 30.0), (
-        f'no cue; node output:\n{proc.stdout.read() if proc.poll() is not None else ""}'
+        f'no cue; node output:\n{proc.output()}'
     )
     cue = early[-1]
     assert [m.phase for m in early] == ['fixation', 'cue']
@@ -135,7 +135,7 @@ def test_duration_ends_the_session(ros, spawn, spin_until):
 def test_bad_parameters_end_the_node_with_the_reason(ros, spawn, params, match):
     proc = spawn('mindgrasp_trainer.graz_node', **params)
     assert proc.wait(30) == 2
-    out = proc.stdout.read()
+    out = proc.output()
     assert match in out, out
 
 

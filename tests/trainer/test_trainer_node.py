@@ -138,10 +138,10 @@ def test_trainer_prompts_moves_resets_and_measures(ros, spawn, spin_until, tmp_p
     log_file = tmp_path / 'trials.csv'
     proc = spawn('mindgrasp_trainer.trainer_node', seed=seed, log_file=log_file, **PARAMS)
     ok = spin_until(node, lambda: prompts and prompts[-1][0].phase == 'end', 60.0)
-    out = proc.stdout.read() if proc.poll() is not None else ''
+    out = proc.output()
     assert ok, f'prompts: {[(m.trial, m.phase) for m, _ in prompts]}\n{out}'
     assert proc.wait(10) == 0
-    out = proc.stdout.read()
+    out = proc.output()
 
     msgs = [m for m, _ in prompts]
     assert {m.paradigm for m in msgs} == {'trainer'}
@@ -208,7 +208,7 @@ def test_missing_reset_service_is_reported_and_the_session_goes_on(ros, spawn, s
     proc = spawn('mindgrasp_trainer.trainer_node', seed=0, **(PARAMS | {'n_trials': 2}))
     assert spin_until(node, lambda: prompts and prompts[-1].phase == 'end', 60.0)
     assert proc.wait(10) == 0
-    out = proc.stdout.read()
+    out = proc.output()
     assert 'The reset service /sim/reset is not available, so the robots stay where they are' in out
     # both trials end in a reset attempt: the robot is still low when trial 2 starts
     assert [(m.phase, m.trial) for m in prompts if m.trial > 0] == [
@@ -220,7 +220,7 @@ def test_missing_reset_service_is_reported_and_the_session_goes_on(ros, spawn, s
 def test_trainer_without_training_robot_exits_with_the_fix(ros, spawn):
     proc = spawn('mindgrasp_trainer.trainer_node', robot_timeout=1.0)
     assert proc.wait(30) == 1
-    out = proc.stdout.read()
+    out = proc.output()
     assert 'No message on /trainer_robot/joint_states and /trainer_robot/ee_pose' in out
     assert 'within 1.0 s: start the simulator with the training robot' in out
     assert 'mindgrasp launch trainer' in out
@@ -238,5 +238,5 @@ def test_trainer_without_training_robot_exits_with_the_fix(ros, spawn):
 def test_trainer_bad_parameter(ros, spawn, params, match):
     proc = spawn('mindgrasp_trainer.trainer_node', **params)
     assert proc.wait(30) == 2
-    out = proc.stdout.read()
+    out = proc.output()
     assert match in out, out

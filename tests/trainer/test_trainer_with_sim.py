@@ -45,10 +45,10 @@ def test_trainer_drives_the_simulated_training_robot(ros, spawn, spin_until):
                     wait_duration=0.5, start_delay=0.5,
                     robot_timeout=60.0)  # fmt: skip
     ok = spin_until(node, lambda: prompts and prompts[-1][0].phase == 'end', 90.0)
-    out = trainer.stdout.read() if trainer.poll() is not None else ''
+    out = trainer.output()
     assert ok, f'prompts: {[(m.trial, m.phase) for m, _ in prompts]}\n{out}'
     assert trainer.wait(10) == 0
-    out = trainer.stdout.read()
+    out = trainer.output()
     assert sim.poll() is None, 'the simulator died'
 
     moves = [(m, q) for m, q in prompts if m.phase == 'move']
