@@ -180,3 +180,24 @@ def test_images_of_an_unexpected_size_are_rejected(rclpy_ctx, spawn_node, sim, v
     assert cam.stream(rgb, depth, k, lambda: text in proc.output(), timeout=10.0)
     assert cam.detections == []
     assert proc.stop() == 0
+
+
+def test_with_the_simulator_node(rclpy_ctx, spawn_node):
+    """sim_node -> vision_node -> this process: the home view of the set_locations scene."""
+    from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import DetectionArray
+
+    sim = spawn_node('mindgrasp_sim.sim_node', '--ros-args', '-p', 'scene:=set_locations',
+                     '-p', 'duration:=40.0')
+    vision = spawn_node('mindgrasp_vision.vision_node', '--ros-args', '--params-file', PARAMS,
+                        '-p', 'duration:=40.0')
+    node = rclpy_ctx.node.Node('vision_test_listener')
+    got: list = []
+    node.create_subscription(DetectionArray, '/vision/detections', got.append, 10)
+    assert _spin_until(rclpy_ctx, node, lambda: len(got) >= 3, 40.0), \
+        sim.output()[-2000:] + vision.output()[-2000:]
+    msg = got[-1]
+    by_x = sorted(msg.detections, key=lambda d: d.centre_x)
+    assert [d.colour for d in by_x] == ['blue', 'red', 'yellow']
+    assert _target(msg).colour == 'red'    # straight ahead: the red cube
+    assert all(0.4 < d.distance < 0.8 for d in msg.detections)
+    assert vision.stop() == 0
