@@ -73,10 +73,13 @@ class Camera:
         self.color.publish(msg)
         return header.stamp
 
-    def stream(self, rgb, depth, k, until, timeout: float = 20.0, **kwargs) -> bool:
-        """Publish the frame at about 10 Hz until ``until()`` holds."""
+    def stream(self, rgb, depth, k, until, timeout: float = 20.0, mi_class: int | None = None,
+               **kwargs) -> bool:
+        """Publish the frame (and the MI prediction, if given) at about 10 Hz until ``until()``."""
         deadline = time.monotonic() + timeout
         while time.monotonic() < deadline:
+            if mi_class is not None:
+                self.predict(mi_class)
             self.publish(rgb, depth, k, **kwargs)
             if _spin_until(self.rclpy, self.node, until, 0.1):
                 return True
@@ -123,9 +126,8 @@ def test_detections_overlay_focus_shift_and_shape(rclpy_ctx, spawn_node, sim, vi
     img = np.asarray(overlay.data).reshape(128, 128, 3)
     assert np.all(img == (0, 255, 0), axis=2).sum() > 40        # the green box
     # the user imagines the left hand: the focus moves left, so does the object of interest
-    cam.predict(0)
-    assert cam.stream(*three, k, lambda: _target(cam.detections[-1]).colour == 'red'), \
-        [_target(m).colour for m in cam.detections[-10:]]
+    assert cam.stream(*three, k, lambda: _target(cam.detections[-1]).colour == 'red',
+                      mi_class=0), [_target(m).colour for m in cam.detections[-10:]]
     # close to one object: the shape CNN names it
     assert cam.stream(*close, k, lambda: _target(cam.detections[-1]).shape != 'unknown')
     target = _target(cam.detections[-1])
