@@ -242,7 +242,7 @@ class Simulation:
         self._step_count = 0
         self._proj = None
         self._rays: np.ndarray | None = None
-        self._ground_rgb = np.zeros(3, dtype=np.uint8)
+        self._ground_rgba = np.uint32(0)
         self.last_ik_error = 0.0
         self._scene: SceneSpec | None = None
         self.seed = int(seed)
@@ -609,33 +609,37 @@ class Simulation:
             c.width, c.height, view, self._proj, renderer=self._renderer, shadow=0,
             flags=pb.ER_NO_SEGMENTATION_MASK, **_LIGHT)
         self._unhide(hidden)
-        rgb = np.asarray(rgba, dtype=np.uint8).reshape(c.height, c.width, 4)[:, :, :3].copy()
+        rgba = np.array(rgba, dtype=np.uint8, copy=True).reshape(c.height, c.width, 4)
         d = np.asarray(depth_buf, dtype=np.float32).reshape(c.height, c.width)
         depth = (c.far * c.near / (c.far - (c.far - c.near) * d)).astype(np.float32)
         if not self._ground_visual:
-            self._draw_ground(rgb, depth, depth > c.far * 0.999, pos, rot)
+            self._draw_ground(rgba, depth, depth > c.far * 0.999, pos, rot)
+        rgb = rgba[:, :, :3].copy()
         return rgb, depth
 
-    def _draw_ground(self, rgb: np.ndarray, depth: np.ndarray, empty: np.ndarray,
+    def _draw_ground(self, rgba: np.ndarray, depth: np.ndarray, empty: np.ndarray,
                      pos: np.ndarray, rot: np.ndarray) -> None:
-        """Fill pixels that hit nothing with the ground plane z = 0 (exact ray-plane depth)."""
+        """Fill pixels that hit nothing with the ground plane z = 0 (exact ray-plane depth).
+
+        rgba: (H, W, 4) uint8, C-contiguous; depth: (H, W) float32 m; empty: (H, W) bool.
+        """
         if self._rays is None:
             k, w, h = self.camera_intrinsics()
             u, v = np.meshgrid(np.arange(w, dtype=float), np.arange(h, dtype=float))
-            self._rays = np.stack([(u - k[0, 2]) / k[0, 0], (v - k[1, 2]) / k[1, 1],
-                                   np.ones_like(u)], axis=-1)   # (H, W, 3), optical z = 1
-            self._ground_rgb = self._ground_colour()
-        idx = np.flatnonzero(empty)
-        if idx.size == 0:
-            return
-        # world z component of each empty pixel's ray (optical-axis depth 1), then depth to z = 0
-        rz = self._rays.reshape(-1, 3)[idx] @ rot[2]
-        down = rz < -1e-9
-        idx, t = idx[down], -pos[2] / rz[down]
-        keep = t <= self.camera.far
-        idx, t = idx[keep], t[keep]
-        rgb.reshape(-1, 3)[idx] = self._ground_rgb
-        depth.reshape(-1)[idx] = t
+            # optical-frame ray of each pixel with depth 1: (x, y, 1)
+            self._rays = np.stack([(u - k[0, 2]) / k[0, 0],
+                                   (v - k[1, 2]) / k[1, 1]]).astype(np.float32)
+            colour = np.array([*self._ground_colour(), 255], dtype=np.uint8)
+            self._ground_rgba = colour.view(np.uint32)[0]
+        # world z component of each ray, then the depth at which it meets z = 0
+        r = rot[2].astype(np.float32)
+        rz = self._rays[0] * r[0] + self._rays[1] * r[1] + r[2]
+        with np.errstate(divide='ignore', invalid='ignore'):
+            t = np.float32(-pos[2]) / rz
+        hit = empty & (rz < 0) & (t <= self.camera.far)
+        np.copyto(depth, t, where=hit)
+        # one 32-bit word per pixel: a masked fill instead of a per-channel scatter
+        np.copyto(rgba.view(np.uint32).reshape(hit.shape), self._ground_rgba, where=hit)
 
     def _hide_other_robots(self, robot: str) -> list[int]:
         # the trainer's ghost arm is seen by people, not by the user's camera: park it below
