@@ -56,6 +56,9 @@ COMMANDS: dict[str, str | dict[str, str]] = {
     'export': {
         'eeg': 'mindgrasp_eeg.export_cli',
     },
+    'trainer': {
+        'schedule': 'mindgrasp_trainer.schedule_cli',
+    },
 }
 
 
