@@ -62,6 +62,8 @@ def gripper_from_fingers(positions: Sequence[float], stamp: float,
     touch (thumb against a finger), when contact flags are given."""
     pos = np.asarray(positions, dtype=float)
     opening = float(np.clip((closed_angle - pos.mean()) / (closed_angle - open_angle), 0.0, 1.0))
-    contact = None if contacts is None else bool(np.count_nonzero(contacts) >= 2)
+    n = None if contacts is None else int(np.count_nonzero(contacts))
+    contact = None if n is None else n >= 2
     force = float(np.sum(np.abs(efforts))) if efforts is not None else math.nan
-    return GripperState(opening=opening, force=force, stamp=float(stamp), contact=contact)
+    return GripperState(opening=opening, force=force, stamp=float(stamp), contact=contact,
+                        fingers_in_contact=n)

@@ -121,6 +121,7 @@ class GraspFsm:
         self._sweep = 0
         self._sweep_dir = 1.0
         self._ignore_from: float | None = None
+        self._return_lift: bool | None = None
         self._attempt = 0
         self._outcome = ''
         self._gripper = GripperCommand(self.params.gripper_open_position, 0.0)
@@ -170,6 +171,7 @@ class GraspFsm:
             self.policy.begin_grasp(self._clock)
             self._gripper = self.policy.gripper
         elif new == State.RETURN_TO_START:
+            self._return_lift = None
             self._gripper = self.policy.gripper if self._outcome == 'holding' else \
                 GripperCommand(self.params.gripper_open_position, 0.0)
 
@@ -496,6 +498,20 @@ class GraspFsm:
     # ---------------------------------------------------------------------------- state 6
     def _return(self, t: float, q: np.ndarray, inputs: FsmInputs) -> tuple[np.ndarray, str]:
         p = self.params
+        holding = self._outcome == 'holding'
+        if holding and self.kinematics is not None and self._return_lift is None:
+            tool = self.kinematics.tool_position(q)
+            self._return_lift = max(p.return_lift_height - float(tool[2]), 0.0) > 0.01
+            if self._return_lift:
+                target = tool.copy()
+                target[2] = p.return_lift_height
+                self.policy.start_lift(t, q, target)
+        if holding and self._return_lift:
+            # carrying: rise straight up first, so the object clears the table and the arm
+            v, done = self.policy.lift_step(t, q)
+            if not done:
+                return self._ramp(t, v, p.return_velocity_holding), 'lifting'
+            self._return_lift = False
         err = np.asarray(p.home_position) - q
         if np.max(np.abs(err)) < p.return_tolerance:
             self._goto(State.OBJECT_SEARCH, 'returned to the start position')
@@ -505,10 +521,18 @@ class GraspFsm:
             return np.zeros(6), 'timeout'
         v = p.return_gain * err
         vmax = np.asarray(p.max_joint_velocity)
+        if holding:
+            vmax = np.minimum(vmax, p.return_velocity_holding)
         scale = float(np.max(np.abs(v) / vmax))
         if scale > 1.0:
             v = v / scale
-        return v, 'returning'
+        return self._ramp(t, v, float(np.max(vmax))), 'returning'
+
+    def _ramp(self, t: float, v: np.ndarray, vmax: float) -> np.ndarray:
+        """Limit the speed to ``return_acceleration`` * time in state (a smooth start)."""
+        limit = min(vmax, self.params.return_acceleration * (t - self._state_since) + 0.02)
+        peak = float(np.max(np.abs(v)))
+        return v * (limit / peak) if peak > limit else v
 
     # ---------------------------------------------------------------------------- info
     @property

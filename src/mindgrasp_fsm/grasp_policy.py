@@ -149,7 +149,9 @@ class GraspPolicy:
         """Grasp-point height (m): a fraction of the object height, but high enough that the
         fingertips, which reach ``min_tcp_height`` below the grasp point, clear the table."""
         frac = self.params.shape_value(self.shape, 'grasp_height_fraction')
-        return self.params.table_height + max(self._height() * frac, self.params.min_tcp_height)
+        offset = self.params.shape_value(self.shape, 'grasp_height_offset')
+        return self.params.table_height + max(self._height() * frac + offset,
+                                              self.params.min_tcp_height)
 
     def _pregrasp_point(self) -> np.ndarray:
         assert self.object_position is not None
@@ -285,6 +287,16 @@ class GraspPolicy:
         self._start_line(t, q, target)
         return PolicyStep(self._zeros(), self._gripper, self.phase)
 
+    # ------------------------------------------------------------------ straight lift (state 6)
+    def start_lift(self, t: float, q: np.ndarray, target: np.ndarray) -> None:
+        """Begin a straight tool motion to ``target`` (m) keeping the grasp orientation."""
+        self._start_line(t, q, target)
+
+    def lift_step(self, t: float, q: np.ndarray) -> tuple[np.ndarray, bool]:
+        """One tick of :meth:`start_lift`; returns (velocities, done)."""
+        v, done, failed = self._follow_line(t, q)
+        return (np.zeros(6), True) if failed else (v, done)
+
     # ------------------------------------------------------------------ state 5
     def begin_grasp(self, t: float) -> None:
         """Enter the grasp: close with the shape's force limit."""
@@ -304,7 +316,12 @@ class GraspPolicy:
                     else gripper.force >= self.params.contact_min_force)
         if not touching:
             return False, f'no finger contact (force {gripper.force:.1f} N)'
-        return True, f'finger contact, opening {gripper.opening:.2f}, force {gripper.force:.1f} N'
+        n = gripper.fingers_in_contact
+        if n is not None and n < self.params.min_fingers_in_contact:
+            return False, (f'only {n} finger(s) touch the object, '
+                           f'{self.params.min_fingers_in_contact} wanted for a firm grasp')
+        fingers = '' if n is None else f'{n} fingers, '
+        return True, f'finger contact ({fingers}opening {gripper.opening:.2f})'
 
     def _fail(self, t: float, q: np.ndarray, why: str, can_retry: bool) -> PolicyStep:
         """Open, back off upwards, then report retry or failure."""
@@ -345,6 +362,13 @@ class GraspPolicy:
                 ok, why = self._holding(gripper)
                 if not ok:
                     return self._fail(t, q, why, can_retry)
+                if gripper is not None and p.grip_squeeze > 0:
+                    # hold: fingers a little past where they stalled on the object, so the grip
+                    # is a stiff position equilibrium instead of a torque-limited squeeze that
+                    # lets the stronger thumb push the object out between the fingers
+                    closure = min((1.0 - gripper.opening) + p.grip_squeeze,
+                                  p.gripper_closed_position)
+                    self._gripper = GripperCommand(closure, self._gripper.max_force)
                 tool = self.kinematics.tool_position(q)
                 self.phase = 'lift'
                 self._start_line(t, q, tool + np.array([0.0, 0.0, p.lift_height]))

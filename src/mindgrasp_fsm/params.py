@@ -86,22 +86,27 @@ class FsmParams:
     min_reach: float = 0.12             # m, objects closer to the base axis are not grasped
     max_reach: float = 0.85             # m
     segment_timeout: float = 8.0        # s for one motion segment
-    min_tcp_height: float = 0.035       # m above the table: the fingertips reach 0.025 m below
+    min_tcp_height: float = 0.03        # m above the table (the fingertips reach 0.025 m below
+    # the grasp point and would stall on the table)
     # per shape: pre-grasp height above the object top, grasp height as a fraction of the
-    # object height from the table, object size (m) used for the depth-surface correction,
-    # wrist yaw offset (rad) relative to the approach direction, closing force (N)
+    # object height from the table plus an offset (m; a sphere is held with the fingertips at its
+    # equator, not squeezed upwards from below), object size (m) used for the depth-surface
+    # correction, wrist yaw offset (rad) relative to the approach direction, closing force (N)
     cube_approach_height: float = 0.10
     cube_grasp_height_fraction: float = 0.5
+    cube_grasp_height_offset: float = 0.0
     cube_size: float = 0.05
     cube_wrist_yaw: float = 0.0
     cube_close_force: float = 40.0
     cylinder_approach_height: float = 0.10
     cylinder_grasp_height_fraction: float = 0.5
+    cylinder_grasp_height_offset: float = 0.0
     cylinder_size: float = 0.05
     cylinder_wrist_yaw: float = 0.0
     cylinder_close_force: float = 40.0
     sphere_approach_height: float = 0.10
-    sphere_grasp_height_fraction: float = 0.55
+    sphere_grasp_height_fraction: float = 0.6
+    sphere_grasp_height_offset: float = 0.015
     sphere_size: float = 0.05
     sphere_wrist_yaw: float = 0.0
     sphere_close_force: float = 30.0
@@ -110,7 +115,9 @@ class FsmParams:
     gripper_closed_position: float = 1.0
     close_timeout: float = 2.0          # s to reach contact
     stall_rate: float = 0.05            # 1/s opening change below which the fingers have stalled
+    grip_squeeze: float = 0.15          # closure (0..1) held past the stall point; 0: full close
     contact_min_force: float = 1.0      # N finger force that counts as contact
+    min_fingers_in_contact: int = 3     # fingers that must touch for a firm grasp (contact sensing)
     closed_empty_opening: float = 0.05  # opening (0 closed .. 1 open) below which the hand is empty
     lift_height: float = 0.12           # m lift after closing
     lift_check_time: float = 0.3        # s held still after the lift before checking
@@ -119,7 +126,10 @@ class FsmParams:
     # --- state 6: return to start --------------------------------------------------------------
     return_gain: float = 1.0            # 1/s, joint velocity = gain * (home - position)
     return_tolerance: float = 0.05      # rad per joint
-    return_timeout: float = 15.0        # s
+    return_timeout: float = 20.0        # s
+    return_velocity_holding: float = 0.5  # rad/s per joint at most while carrying an object
+    return_acceleration: float = 1.0    # rad/s^2 ramp at the start of the return (no jerk)
+    return_lift_height: float = 0.25    # m; carrying, the hand first rises straight to this height
 
     def __post_init__(self) -> None:
         self.validate()

@@ -115,6 +115,7 @@ class GripperState:
     force: float
     stamp: float
     contact: bool | None = None     # from contact sensing when available
+    fingers_in_contact: int | None = None   # how many fingers touch the object, when sensed
 
 
 @dataclass(frozen=True)
