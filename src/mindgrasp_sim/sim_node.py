@@ -39,16 +39,16 @@ from mindgrasp_ros.interfaces.mindgrasp_msgs.srv import LoadScene, ResetSim, Ste
 from mindgrasp_ros.interfaces.rosgraph_msgs.msg import Clock
 from mindgrasp_ros.interfaces.sensor_msgs.msg import CameraInfo, Image, JointState
 from mindgrasp_ros.interfaces.std_msgs.msg import Float64MultiArray, Header, UInt8MultiArray
-from mindgrasp_ros.interfaces.visualization_msgs.msg import Marker, MarkerArray
+from mindgrasp_ros.interfaces.visualization_msgs.msg import MarkerArray
 
 from mindgrasp_ros import rclpy
+from mindgrasp_sim import messages as msgs
 from mindgrasp_sim.control import CommandGate, gripper_closure
 from mindgrasp_sim.errors import SimError
 from mindgrasp_sim.simulation import CameraConfig, Simulation
 from mindgrasp_sim.task import TaskMonitor
 
 TIME_MODES = ('realtime', 'fast', 'lockstep')
-_MARKER_TYPE = {'cube': 1, 'sphere': 2, 'cylinder': 3, 'mesh': 10}
 
 _PARAMS = (
     ('scene', 'set_locations'), ('seed', 0), ('n_objects', -1), ('physics_hz', 240.0),
@@ -200,8 +200,7 @@ class SimNode(rclpy.node.Node):
         # integer nanoseconds: start time plus whole physics steps (no float drift)
         if self._stamp_cache[0] != self.total_steps:
             ns = self._t0_ns + self.total_steps * self._dt_ns
-            self._stamp_cache = (self.total_steps, TimeMsg(sec=ns // 1_000_000_000,
-                                                           nanosec=ns % 1_000_000_000))
+            self._stamp_cache = (self.total_steps, msgs.stamp(ns))
         return self._stamp_cache[1]
 
     def advance(self, n_steps: int) -> None:
@@ -351,7 +350,7 @@ class SimNode(rclpy.node.Node):
 
     # ------------------------------------------------------------------ publishing
     def _header(self, frame_id: str = '') -> Header:
-        return Header(stamp=self._stamp(), frame_id=frame_id)
+        return msgs.header(self._stamp(), frame_id)
 
     def publish_all(self) -> None:
         self.publish_states()
@@ -361,73 +360,42 @@ class SimNode(rclpy.node.Node):
             self.clock_pub.publish(Clock(clock=self._stamp()))
 
     def publish_states(self) -> None:
+        """Joint states, finger states and contacts, and the TCP pose of every robot."""
         self._last_state_step = self.total_steps
         sim = self.sim
-        header = self._header()
-        world = self._header(self.p['frame_id'])
+        hdr, world = self._header(), self._header(self.p['frame_id'])
         for io in self.robots.values():
-            io.pubs['js'].publish(JointState(
-                header=header, name=list(sim.joint_names),
-                position=sim.joint_positions(io.name), velocity=sim.joint_velocities(io.name),
-                effort=sim.joint_efforts(io.name)))
+            io.pubs['js'].publish(msgs.joint_state(
+                hdr, sim.joint_names, sim.joint_positions(io.name),
+                sim.joint_velocities(io.name), sim.joint_efforts(io.name)))
             state = sim.gripper_state(io.name)
-            io.pubs['gripper'].publish(JointState(
-                header=header, name=list(sim.finger_names), position=state['positions'],
-                velocity=np.zeros(3), effort=np.zeros(3)))
+            io.pubs['gripper'].publish(msgs.joint_state(hdr, sim.finger_names,
+                                                        state['positions']))
             io.pubs['contacts'].publish(UInt8MultiArray(
                 data=state['contacts'].astype(np.uint8)))
-            pos, quat = sim.ee_pose(io.name)
-            pose = PoseStamped(header=world)
-            pose.pose.position.x, pose.pose.position.y, pose.pose.position.z = map(float, pos)
-            o = pose.pose.orientation
-            o.x, o.y, o.z, o.w = map(float, quat)
-            io.pubs['ee'].publish(pose)
-
-    def _camera_info(self, header: Header) -> CameraInfo:
-        k, w, h = self.sim.camera_intrinsics()
-        p = np.zeros((3, 4))
-        p[:, :3] = k
-        return CameraInfo(header=header, height=h, width=w, distortion_model='plumb_bob',
-                          d=np.zeros(5), k=k.reshape(-1), r=np.eye(3).reshape(-1),
-                          p=p.reshape(-1))
+            io.pubs['ee'].publish(msgs.pose_stamped(world, *sim.ee_pose(io.name)))
 
     def publish_camera(self) -> None:
+        """Colour and depth images of the user's eye-in-hand camera, with camera_info."""
         rgb, depth = self.sim.render_camera()
-        h, w = depth.shape
-        header = self._header('camera_color_optical_frame')
-        self.color_pub.publish(Image(header=header, height=h, width=w, encoding='rgb8',
-                                     is_bigendian=0, step=w * 3, data=rgb.reshape(-1)))
-        self.depth_pub.publish(Image(header=header, height=h, width=w, encoding='32FC1',
-                                     is_bigendian=0, step=w * 4,
-                                     data=depth.astype('<f4').view(np.uint8).reshape(-1)))
-        self.info_pub.publish(self._camera_info(header))
-        self.depth_info_pub.publish(self._camera_info(header))
+        hdr = self._header(msgs.OPTICAL_FRAME)
+        color, depth_msg = msgs.image_messages(hdr, rgb, depth)
+        self.color_pub.publish(color)
+        self.depth_pub.publish(depth_msg)
+        k, w, h = self.sim.camera_intrinsics()
+        self.info_pub.publish(msgs.camera_info(hdr, k, w, h))
+        self.depth_info_pub.publish(msgs.camera_info(hdr, k, w, h))
 
     def publish_objects(self) -> None:
-        markers = []
-        header = self._header(self.p['frame_id'])
-        for obj in self.sim.objects():
-            m = Marker(header=header, ns='objects', id=obj.id, type=_MARKER_TYPE[obj.shape],
-                       action=0, text=obj.label, frame_locked=False)
-            m.pose.position.x, m.pose.position.y, m.pose.position.z = map(float, obj.position)
-            o = m.pose.orientation
-            o.x, o.y, o.z, o.w = map(float, obj.orientation)
-            m.scale.x = m.scale.y = m.scale.z = float(obj.size)
-            r, g, b, a = obj.rgba
-            m.color.r, m.color.g, m.color.b, m.color.a = float(r), float(g), float(b), float(a)
-            markers.append(m)
-        self.objects_pub.publish(MarkerArray(markers=markers))
+        self.objects_pub.publish(msgs.object_markers(self._header(self.p['frame_id']),
+                                                     self.sim.objects()))
 
     def check_task(self) -> None:
         """Publish /task/result on a lift or a drop; report new arm collisions."""
         event = self.monitor.update(self.sim)
         if event is not None:
-            result = GraspResult(
-                header=self._header(self.p['frame_id']), trial=event.trial,
-                desired_object=self.desired, grasped_object=event.grasped_object,
-                success=event.success, duration=float(event.duration),
-                lift_height=float(event.lift_height), reason=event.reason)
-            self.result_pub.publish(result)
+            self.result_pub.publish(msgs.grasp_result(self._header(self.p['frame_id']), event,
+                                                      self.desired))
             self.get_logger().info(
                 f'Trial {event.trial}: {event.grasped_object} {event.reason} '
                 f'(lift {event.lift_height:.3f} m, {event.duration:.1f} s).')
