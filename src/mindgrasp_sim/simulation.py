@@ -21,6 +21,8 @@ from __future__ import annotations
 
 import contextlib
 import math
+import os
+import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -201,6 +203,10 @@ class Simulation:
         self.urdf = Path(urdf) if urdf else config_dir() / 'robots' / 'mindgrasp_arm.urdf'
         if not self.urdf.is_file():
             msg = f'Robot description {str(self.urdf)!r} does not exist; give an existing URDF.'
+            raise SimError(msg)
+        if self.gui and sys.platform.startswith('linux') and not os.environ.get('DISPLAY'):
+            msg = 'gui=True needs a display, but DISPLAY is not set; run with gui=False ' \
+                  '(headless) or from a desktop session.'
             raise SimError(msg)
         self._p = BulletClient(connection_mode=pb.GUI if self.gui else pb.DIRECT)
         self._kin = BulletClient(connection_mode=pb.DIRECT)   # kinematic twin for IK / FK

@@ -315,6 +315,12 @@ def test_bad_construction_arguments():
         s.reset(new_random_draw=True)
 
 
+def test_gui_without_display_is_refused(monkeypatch):
+    monkeypatch.setenv('DISPLAY', '')
+    with pytest.raises(SimError, match='gui=True needs a display'):
+        Simulation(gui=True)
+
+
 def test_collisions_with_the_ground_and_itself_are_reported(sim):
     assert sim.collisions() == []
     sim.set_joint_positions(np.array([0, 1.2, 1.2, 0, 0, 0]))   # wrist driven into the ground
