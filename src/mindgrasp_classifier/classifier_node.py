@@ -46,6 +46,16 @@ PARAMETERS = [
 ]
 
 
+def resolve_model_path(path: str) -> Path:
+    """A relative model path is taken from the working directory, else from the repository root
+    (so ``models/default_classifier.json`` works from anywhere)."""
+    p = Path(path).expanduser()
+    if p.is_absolute() or p.exists() or p.with_suffix('.json').exists():
+        return p
+    repo = DEFAULT_MODEL.parents[1] / p
+    return repo if repo.exists() or repo.with_suffix('.json').exists() else p
+
+
 class ClassifierNode(rclpy.node.Node):
     """Wires :class:`MiDecoder` to ``/eeg/raw``, ``/trainer/prompt``, ``/bci/prediction``."""
 
@@ -56,6 +66,7 @@ class ClassifierNode(rclpy.node.Node):
         if self.p['blas_threads'] > 0:
             # small matrices: multi-threaded BLAS only adds latency, worst on a busy machine
             threadpool_limits(limits=int(self.p['blas_threads']))
+        self.p['model'] = str(resolve_model_path(self.p['model']))
         self.model = MiModel.load(self.p['model'])
         if self.p['classes']:
             check_classes(self.model, self.p['classes'])
