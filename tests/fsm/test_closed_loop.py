@@ -48,7 +48,9 @@ def test_oracle_bci_grasps_the_desired_object(set_locations_loop: LockstepLoop, 
     out = loop.run(target, timeout=90.0, oracle=OracleBci(target))
     assert out.success, (out.reason, out.states)
     assert out.grasped_object == label
-    assert out.states[:4] == [1, 2, 3, 4] and out.states[-1] == 1
+    assert out.states[:6] == [1, 2, 3, 4, 5, 6]
+    # back in Object Search (the subject may select again at once: state 2 in the same tick)
+    assert 'returned to the start position' in out.reason
 
 
 @pytest.mark.slow
