@@ -156,8 +156,12 @@ class CausalBandpass:
 
 
 def step_samples(rate: float, step: float) -> int:
-    """Window step in samples (at least 1) for a step of ``step`` seconds."""
-    return max(1, round(rate * step))
+    """Window step in samples (at least 1) for a step of ``step`` seconds.
+
+    Rounded down, so the prediction rate is never below ``1 / step`` (250 Hz, 1/16 s: 15
+    samples, 16.7 predictions/s).
+    """
+    return max(1, int(rate * step + 1e-9))
 
 
 def window_samples(rate: float, length: float) -> int:
