@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 from mindgrasp_ros.interfaces.builtin_interfaces.msg import Time
+from mindgrasp_ros.interfaces.diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from mindgrasp_ros.interfaces.geometry_msgs.msg import PoseStamped
 from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import GraspResult
 from mindgrasp_ros.interfaces.sensor_msgs.msg import CameraInfo, Image, JointState
@@ -23,7 +24,7 @@ MARKER_TYPE = {'cube': Marker.CUBE, 'sphere': Marker.SPHERE, 'cylinder': Marker.
 OPTICAL_FRAME = 'camera_color_optical_frame'
 
 __all__ = ['MARKER_TYPE', 'OPTICAL_FRAME', 'camera_info', 'grasp_result', 'header',
-           'image_messages', 'joint_state', 'object_markers', 'pose_stamped', 'stamp']
+           'image_messages', 'joint_state', 'object_markers', 'pose_stamped', 'stamp', 'status']
 
 
 def stamp(ns: int) -> Time:
@@ -97,3 +98,11 @@ def grasp_result(hdr: Header, event: TaskEvent, desired_object: str = '') -> Gra
                        grasped_object=event.grasped_object, success=event.success,
                        duration=float(event.duration), lift_height=float(event.lift_height),
                        reason=event.reason)
+
+
+def status(hdr: Header, ok: bool, message: str, values: dict[str, object]) -> DiagnosticArray:
+    """A one-entry DiagnosticArray named ``sim`` (level OK or WARN) with ``values`` as text."""
+    level = DiagnosticStatus.OK if ok else DiagnosticStatus.WARN
+    item = DiagnosticStatus(level=level, name='sim', message=message, hardware_id='pybullet',
+                            values=[KeyValue(key=k, value=str(v)) for k, v in values.items()])
+    return DiagnosticArray(header=hdr, status=[item])

@@ -12,9 +12,11 @@ Publishes ``/joint_states`` (6 arm joints), ``/gripper/joint_states`` (3 fingers
 ``/gripper/contacts`` (std_msgs/UInt8MultiArray, 1 = finger touches an object), ``/ee_pose``
 (geometry_msgs/PoseStamped, TCP in ``world``), ``/camera/color/image_raw`` (rgb8),
 ``/camera/depth/image_raw`` (32FC1, m), ``/camera/color/camera_info``,
-``/camera/depth/camera_info``, ``/sim/objects`` (visualization_msgs/MarkerArray) and
-``/task/result`` (mindgrasp_msgs/GraspResult). With ``trainer_robot:=true`` (alias
-``training_robot``) the training robot has the same arm topics under ``/trainer_robot/``.
+``/camera/depth/camera_info``, ``/sim/objects`` (visualization_msgs/MarkerArray),
+``/task/result`` (mindgrasp_msgs/GraspResult) and ``/sim/status`` (diagnostic_msgs/
+DiagnosticArray: scene, simulated time, real-time factor, collisions). With
+``trainer_robot:=true`` (alias ``training_robot``) the training robot has the same arm topics
+under ``/trainer_robot/``.
 Services ``/sim/reset`` (ResetSim), ``/sim/load_scene`` (LoadScene) and, in lock-step mode,
 ``/sim/step`` (Step).
 
@@ -33,6 +35,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from mindgrasp_ros.interfaces.builtin_interfaces.msg import Time as TimeMsg
+from mindgrasp_ros.interfaces.diagnostic_msgs.msg import DiagnosticArray
 from mindgrasp_ros.interfaces.geometry_msgs.msg import PoseStamped
 from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import GraspResult, TaskTarget
 from mindgrasp_ros.interfaces.mindgrasp_msgs.srv import LoadScene, ResetSim, Step
@@ -122,6 +125,7 @@ class SimNode(rclpy.node.Node):
         self.cam_every = self.sim.physics_hz / self.sim.camera.rate_hz
         self.obj_every = self.sim.physics_hz / float(p['objects_rate'])
         self.task_every = max(1, round(self.sim.physics_hz / 20.0))
+        self.status_every = max(1, round(self.sim.physics_hz))     # 1 s of simulated time
         self._next = {'js': 0.0, 'cam': 0.0, 'obj': 0.0}
         self._collisions: list[str] = []
         self._last_state_step = -1
@@ -157,6 +161,8 @@ class SimNode(rclpy.node.Node):
                                                     sensor)
         self.objects_pub = self.create_publisher(MarkerArray, '/sim/objects', latched)
         self.result_pub = self.create_publisher(GraspResult, '/task/result', reliable)
+        self.status_pub = self.create_publisher(DiagnosticArray, '/sim/status', reliable)
+        self._status_mark = (time.monotonic(), 0)
         self.clock_pub = None
         if self.mode in ('fast', 'lockstep'):
             self.clock_pub = self.create_publisher(
@@ -227,6 +233,8 @@ class SimNode(rclpy.node.Node):
                 self.publish_objects()
             if self.total_steps % self.task_every == 0:
                 self.check_task()
+            if self.total_steps % self.status_every == 0:
+                self.publish_status()
         if self.clock_pub is not None:
             self.clock_pub.publish(Clock(clock=self._stamp()))
         limit = float(self.p['sim_duration'])
@@ -402,9 +410,29 @@ class SimNode(rclpy.node.Node):
         if self.total_steps % (self.task_every * 4) == 0:
             collisions = self.sim.collisions()
             new = sorted(set(collisions) - set(self._collisions))
+            self._collisions = collisions
             if new:
                 self.get_logger().warning(f'Arm collision: {", ".join(new)}.')
-            self._collisions = collisions
+                self.publish_status()
+
+    def publish_status(self) -> None:
+        """/sim/status: scene, simulated time, real-time factor since the last status,
+        collisions (WARN while the arm touches the ground or itself)."""
+        wall, steps = time.monotonic(), self.total_steps
+        wall0, steps0 = self._status_mark
+        self._status_mark = (wall, steps)
+        rtf = (steps - steps0) * self.sim.dt / max(wall - wall0, 1e-9)
+        held = self.sim.held_object()
+        values = {
+            'scene': self.sim.scene.name, 'layout_seed': self.sim.layout_seed,
+            'time_mode': self.mode, 'sim_time_s': f'{self.sim.time:.3f}',
+            'real_time_factor': f'{rtf:.2f}', 'trial': self.monitor.trial,
+            'held_object': held.label if held else '',
+            'collisions': ', '.join(self._collisions),
+        }
+        ok = not self._collisions
+        text = 'running' if ok else f'arm collision: {", ".join(self._collisions)}'
+        self.status_pub.publish(msgs.status(self._header(), ok, text, values))
 
     # ------------------------------------------------------------------ lifecycle
     def run(self) -> None:

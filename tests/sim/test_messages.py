@@ -77,3 +77,11 @@ def test_grasp_result():
     assert (r.trial, r.grasped_object, r.desired_object, r.success) == (3, 'red cube',
                                                                          'red cube', True)
     assert r.duration == pytest.approx(12.5) and r.lift_height == pytest.approx(0.31)
+
+
+def test_status():
+    arr = msgs.status(msgs.header(msgs.stamp(0)), False, 'arm collision: palm - ground',
+                      {'scene': 'set_locations', 'real_time_factor': '1.00'})
+    (item,) = arr.status
+    assert item.name == 'sim' and item.level == 1 and 'palm - ground' in item.message
+    assert {kv.key: kv.value for kv in item.values}['scene'] == 'set_locations'

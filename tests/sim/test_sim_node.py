@@ -31,6 +31,7 @@ class Probe:
     """A test node that listens to the simulator's topics and talks to its inputs."""
 
     def __init__(self, rclpy, prefix: str = '') -> None:
+        from mindgrasp_ros.interfaces.diagnostic_msgs.msg import DiagnosticArray
         from mindgrasp_ros.interfaces.geometry_msgs.msg import PoseStamped
         from mindgrasp_ros.interfaces.mindgrasp_msgs.srv import LoadScene, ResetSim, Step
         from mindgrasp_ros.interfaces.rosgraph_msgs.msg import Clock
@@ -47,6 +48,7 @@ class Probe:
         self.poses: list = []
         self.markers: list = []
         self.clocks: list = []
+        self.status: list = []
         n = self.node
         sensor = rclpy.qos.qos_profile_sensor_data
         latched = rclpy.qos.QoSProfile(
@@ -58,6 +60,7 @@ class Probe:
         n.create_subscription(Image, '/camera/depth/image_raw', self.depths.append, sensor)
         n.create_subscription(CameraInfo, '/camera/color/camera_info', self.infos.append, sensor)
         n.create_subscription(MarkerArray, '/sim/objects', self.markers.append, latched)
+        n.create_subscription(DiagnosticArray, '/sim/status', self.status.append, 10)
         n.create_subscription(Clock, '/clock', self.clocks.append, rclpy.qos.QoSProfile(
             depth=10, reliability=rclpy.qos.ReliabilityPolicy.BEST_EFFORT))
         self.cmd_pub = n.create_publisher(Float64MultiArray, f'{prefix}/arm_controller/commands',
@@ -126,6 +129,11 @@ def test_realtime_node_serves_the_arm_and_camera_contract(rclpy_ctx, spawn_node)
     labels = [m.text for m in probe.markers[-1].markers]
     assert labels[:3] == ['red cube', 'blue cylinder', 'yellow sphere'] and len(labels) == 9
     assert probe.poses and probe.poses[-1].header.frame_id == 'world'
+    assert spin_until(rclpy, node, lambda: probe.status)
+    status = probe.status[-1].status[0]
+    values = {kv.key: kv.value for kv in status.values}
+    assert status.name == 'sim' and status.level == 0 and values['scene'] == 'set_locations'
+    assert float(values['real_time_factor']) > 0.2 and values['time_mode'] == 'realtime'
 
     # a velocity command from outside moves joint 1 at the commanded rate
     q0 = probe.q()[0]
