@@ -91,6 +91,8 @@ class GraspPolicy:
         self._gripper = GripperCommand(params.gripper_open_position, 0.0)
         self._last_opening: tuple[float, float] | None = None  # (time, opening)
         self._stall_since: float | None = None
+        self._contact_since: float | None = None   # all fingers touching since (s)
+        self._hold_since: float | None = None      # compliant hold commanded since (s)
         self._after_retreat = ''
         self._retreat_reason = ''
         self._lost_since: float | None = None
@@ -304,8 +306,20 @@ class GraspPolicy:
         self._t0 = t
         self._stall_since = None
         self._last_opening = None
+        self._contact_since = None
+        self._hold_since = None
         self._gripper = GripperCommand(self.params.gripper_closed_position,
                                        self.params.shape_value(self.shape, 'close_force'))
+
+    def _set_hold(self, gripper: GripperState) -> None:
+        """Force control of a torque-limited hand: command the fingers ``grip_squeeze`` past
+        where they touch the object, so the grip is a stiff position equilibrium. Closing on with
+        full torque lets the stronger thumb push the object out between the two fingers."""
+        p = self.params
+        if p.grip_squeeze <= 0:
+            return
+        closure = min((1.0 - gripper.opening) + p.grip_squeeze, p.gripper_closed_position)
+        self._gripper = GripperCommand(closure, self._gripper.max_force)
 
     def _holding(self, gripper: GripperState | None) -> tuple[bool, str]:
         if gripper is None:
@@ -358,17 +372,21 @@ class GraspPolicy:
                 else:
                     self._stall_since = None
                 self._last_opening = (t, gripper.opening)
-            if (elapsed >= 0.3 and stalled) or elapsed >= p.close_timeout:
+                n = gripper.fingers_in_contact
+                if self._hold_since is None and n is not None and n >= p.min_fingers_in_contact:
+                    # every finger touches: stop closing and hold a little past this point
+                    self._contact_since = self._contact_since if self._contact_since is not None \
+                        else t
+                    if t - self._contact_since >= p.contact_settle_time:
+                        self._set_hold(gripper)
+                        self._hold_since = t
+            held_long = self._hold_since is not None and t - self._hold_since >= p.settle_time
+            if (elapsed >= 0.3 and stalled) or held_long or elapsed >= p.close_timeout:
                 ok, why = self._holding(gripper)
                 if not ok:
                     return self._fail(t, q, why, can_retry)
-                if gripper is not None and p.grip_squeeze > 0:
-                    # hold: fingers a little past where they stalled on the object, so the grip
-                    # is a stiff position equilibrium instead of a torque-limited squeeze that
-                    # lets the stronger thumb push the object out between the fingers
-                    closure = min((1.0 - gripper.opening) + p.grip_squeeze,
-                                  p.gripper_closed_position)
-                    self._gripper = GripperCommand(closure, self._gripper.max_force)
+                if self._hold_since is None and gripper is not None:
+                    self._set_hold(gripper)
                 tool = self.kinematics.tool_position(q)
                 self.phase = 'lift'
                 self._start_line(t, q, tool + np.array([0.0, 0.0, p.lift_height]))

@@ -115,7 +115,8 @@ class FsmParams:
     gripper_closed_position: float = 1.0
     close_timeout: float = 2.0          # s to reach contact
     stall_rate: float = 0.05            # 1/s opening change below which the fingers have stalled
-    grip_squeeze: float = 0.15          # closure (0..1) held past the stall point; 0: full close
+    grip_squeeze: float = 0.15          # closure (0..1) held past the contact point; 0: full close
+    contact_settle_time: float = 0.05   # s all fingers touch before the closing stops
     contact_min_force: float = 1.0      # N finger force that counts as contact
     min_fingers_in_contact: int = 3     # fingers that must touch for a firm grasp (contact sensing)
     closed_empty_opening: float = 0.05  # opening (0 closed .. 1 open) below which the hand is empty
