@@ -119,6 +119,7 @@ class _Robot:
     v_cmd: np.ndarray
     closure: float = 0.0
     gripper_dirty: bool = True
+    holding: bool = False     # zero command already given to the motors: nothing to update
 
 
 def _quat_to_matrix(quat: np.ndarray) -> np.ndarray:
@@ -392,6 +393,7 @@ class Simulation:
             robot.v_cmd = np.zeros(6)
             robot.closure = 0.0
             robot.gripper_dirty = True
+            robot.holding = False
         self._step_count = 0
 
     # ------------------------------------------------------------------ time and commands
@@ -430,7 +432,9 @@ class Simulation:
         Raises SimError for a wrong length or NaN/inf (the previous command stays in force).
         """
         v = validate_velocities(velocities, 6)
-        self._robot(robot).v_cmd = np.clip(v, -self.max_velocity, self.max_velocity)
+        r = self._robot(robot)
+        r.v_cmd = np.clip(v, -self.max_velocity, self.max_velocity)
+        r.holding = False
 
     def stop(self, robot: str = 'user') -> None:
         """Zero velocity command (the arm holds its current reference)."""
@@ -455,6 +459,7 @@ class Simulation:
             self._p.resetJointState(r.body, j, q[i], 0.0)
         r.q_ref = q.copy()
         r.v_cmd = np.zeros(6)
+        r.holding = False
 
     def step(self, n: int = 1) -> None:
         """Advance the physics by ``n`` steps of ``1 / physics_hz`` s."""
@@ -462,16 +467,15 @@ class Simulation:
         dt = self.dt
         for _ in range(int(n)):
             for r in self._robots.values():
-                q = np.array([s[0] for s in p.getJointStates(r.body, self._arm_idx)])
-                # keep the reference near the real joints (a blocked arm does not wind up)
-                q_ref = np.clip(r.q_ref, q - 0.05, q + 0.05)
-                new_ref = np.clip(q_ref + r.v_cmd * dt, self.lower, self.upper)
-                v_ff = (new_ref - q_ref) / dt
-                r.q_ref = new_ref
-                p.setJointMotorControlArray(
-                    r.body, self._arm_idx, pb.POSITION_CONTROL, targetPositions=new_ref,
-                    targetVelocities=v_ff, forces=self.max_effort,
-                    positionGains=[ARM_POSITION_GAIN] * 6, velocityGains=[1.0] * 6)
+                if r.v_cmd.any():
+                    self._track(p, r, dt)
+                elif not r.holding:
+                    # stopping: hold the current reference (set once, then left alone)
+                    p.setJointMotorControlArray(
+                        r.body, self._arm_idx, pb.POSITION_CONTROL, targetPositions=r.q_ref,
+                        targetVelocities=[0.0] * 6, forces=self.max_effort,
+                        positionGains=[ARM_POSITION_GAIN] * 6, velocityGains=[1.0] * 6)
+                    r.holding = True
                 if r.gripper_dirty:
                     target = FINGER_OPEN + (FINGER_CLOSED - FINGER_OPEN) * r.closure
                     for k, j in enumerate(self._finger_idx):
@@ -482,6 +486,19 @@ class Simulation:
                     r.gripper_dirty = False
             p.stepSimulation()
             self._step_count += 1
+
+    def _track(self, p: BulletClient, r: _Robot, dt: float) -> None:
+        """Advance the joint reference by the velocity command and send it to the motors."""
+        q = np.array([s[0] for s in p.getJointStates(r.body, self._arm_idx)])
+        # keep the reference near the real joints (a blocked arm does not wind up)
+        q_ref = np.clip(r.q_ref, q - 0.05, q + 0.05)
+        new_ref = np.clip(q_ref + r.v_cmd * dt, self.lower, self.upper)
+        v_ff = (new_ref - q_ref) / dt
+        r.q_ref = new_ref
+        p.setJointMotorControlArray(
+            r.body, self._arm_idx, pb.POSITION_CONTROL, targetPositions=new_ref,
+            targetVelocities=v_ff, forces=self.max_effort,
+            positionGains=[ARM_POSITION_GAIN] * 6, velocityGains=[1.0] * 6)
 
     # ------------------------------------------------------------------ state
     def joint_positions(self, robot: str = 'user') -> np.ndarray:
