@@ -177,6 +177,8 @@ class Simulation:
         Number of random objects (random scenes); None: the scene file's number.
     urdf : str | Path | None
         Robot description (default ``config/robots/mindgrasp_arm.urdf``).
+    solver_iterations : int
+        Constraint solver iterations per step (contacts and motors; 50 holds grasps well).
     """
 
     joint_names: tuple[str, ...] = ARM_JOINTS
@@ -232,6 +234,13 @@ class Simulation:
         names = {p.getJointInfo(self._robots['user'].body, j)[1].decode():
                  j for j in range(p.getNumJoints(self._robots['user'].body))}
         self._names = names
+        missing = [n for n in (*ARM_JOINTS, *FINGER_JOINTS, 'tcp_joint', 'camera_joint')
+                   if n not in names]
+        if missing:
+            msg = (f'Robot description {str(self.urdf)!r} lacks the joints {missing}; a MIndGrasp '
+                   'arm needs joint_1..joint_6, the three finger joints, tcp_joint and '
+                   'camera_joint (see mindgrasp_sim.robot_model).')
+            raise SimError(msg)
         self._arm_idx = [names[n] for n in ARM_JOINTS]
         self._finger_idx = [names[n] for n in FINGER_JOINTS]
         self._tcp_idx = names['tcp_joint']

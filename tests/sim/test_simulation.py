@@ -315,6 +315,13 @@ def test_bad_construction_arguments():
         s.reset(new_random_draw=True)
 
 
+def test_foreign_urdf_is_refused_with_the_missing_joints(tmp_path):
+    urdf = tmp_path / 'arm.urdf'
+    urdf.write_text(build_urdf().replace('joint_6', 'wrist_roll'))
+    with pytest.raises(SimError, match=r"lacks the joints \['joint_6'\]"):
+        Simulation(urdf=urdf)
+
+
 def test_gui_without_display_is_refused(monkeypatch):
     monkeypatch.setenv('DISPLAY', '')
     with pytest.raises(SimError, match='gui=True needs a display'):
