@@ -440,15 +440,17 @@ class SimNode(rclpy.node.Node):
         self._wall_start = time.monotonic()
         cpu0 = time.process_time()
         steps0 = self.total_steps
-        while rclpy.ok() and not self.finished:
-            rclpy.spin_once(self, timeout_sec=0.05)
-        wall = time.monotonic() - self._wall_start
-        simulated = (self.total_steps - steps0) * self.sim.dt
-        cpu = time.process_time() - cpu0
-        self.get_logger().info(
-            f'Simulated {simulated:.2f} s in {wall:.2f} s wall time: real-time factor '
-            f'{simulated / max(wall, 1e-9):.2f}x ({simulated / max(cpu, 1e-9):.2f}x per CPU '
-            'second of this process).')
+        try:
+            while rclpy.ok() and not self.finished:
+                rclpy.spin_once(self, timeout_sec=0.05)
+        finally:    # also after Ctrl-C
+            wall = time.monotonic() - self._wall_start
+            simulated = (self.total_steps - steps0) * self.sim.dt
+            cpu = time.process_time() - cpu0
+            self.get_logger().info(
+                f'Simulated {simulated:.2f} s in {wall:.2f} s wall time: real-time factor '
+                f'{simulated / max(wall, 1e-9):.2f}x ({simulated / max(cpu, 1e-9):.2f}x per CPU '
+                'second of this process).')
 
     def destroy_node(self) -> None:
         self.sim.close()
