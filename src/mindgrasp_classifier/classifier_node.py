@@ -181,7 +181,7 @@ class ClassifierNode(rclpy.node.Node):
         self._state = (level, message)
         if old[0] != level or (level != DiagnosticStatus.OK and old[1].split(':')[0]
                                != message.split(':')[0]):
-            if level != DiagnosticStatus.OK and not message.startswith('Filling'):
+            if level == DiagnosticStatus.WARN and not message.startswith('Filling'):
                 self.get_logger().warning(message)
             self.status_callback()
 

@@ -141,3 +141,36 @@ def test_node_refuses_missing_model_and_wrong_classes(spawn_node, tmp_path, mode
                       f'model:={model_path}', '-p', 'classes:=[left_hand, right_hand]')
     assert proc.wait(60) == 1
     assert "are expected; train the model on those classes" in proc.output()
+
+
+def test_node_adapts_class_means_from_prompts(spawn_node, source, model_path, rclpy_ctx):
+    from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import Prompt
+
+    latched = rclpy_ctx.qos.QoSProfile(
+        depth=10, reliability=rclpy_ctx.qos.ReliabilityPolicy.RELIABLE,
+        durability=rclpy_ctx.qos.DurabilityPolicy.TRANSIENT_LOCAL)
+    prompts = source.node.create_publisher(Prompt, '/trainer/prompt', latched)
+    proc = spawn_node('mindgrasp_classifier.classifier_node', '--ros-args', '-p',
+                      f'model:={model_path}', '-p', 'duration:=60.0', '-p', 'status_period:=0.5',
+                      '-p', 'adaptation:=supervised', '-p', 'adaptation_rate:=0.01')
+    assert proc.wait_for_output('Loaded', 60), proc.output()
+    assert source.wait_matched()
+    cue = Prompt(paradigm='graz', class_index=0, class_name='left_hand', phase='cue', trial=1,
+                 duration=4.0)
+    cue.header.stamp.sec, cue.header.stamp.nanosec = 1000, 0       # stream time of sample 0
+    prompts.publish(cue)
+    source.spin(1.0)
+    rec = make_recording(classes=(0,), trials_per_class=1, seed=3)
+    for k in range(0, round(3 * RATE), 4):
+        source.publish(rec.data[k:k + 4], k)
+        source.spin(0.01)
+
+    def updates() -> int:
+        for s in reversed(source.status):
+            values = {kv.key: kv.value for kv in s.status[0].values}
+            if 'adaptive_updates' in values:
+                return int(values['adaptive_updates'])
+        return 0
+
+    assert source.spin(10.0, until=lambda: updates() >= 10), (updates(), proc.output())
+    assert 'adaptation supervised' in proc.output()
