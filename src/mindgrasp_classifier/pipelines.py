@@ -273,3 +273,16 @@ def classifier_from_arrays(name: str, classes: np.ndarray,
         msg = f'The model names an unknown pipeline {name!r}; known: {list(PIPELINES)}.'
         raise ClassifierError(msg)
     return _CLASSES[name].from_arrays(classes, arrays)
+
+
+def make_pipeline(name: str = 'mdm', estimator: str = 'oas'):
+    """A scikit-learn pipeline on band-passed windows: pyRiemann ``Covariances`` + classifier.
+
+    For use with scikit-learn tools (``cross_val_score``, grid search) on epochs of shape
+    (n_windows, n_channels, n_samples); the online decoder uses the same pieces.
+    """
+    from pyriemann.estimation import Covariances
+    from sklearn.pipeline import Pipeline
+
+    return Pipeline([('covariances', Covariances(estimator=estimator)),
+                     ('classifier', make_classifier(name))])

@@ -254,3 +254,16 @@ def test_oas_equals_pyriemann():
     x = rng.randn(6, 8, 100) * 5.0 + 2.0
     np.testing.assert_allclose(oas_covariances(x), Covariances(estimator='oas').transform(x),
                                rtol=1e-10, atol=1e-12)
+
+
+@pytest.mark.parametrize('name', PIPELINES)
+def test_sklearn_pipeline_cross_validates(name):
+    from sklearn.model_selection import cross_val_score
+
+    from mindgrasp_classifier.pipelines import make_pipeline
+
+    rng = np.random.RandomState(1234)
+    mix = [np.diag(rng.uniform(0.3, 3.0, 6)) for _ in range(2)]
+    x = np.array([mix[i % 2] @ rng.randn(6, 128) for i in range(40)])
+    y = np.arange(40) % 2
+    assert cross_val_score(make_pipeline(name), x, y, cv=4).mean() > 0.9

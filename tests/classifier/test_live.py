@@ -22,7 +22,7 @@ def test_live_agrees_with_offline(tmp_path):
     model, _ = train([make_recording(trials_per_class=6, seed=0)], TrainingConfig(channels='all'),
                      cross_validate=False)
     path = model.save(tmp_path / 'm')
-    rec = make_recording(trials_per_class=2, seed=21)
+    rec = make_recording(trials_per_class=1, seed=21)       # 24 s, played in real time
     # extra sensor noise, so that the model makes mistakes and agreement is not trivial
     rec.data = rec.data + np.random.RandomState(5).randn(*rec.data.shape) * 10e-6
     bag = write_run_bag(tmp_path / 'run', rec, drop=())
