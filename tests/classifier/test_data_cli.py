@@ -17,7 +17,7 @@ from .classifier_synth import RATE, make_recording
 NO_CLASS = 255
 
 
-def write_run_bag(path, rec, t0=500.0, chunk=4, drop=(40, 41)):
+def write_run_bag(path, rec, t0=500.0, chunk=4, drop=(40, 41), writer_kind='rosbags'):
     """A rosbag2 (MCAP) with /eeg/raw chunks and Graz prompts, as a recorded run would have."""
     from rosbags.rosbag2 import StoragePlugin, Writer
 
@@ -45,10 +45,21 @@ def write_run_bag(path, rec, t0=500.0, chunk=4, drop=(40, 41)):
                            duration=3.0)
             p.header.stamp.sec, p.header.stamp.nanosec = ns // 10**9, ns % 10**9
             msgs.append((ns, '/trainer/prompt', prompt_t, p))
+    msgs.sort(key=lambda x: x[0])
+    topics = (('/eeg/raw', eeg_t), ('/trainer/prompt', prompt_t))
+    if writer_kind == 'mindgrasp':        # the project's recorder (mindgrasp bag record)
+        from mindgrasp_bringup.bag.writer import BagWriter
+
+        with BagWriter(path) as writer:
+            for topic, typ in topics:
+                writer.add_topic(topic, typ)
+            for ns, topic, typ, m in msgs:
+                writer.write(topic, ns, store.serialize_cdr(m, typ))
+        return path
     with Writer(path, version=9, storage_plugin=StoragePlugin.MCAP) as writer:
         conns = {topic: writer.add_connection(topic, typ, typestore=store)
-                 for topic, typ in (('/eeg/raw', eeg_t), ('/trainer/prompt', prompt_t))}
-        for ns, topic, typ, m in sorted(msgs, key=lambda x: x[0]):
+                 for topic, typ in topics}
+        for ns, topic, typ, m in msgs:
             writer.write(conns[topic], ns, store.serialize_cdr(m, typ))
     return path
 
@@ -73,6 +84,14 @@ def test_load_bag_recovers_data_and_cues(bags):
     ok = np.ones(len(rec.data), bool)
     ok[gap] = False
     np.testing.assert_allclose(loaded.data[ok], rec.data[ok], rtol=1e-6)
+
+
+def test_load_bag_written_by_the_project_recorder(tmp_path):
+    pytest.importorskip('mindgrasp_bringup.bag.writer')
+    rec = make_recording(trials_per_class=1, seed=2)
+    loaded = load_bag(write_run_bag(tmp_path / 'rec', rec, drop=(), writer_kind='mindgrasp'))
+    np.testing.assert_array_equal(loaded.events, rec.events)
+    np.testing.assert_allclose(loaded.data, rec.data, rtol=1e-6)
 
 
 def test_load_bag_errors(tmp_path, bags):
