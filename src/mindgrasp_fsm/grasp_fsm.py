@@ -87,14 +87,14 @@ class GraspFsm:
 
     @classmethod
     def from_params(cls, params: FsmParams | None = None) -> GraspFsm:
-        """Controller with the robot model named by ``params.robot_description`` (URDF)."""
+        """Controller with the robot model named by ``params.urdf_file`` (URDF)."""
         from pathlib import Path
 
         from mindgrasp_fsm.kinematics import UrdfKinematics
         from mindgrasp_fsm.params import default_params_path
 
         params = params or FsmParams()
-        urdf = Path(params.robot_description).expanduser()
+        urdf = Path(params.urdf_file).expanduser()
         if not urdf.is_absolute():
             urdf = default_params_path().parents[2] / urdf
         kinematics = UrdfKinematics(str(urdf), params.joint_names, params.tool_link,

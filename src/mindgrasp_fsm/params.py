@@ -25,7 +25,7 @@ class FsmParams:
 
     # --- general -------------------------------------------------------------------------------
     autonomous: bool = False            # no BCI: search left, approach and grasp on vision alone
-    robot_description: str = 'config/robots/mindgrasp_arm.urdf'  # URDF for FK / IK (repo-relative)
+    urdf_file: str = 'config/robots/mindgrasp_arm.urdf'  # URDF for FK / IK (repo-relative)
     tool_link: str = 'tcp'              # grasp point between the fingertips
     camera_link: str = 'camera_color_optical_frame'
     joint_names: list[str] = field(default_factory=lambda: [f'joint_{i}' for i in range(1, 7)])

@@ -49,3 +49,12 @@ def test_per_shape_values() -> None:
     p = FsmParams(sphere_grasp_height_fraction=0.4)
     assert p.shape_value('sphere', 'grasp_height_fraction') == 0.4
     assert p.shape_value('unknown', 'approach_height') == p.cube_approach_height
+
+
+def test_missing_robot_model_is_named() -> None:
+    from mindgrasp_fsm.grasp_fsm import GraspFsm
+
+    with pytest.raises(FsmError, match=r'Cannot read the robot description .*nope\.urdf'):
+        GraspFsm.from_params(FsmParams(urdf_file='/nonexistent/nope.urdf'))
+    with pytest.raises(FsmError, match=r"The link 'gripper_tip' is not in"):
+        GraspFsm.from_params(FsmParams(tool_link='gripper_tip'))
