@@ -76,6 +76,7 @@ class ClassifierNode(rclpy.node.Node):
             recenter_rate=self.p['recenter_rate'])
         self.adaptation.check()
         self.cues = CueLabels(self.p['label_tmin'], self.p['label_tmax'])
+        self._last_trial = -1
         self.decoder: MiDecoder | None = None
         self.error: str | None = None
         self.n_predictions = 0
@@ -162,8 +163,11 @@ class ClassifierNode(rclpy.node.Node):
         self.n_predictions += 1
 
     def prompt_callback(self, msg: Prompt) -> None:
-        """Remember cue onsets for supervised adaptation."""
-        if msg.class_index != Prompt.NO_CLASS and msg.phase in ('cue', 'move'):
+        """Remember cue onsets (first classed prompt of a trial, as training epochs) for
+        supervised adaptation."""
+        if (msg.class_index != Prompt.NO_CLASS and msg.phase in ('cue', 'move')
+                and msg.trial != self._last_trial):
+            self._last_trial = msg.trial
             self.cues.add(msg.header.stamp.sec + 1e-9 * msg.header.stamp.nanosec,
                           int(msg.class_index))
 
