@@ -108,13 +108,21 @@ class ClassifierNode(rclpy.node.Node):
         if self.error is not None:
             return
         n_ch = len(msg.channel_names)
+        layout = (list(msg.channel_names), float(msg.sample_rate))
         if self.decoder is None:
             try:
-                self.decoder = MiDecoder(self.model, list(msg.channel_names), msg.sample_rate,
+                self.decoder = MiDecoder(self.model, layout[0], layout[1],
                                          self.adaptation, self.p['flat_threshold'])
             except ClassifierError as exc:
                 self.fail(str(exc))
                 return
+            self._layout = layout
+        elif layout != self._layout:
+            self.fail(f'The EEG stream on /eeg/raw changed from {len(self._layout[0])} channels '
+                      f'at {self._layout[1]:g} Hz to {n_ch} channels at {layout[1]:g} Hz '
+                      '(another amplifier or a second publisher?); keep one stream per topic '
+                      'and restart the classifier.')
+            return
         data = np.asarray(msg.data, dtype=float)
         if n_ch == 0 or data.size != int(msg.n_samples) * n_ch:
             self.set_state(DiagnosticStatus.WARN, f'Dropped a malformed EEG chunk ({data.size} '

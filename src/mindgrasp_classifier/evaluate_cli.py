@@ -26,10 +26,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--json', action='store_true',
                         help='print the results as one JSON object on the last line')
     parser.add_argument('--live', action='store_true',
-                        help='also stream the data through LSL, the acquisition node and the '
-                             'classifier node, and score the published predictions')
-    parser.add_argument('--speed', type=float, default=1.0,
-                        help='--live playback speed relative to real time (1.0)')
+                        help='also stream the data in real time through LSL, the acquisition '
+                             'node and the classifier node, and score the published predictions')
 
 
 def main(args: argparse.Namespace) -> int:
@@ -49,7 +47,7 @@ def main(args: argparse.Namespace) -> int:
         from mindgrasp_classifier.live import evaluate_live
 
         try:
-            live = evaluate_live(args.model, recordings, args.tmin, args.tmax, speed=args.speed)
+            live = evaluate_live(args.model, recordings, args.tmin, args.tmax)
         except ClassifierError as exc:
             print(f'mindgrasp evaluate classifier --live: {exc}', file=sys.stderr)
             return 1

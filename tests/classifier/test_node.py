@@ -174,3 +174,21 @@ def test_node_adapts_class_means_from_prompts(spawn_node, source, model_path, rc
 
     assert source.spin(10.0, until=lambda: updates() >= 10), (updates(), proc.output())
     assert 'adaptation supervised' in proc.output()
+
+
+def test_node_stops_when_the_stream_layout_changes(spawn_node, source, model_path):
+    proc = spawn_node('mindgrasp_classifier.classifier_node', '--ros-args', '-p',
+                      f'model:={model_path}', '-p', 'duration:=60.0')
+    assert proc.wait_for_output('Loaded', 60), proc.output()
+    assert source.wait_matched()
+    rec = make_recording(trials_per_class=1, seed=3)
+    for k in range(0, 64, 4):
+        source.publish(rec.data[k:k + 4], k)
+        source.spin(0.01)
+    extra = np.hstack([rec.data[64:68], rec.data[64:68, :1]])
+    deadline = time.monotonic() + 20
+    while proc.proc.poll() is None and time.monotonic() < deadline:
+        source.publish(extra, 64, channels=[*CHANNELS, 'Oz'])
+        source.spin(0.2)
+    assert proc.wait(10) == 1
+    assert 'changed from 12 channels at 128 Hz to 13 channels at 128 Hz' in proc.output()
