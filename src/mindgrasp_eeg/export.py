@@ -66,20 +66,9 @@ def find_bag(path: str | Path) -> Path:
 
 
 def _typestore():
-    try:
-        from mindgrasp_ros.typesupport import typestore
+    from mindgrasp_ros.typesupport import typestore
 
-        return typestore()
-    except ImportError:          # without the ROS layer: the Jazzy store + our .msg files
-        from rosbags.typesys import Stores, get_types_from_msg, get_typestore
-
-        store = get_typestore(Stores.ROS2_JAZZY)
-        msg_dir = Path(__file__).resolve().parents[1] / 'mindgrasp_msgs' / 'msg'
-        types = {}
-        for f in msg_dir.glob('*.msg'):
-            types.update(get_types_from_msg(f.read_text(), f'mindgrasp_msgs/msg/{f.stem}'))
-        store.register(types)
-        return store
+    return typestore()
 
 
 def _stamp_ns(header: object) -> int:

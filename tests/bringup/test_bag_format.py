@@ -222,20 +222,3 @@ def test_missing_and_corrupt_bags_give_clear_errors(tmp_path):
     (bag2 / 'run_0.mcap').unlink()
     with pytest.raises(BagError, match=r'is not a rosbag2 bag|cannot be read'):
         BagReader(bag2).open()
-
-
-def test_fallback_type_store_matches_the_client_layer():
-    """The bag package's own mindgrasp_msgs parsing gives the client layer's definitions."""
-    from rosbags.typesys import Stores, get_typestore
-
-    from mindgrasp_bringup.bag.typestore import custom_types
-
-    fallback = get_typestore(Stores.ROS2_JAZZY)
-    fallback.register(custom_types())
-    shared = typestore()
-    names = [n for n in custom_types() if n.startswith('mindgrasp_msgs/')]
-    assert 'mindgrasp_msgs/msg/EEGChunk' in names and 'mindgrasp_msgs/srv/Step_Request' in names
-    for name in names:
-        assert fallback.hash_rihs01(name) == shared.hash_rihs01(name), name
-        assert fallback.generate_msgdef(name, ros_version=2) == \
-            shared.generate_msgdef(name, ros_version=2), name
