@@ -89,7 +89,7 @@ def _add_command(subparsers: argparse._SubParsersAction, name: str, module_name:
         module.add_arguments(parser)
 
 
-def _import(module_name: str):  # noqa: ANN202 - returns a module
+def _import(module_name: str):
     try:
         return importlib.import_module(module_name)
     except ModuleNotFoundError as exc:

@@ -121,6 +121,7 @@ class GraspFsm:
         self._sweep = 0
         self._sweep_dir = 1.0
         self._ignore_from: float | None = None
+        self._gave_up_at = -math.inf
         self._return_lift: bool | None = None
         self._attempt = 0
         self._outcome = ''
@@ -333,7 +334,14 @@ class GraspFsm:
         elif cls == MiClass.RIGHT_HAND:
             v[0] = -p.search_gain * cert
         elif cls == MiClass.BOTH_HANDS:
+            if ooi is not None and self._ignore_from is not None and \
+                    abs(q[0] - self._ignore_from) < p.bci_reselect_angle and \
+                    t - self._gave_up_at < p.bci_reselect_delay:
+                # it could not be centred from here: without this, selecting it again at once
+                # flips between states 1 and 2 every tick
+                return v, f'the {ooi.label} cannot be centred from here: turn left or right'
             if ooi is not None:
+                self._ignore_from = None
                 self._center_next = State.INITIAL_APPROACH
                 self._goto(State.CENTER_OBJECT, f'both-hands MI selected the {ooi.label}')
                 return v, 'selected'
@@ -411,6 +419,7 @@ class GraspFsm:
         if abs(v[0]) > 1e-3:
             self._sweep_dir = -float(np.sign(v[0]))
         self._ignore_from = float(q[0])
+        self._gave_up_at = self._clock
         self._goto(State.OBJECT_SEARCH, reason)
 
     # ---------------------------------------------------------------------------- state 3

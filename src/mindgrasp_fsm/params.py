@@ -55,6 +55,10 @@ class FsmParams:
     autonomous_search_tilts: list[float] = field(default_factory=lambda: [0.15, 0.15, 0.3, 0.0])
     search_confirm_time: float = 0.2    # s an object must be seen before it is taken
     search_ignore_angle: float = 1.0    # rad joint 1 turns away from an object it could not centre
+    # BCI mode: after an object could not be centred, both-hands MI does not select again until
+    # joint 1 has turned this far (rad) or this long has passed (s); the user turns first
+    bci_reselect_angle: float = 0.1
+    bci_reselect_delay: float = 3.0
     # --- state 2: center object ----------------------------------------------------------------
     center_gain_joint1: float = 1.5     # rad/s per unit normalised x error (error / width)
     center_gain_joint5: float = 1.5     # rad/s per unit normalised y error (error / height)

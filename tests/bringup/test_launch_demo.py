@@ -27,14 +27,18 @@ def test_demo_runs_headless_ends_cleanly_and_records_the_session(tmp_path: Path)
     run_dir = tmp_path / 'run'
     stream = f'mg-demo-test-{uuid.uuid4().hex[:8]}'  # LSL names are host-wide
     # generous stop timeout: this machine may be loaded by other test runs
-    result = run_launch('demo', 'duration:=30', f'eeg_stream:={stream}', 'target_colour:=blue',
-                        '--sigint-timeout', '20', '--run-dir', str(run_dir), timeout=300)
+    # one trial: the virtual subject (pursue) must drive the arm to grasp the red cube; the
+    # trial manager then ends the launch (duration is only a safety net)
+    result = run_launch('demo', 'duration:=150', f'eeg_stream:={stream}', 'trials:=1',
+                        "targets:=red cube", '--sigint-timeout', '20', '--run-dir', str(run_dir),
+                        timeout=400)
     assert result.returncode == 0, result.stderr[-4000:]
     summary = yaml.safe_load((run_dir / 'summary.yaml').read_text())
-    assert summary['stop_reason'] == 'duration of 30 s reached'
     assert {p['label'] for p in summary['processes']} == {
-        'recorder', 'task', 'sim', 'virtual_amp', 'eeg_acquisition', 'classifier', 'vision',
-        'fsm'}
+        'recorder', 'trial_manager', 'sim', 'virtual_amp', 'eeg_acquisition', 'classifier',
+        'vision', 'fsm'}
+    log = (run_dir / 'logs' / 'trial_manager.log').read_text()
+    assert 'Trial 1 (red cube): correct object grasped' in log, log[-2000:]
     for label in ('sim', 'eeg_acquisition', 'classifier', 'vision', 'fsm'):
         assert (run_dir / 'logs' / f'{label}.log').stat().st_size > 0, label
     from mindgrasp_bringup.bag.reader import BagReader
@@ -43,5 +47,5 @@ def test_demo_runs_headless_ends_cleanly_and_records_the_session(tmp_path: Path)
         reader.open()
         counts = {name: info.message_count for name, info in reader.topics.items()}
     for topic in ('/eeg/raw', '/joint_states', '/camera/color/image_raw', '/task/target',
-                  '/bci/prediction', '/vision/detections', '/fsm/state'):
+                  '/bci/prediction', '/vision/detections', '/fsm/state', '/task/result'):
         assert counts.get(topic, 0) > 0, (topic, counts)

@@ -20,10 +20,11 @@ def test_mine_and_the_helpers_profiles_exist() -> None:
 
 def test_demo_starts_every_node_after_the_recorder() -> None:
     procs = processes('demo', 'seed:=4', 'eeg_stream:=amp-x')
-    assert list(procs) == ['recorder', 'task', 'sim', 'virtual_amp', 'eeg_acquisition',
+    assert list(procs) == ['recorder', 'trial_manager', 'sim', 'virtual_amp', 'eeg_acquisition',
                            'classifier', 'vision', 'fsm']
-    assert 'colour: red, shape: cube}' in ' '.join(procs['task'].program)
-    assert 'task' not in processes('demo', 'target_colour:=')
+    assert procs['trial_manager'].parameters['targets'] == 'red cube'
+    assert procs['trial_manager'].parameters['seed'] == 4
+    assert processes('demo', 'trials:=3')['trial_manager'].parameters['n_trials'] == 3
     assert procs['recorder'].daemon
     assert procs['sim'].module == 'mindgrasp_sim.sim_node'
     assert procs['sim'].parameters['seed'] == 4 and procs['sim'].parameters['gui'] is False

@@ -412,6 +412,25 @@ def test_object_beyond_the_joint1_limit_is_searched_the_other_way(params: FsmPar
     assert out.state == State.CENTER_OBJECT
 
 
+def test_bci_does_not_reselect_an_object_it_could_not_centre(params: FsmParams) -> None:
+    """Found in the demo: both-hands MI re-selected an object beyond the joint-1 limit on every
+    tick, flipping between states 1 and 2 at the control rate."""
+    fsm = GraspFsm.from_params(params)
+    fsm.force_state(State.CENTER_OBJECT, center_next=State.INITIAL_APPROACH)
+    q = HOME.copy()
+    q[0] = params.joint_upper_limits[0] - params.joint_limit_margin - 0.01
+    left = observation(20, 64)
+    out = fsm.tick(inputs(0.0, q=q, cls=MiClass.BOTH_HANDS, obs=left))
+    assert out.state == State.OBJECT_SEARCH and 'joint 1 is at its limit' in out.reason
+    outs, t = run(fsm, 0.02, params.bci_reselect_delay - 0.1, q=q, cls=MiClass.BOTH_HANDS,
+                  obs=left)
+    assert all(o.state == State.OBJECT_SEARCH for o in outs)
+    assert 'turn left or right' in outs[-1].phase
+    q[0] -= params.bci_reselect_angle + 0.05  # the user turned right: it may be selected again
+    out = fsm.tick(inputs(t, q=q, cls=MiClass.BOTH_HANDS, obs=left))
+    assert out.state == State.CENTER_OBJECT
+
+
 def test_centring_timeout_far_off_centre_searches_again(params: FsmParams) -> None:
     params.center_timeout = 0.3
     params.center_gain_joint1 = 0.0     # a centring that gets nowhere

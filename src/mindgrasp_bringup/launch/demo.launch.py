@@ -2,25 +2,24 @@
 acquisition, MI classifier, vision and the grasp controller, recorded to the run directory.
 
     mindgrasp launch demo                          # until Ctrl-C; runs/<UTC time>_demo/
-    mindgrasp launch demo duration:=120 gui:=true target_colour:=blue target_shape:=sphere
+    mindgrasp launch demo duration:=120 gui:=true targets:='blue cylinder, red cube' trials:=2
     mindgrasp launch demo --show-args
 
-The task: grasp the target object; it is published (latched) on /task/target, where the virtual
-subject (subject:=pursue) reads what to imagine and the simulator which grasp counts as success.
+The task, as in the paper's set-locations experiment: the trial manager names the object to grasp
+on /task/target (latched), where the virtual subject (subject:=pursue) reads what to imagine and
+the simulator which grasp counts; after each grasp it resets the scene and starts the next trial.
 
 Parameters: config/params/<package>.yaml of each package, then config/params/demo.yaml (the demo's
 own settings), then the launch arguments below (later entries win).
 """
 
-import sys
 
 from mindgrasp_bringup.launch_system import (
     DeclareLaunchArgument,
-    ExecuteProcess,
     LaunchConfiguration,
-    LaunchConfigurationNotEquals,
     LaunchDescription,
     Node,
+    Shutdown,
     config_files,
 )
 from mindgrasp_bringup.launch_system.common import classifier_nodes
@@ -48,23 +47,18 @@ def generate_launch_description() -> LaunchDescription:
                               description='classifier model (.json written by mindgrasp train '
                                           'classifier); empty: the one in '
                                           'config/params/classifier.yaml'),
-        DeclareLaunchArgument('target_colour', default_value='red',
-                              choices=['red', 'yellow', 'blue', ''],
-                              description="colour of the object to grasp ('': no task)"),
-        DeclareLaunchArgument('target_shape', default_value='cube',
-                              choices=['cube', 'cylinder', 'sphere'],
-                              description='shape of the object to grasp'),
-        # 0 the task: which object to grasp (latched, so late joiners get it too)
-        ExecuteProcess(
-            name='task', output='log',
-            cmd=[sys.executable, '-m', 'mindgrasp_bringup', 'topic', 'pub', '/task/target',
-                 'mindgrasp_msgs/msg/TaskTarget',
-                 ['{trial: 1, object_id: -1, scene: demo, colour: ',
-                  LaunchConfiguration('target_colour'), ', shape: ',
-                  LaunchConfiguration('target_shape'), '}'],
-                 '--qos-durability', 'transient_local', '--rate', '0.1',
-                 '--wait-matching-subscriptions', '0'],
-            condition=LaunchConfigurationNotEquals('target_colour', '')),
+        DeclareLaunchArgument('targets', default_value='red cube',
+                              description='objects to grasp in turn, comma-separated ("red cube, '
+                                          'blue sphere"); empty: drawn at random from the scene'),
+        DeclareLaunchArgument('trials', default_value='0',
+                              description='grasp trials before the demo ends (0: until duration '
+                                          'or Ctrl-C)'),
+        # 0 the trials: which object to grasp, reset between grasps
+        Node(package='mindgrasp_bringup', executable='trial_manager_node', name='trial_manager',
+             parameters=[*config_files('demo'),
+                         {'targets': LaunchConfiguration('targets'),
+                          'n_trials': LaunchConfiguration('trials'), 'seed': seed}],
+             on_exit=Shutdown()),  # trials:=N done: the demo ends
         # 1 simulator: arm, gripper, objects, RGB-D camera (the arm contract of ros2_control)
         Node(package='mindgrasp_sim', executable='sim_node', name='sim',
              parameters=[*config_files('sim', 'demo'), {'gui': gui, 'seed': seed}]),
