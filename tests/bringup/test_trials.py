@@ -11,8 +11,10 @@ SCENE = [SceneObjectRef(i, c, s) for i, (c, s) in enumerate(
 
 
 def test_random_targets_are_seeded():
-    draws = [[TrialPlanner(seed=3).next_target(t, SCENE).label for t in range(1, 20)]
-             for _ in range(2)]
+    draws = []
+    for _ in range(2):
+        planner = TrialPlanner(seed=3)
+        draws.append([planner.next_target(t, SCENE).label for t in range(1, 20)])
     assert draws[0] == draws[1] and len(set(draws[0])) == 3
 
 
