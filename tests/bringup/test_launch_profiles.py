@@ -22,7 +22,8 @@ def test_demo_starts_every_node_after_the_recorder() -> None:
     procs = processes('demo', 'seed:=4', 'eeg_stream:=amp-x')
     assert list(procs) == ['recorder', 'trial_manager', 'sim', 'virtual_amp', 'eeg_acquisition',
                            'classifier', 'vision', 'fsm']
-    assert procs['trial_manager'].parameters['targets'] == 'red cube'
+    assert procs['trial_manager'].parameters['targets'] == 'red cube, blue cylinder, yellow sphere'
+    assert procs['trial_manager'].parameters['n_trials'] == 3
     assert procs['trial_manager'].parameters['seed'] == 4
     assert processes('demo', 'trials:=3')['trial_manager'].parameters['n_trials'] == 3
     assert procs['recorder'].daemon

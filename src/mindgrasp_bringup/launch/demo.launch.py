@@ -1,7 +1,8 @@
 """The headless main demo: simulated arm and camera, virtual amplifier + virtual subject, EEG
 acquisition, MI classifier, vision and the grasp controller, recorded to the run directory.
 
-    mindgrasp launch demo                          # until Ctrl-C; runs/<UTC time>_demo/
+    mindgrasp launch demo                          # 3 grasp trials, then ends; runs/<UTC>_demo/
+    mindgrasp launch demo trials:=0                # trials until Ctrl-C
     mindgrasp launch demo duration:=120 gui:=true targets:='blue cylinder, red cube' trials:=2
     mindgrasp launch demo --show-args
 
@@ -47,10 +48,10 @@ def generate_launch_description() -> LaunchDescription:
                               description='classifier model (.json written by mindgrasp train '
                                           'classifier); empty: the one in '
                                           'config/params/classifier.yaml'),
-        DeclareLaunchArgument('targets', default_value='red cube',
+        DeclareLaunchArgument('targets', default_value='red cube, blue cylinder, yellow sphere',
                               description='objects to grasp in turn, comma-separated ("red cube, '
                                           'blue sphere"); empty: drawn at random from the scene'),
-        DeclareLaunchArgument('trials', default_value='0',
+        DeclareLaunchArgument('trials', default_value='3',
                               description='grasp trials before the demo ends (0: until duration '
                                           'or Ctrl-C)'),
         # 0 the trials: which object to grasp, reset between grasps
