@@ -18,9 +18,9 @@ import numpy as np
 from mindgrasp_ros.interfaces.diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import EEGChunk
 
-from mindgrasp_eeg import EEGError
 from mindgrasp_eeg.acquisition import ERROR, OK, WARN, EEGAcquisition, ros_stamp_ns
 from mindgrasp_eeg.montage import NAUTILUS_32
+from mindgrasp_eeg.node_main import run_node
 from mindgrasp_eeg.ros_conversions import ns_to_time_fields
 from mindgrasp_ros import rclpy
 
@@ -127,26 +127,7 @@ class AcquisitionNode(rclpy.node.Node):
 
 def main(args: list[str] | None = None) -> int:
     """Run the node until Ctrl-C or ``duration``; exit 1 with a message on bad input."""
-    rclpy.init(args=args)
-    node = None
-    try:
-        node = AcquisitionNode()
-        # one executor for the node's lifetime (adding/removing a node per spin_once wakes the
-        # wait set every time, i.e. busy-waits)
-        executor = rclpy.executors.SingleThreadedExecutor()
-        executor.add_node(node)
-        while rclpy.ok() and not node.done:
-            executor.spin_once(timeout_sec=0.1)
-    except EEGError as exc:
-        print(f'[eeg_acquisition] ERROR: {exc}', file=sys.stderr, flush=True)
-        return 1
-    except KeyboardInterrupt:
-        pass
-    finally:
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
-    return 0
+    return run_node(AcquisitionNode, 'eeg_acquisition', args)
 
 
 if __name__ == '__main__':

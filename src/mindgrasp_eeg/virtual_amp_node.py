@@ -20,9 +20,9 @@ from mindgrasp_ros.interfaces.sensor_msgs.msg import JointState
 from mindgrasp_ros.interfaces.std_msgs.msg import String
 from mindgrasp_ros.interfaces.visualization_msgs.msg import MarkerArray
 
-from mindgrasp_eeg import EEGError
 from mindgrasp_eeg.lsl import EEGOutlet, MarkerOutlet
 from mindgrasp_eeg.montage import NAUTILUS_32, class_name
+from mindgrasp_eeg.node_main import run_node
 from mindgrasp_eeg.ros_conversions import base_yaw_from_joint_state, markers_to_objects, time_to_s
 from mindgrasp_eeg.subject import VirtualSubject
 from mindgrasp_eeg.synthetic import SyntheticEEG
@@ -145,26 +145,7 @@ class VirtualAmpNode(rclpy.node.Node):
 
 def main(args: list[str] | None = None) -> int:
     """Run until Ctrl-C or ``duration``; exit 1 with a message on bad parameters."""
-    rclpy.init(args=args)
-    node = None
-    try:
-        node = VirtualAmpNode()
-        # one executor for the node's lifetime (adding/removing a node per spin_once wakes the
-        # wait set every time, i.e. busy-waits)
-        executor = rclpy.executors.SingleThreadedExecutor()
-        executor.add_node(node)
-        while rclpy.ok() and not node.done:
-            executor.spin_once(timeout_sec=0.1)
-    except EEGError as exc:
-        print(f'[virtual_amp] ERROR: {exc}', file=sys.stderr, flush=True)
-        return 1
-    except KeyboardInterrupt:
-        pass
-    finally:
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
-    return 0
+    return run_node(VirtualAmpNode, 'virtual_amp', args)
 
 
 if __name__ == '__main__':
