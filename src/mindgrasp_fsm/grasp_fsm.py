@@ -122,6 +122,7 @@ class GraspFsm:
         self._sweep_dir = 1.0
         self._ignore_from: float | None = None
         self._gave_up_at = -math.inf
+        self._both_since: float | None = None   # since when both-hands is decoded without break
         self._return_lift: bool | None = None
         self._attempt = 0
         self._outcome = ''
@@ -313,6 +314,12 @@ class GraspFsm:
     def _search(self, t: float, q: np.ndarray, inputs: FsmInputs) -> tuple[np.ndarray, str]:
         p = self.params
         v = np.zeros(6)
+        g = inputs.gripper
+        if (self._gripper.position != p.gripper_open_position and g is not None
+                and (g.fingers_in_contact == 0 or g.contact is False)):
+            # closed on nothing (the scene was reset under the hand, or the object fell):
+            # the fingers only hide the camera's view, so open them
+            self._gripper = GripperCommand(p.gripper_open_position, 0.0)
         ooi = self._visible(inputs)
         if p.autonomous:
             if self._ignore_from is not None:
@@ -329,6 +336,10 @@ class GraspFsm:
                 return v, 'confirming'
             return self._sweep_step(q), f'sweep {self._sweep}'
         cls, cert = self._certainty(inputs)
+        if cls != MiClass.BOTH_HANDS:
+            self._both_since = None
+        elif self._both_since is None:
+            self._both_since = t
         if cls == MiClass.LEFT_HAND:
             v[0] = p.search_gain * cert
         elif cls == MiClass.RIGHT_HAND:
@@ -340,6 +351,8 @@ class GraspFsm:
                 # it could not be centred from here: without this, selecting it again at once
                 # flips between states 1 and 2 every tick
                 return v, f'the {ooi.label} cannot be centred from here: turn left or right'
+            if ooi is not None and t - self._both_since < p.bci_select_dwell:
+                return v, f'both hands for {t - self._both_since:.2f} s'
             if ooi is not None:
                 self._ignore_from = None
                 self._center_next = State.INITIAL_APPROACH

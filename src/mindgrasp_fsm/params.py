@@ -58,6 +58,9 @@ class FsmParams:
     # BCI mode: after an object could not be centred, both-hands MI does not select again until
     # joint 1 has turned this far (rad) or this long has passed (s); the user turns first
     bci_reselect_angle: float = 0.1
+    # BCI mode: both-hands must be decoded without a break for this long (s) before it selects
+    # the object in view; one misdecoded window of a left/right intent must not start a grasp
+    bci_select_dwell: float = 0.5
     bci_reselect_delay: float = 3.0
     # --- state 2: center object ----------------------------------------------------------------
     center_gain_joint1: float = 1.5     # rad/s per unit normalised x error (error / width)

@@ -10,7 +10,14 @@ import pytest
 
 from mindgrasp_fsm.grasp_fsm import GraspFsm, clamp_to_limits
 from mindgrasp_fsm.params import FsmParams
-from mindgrasp_fsm.types import FsmInputs, GripperState, JointStateIn, MiClass, State
+from mindgrasp_fsm.types import (
+    FsmInputs,
+    GripperCommand,
+    GripperState,
+    JointStateIn,
+    MiClass,
+    State,
+)
 
 from .conftest import HOME, inputs, observation, run
 
@@ -36,7 +43,7 @@ def _settle(fsm: GraspFsm, t: float, **kwargs: object) -> tuple[list, float]:
 # (name, start state, Center-Object continuation, autonomous, inputs, seconds, end state, locked)
 TRANSITIONS = [
     ('1->2 both hands selects the object', State.OBJECT_SEARCH, None, False,
-     {'cls': MiClass.BOTH_HANDS, 'obs': CENTRED}, 0.04, State.CENTER_OBJECT, False),
+     {'cls': MiClass.BOTH_HANDS, 'obs': CENTRED}, 0.54, State.CENTER_OBJECT, False),
     ('1->2 autonomous search sees an object', State.OBJECT_SEARCH, None, True,
      {'cls': None, 'obs': CENTRED}, 0.4, State.CENTER_OBJECT, False),
     ('2->3 centred after selection', State.CENTER_OBJECT, State.INITIAL_APPROACH, False,
@@ -87,6 +94,14 @@ def test_transition(params: FsmParams, name: str, start: State, center_next: Sta
         assert outs[-1].state == AFTER_LOCK[name]
         assert outs[-1].previous_state == start
         assert not outs[-1].locked
+
+
+def test_a_single_both_hands_window_does_not_select(fsm: GraspFsm) -> None:
+    """One misdecoded window while the user turns must not start a grasp (bci_select_dwell)."""
+    outs, t = run(fsm, 0.0, 0.3, cls=MiClass.BOTH_HANDS, obs=CENTRED)
+    outs2, _ = run(fsm, t, 0.04, cls=MiClass.LEFT_HAND, obs=CENTRED)
+    outs3, _ = run(fsm, t + 0.04, 0.3, cls=MiClass.BOTH_HANDS, obs=CENTRED)
+    assert all(o.state == State.OBJECT_SEARCH for o in outs + outs2 + outs3)
 
 
 def test_both_hands_without_object_stays_in_search(fsm: GraspFsm) -> None:
@@ -263,8 +278,8 @@ def test_4_to_6_abort_when_out_of_reach(fsm: GraspFsm) -> None:
 
 # ------------------------------------------------------------------------- locks, watchdog
 def test_no_lock_into_and_out_of_center(fsm: GraspFsm) -> None:
-    out = fsm.tick(inputs(0.0, cls=MiClass.BOTH_HANDS, obs=CENTRED))
-    assert out.state == State.CENTER_OBJECT and not out.locked
+    outs, _ = run(fsm, 0.0, 0.54, cls=MiClass.BOTH_HANDS, obs=CENTRED)  # dwell, then select
+    assert outs[-1].state == State.CENTER_OBJECT and not any(o.locked for o in outs)
 
 
 def test_lock_holds_all_joints_for_lock_duration(fsm: GraspFsm) -> None:
@@ -429,6 +444,19 @@ def test_bci_does_not_reselect_an_object_it_could_not_centre(params: FsmParams) 
     q[0] -= params.bci_reselect_angle + 0.05  # the user turned right: it may be selected again
     out = fsm.tick(inputs(t, q=q, cls=MiClass.BOTH_HANDS, obs=left))
     assert out.state == State.CENTER_OBJECT
+
+
+def test_search_opens_a_gripper_closed_on_nothing(params: FsmParams) -> None:
+    """Found in the demo: after a scene reset the hand stayed closed and its fingers hid the
+    next object from the camera."""
+    fsm = GraspFsm.from_params(params)
+    fsm._gripper = GripperCommand(1.0, 20.0)
+    holding = GripperState(0.3, 5.0, 0.0, contact=True, fingers_in_contact=3)
+    out = fsm.tick(inputs(0.0, cls=MiClass.LEFT_HAND, cert=0.0, gripper=holding))
+    assert out.state == State.OBJECT_SEARCH and out.gripper.position == 1.0  # still holding
+    empty = GripperState(0.0, 0.0, 0.02, contact=False, fingers_in_contact=0)
+    out = fsm.tick(inputs(0.02, cls=MiClass.LEFT_HAND, cert=0.0, gripper=empty))
+    assert out.gripper.position == params.gripper_open_position
 
 
 def test_centring_timeout_far_off_centre_searches_again(params: FsmParams) -> None:
