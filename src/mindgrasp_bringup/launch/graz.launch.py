@@ -13,24 +13,22 @@ from mindgrasp_bringup.launch_system import (
     GroupAction,
     IfCondition,
     LaunchConfiguration,
-    LaunchConfigurationEquals,
     LaunchDescription,
     Node,
     Shutdown,
     config_files,
 )
-from mindgrasp_bringup.launch_system.common import classifier_nodes
+from mindgrasp_bringup.launch_system.common import (
+    classifier_nodes,
+    eeg_source_arguments,
+    eeg_source_nodes,
+)
 
 
 def generate_launch_description() -> LaunchDescription:
     seed = LaunchConfiguration('seed')
-    eeg_stream = LaunchConfiguration('eeg_stream')
     return LaunchDescription([
-        DeclareLaunchArgument('amp', default_value='virtual', choices=['virtual', 'lsl'],
-                              description='EEG source: virtual (virtual amplifier + virtual '
-                                          'subject) or lsl (a real amplifier streaming over LSL)'),
-        DeclareLaunchArgument('eeg_stream', default_value='MIndGrasp-VirtualAmp',
-                              description='LSL stream name of the amplifier'),
+        *eeg_source_arguments(),
         DeclareLaunchArgument('trials', default_value='40',
                               description='number of trials (a multiple of 4 balances classes)'),
         DeclareLaunchArgument('seed', default_value='0',
@@ -42,12 +40,7 @@ def generate_launch_description() -> LaunchDescription:
                               description='classifier model for feedback:=true (.json written '
                                           'by mindgrasp train classifier); empty: the one in '
                                           'config/params/classifier.yaml'),
-        Node(package='mindgrasp_eeg', executable='virtual_amp_node', name='virtual_amp',
-             parameters=[*config_files('eeg'),
-                         {'stream_name': eeg_stream, 'seed': seed, 'subject_mode': 'follow'}],
-             condition=LaunchConfigurationEquals('amp', 'virtual')),
-        Node(package='mindgrasp_eeg', executable='acquisition_node', name='eeg_acquisition',
-             parameters=[*config_files('eeg'), {'stream_name': eeg_stream}]),
+        *eeg_source_nodes(config_files('eeg'), seed, 'follow'),
         GroupAction(classifier_nodes(config_files('classifier')),
                     condition=IfCondition(LaunchConfiguration('feedback'))),
         Node(package='mindgrasp_trainer', executable='graz_node', name='graz_prompter',

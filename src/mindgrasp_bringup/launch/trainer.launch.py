@@ -11,24 +11,22 @@ The launch ends when the trainer has run all its trials (or after duration:=S).
 from mindgrasp_bringup.launch_system import (
     DeclareLaunchArgument,
     LaunchConfiguration,
-    LaunchConfigurationEquals,
     LaunchDescription,
     Node,
     Shutdown,
     config_files,
 )
-from mindgrasp_bringup.launch_system.common import classifier_nodes
+from mindgrasp_bringup.launch_system.common import (
+    classifier_nodes,
+    eeg_source_arguments,
+    eeg_source_nodes,
+)
 
 
 def generate_launch_description() -> LaunchDescription:
     seed = LaunchConfiguration('seed')
-    eeg_stream = LaunchConfiguration('eeg_stream')
     return LaunchDescription([
-        DeclareLaunchArgument('amp', default_value='virtual', choices=['virtual', 'lsl'],
-                              description='EEG source: virtual (virtual amplifier + virtual '
-                                          'subject) or lsl (a real amplifier streaming over LSL)'),
-        DeclareLaunchArgument('eeg_stream', default_value='MIndGrasp-VirtualAmp',
-                              description='LSL stream name of the amplifier'),
+        *eeg_source_arguments(),
         DeclareLaunchArgument('subject', default_value='follow',
                               choices=['noise', 'follow', 'pursue'],
                               description='virtual subject (amp:=virtual): follow imagines what '
@@ -47,13 +45,7 @@ def generate_launch_description() -> LaunchDescription:
              parameters=[*config_files('sim'),
                          {'gui': LaunchConfiguration('gui'), 'seed': seed,
                           'trainer_robot': True}]),
-        Node(package='mindgrasp_eeg', executable='virtual_amp_node', name='virtual_amp',
-             parameters=[*config_files('eeg'),
-                         {'stream_name': eeg_stream, 'seed': seed,
-                          'subject_mode': LaunchConfiguration('subject')}],
-             condition=LaunchConfigurationEquals('amp', 'virtual')),
-        Node(package='mindgrasp_eeg', executable='acquisition_node', name='eeg_acquisition',
-             parameters=[*config_files('eeg'), {'stream_name': eeg_stream}]),
+        *eeg_source_nodes(config_files('eeg'), seed, LaunchConfiguration('subject')),
         *classifier_nodes(config_files('classifier')),
         Node(package='mindgrasp_vision', executable='vision_node', name='vision',
              parameters=config_files('vision')),
