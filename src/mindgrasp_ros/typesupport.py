@@ -141,7 +141,7 @@ def typestore() -> Typestore:
 # --------------------------------------------------------------------------- message classes
 
 
-def _field_default_factory(store: Typestore, desc: tuple) -> Any:
+def _field_default_factory(desc: tuple) -> Any:
     kind, detail = desc
     if kind == Nodetype.BASE:
         base, _bound = detail
@@ -286,7 +286,7 @@ def _make_message_class(store: Typestore, typename: str) -> type[Message]:
         if fname in extra:
             defaults.append(functools.partial(lambda v: v, extra[fname]))
         else:
-            defaults.append(_field_default_factory(store, desc))
+            defaults.append(_field_default_factory(desc))
     namespace: dict[str, Any] = {
         '__slots__': field_names,
         '__msgtype__': typename,
