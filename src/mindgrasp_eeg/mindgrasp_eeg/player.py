@@ -56,7 +56,7 @@ def eegbci_path() -> str | None:
     env = os.environ.get('MNE_DATASETS_EEGBCI_PATH')
     if env:
         return env
-    shared = Path(__file__).resolve().parents[3] / 'shared' / 'data'
+    shared = Path(__file__).resolve().parents[4] / 'shared' / 'data'
     return str(shared) if shared.is_dir() else None
 
 

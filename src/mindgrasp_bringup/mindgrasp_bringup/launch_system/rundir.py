@@ -31,7 +31,7 @@ import yaml
 from mindgrasp_bringup.launch_system.errors import LaunchError
 
 #: the repository root (src layout: <root>/src/mindgrasp_bringup/launch_system/rundir.py)
-PROJECT_ROOT = Path(__file__).resolve().parents[3]
+PROJECT_ROOT = Path(__file__).resolve().parents[4]
 DIST_NAME = 'mindgrasp-ros'
 _ENV_KEYS = ('ROS_DOMAIN_ID', 'ROS_AUTOMATIC_DISCOVERY_RANGE', 'ROS_STATIC_PEERS',
              'RMW_IMPLEMENTATION', 'MINDGRASP_RMW', 'CYCLONEDDS_URI', 'ROS_DISTRO')

@@ -35,7 +35,7 @@ from mindgrasp_classifier.model import CLASS_NAMES, MiModel
 from mindgrasp_ros import rclpy
 
 #: The demo model trained by scripts/train_default_classifier.py.
-DEFAULT_MODEL = Path(__file__).resolve().parents[2] / 'models' / 'default_classifier.json'
+DEFAULT_MODEL = Path(__file__).resolve().parents[3] / 'models' / 'default_classifier.json'
 
 PARAMETERS = [
     ('model', str(DEFAULT_MODEL)), ('classes', list(CLASS_NAMES)),

@@ -63,7 +63,7 @@ def config_dir() -> Path:
     env = os.environ.get('MINDGRASP_CONFIG_DIR')
     if env:
         return Path(env)
-    return Path(__file__).resolve().parents[2] / 'config'
+    return Path(__file__).resolve().parents[3] / 'config'
 
 
 @dataclass(frozen=True)

@@ -109,7 +109,7 @@ def interface_dir() -> Path:
     sourced ``import mindgrasp_msgs.msg`` finds the colcon-generated package, not this folder.
     """
     override = os.environ.get('MINDGRASP_MSGS_DIR')
-    folder = Path(override) if override else Path(__file__).resolve().parents[1] / 'mindgrasp_msgs'
+    folder = Path(override) if override else Path(__file__).resolve().parents[2] / 'mindgrasp_msgs'
     if not (folder / 'msg').is_dir():
         msg = (f'The mindgrasp_msgs interface folder {folder} has no msg/ directory; install '
                'the project editable (pip install -e .) or set MINDGRASP_MSGS_DIR to '

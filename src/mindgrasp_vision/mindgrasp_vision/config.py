@@ -15,7 +15,7 @@ __all__ = ['DEFAULT_SHAPE_MODEL', 'VisionConfig', 'resolve_model_path']
 
 #: the committed shape model (``models/vision/shape_cnn.pt`` + ``.json``), relative to the repo root
 DEFAULT_SHAPE_MODEL = 'models/vision/shape_cnn'
-_REPO_ROOT = Path(__file__).resolve().parents[2]
+_REPO_ROOT = Path(__file__).resolve().parents[3]
 
 
 def resolve_model_path(path: str) -> Path:

@@ -144,7 +144,7 @@ def dump_parameters(per_node: Mapping[str, Mapping[str, Any]]) -> str:
 
 
 #: config/params of the repository (src layout: <root>/src/mindgrasp_bringup/launch_system/)
-PARAMS_DIR = Path(__file__).resolve().parents[3] / 'config' / 'params'
+PARAMS_DIR = Path(__file__).resolve().parents[4] / 'config' / 'params'
 
 
 def config_files(*names: str) -> list[Path]:

@@ -246,4 +246,4 @@ class FsmParams:
 
 def default_params_path() -> Path:
     """``config/params/fsm.yaml`` of the source tree."""
-    return Path(__file__).resolve().parents[2] / 'config' / 'params' / 'fsm.yaml'
+    return Path(__file__).resolve().parents[3] / 'config' / 'params' / 'fsm.yaml'
