@@ -1,0 +1,84 @@
+"""Package data through mindgrasp_common.resources."""
+
+import os
+from pathlib import Path
+
+import pytest
+
+from mindgrasp_common import ResourceNotFoundError, resolve_path, resource_path
+
+
+def test_resource_path_finds_package_data():
+    path = resource_path('mindgrasp_common', 'resources.py')
+    assert path.is_file() and path.name == 'resources.py'
+    assert resource_path('mindgrasp_common') == path.parent
+    mi = resource_path('mindgrasp_common', 'mi.py')
+    assert mi == resource_path('mindgrasp_common', '', 'mi.py')
+
+
+def test_missing_file_names_package_and_file():
+    with pytest.raises(ResourceNotFoundError,
+                       match=r"package 'mindgrasp_common' has no data file 'config/nope.yaml' "
+                             r'\(check the name\)'):
+        resource_path('mindgrasp_common', 'config', 'nope.yaml')
+
+
+def test_missing_file_lists_what_the_folder_holds():
+    with pytest.raises(ResourceNotFoundError, match=r"no data file 'typo.py' \(its top folder "
+                                                    r"holds \[.*'types.py'"):
+        resource_path('mindgrasp_common', 'typo.py')
+
+
+def test_missing_package_names_it_and_the_fix():
+    with pytest.raises(ResourceNotFoundError,
+                       match=r"Cannot find the package 'mindgrasp_nothing'.*pip install -e"):
+        resource_path('mindgrasp_nothing', 'x.yaml')
+
+
+@pytest.mark.parametrize('rel', ['../pyproject.toml', '/etc/passwd', 'a/./b'])
+def test_paths_outside_the_package_are_refused(rel):
+    with pytest.raises(ResourceNotFoundError, match="relative path inside the package"):
+        resource_path('mindgrasp_common', rel)
+
+
+def test_resource_error_is_a_file_not_found_error():
+    assert issubclass(ResourceNotFoundError, FileNotFoundError)
+
+
+def test_resolve_path_package_uri_and_fallbacks(tmp_path, monkeypatch):
+    here = resource_path('mindgrasp_common', 'types.py')
+    assert resolve_path('package://mindgrasp_common/types.py', 'x') == here
+    # a relative name that is no file here: the package's data file
+    monkeypatch.chdir(tmp_path)
+    assert resolve_path('types.py', 'mindgrasp_common') == here
+    # stems of file sets: found when stem + suffix exists
+    assert resolve_path('types', 'mindgrasp_common', ('.py',)) == here.with_suffix('')
+    assert resolve_path('package://mindgrasp_common/types', 'x', ('.py',)) == here.with_suffix('')
+    # a file in the working directory wins over package data
+    (tmp_path / 'types.py').write_text('')
+    assert resolve_path('types.py', 'mindgrasp_common') == Path('types.py')
+    # unknown: returned unchanged for the caller's own error
+    assert resolve_path('nothing.json', 'mindgrasp_common') == Path('nothing.json')
+    absolute = tmp_path / 'absent.json'
+    assert resolve_path(str(absolute), 'mindgrasp_common') == absolute
+
+
+def test_resolve_path_bad_package_uri():
+    with pytest.raises(ResourceNotFoundError, match=r"has no data file 'nope\.json'"):
+        resolve_path('package://mindgrasp_common/nope.json', 'x')
+    with pytest.raises(ResourceNotFoundError, match=r"no data file 'nope' \(nor nope.json\)"):
+        resolve_path('package://mindgrasp_common/nope', 'x', ('.json',))
+
+
+def test_share_directory_of_an_ament_install_wins(tmp_path, monkeypatch):
+    """With ROS 2 sourced, a colcon install's share/<pkg>/ is preferred."""
+    pytest.importorskip('ament_index_python')
+    prefix = tmp_path / 'install'
+    index = prefix / 'share' / 'ament_index' / 'resource_index' / 'packages'
+    index.mkdir(parents=True)
+    (index / 'mindgrasp_common').write_text('')
+    share = prefix / 'share' / 'mindgrasp_common'
+    share.mkdir()
+    (share / 'types.py').write_text('')
+    monkeypatch.setenv('AMENT_PREFIX_PATH', os.pathsep.join([str(prefix)]))
+    assert resource_path('mindgrasp_common', 'types.py') == share / 'types.py'
