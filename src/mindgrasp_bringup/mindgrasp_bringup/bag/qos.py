@@ -15,7 +15,8 @@ from typing import Any
 
 import yaml
 
-__all__ = ['adapted_qos', 'dump_offered_qos', 'parse_offered_qos', 'qos_to_dict']
+__all__ = ['adapted_qos', 'compatible', 'dump_offered_qos', 'parse_offered_qos', 'qos_to_dict',
+           'resubscribe_qos']
 
 # Integer values used by metadata version <= 8 (rmw enums), mapped to the v9 names.
 _HISTORY = {0: 'system_default', 1: 'keep_last', 2: 'keep_all', 3: 'unknown'}
@@ -103,3 +104,29 @@ def adapted_qos(profiles: Sequence[dict[str, Any]], default_depth: int = 10) -> 
     depth = max([int(p.get('depth') or 0) for p in profiles] + [default_depth])
     return {'reliability': 'reliable' if reliable else 'best_effort',
             'durability': 'transient_local' if transient else 'volatile', 'depth': depth}
+
+
+def compatible(offered: dict[str, Any], requested: dict[str, Any]) -> bool:
+    """True when a publisher offering ``offered`` matches a subscription requesting ``requested``.
+
+    DDS request/offered rule: a reliable reader needs a reliable writer, a transient-local reader
+    needs a transient-local writer; the other combinations match.
+    """
+    if requested.get('reliability') == 'reliable' and offered.get('reliability') != 'reliable':
+        return False
+    return not (requested.get('durability') == 'transient_local'
+                and offered.get('durability') != 'transient_local')
+
+
+def resubscribe_qos(requested: dict[str, Any], profiles: Sequence[dict[str, Any]],
+                    default_depth: int = 10) -> dict[str, Any] | None:
+    """The QoS to subscribe again with when a publisher does not match ``requested``, else None.
+
+    rosbag2 only warns that such a publisher ("offering best effort, but rosbag already
+    subscribed requesting reliable") will not be recorded; we subscribe again with
+    :func:`adapted_qos` over all publishers, which only ever relaxes the request, so the
+    publishers matched before stay matched.
+    """
+    if all(compatible(p, requested) for p in profiles):
+        return None
+    return adapted_qos(profiles, default_depth)

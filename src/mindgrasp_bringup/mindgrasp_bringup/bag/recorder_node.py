@@ -4,6 +4,15 @@ Run: ``python -m mindgrasp_bringup.bag.recorder_node --ros-args -p output:=runs/
 -p topics:="['/eeg/raw']" -p duration:=10.0``. New topics are discovered while it runs; the
 subscriptions take raw CDR bytes, and a :class:`~mindgrasp_bringup.bag.recorder.Recorder`
 writes them from its own thread, so callbacks never wait for the disk.
+
+QoS as rosbag2 does it: a topic is subscribed once it has a publisher (a topic that only has
+subscribers is not, as ``ros2 bag record`` without ``--include-unpublished-topics``), with the QoS
+adapted to the publishers found (best effort when any publisher is best effort, transient local
+when all are). When a publisher appears later that the subscription cannot match (a best-effort
+camera after a reliable one, a volatile publisher on a transient-local topic), the topic is
+subscribed again with the relaxed QoS. At the end, every wanted topic that was not recorded is
+reported with the reason, in the log and in metadata.yaml ``custom_data``
+(``not_recorded:/topic``).
 """
 
 from __future__ import annotations
@@ -15,7 +24,7 @@ import time
 from typing import Any
 
 from mindgrasp_bringup.bag.errors import BagError
-from mindgrasp_bringup.bag.qos import adapted_qos, qos_to_dict
+from mindgrasp_bringup.bag.qos import adapted_qos, qos_to_dict, resubscribe_qos
 from mindgrasp_bringup.bag.recorder import Recorder
 from mindgrasp_bringup.bag.ros_glue import message_class, qos_profile
 from mindgrasp_bringup.bag.writer import BagWriter
@@ -58,7 +67,11 @@ class RecorderNode(rclpy.node.Node):
                                  on_error=self._on_error)
         self.recorder.start()
         self._topic_subscriptions: dict[str, Any] = {}
+        self._requested: dict[str, dict[str, Any]] = {}     # topic -> QoS subscribed with
+        self._matched: set[str] = set()                     # topics that matched a publisher
+        self._unpublished: set[str] = set()                 # seen with subscribers only
         self._refused: set[str] = set()
+        self._types: dict[str, str] = {}
         self.finished = False
         self.get_logger().info(f'Recording to {writer.path} (MCAP, compression '
                                f'{writer.compression}).')
@@ -80,32 +93,87 @@ class RecorderNode(rclpy.node.Node):
         return not self.topics  # no list and no regex: everything
 
     def discover_callback(self) -> None:
-        """Subscribe to every new matching topic of the graph."""
+        """Subscribe to every new matching topic that has a publisher; re-match changed ones."""
         if self.recorder.error is not None:
             return
         for topic, types in self.get_topic_names_and_types():
-            known = topic in self._topic_subscriptions or topic in self._refused
-            if known or not self._wanted(topic):
+            if topic in self._refused or not self._wanted(topic):
+                continue
+            offered = [qos_to_dict(i.qos_profile)
+                       for i in self.get_publishers_info_by_topic(topic)]
+            sub = self._topic_subscriptions.get(topic)
+            if sub is not None:
+                if sub.get_publisher_count() > 0:
+                    self._matched.add(topic)
+                new_qos = resubscribe_qos(self._requested[topic], offered, default_depth=100)
+                if new_qos is not None:
+                    self._subscribe(topic, self._types[topic], offered, new_qos, again=True)
+                continue
+            if not offered:  # subscribers only: nothing to record yet
+                if topic not in self._unpublished:
+                    self._unpublished.add(topic)
+                    self.get_logger().info(f'Waiting for a publisher on {topic} (it has '
+                                           'subscribers only).')
                 continue
             msgtype = types[0]
             if len(types) > 1:
                 self.get_logger().warning(f'{topic} is published with several types {types}; '
                                           f'recording {msgtype} only.')
-            try:
-                msg_class = message_class(msgtype)
-            except (ImportError, AttributeError, ValueError):
-                self._refused.add(topic)
-                self.get_logger().warning(f'Not recording {topic}: its type {msgtype} is unknown '
-                                          'to the client layer (add its .msg to the type store).')
-                continue
-            offered = [qos_to_dict(i.qos_profile)
-                       for i in self.get_publishers_info_by_topic(topic)]
-            qos = adapted_qos(offered, default_depth=100)
+            self._subscribe(topic, msgtype, offered, adapted_qos(offered, default_depth=100))
+
+    def _subscribe(self, topic: str, msgtype: str, offered: list[dict[str, Any]],
+                   qos: dict[str, Any], *, again: bool = False) -> None:
+        try:
+            msg_class = message_class(msgtype)
+        except (ImportError, AttributeError, ValueError):
+            self._refused.add(topic)
+            self.get_logger().warning(f'Not recording {topic}: its type {msgtype} is unknown '
+                                      'to the client layer (add its .msg to the type store).')
+            return
+        self._types[topic] = msgtype
+        if not again:
+            # The offered QoS stays that of the first publishers, as in rosbag2: the MCAP channel
+            # holds it, and readers (rosbags) pair channels with metadata.yaml by it.
             self.recorder.add_topic(topic, msgtype, offered)
-            self._topic_subscriptions[topic] = self.create_subscription(
-                msg_class, topic, self._make_callback(topic), qos_profile(rclpy, qos), raw=True)
+        old = self._topic_subscriptions.pop(topic, None)
+        if old is not None:
+            # Destroyed first: the middleware keeps one reader QoS per topic and process.
+            self.destroy_subscription(old)
+        self._requested[topic] = qos
+        self._topic_subscriptions[topic] = self.create_subscription(
+            msg_class, topic, self._make_callback(topic), qos_profile(rclpy, qos), raw=True)
+        if again:
+            self.get_logger().info(
+                f'Subscribed again to {topic} with {qos["reliability"]}, {qos["durability"]}: '
+                'a publisher appeared that the previous QoS could not match.')
+        else:
             self.get_logger().info(f'Subscribed to {topic} ({msgtype}, {qos["reliability"]}, '
                                    f'{qos["durability"]}).')
+
+    def not_recorded(self) -> dict[str, str]:
+        """Wanted topics without any recorded message: topic -> why (a sentence)."""
+        out: dict[str, str] = {}
+        counters = self.recorder.counters
+        for topic in sorted(set(self.topics) | self._unpublished | set(self._requested)):
+            if counters.get(topic) is not None and counters[topic].received:
+                continue
+            if topic in self._requested:
+                qos = self._requested[topic]
+                if topic in self._matched:
+                    out[topic] = 'its publishers sent nothing while recording.'
+                else:
+                    out[topic] = (f'the subscription ({qos["reliability"]}, '
+                                  f'{qos["durability"]}) never matched a publisher (incompatible '
+                                  'QoS, or the publisher left before matching).')
+            elif topic in self._refused:
+                out[topic] = 'its message type is unknown to the client layer.'
+            elif topic in self._unpublished:
+                out[topic] = ('it had subscribers but no publisher appeared while recording, so '
+                              'it was never subscribed.')
+            else:
+                out[topic] = ('no node published or subscribed to it while recording (check the '
+                              'topic name).')
+        return out
 
     def _make_callback(self, topic: str) -> Any:
         push = self.recorder.push
@@ -131,7 +199,14 @@ class RecorderNode(rclpy.node.Node):
         self.get_logger().error(message)
 
     def stop(self) -> None:
-        """Write what is queued and close the bag; log the counters."""
+        """Write what is queued and close the bag; log the counters and the topics not
+        recorded (with the reason, also stored in metadata.yaml ``custom_data``)."""
+        for sub in self._topic_subscriptions.values():
+            if sub.get_publisher_count() > 0:
+                self._matched.add(sub.topic_name)
+        missing = self.not_recorded()
+        for topic, why in missing.items():
+            self.recorder.writer.custom_data[f'not_recorded:{topic}'] = why
         try:
             counters = self.recorder.stop()
         except BagError as exc:
@@ -141,8 +216,12 @@ class RecorderNode(rclpy.node.Node):
             self.get_logger().warning(line)
         total = sum(c.written for c in counters.values())
         dropped = sum(c.dropped_queue_full for c in counters.values())
-        self.get_logger().info(f'Recorded {total} message(s) on {len(counters)} topic(s) to '
-                               f'{self.recorder.writer.path}; {dropped} dropped.')
+        recorded = sum(1 for c in counters.values() if c.written)
+        self.get_logger().info(f'Recorded {total} message(s) on {recorded} topic(s) to '
+                               f'{self.recorder.writer.path}; {dropped} dropped; '
+                               f'{len(missing)} topic(s) not recorded.')
+        for topic, why in missing.items():
+            self.get_logger().warning(f'Not recorded: {topic}: {why}')
 
 
 def main(args: list[str] | None = None) -> int:
