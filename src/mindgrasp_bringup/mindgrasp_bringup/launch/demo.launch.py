@@ -15,15 +15,15 @@ own settings), then the launch arguments below (later entries win).
 """
 
 
-from mindgrasp_bringup.launch_system import (
+from mindgrasp_bringup.launch_api import (
     DeclareLaunchArgument,
     LaunchConfiguration,
     LaunchDescription,
     Node,
     Shutdown,
+    classifier_nodes,
     config_files,
 )
-from mindgrasp_bringup.launch_system.common import classifier_nodes
 
 
 def generate_launch_description() -> LaunchDescription:

@@ -11,7 +11,7 @@ adapt:=true (the default here) the node adopts the stream's channel count, rate 
 warning; adapt:=false holds the stream to config/params/eeg.yaml (32 ch, 250 Hz, g.Nautilus names).
 """
 
-from mindgrasp_bringup.launch_system import (
+from mindgrasp_bringup.launch_api import (
     DeclareLaunchArgument,
     IfCondition,
     LaunchConfiguration,

@@ -8,7 +8,7 @@ EEG are recorded so that the classifier can be trained on them.
 The launch ends when the prompter has run all its trials (or after duration:=S).
 """
 
-from mindgrasp_bringup.launch_system import (
+from mindgrasp_bringup.launch_api import (
     DeclareLaunchArgument,
     GroupAction,
     IfCondition,
@@ -16,10 +16,8 @@ from mindgrasp_bringup.launch_system import (
     LaunchDescription,
     Node,
     Shutdown,
-    config_files,
-)
-from mindgrasp_bringup.launch_system.common import (
     classifier_nodes,
+    config_files,
     eeg_source_arguments,
     eeg_source_nodes,
 )

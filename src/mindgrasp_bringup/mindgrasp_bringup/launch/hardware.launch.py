@@ -14,16 +14,16 @@ camera_driver) publishes /camera/color/image_raw (rgb8), /camera/depth/image_raw
 /camera/color/camera_info. Drivers are started as ROS nodes (``--ros-args -r __node:=...``).
 """
 
-from mindgrasp_bringup.launch_system import (
+from mindgrasp_bringup.launch_api import (
     DeclareLaunchArgument,
     LaunchConfiguration,
     LaunchConfigurationNotEquals,
     LaunchDescription,
     Node,
     SplitArguments,
+    classifier_nodes,
     config_files,
 )
-from mindgrasp_bringup.launch_system.common import classifier_nodes
 
 
 def generate_launch_description() -> LaunchDescription:

@@ -10,7 +10,7 @@ commands; /vision/* with vision:=true) are not played, so they come only from th
 launch ends when the bag has been played (loop:=true: until Ctrl-C or duration:=S).
 """
 
-from mindgrasp_bringup.launch_system import (
+from mindgrasp_bringup.launch_api import (
     DeclareLaunchArgument,
     IfCondition,
     LaunchConfiguration,
@@ -19,9 +19,9 @@ from mindgrasp_bringup.launch_system import (
     SetParameter,
     Shutdown,
     UnlessCondition,
+    classifier_nodes,
     config_files,
 )
-from mindgrasp_bringup.launch_system.common import classifier_nodes
 
 RERUN = '^/(bci/prediction|fsm/|arm_controller/|gripper_controller/'
 
@@ -30,7 +30,7 @@ def generate_launch_description() -> LaunchDescription:
     vision = LaunchConfiguration('vision')
 
     def player(exclude: str, condition: object) -> Node:
-        return Node(package='mindgrasp_bringup.bag', executable='player_node', name='bag_player',
+        return Node(package='mindgrasp_bringup', executable='player_node', name='bag_player',
                     parameters=[{'bag': LaunchConfiguration('bag'),
                                  'rate': LaunchConfiguration('rate'),
                                  'loop': LaunchConfiguration('loop'),

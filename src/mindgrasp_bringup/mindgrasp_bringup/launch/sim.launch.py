@@ -10,7 +10,7 @@ the arm contract of a ros2_control forward velocity controller (drive it from ou
 Parameters: config/params/sim.yaml, then the launch arguments below.
 """
 
-from mindgrasp_bringup.launch_system import (
+from mindgrasp_bringup.launch_api import (
     DeclareLaunchArgument,
     LaunchConfiguration,
     LaunchDescription,

@@ -8,16 +8,14 @@ follows it with their own arm by motor imagery; prompts and EEG are recorded for
 The launch ends when the trainer has run all its trials (or after duration:=S).
 """
 
-from mindgrasp_bringup.launch_system import (
+from mindgrasp_bringup.launch_api import (
     DeclareLaunchArgument,
     LaunchConfiguration,
     LaunchDescription,
     Node,
     Shutdown,
-    config_files,
-)
-from mindgrasp_bringup.launch_system.common import (
     classifier_nodes,
+    config_files,
     eeg_source_arguments,
     eeg_source_nodes,
 )

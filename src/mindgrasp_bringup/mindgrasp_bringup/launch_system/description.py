@@ -8,6 +8,7 @@ from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from mindgrasp_bringup.launch_api import own_launcher
 from mindgrasp_bringup.launch_system.actions.action import Action
 from mindgrasp_bringup.launch_system.actions.declare_launch_argument import DeclareLaunchArgument
 from mindgrasp_bringup.launch_system.errors import LaunchError
@@ -107,7 +108,8 @@ def load_launch_file(path: str | Path) -> LaunchDescription:
     module = importlib.util.module_from_spec(spec)
     sys.modules[module_name] = module
     try:
-        spec.loader.exec_module(module)
+        with own_launcher():  # the file's launch_api imports resolve to our actions
+            spec.loader.exec_module(module)
     except LaunchError:
         raise
     except Exception as exc:
@@ -118,7 +120,8 @@ def load_launch_file(path: str | Path) -> LaunchDescription:
         msg = f'launch file {path} has no generate_launch_description() function; add one.'
         raise LaunchError(msg)
     try:
-        description = generate()
+        with own_launcher():
+            description = generate()
     except LaunchError:
         raise
     except Exception as exc:

@@ -41,7 +41,7 @@ from mindgrasp_bringup.launch_system.supervisor import ProcessResult, Supervisor
 
 logger = logging.getLogger('launch')
 
-RECORDER_PACKAGE = 'mindgrasp_bringup.bag'
+RECORDER_PACKAGE = 'mindgrasp_bringup'
 RECORDER_EXECUTABLE = 'recorder_node'
 RECORDER_NAME = 'recorder'
 

@@ -41,23 +41,58 @@ def find_module(module: str) -> bool:
         return False
 
 
+def node_module(package: str, executable: str) -> str | None:
+    """The Python module of a node of one of our packages, as its console script names it.
+
+    ``<package>.<executable>`` (``mindgrasp_fsm.fsm_node``), else one subpackage down
+    (``mindgrasp_bringup.bag.player_node``): where ``setup.py`` points the console script
+    ``<executable> = <module>:main``. None when neither exists.
+    """
+    module = f'{package}.{executable}'
+    if find_module(module):
+        return module
+    try:
+        spec = importlib.util.find_spec(package)
+    except (ImportError, ValueError):
+        return None
+    if spec is None or not spec.submodule_search_locations:
+        return None
+    for location in spec.submodule_search_locations:
+        for sub in sorted(Path(location).iterdir()):
+            if (sub / '__init__.py').is_file() and (sub / f'{executable}.py').is_file():
+                return f'{package}.{sub.name}.{executable}'
+    return None
+
+
+def ament_executable(package: str, executable: str) -> str | None:
+    """``<prefix>/lib/<package>/<executable>`` of a sourced ROS 2 workspace (``AMENT_PREFIX_PATH``),
+    as ``ros2 run`` finds it; None when no prefix has it."""
+    for prefix in os.environ.get('AMENT_PREFIX_PATH', '').split(os.pathsep):
+        candidate = Path(prefix) / 'lib' / package / executable
+        if prefix and candidate.is_file() and os.access(candidate, os.X_OK):
+            return str(candidate)
+    return None
+
+
 def resolve_program(package: str | None, executable: str) -> tuple[list[str], str | None, str |
                                                                                          None]:
     """The program of a node: ``(argv prefix, python module or None, problem or None)``.
 
-    ``package`` + ``executable`` is the module ``package.executable`` of our packages, run as
-    ``python -m``; failing that, an executable of that name on PATH (an external driver).
+    ``package`` + ``executable`` is the node module of our packages (:func:`node_module`), run as
+    ``python -m``; failing that, the console script ``lib/<package>/<executable>`` of a sourced
+    ROS 2 workspace (as ``ros2 run`` finds it), or an executable of that name on PATH.
     Without a package, ``executable`` is a path, a program on PATH, a dotted module name, or
     ``package/executable``: our module ``package.executable``, else ``ros2 run package executable``
     (a ROS 2 driver, when ROS 2 is sourced).
     """
     if package:
-        module = f'{package}.{executable}'
-        if find_module(module):
+        module = node_module(package, executable)
+        if module is not None:
             return [sys.executable, '-m', module], module, None
-        found = shutil.which(executable)
+        found = ament_executable(package, executable) or shutil.which(executable)
         if found:
             return [found], None, None
+        module = f'{package}.{executable}'
         problem = (f"the node module '{module}' does not exist (yet), so 'python -m {module}' "
                    f"cannot start: write or install it, check package= and executable=, or "
                    f"leave the node out.")
@@ -75,9 +110,10 @@ def resolve_program(package: str | None, executable: str) -> tuple[list[str], st
         return [sys.executable, '-m', executable], executable, None
     pkg, sep, exe = executable.partition('/')
     if sep and pkg and exe and '/' not in exe:  # 'package/executable', as `ros2 run` takes it
-        module = f'{pkg}.{exe}'
-        if find_module(module):
+        module = node_module(pkg, exe)
+        if module is not None:
             return [sys.executable, '-m', module], module, None
+        module = f'{pkg}.{exe}'
         ros2 = shutil.which('ros2')
         if ros2:
             return [ros2, 'run', pkg, exe], None, None
