@@ -24,7 +24,8 @@ MARKER_TYPE = {'cube': Marker.CUBE, 'sphere': Marker.SPHERE, 'cylinder': Marker.
 OPTICAL_FRAME = 'camera_color_optical_frame'
 
 __all__ = ['MARKER_TYPE', 'OPTICAL_FRAME', 'camera_info', 'grasp_result', 'header',
-           'image_messages', 'joint_state', 'object_markers', 'pose_stamped', 'stamp', 'status']
+           'image_messages', 'joint_state', 'object_markers', 'pose_stamped', 'rgb_image', 'stamp',
+           'status']
 
 
 def stamp(ns: int) -> Time:
@@ -65,6 +66,13 @@ def image_messages(hdr: Header, rgb: np.ndarray, depth: np.ndarray) -> tuple[Ima
                       step=w * 4, data=np.ascontiguousarray(depth, dtype='<f4')
                       .view(np.uint8).reshape(-1))
     return color, depth_msg
+
+
+def rgb_image(hdr: Header, rgb: np.ndarray) -> Image:
+    """``rgb8`` image of rgb uint8 (H, W, 3)."""
+    h, w = rgb.shape[:2]
+    return Image(header=hdr, height=h, width=w, encoding='rgb8', is_bigendian=0, step=w * 3,
+                 data=np.ascontiguousarray(rgb, dtype=np.uint8).reshape(-1))
 
 
 def camera_info(hdr: Header, k: np.ndarray, width: int, height: int) -> CameraInfo:

@@ -13,8 +13,9 @@ Publishes ``/joint_states`` (6 arm joints), ``/gripper/joint_states`` (3 fingers
 (geometry_msgs/PoseStamped, TCP in ``world``), ``/camera/color/image_raw`` (rgb8),
 ``/camera/depth/image_raw`` (32FC1, m), ``/camera/color/camera_info``,
 ``/camera/depth/camera_info``, ``/sim/objects`` (visualization_msgs/MarkerArray),
-``/task/result`` (mindgrasp_msgs/GraspResult) and ``/sim/status`` (diagnostic_msgs/
-DiagnosticArray: scene, simulated time, real-time factor, collisions). With
+``/scene/image_raw`` (rgb8, a third-person view of both robots for the participant's display;
+``scene_camera_rate`` > 0), ``/task/result`` (mindgrasp_msgs/GraspResult) and ``/sim/status``
+(diagnostic_msgs/DiagnosticArray: scene, simulated time, real-time factor, collisions). With
 ``trainer_robot:=true`` (alias ``training_robot``) the training robot has the same arm topics
 under ``/trainer_robot/``.
 Services ``/sim/reset`` (ResetSim), ``/sim/load_scene`` (LoadScene) and, in lock-step mode,
@@ -61,6 +62,7 @@ _PARAMS = (
     ('time_mode', 'realtime'), ('command_timeout', 0.25), ('trainer_robot', False),
     ('training_robot', False), ('gui', False), ('duration', 0.0), ('sim_duration', 0.0),
     ('success_height', 0.22), ('frame_id', 'world'), ('max_catch_up', 0.25),
+    ('scene_camera_rate', 0.0), ('scene_camera_width', 320), ('scene_camera_height', 240),
 )  # fmt: skip
 
 
@@ -78,6 +80,11 @@ class _RobotIO:
 def _check_params(p: dict) -> None:
     if p['time_mode'] not in TIME_MODES:
         msg = f"Parameter 'time_mode' is {p['time_mode']!r}; use one of {list(TIME_MODES)}."
+        raise SimError(msg)
+    rate = p['scene_camera_rate']
+    if not (isinstance(rate, (int, float)) and 0 <= rate <= p['physics_hz']):
+        msg = (f"Parameter 'scene_camera_rate' must be 0 (off) or a rate up to 'physics_hz' "
+               f'({p["physics_hz"]} Hz), got {rate!r}; the participant display uses 5-10 Hz.')
         raise SimError(msg)
     for name in ('joint_state_rate', 'objects_rate', 'command_timeout', 'physics_hz'):
         if not (isinstance(p[name], (int, float)) and p[name] > 0):
@@ -126,7 +133,9 @@ class SimNode(rclpy.node.Node):
         self.obj_every = self.sim.physics_hz / float(p['objects_rate'])
         self.task_every = max(1, round(self.sim.physics_hz / 20.0))
         self.status_every = max(1, round(self.sim.physics_hz))     # 1 s of simulated time
-        self._next = {'js': 0.0, 'cam': 0.0, 'obj': 0.0}
+        scene_rate = float(p['scene_camera_rate'])
+        self.scene_every = self.sim.physics_hz / scene_rate if scene_rate > 0 else math.inf
+        self._next = {'js': 0.0, 'cam': 0.0, 'obj': 0.0, 'scene': 0.0}
         self._collisions: list[str] = []
         self._last_state_step = -1
         self._wall_start = time.monotonic()
@@ -159,6 +168,8 @@ class SimNode(rclpy.node.Node):
         self.info_pub = self.create_publisher(CameraInfo, '/camera/color/camera_info', sensor)
         self.depth_info_pub = self.create_publisher(CameraInfo, '/camera/depth/camera_info',
                                                     sensor)
+        self.scene_pub = (self.create_publisher(Image, '/scene/image_raw', sensor)
+                          if self.scene_every < math.inf else None)
         self.objects_pub = self.create_publisher(MarkerArray, '/sim/objects', latched)
         self.result_pub = self.create_publisher(GraspResult, '/task/result', reliable)
         self.status_pub = self.create_publisher(DiagnosticArray, '/sim/status', reliable)
@@ -228,6 +239,9 @@ class SimNode(rclpy.node.Node):
             if k >= self._next['cam']:
                 self._next['cam'] += self.cam_every
                 self.publish_camera()
+            if k >= self._next['scene']:
+                self._next['scene'] += self.scene_every
+                self.publish_scene()
             if k >= self._next['obj']:
                 self._next['obj'] += self.obj_every
                 self.publish_objects()
@@ -393,6 +407,12 @@ class SimNode(rclpy.node.Node):
         k, w, h = self.sim.camera_intrinsics()
         self.info_pub.publish(msgs.camera_info(hdr, k, w, h))
         self.depth_info_pub.publish(msgs.camera_info(hdr, k, w, h))
+
+    def publish_scene(self) -> None:
+        """/scene/image_raw (rgb8): the third-person view for the participant's display."""
+        rgb = self.sim.render_scene(int(self.p['scene_camera_width']),
+                                    int(self.p['scene_camera_height']))
+        self.scene_pub.publish(msgs.rgb_image(self._header('scene_camera'), rgb))
 
     def publish_objects(self) -> None:
         self.objects_pub.publish(msgs.object_markers(self._header(self.p['frame_id']),

@@ -45,6 +45,10 @@ ARM_POSITION_GAIN = 0.8
 GROUND_RGBA = (0.78, 0.77, 0.74, 1.0)
 TRAINER_RGBA = (0.1, 0.85, 0.1, 0.35)
 ROBOTS = ('user', 'trainer')
+#: default third-person scene camera (m, world): behind-right of the base, looking at the objects
+SCENE_EYE = (-0.55, -1.0, 0.9)
+SCENE_TARGET = (0.25, 0.0, 0.3)
+SKY_RGB = (70, 80, 100)
 #: camera light: mostly ambient so the task colours stay saturated (original thresholds 0.7/0.3)
 _LIGHT = {'lightDirection': [0.4, -0.3, 1.0], 'lightAmbientCoeff': 0.55,
           'lightDiffuseCoeff': 0.5, 'lightSpecularCoeff': 0.0}
@@ -672,6 +676,75 @@ class Simulation:
         np.copyto(depth, t, where=hit)
         # one 32-bit word per pixel: a masked fill instead of a per-channel scatter
         np.copyto(rgba.view(np.uint32).reshape(hit.shape), self._ground_rgba, where=hit)
+
+    def render_scene(self, width: int = 320, height: int = 240,
+                     eye: tuple[float, float, float] = SCENE_EYE,
+                     target: tuple[float, float, float] = SCENE_TARGET,
+                     fov_deg: float = 50.0) -> np.ndarray:
+        """Render a third-person view of the scene for people (the participant's screen).
+
+        Both arms are drawn; the training robot (when loaded) is blended at 50 % over what is
+        behind it, so it looks green and semi-transparent (TinyRenderer ignores alpha, so the
+        view is rendered twice: without and with the training robot). Pixels that hit nothing
+        show the ground plane (z = 0) or, above the horizon, a plain sky.
+
+        Parameters
+        ----------
+        width, height : int
+            Image size (px), 8..4096.
+        eye, target : (x, y, z)
+            Camera position and the point it looks at (m, world frame; z up).
+        fov_deg : float
+            Vertical field of view (deg).
+
+        Returns
+        -------
+        rgb : ndarray of uint8, shape (height, width, 3)
+        """
+        for name, value in (('width', width), ('height', height)):
+            if not isinstance(value, (int, np.integer)) or not 8 <= value <= 4096:
+                msg = (f'Scene camera {name} must be an integer number of pixels in 8..4096, got '
+                       f'{value!r}; use e.g. 320x240.')
+                raise SimError(msg)
+        p = self._p
+        near, far = 0.05, 6.0
+        view = p.computeViewMatrix(list(eye), list(target), [0.0, 0.0, 1.0])
+        proj = p.computeProjectionMatrixFOV(fov_deg, width / height, near, far)
+        kw = {'renderer': self._renderer, 'shadow': 0, **_LIGHT}
+        ghost = self._robots.get('trainer')
+        hidden = self._hide_other_robots('user') if ghost is not None else []
+        _, _, rgba, depth_buf, _ = p.getCameraImage(width, height, view, proj,
+                                                    flags=pb.ER_NO_SEGMENTATION_MASK, **kw)
+        self._unhide(hidden)
+        rgb = np.array(rgba, dtype=np.uint8).reshape(height, width, 4)[:, :, :3].copy()
+        empty = np.asarray(depth_buf, dtype=np.float32).reshape(height, width) > 0.9999
+        self._scene_background(rgb, empty, np.asarray(eye, float), np.asarray(target, float),
+                               fov_deg)
+        if ghost is not None:
+            _, _, rgba2, _, seg = p.getCameraImage(width, height, view, proj, **kw)
+            seg = np.asarray(seg, dtype=np.int64).reshape(height, width)
+            mask = (seg >= 0) & ((seg & ((1 << 24) - 1)) == ghost.body)
+            over = np.asarray(rgba2, dtype=np.uint8).reshape(height, width, 4)[:, :, :3]
+            rgb[mask] = ((rgb[mask].astype(np.uint16) + over[mask]) // 2).astype(np.uint8)
+        return rgb
+
+    def _scene_background(self, rgb: np.ndarray, empty: np.ndarray, eye: np.ndarray,
+                          target: np.ndarray, fov_deg: float) -> None:
+        """Paint ``empty`` pixels of a scene view (rgb (H, W, 3) uint8) as ground or sky."""
+        h, w = empty.shape
+        forward = target - eye
+        forward /= np.linalg.norm(forward)
+        right = np.cross(forward, [0.0, 0.0, 1.0])
+        right /= np.linalg.norm(right)
+        up = np.cross(right, forward)
+        f = h / 2.0 / math.tan(math.radians(fov_deg) / 2.0)
+        u = (np.arange(w) - (w - 1) / 2.0) / f
+        v = (np.arange(h) - (h - 1) / 2.0) / f
+        # world z of the ray through each pixel (image v grows downwards)
+        rz = forward[2] + u[None, :] * right[2] - v[:, None] * up[2]
+        ground = empty & (rz < 0)
+        rgb[ground] = np.asarray(GROUND_RGBA[:3]) * 255 * 0.85
+        rgb[empty & ~ground] = SKY_RGB
 
     def _hide_other_robots(self, robot: str) -> list[int]:
         # the trainer's ghost arm is seen by people, not by the user's camera: park it below
