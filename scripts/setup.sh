@@ -2,7 +2,8 @@
 # Set up MIndGrasp-ROS on a fresh machine: a project-local virtual environment `.venv` with pinned
 # versions (constraints.txt; torch==2.13.0 CPU), the project installed editable. Idempotent: a second
 # run only checks. Debian packages: none are needed (PyBullet renders headless with TinyRenderer,
-# pylsl bundles liblsl, cyclonedds bundles Cyclone DDS); see README for the optional GUI.
+# pylsl bundles liblsl, cyclonedds bundles Cyclone DDS); see README for the optional GUI. Xvfb (for
+# the display window tests) is installed when missing and this runs as root.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 PY=${PYTHON:-python3}
@@ -18,5 +19,14 @@ fi
 # torch first and pinned: an unpinned torch pulls GBs of CUDA packages.
 .venv/bin/python -m pip install --quiet -c constraints.txt "torch==2.13.0"
 .venv/bin/python -m pip install --quiet -c constraints.txt -e ".[test]"
+# Xvfb: the participant display's window tests run under a private X server. Installed when
+# missing and apt-get can (root); otherwise those tests are skipped with the reason.
+if ! command -v Xvfb >/dev/null 2>&1; then
+  if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
+    apt-get install -y -qq xvfb >/dev/null || echo "setup: could not install xvfb (window tests skip)"
+  else
+    echo "setup: Xvfb is missing; 'sudo apt-get install xvfb' runs the display window tests"
+  fi
+fi
 echo "$want" > "$stamp"
 echo "setup: .venv ready ($(.venv/bin/python --version))"

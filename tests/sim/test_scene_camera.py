@@ -26,7 +26,7 @@ def test_scene_view_shows_the_training_robot_green_and_semi_transparent():
         assert green_pixels(rgb) > 150
         # semi-transparent: the training robot's pixels mix its green with what is behind it,
         # so they are darker than its pure colour rendered alone
-        ys, xs = np.nonzero((rgb[:, :, 1].astype(int) > rgb[:, :, 0] + 40))
+        ys, xs = np.nonzero(rgb[:, :, 1].astype(int) > rgb[:, :, 0] + 40)
         assert rgb[ys, xs, 1].mean() < 200
         # the user's arm is in both views at the same place (rendering the ghost moves nothing)
         np.testing.assert_allclose(s.joint_positions('user'), s.home_pose, atol=2e-3)

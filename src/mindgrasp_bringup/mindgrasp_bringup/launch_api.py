@@ -63,6 +63,9 @@ _HELPERS = {
     'classifier_nodes': 'mindgrasp_bringup.launch_system.common',
     'eeg_source_arguments': 'mindgrasp_bringup.launch_system.common',
     'eeg_source_nodes': 'mindgrasp_bringup.launch_system.common',
+    'display_arguments': 'mindgrasp_bringup.launch_system.common',
+    'display_nodes': 'mindgrasp_bringup.launch_system.common',
+    'sim_scene_camera': 'mindgrasp_bringup.launch_system.common',
 }
 
 __all__ = ['own_launcher', 'using_real_launch', *_SOURCES, *_HELPERS]

@@ -135,7 +135,9 @@ class SimNode(rclpy.node.Node):
         self.status_every = max(1, round(self.sim.physics_hz))     # 1 s of simulated time
         scene_rate = float(p['scene_camera_rate'])
         self.scene_every = self.sim.physics_hz / scene_rate if scene_rate > 0 else math.inf
-        self._next = {'js': 0.0, 'cam': 0.0, 'obj': 0.0, 'scene': 0.0}
+        # the scene camera's first frame is due at once; never when it is off
+        self._next = {'js': 0.0, 'cam': 0.0, 'obj': 0.0,
+                      'scene': 0.0 if scene_rate > 0 else math.inf}
         self._collisions: list[str] = []
         self._last_state_step = -1
         self._wall_start = time.monotonic()

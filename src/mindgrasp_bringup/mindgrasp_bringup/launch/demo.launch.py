@@ -4,6 +4,7 @@ acquisition, MI classifier, vision and the grasp controller, recorded to the run
     mindgrasp launch demo                          # 3 grasp trials, then ends; runs/<UTC>_demo/
     mindgrasp launch demo trials:=0                # trials until Ctrl-C
     mindgrasp launch demo duration:=120 gui:=true targets:='blue cylinder, red cube' trials:=2
+    mindgrasp launch demo display:=window           # with the participant's screen
     mindgrasp launch demo --show-args
 
 The task, as in the paper's set-locations experiment: the trial manager names the object to grasp
@@ -23,6 +24,9 @@ from mindgrasp_bringup.launch_api import (
     Shutdown,
     classifier_nodes,
     config_files,
+    display_arguments,
+    display_nodes,
+    sim_scene_camera,
 )
 
 
@@ -54,6 +58,7 @@ def generate_launch_description() -> LaunchDescription:
         DeclareLaunchArgument('trials', default_value='3',
                               description='grasp trials before the demo ends (0: until duration '
                                           'or Ctrl-C)'),
+        *display_arguments(),
         # 0 the trials: which object to grasp, reset between grasps
         Node(package='mindgrasp_bringup', executable='trial_manager_node', name='trial_manager',
              parameters=[*config_files('demo'),
@@ -61,8 +66,9 @@ def generate_launch_description() -> LaunchDescription:
                           'n_trials': LaunchConfiguration('trials'), 'seed': seed}],
              on_exit=Shutdown()),  # trials:=N done: the demo ends
         # 1 simulator: arm, gripper, objects, RGB-D camera (the arm contract of ros2_control)
-        Node(package='mindgrasp_sim', executable='sim_node', name='sim',
-             parameters=[*config_files('sim', 'demo'), {'gui': gui, 'seed': seed}]),
+        *[Node(package='mindgrasp_sim', executable='sim_node', name='sim',
+               parameters=[*config_files('sim', 'demo'), {'gui': gui, 'seed': seed, **scene}],
+               condition=condition) for condition, scene in sim_scene_camera()],
         # 2 virtual amplifier: synthetic EEG of the virtual subject as an LSL stream
         Node(package='mindgrasp_eeg', executable='virtual_amp_node', name='virtual_amp',
              parameters=[*config_files('eeg', 'demo'),
@@ -71,6 +77,8 @@ def generate_launch_description() -> LaunchDescription:
         # 3 acquisition: LSL inlet -> /eeg/raw
         Node(package='mindgrasp_eeg', executable='acquisition_node', name='eeg_acquisition',
              parameters=[*config_files('eeg', 'demo'), {'stream_name': eeg_stream}]),
+        # the participant's screen (display:=window|fullscreen|headless)
+        *display_nodes(config_files('trainer'), LaunchConfiguration('trials')),
         # 4 classifier: /eeg/raw -> /bci/prediction
         *classifier_nodes(config_files('classifier', 'demo')),
         # 5 vision: camera -> /vision/detections, /vision/overlay

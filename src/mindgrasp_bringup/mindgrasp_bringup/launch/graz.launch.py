@@ -4,6 +4,7 @@ EEG are recorded so that the classifier can be trained on them.
     mindgrasp launch graz                             # virtual amplifier, virtual subject
     mindgrasp launch graz amp:=lsl eeg_stream:=MyAmp trials:=80
     mindgrasp launch graz feedback:=true              # classifier feedback bar (trained model)
+    mindgrasp launch graz display:=window             # the participant's screen (pygame)
 
 The launch ends when the prompter has run all its trials (or after duration:=S).
 """
@@ -18,6 +19,8 @@ from mindgrasp_bringup.launch_api import (
     Shutdown,
     classifier_nodes,
     config_files,
+    display_arguments,
+    display_nodes,
     eeg_source_arguments,
     eeg_source_nodes,
 )
@@ -27,6 +30,7 @@ def generate_launch_description() -> LaunchDescription:
     seed = LaunchConfiguration('seed')
     return LaunchDescription([
         *eeg_source_arguments(),
+        *display_arguments(),
         DeclareLaunchArgument('trials', default_value='40',
                               description='number of trials (a multiple of 4 balances classes)'),
         DeclareLaunchArgument('seed', default_value='0',
@@ -41,6 +45,7 @@ def generate_launch_description() -> LaunchDescription:
         *eeg_source_nodes(config_files('eeg'), seed, 'follow'),
         GroupAction(classifier_nodes(config_files('classifier')),
                     condition=IfCondition(LaunchConfiguration('feedback'))),
+        *display_nodes(config_files('trainer'), LaunchConfiguration('trials')),
         Node(package='mindgrasp_trainer', executable='graz_node', name='graz_prompter',
              parameters=[*config_files('trainer'),
                          {'n_trials': LaunchConfiguration('trials'), 'seed': seed}],

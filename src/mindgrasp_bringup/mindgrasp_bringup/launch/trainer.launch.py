@@ -2,7 +2,7 @@
 follows it with their own arm by motor imagery; prompts and EEG are recorded for training.
 
     mindgrasp launch trainer                          # virtual subject, simulated arms
-    mindgrasp launch trainer amp:=lsl eeg_stream:=MyAmp trials:=80
+    mindgrasp launch trainer amp:=lsl eeg_stream:=MyAmp trials:=80 display:=fullscreen
     mindgrasp train classifier runs/<run>/bag         # then train on the recording
 
 The launch ends when the trainer has run all its trials (or after duration:=S).
@@ -16,8 +16,11 @@ from mindgrasp_bringup.launch_api import (
     Shutdown,
     classifier_nodes,
     config_files,
+    display_arguments,
+    display_nodes,
     eeg_source_arguments,
     eeg_source_nodes,
+    sim_scene_camera,
 )
 
 
@@ -25,6 +28,7 @@ def generate_launch_description() -> LaunchDescription:
     seed = LaunchConfiguration('seed')
     return LaunchDescription([
         *eeg_source_arguments(),
+        *display_arguments(),
         DeclareLaunchArgument('subject', default_value='follow',
                               choices=['noise', 'follow', 'pursue'],
                               description='virtual subject (amp:=virtual): follow imagines what '
@@ -39,16 +43,18 @@ def generate_launch_description() -> LaunchDescription:
                               description='classifier model (.json written by mindgrasp train '
                                           'classifier); empty: the one in '
                                           'config/params/classifier.yaml'),
-        Node(package='mindgrasp_sim', executable='sim_node', name='sim',
-             parameters=[*config_files('sim'),
-                         {'gui': LaunchConfiguration('gui'), 'seed': seed,
-                          'trainer_robot': True}]),
+        *[Node(package='mindgrasp_sim', executable='sim_node', name='sim',
+               parameters=[*config_files('sim'),
+                           {'gui': LaunchConfiguration('gui'), 'seed': seed,
+                            'trainer_robot': True, **scene}], condition=condition)
+          for condition, scene in sim_scene_camera()],
         *eeg_source_nodes(config_files('eeg'), seed, LaunchConfiguration('subject')),
         *classifier_nodes(config_files('classifier')),
         Node(package='mindgrasp_vision', executable='vision_node', name='vision',
              parameters=config_files('vision')),
         Node(package='mindgrasp_fsm', executable='fsm_node', name='fsm',
              parameters=config_files('fsm')),
+        *display_nodes(config_files('trainer'), LaunchConfiguration('trials')),
         # last: it starts prompting once everything else runs, and its end ends the launch
         Node(package='mindgrasp_trainer', executable='trainer_node', name='trainer',
              parameters=[*config_files('trainer'),

@@ -46,3 +46,49 @@ def eeg_source_nodes(files: list[Path], seed: object, subject_mode: object) -> l
         la.Node(package='mindgrasp_eeg', executable='acquisition_node', name='eeg_acquisition',
                 parameters=[*files, {'stream_name': stream}]),
     ]
+
+
+#: values of the ``display:=`` launch argument
+DISPLAY_MODES = ('off', 'window', 'fullscreen', 'headless')
+
+
+def display_arguments() -> list[Any]:
+    """``display:=off|window|fullscreen|headless`` and the display's options, for
+    :func:`display_nodes`."""
+    return [
+        la.DeclareLaunchArgument('display', default_value='off', choices=list(DISPLAY_MODES),
+                              description="the participant's screen (pygame): a window, full "
+                                          'screen, or headless (frames to /display/image and '
+                                          'PNG files); off: none'),
+        la.DeclareLaunchArgument('display_png_dir', default_value='',
+                              description='folder for the display PNG frames (one per prompt '
+                                          "phase); '' none"),
+        la.DeclareLaunchArgument('display_layout', default_value='auto',
+                              choices=['auto', 'graz', 'trainer', 'test'],
+                              description='display layout; auto follows the prompts'),
+        la.DeclareLaunchArgument('display_label', default_value='',
+                              description="phase name in the display's banner"),
+    ]
+
+
+def display_nodes(files: list[Path], n_trials: object = 0) -> list[Any]:
+    """The participant display node (name ``participant_display``) in the mode of ``display:=``;
+    declare :func:`display_arguments` in the profile."""
+    common = {'png_dir': la.LaunchConfiguration('display_png_dir'),
+              'layout': la.LaunchConfiguration('display_layout'),
+              'phase_label': la.LaunchConfiguration('display_label'), 'n_trials': n_trials}
+    return [
+        la.Node(package='mindgrasp_trainer', executable='display_node', name='participant_display',
+             parameters=[*files, {**common, 'headless': mode == 'headless',
+                                  'fullscreen': mode == 'fullscreen'}],
+             condition=la.LaunchConfigurationEquals('display', mode))
+        for mode in DISPLAY_MODES[1:]
+    ]
+
+
+def sim_scene_camera(display_rate: float = 5.0) -> list[tuple[object, dict]]:
+    """(condition, parameters) pairs for the simulator: its scene camera
+    (``/scene/image_raw``) runs at ``display_rate`` Hz when a display is shown, else it is off."""
+    return [(la.LaunchConfigurationEquals('display', 'off'), {'scene_camera_rate': 0.0}),
+            (la.LaunchConfigurationNotEquals('display', 'off'),
+             {'scene_camera_rate': display_rate})]

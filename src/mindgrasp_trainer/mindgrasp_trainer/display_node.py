@@ -1,0 +1,314 @@
+"""Participant display node: the screen a participant looks at during a session (pygame).
+
+Run::
+
+    python -m mindgrasp_trainer.display_node                         # a window
+    python -m mindgrasp_trainer.display_node --fullscreen
+    python -m mindgrasp_trainer.display_node --headless --ros-args -p png_dir:=frames
+
+Shows (layout by phase, see :mod:`mindgrasp_trainer.screen`) the Graz cue and feedback bar, the
+third-person scene with the green training robot, the eye-in-hand view with the vision overlay,
+the desired object of a test, the controller state, and a banner with the phase and trial.
+
+Topics (QoS):
+
+==========================  ============================  ===============================
+topic                       type                          QoS
+==========================  ============================  ===============================
+/trainer/prompt (sub)       mindgrasp_msgs/Prompt         reliable, transient local, 1
+/bci/prediction (sub)       mindgrasp_msgs/MIPrediction   reliable, 10
+/scene/image_raw (sub)      sensor_msgs/Image rgb8        sensor data
+/vision/overlay (sub)       sensor_msgs/Image rgb8        sensor data
+/fsm/state (sub)            mindgrasp_msgs/FsmState       reliable, transient local, 10
+/task/target (sub)          mindgrasp_msgs/TaskTarget     reliable, transient local, 1
+/trainer/ee_distance (sub)  std_msgs/Float64              reliable, 10
+/display/flip (pub)         mindgrasp_msgs/Prompt         reliable, 50
+/display/image (pub)        sensor_msgs/Image rgb8        sensor data (headless)
+==========================  ============================  ===============================
+
+Each new prompt phase is drawn at once (not at the next frame tick); right after the flip the node
+publishes the prompt again on ``/display/flip`` with ``header.stamp`` = the time of the flip, so
+labels can use display time, and logs a warning when the flip came more than ``late_threshold``
+(20 ms) after the prompt's stamp. Frame times are checked every 5 s; a display that cannot keep
+up with ``rate`` is logged with its measured frame times.
+
+``--headless`` (or ``-p headless:=true``) draws off-screen (SDL dummy driver), publishes the frames
+on ``/display/image`` at ``image_rate`` and writes PNG files to ``png_dir`` (one per prompt phase
+and ``png_rate`` per second). Ends by itself after ``duration`` s when that is > 0, or when the
+window is closed (Esc).
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+import time
+from dataclasses import dataclass, fields
+from pathlib import Path
+
+import cv2
+import numpy as np
+from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import FsmState, MIPrediction, Prompt, TaskTarget
+from mindgrasp_ros.interfaces.sensor_msgs.msg import Image
+from mindgrasp_ros.interfaces.std_msgs.msg import Float64
+
+from mindgrasp_ros import rclpy
+from mindgrasp_trainer.protocol import PromptEvent, TrainerError
+from mindgrasp_trainer.ros_common import check_rate, prompt_qos
+from mindgrasp_trainer.screen import ParticipantScreen, ScreenState
+from mindgrasp_trainer.window import Window
+
+
+@dataclass
+class DisplayParams:
+    """ROS parameters of the display node (units: Hz, px, s)."""
+
+    rate: float = 30.0              # frames per second (Hz)
+    width: int = 1024               # frame size (px)
+    height: int = 600
+    fullscreen: bool = False        # take the whole screen (Esc ends)
+    headless: bool = False          # draw off-screen; frames to /display/image and png_dir
+    layout: str = 'auto'            # auto | graz | trainer | test | idle
+    phase_label: str = ''           # banner text, e.g. 'Graz with feedback'; '' from the prompts
+    n_trials: int = 0               # trials planned in this phase, for the banner (0 unknown)
+    feedback: str = 'move'          # Graz feedback bar: off | move | always
+    max_certainty: float = 1.0      # certainty that fills the feedback bar
+    prediction_timeout: float = 1.0  # s; older predictions are not shown
+    late_threshold: float = 0.02    # s; a flip later than this after its prompt is logged
+    image_rate: float = 2.0         # Hz of /display/image when headless (0 off)
+    png_dir: str = ''               # folder for PNG frames ('' none)
+    png_rate: float = 0.0           # PNG frames per second besides one per prompt phase
+    duration: float = 0.0           # s; end after this long (0 = until stopped)
+
+
+def _image_to_rgb(msg: Image) -> np.ndarray | None:
+    """rgb uint8 (H, W, 3) of an rgb8 or bgr8 sensor_msgs/Image; None for other encodings."""
+    if msg.encoding not in ('rgb8', 'bgr8') or msg.height == 0 or msg.width == 0:
+        return None
+    data = np.frombuffer(bytes(msg.data), np.uint8) if not isinstance(msg.data, np.ndarray) \
+        else msg.data.astype(np.uint8, copy=False)
+    rows = data.reshape(msg.height, msg.step)[:, :msg.width * 3]
+    rgb = rows.reshape(msg.height, msg.width, 3)
+    return rgb[:, :, ::-1].copy() if msg.encoding == 'bgr8' else rgb.copy()
+
+
+def _stamp_ns(stamp) -> int:
+    return int(stamp.sec) * 1_000_000_000 + int(stamp.nanosec)
+
+
+class DisplayNode(rclpy.node.Node):
+    """Shows :class:`ParticipantScreen` frames and publishes when each prompt was drawn."""
+
+    def __init__(self, **kwargs) -> None:
+        super().__init__('participant_display', **kwargs)
+        defaults = DisplayParams()
+        self.declare_parameters('', [(f.name, getattr(defaults, f.name))
+                                     for f in fields(DisplayParams)])
+        p = DisplayParams(**{f.name: self.get_parameter(f.name).value
+                             for f in fields(DisplayParams)})
+        self.p = p
+        try:
+            rate = check_rate('rate', p.rate)
+            self.image_rate = check_rate('image_rate', p.image_rate, allow_zero=True)
+            self.png_rate = check_rate('png_rate', p.png_rate, allow_zero=True)
+            self.screen = ParticipantScreen(int(p.width), int(p.height), p.layout, p.feedback,
+                                            float(p.max_certainty))
+            self.png_dir = Path(p.png_dir) if p.png_dir else None
+            if self.png_dir is not None:
+                try:
+                    self.png_dir.mkdir(parents=True, exist_ok=True)
+                except OSError as err:
+                    msg = f"Cannot create 'png_dir' {p.png_dir!r}: {err}; give a writable folder."
+                    raise TrainerError(msg) from None
+            self.window = Window(int(p.width), int(p.height), bool(p.fullscreen),
+                                 bool(p.headless), 'MIndGrasp participant display')
+        except TrainerError as err:
+            self.get_logger().error(str(err))
+            raise
+        self.period = 1.0 / rate
+        self.state = ScreenState(phase_label=str(p.phase_label), n_trials=int(p.n_trials))
+        self.prediction: tuple[int, float] | None = None
+        self.prediction_ns = 0
+        self.pending: list[Prompt] = []       # prompts to stamp at the next flip
+        self.frame_count = 0
+        self.png_count = 0
+        self.last_png = -math.inf
+        self.last_image = -math.inf
+        self.frame_ns: list[int] = []         # monotonic ns of the flips since the last check
+        self.late_count = 0
+        self.started = time.monotonic()
+        self.done = rclpy.task.Future()
+
+        sensor = rclpy.qos.qos_profile_sensor_data
+        latched = rclpy.qos.QoSProfile(
+            depth=1, reliability=rclpy.qos.ReliabilityPolicy.RELIABLE,
+            durability=rclpy.qos.DurabilityPolicy.TRANSIENT_LOCAL)
+        fsm_qos = rclpy.qos.QoSProfile(
+            depth=10, reliability=rclpy.qos.ReliabilityPolicy.RELIABLE,
+            durability=rclpy.qos.DurabilityPolicy.TRANSIENT_LOCAL)
+        self.flip_pub = self.create_publisher(Prompt, '/display/flip', 50)
+        self.image_pub = self.create_publisher(Image, '/display/image', sensor)
+        self.create_subscription(Prompt, '/trainer/prompt', self.prompt_callback, prompt_qos())
+        self.create_subscription(MIPrediction, '/bci/prediction', self.prediction_callback, 10)
+        self.create_subscription(Image, '/scene/image_raw', self.scene_callback, sensor)
+        self.create_subscription(Image, '/vision/overlay', self.overlay_callback, sensor)
+        self.create_subscription(FsmState, '/fsm/state', self.fsm_callback, fsm_qos)
+        self.create_subscription(TaskTarget, '/task/target', self.target_callback, latched)
+        self.create_subscription(Float64, '/trainer/ee_distance', self.distance_callback, 10)
+        self.create_timer(self.period, self.frame_callback)
+        self.create_timer(5.0, self.check_frame_times)
+        mode = 'headless' if p.headless else ('full screen' if p.fullscreen else 'window')
+        self.get_logger().info(
+            f'Participant display ready: {p.width}x{p.height} px at {rate:g} Hz, {mode}, '
+            f"layout {p.layout}{', PNG frames to ' + str(self.png_dir) if self.png_dir else ''}.")
+
+    @property
+    def finished(self) -> bool:
+        return self.done.done()
+
+    # ------------------------------------------------------------------ inputs
+    def prompt_callback(self, msg: Prompt) -> None:
+        self.state.prompt = PromptEvent(_stamp_ns(msg.header.stamp) * 1e-9, msg.phase,
+                                        int(msg.trial), int(msg.class_index),
+                                        float(msg.duration), msg.paradigm)
+        self.pending.append(msg)
+        self.draw()  # a new cue is drawn now, not at the next frame tick
+
+    def prediction_callback(self, msg: MIPrediction) -> None:
+        self.prediction = (int(msg.class_index), float(msg.certainty))
+        self.prediction_ns = self.get_clock().now().nanoseconds
+
+    def scene_callback(self, msg: Image) -> None:
+        self.state.scene = _image_to_rgb(msg)
+
+    def overlay_callback(self, msg: Image) -> None:
+        self.state.camera = _image_to_rgb(msg)
+
+    def fsm_callback(self, msg: FsmState) -> None:
+        self.state.fsm_state_name = str(msg.state_name) or str(int(msg.state))
+
+    def target_callback(self, msg: TaskTarget) -> None:
+        self.state.target = f'{msg.colour} {msg.shape}'.strip()
+        self.state.target_trial = int(msg.trial)
+
+    def distance_callback(self, msg: Float64) -> None:
+        self.state.ee_distance = float(msg.data)
+
+    # ------------------------------------------------------------------ frames
+    def frame_callback(self) -> None:
+        if self.finished:
+            return
+        if not self.window.poll():
+            self.get_logger().info('The display window was closed; the display ends.')
+            self.done.set_result(0)
+            return
+        if self.p.duration > 0 and time.monotonic() - self.started >= self.p.duration:
+            self.done.set_result(0)
+            return
+        self.draw()
+
+    def draw(self) -> None:
+        """Render, flip, then stamp the pending prompts with the flip time."""
+        age_ns = self.get_clock().now().nanoseconds - self.prediction_ns
+        timeout_ns = int(float(self.p.prediction_timeout) * 1e9)
+        self.state.prediction = self.prediction if age_ns <= timeout_ns else None
+        frame = self.screen.render(self.state)
+        flip_mono = self.window.show(frame)
+        flip = self.get_clock().now()
+        self.frame_ns.append(flip_mono)
+        self.frame_count += 1
+        prompts, self.pending = self.pending, []
+        for prompt in prompts:
+            late = (flip.nanoseconds - _stamp_ns(prompt.header.stamp)) * 1e-9
+            prompt.header.stamp = flip.to_msg()
+            self.flip_pub.publish(prompt)
+            if late > float(self.p.late_threshold):
+                self.late_count += 1
+                self.get_logger().warning(
+                    f'Trial {prompt.trial}: {prompt.phase} {prompt.class_name or ""} drawn '
+                    f'{1e3 * late:.1f} ms after its prompt (limit '
+                    f'{1e3 * float(self.p.late_threshold):.0f} ms); /display/flip has the drawn '
+                    'time.')
+        now = time.monotonic()
+        if self.p.headless and self.image_rate > 0 and now - self.last_image >= 1 / self.image_rate:
+            self.last_image = now
+            msg = Image(height=frame.shape[0], width=frame.shape[1], encoding='rgb8',
+                        is_bigendian=0, step=frame.shape[1] * 3, data=frame.reshape(-1))
+            msg.header.stamp = flip.to_msg()
+            msg.header.frame_id = 'participant_display'
+            self.image_pub.publish(msg)
+        if self.png_dir is not None and (
+                prompts or (self.png_rate > 0 and now - self.last_png >= 1 / self.png_rate)):
+            self.last_png = now
+            self.write_png(frame, prompts[-1] if prompts else None)
+
+    def write_png(self, frame: np.ndarray, prompt: Prompt | None) -> None:
+        """``<png_dir>/frame_<n>[_<paradigm>_<trial>_<phase>].png``; a full disk is logged once."""
+        self.png_count += 1
+        tag = f'_{prompt.paradigm}_{prompt.trial:03d}_{prompt.phase}' if prompt else ''
+        path = self.png_dir / f'frame_{self.png_count:06d}{tag}.png'
+        if not cv2.imwrite(str(path), cv2.cvtColor(frame, cv2.COLOR_RGB2BGR)):
+            self.get_logger().error(f'Could not write {path}; PNG frames stop.')
+            self.png_dir = None
+
+    def check_frame_times(self) -> None:
+        """Warn, with the measured frame times, when frames come slower than ``rate``."""
+        ns, self.frame_ns = self.frame_ns, self.frame_ns[-1:]
+        if len(ns) < 3:
+            return
+        dt = np.diff(np.asarray(ns)) * 1e-6  # ms
+        p95 = float(np.percentile(dt, 95))
+        if p95 > 1.5 * self.period * 1e3:
+            self.get_logger().warning(
+                f'The display cannot keep up: frame times median {np.median(dt):.1f} ms, '
+                f'95th percentile {p95:.1f} ms, max {dt.max():.1f} ms over {len(dt)} frames, '
+                f'for {1e3 * self.period:.1f} ms at rate {1 / self.period:g} Hz; lower '
+                "'rate' or the frame size.")
+
+    def destroy_node(self) -> None:
+        self.window.close()
+        super().destroy_node()
+
+
+def _cli_flags(args: list[str]) -> list[str]:
+    """``--headless`` / ``--fullscreen`` before ``--ros-args`` become ROS parameters."""
+    args = list(args)
+    extra = []
+    own = args[:args.index('--ros-args')] if '--ros-args' in args else args
+    for flag in ('--headless', '--fullscreen'):
+        if flag in own:
+            args.remove(flag)
+            extra += ['-p', f'{flag[2:]}:=true']
+    if extra:
+        if '--ros-args' in args:
+            i = args.index('--ros-args') + 1
+            args[i:i] = extra
+        else:
+            args += ['--ros-args', *extra]
+    return args
+
+
+def main(args: list[str] | None = None) -> int:
+    argv = _cli_flags(sys.argv[1:] if args is None else args)
+    rclpy.init(args=[sys.argv[0], *argv])
+    try:
+        node = DisplayNode()
+    except TrainerError:
+        rclpy.shutdown()
+        return 2
+    try:
+        rclpy.spin_until_future_complete(node, node.done)
+    except KeyboardInterrupt:
+        pass
+    finally:
+        node.get_logger().info(
+            f'Participant display drew {node.frame_count} frames, {node.late_count} late '
+            f'prompt(s), {node.png_count} PNG file(s).')
+        node.destroy_node()
+        if rclpy.ok():
+            rclpy.shutdown()
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())
