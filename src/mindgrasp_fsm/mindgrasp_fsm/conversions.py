@@ -59,11 +59,15 @@ def gripper_from_fingers(positions: Sequence[float], stamp: float,
                          ) -> GripperState:
     """Gripper state from finger joint angles (rad), optional per-finger contact flags and
     efforts (N m). Opening: 1 open .. 0 closed (mean over fingers); contact: at least two fingers
-    touch (thumb against a finger), when contact flags are given."""
+    touch (thumb against a finger), when contact flags are given; force: sum of the absolute
+    efforts (N m), NaN without them."""
     pos = np.asarray(positions, dtype=float)
     opening = float(np.clip((closed_angle - pos.mean()) / (closed_angle - open_angle), 0.0, 1.0))
     n = None if contacts is None else int(np.count_nonzero(contacts))
     contact = None if n is None else n >= 2
     force = float(np.sum(np.abs(efforts))) if efforts is not None else math.nan
+    per_finger = None
+    if efforts is not None and len(efforts) == pos.size:
+        per_finger = tuple(float(e) for e in np.asarray(efforts, dtype=float))
     return GripperState(opening=opening, force=force, stamp=float(stamp), contact=contact,
-                        fingers_in_contact=n)
+                        fingers_in_contact=n, efforts=per_finger)

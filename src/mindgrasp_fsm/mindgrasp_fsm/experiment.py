@@ -88,8 +88,12 @@ class TrialRecord:
 
 
 def build_loop(params: FsmParams | None = None, shape_model: str | None = None,
-               camera_hz: float | None = None) -> tuple[LockstepLoop, str]:
-    """Simulation + vision pipeline + controller for the experiment; returns (loop, model note)."""
+               camera_hz: float | None = None, realism: object = None,
+               realism_seed: int = 0) -> tuple[LockstepLoop, str]:
+    """Simulation + vision pipeline + controller for the experiment; returns (loop, model note).
+
+    ``realism``: a :class:`~mindgrasp_sim.realism.RealismProfile`, its name or a YAML path
+    (None: a perfect world); ``realism_seed`` seeds its draws."""
     from mindgrasp_sim.simulation import Simulation
     from mindgrasp_vision.config import VisionConfig
 
@@ -106,7 +110,8 @@ def build_loop(params: FsmParams | None = None, shape_model: str | None = None,
     if classifier is None and not note.startswith('none'):
         note = 'none'
     sim = Simulation(scene={'name': 'empty', 'objects': [
-        {'shape': 'cube', 'colour': 'red', 'radius': 0.5, 'angle_deg': 0}]})
+        {'shape': 'cube', 'colour': 'red', 'radius': 0.5, 'angle_deg': 0}]},
+        realism=realism, realism_seed=realism_seed)
     loop = LockstepLoop(sim, cfg.build_pipeline(classifier), GraspFsm.from_params(params),
                         camera_hz=camera_hz)
     return loop, note
@@ -114,9 +119,12 @@ def build_loop(params: FsmParams | None = None, shape_model: str | None = None,
 
 def run_random_locations(trials: int, seed: int, params: FsmParams | None = None,
                          timeout: float = 120.0, shape_model: str | None = None,
-                         progress: Callable[[TrialRecord], None] | None = None) -> dict:
-    """Run the experiment; returns the summary dict printed by the CLI (see its ``--json``)."""
-    loop, model_note = build_loop(params, shape_model)
+                         progress: Callable[[TrialRecord], None] | None = None,
+                         realism: object = None) -> dict:
+    """Run the experiment; returns the summary dict printed by the CLI (see its ``--json``).
+
+    ``realism``: profile, name or YAML path (None: none); its draws are seeded by ``seed``."""
+    loop, model_note = build_loop(params, shape_model, realism=realism, realism_seed=seed)
     records: list[TrialRecord] = []
     outcomes: list[TrialOutcome] = []
     wall0 = time.perf_counter()
@@ -136,7 +144,9 @@ def run_random_locations(trials: int, seed: int, params: FsmParams | None = None
     finally:
         loop.sim.close()
     wall = time.perf_counter() - wall0
-    return summarise(records, outcomes, seed, wall, sim_time, model_note)
+    summary = summarise(records, outcomes, seed, wall, sim_time, model_note)
+    summary['realism'] = loop.sim.realism.profile.name
+    return summary
 
 
 def summarise(records: list[TrialRecord], outcomes: list[TrialOutcome], seed: int, wall: float,

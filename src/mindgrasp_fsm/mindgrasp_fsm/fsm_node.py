@@ -4,11 +4,12 @@ Run: ``python -m mindgrasp_fsm.fsm_node --ros-args --params-file config/params/f
 
 Subscribes ``/bci/prediction`` (mindgrasp_msgs/MIPrediction), ``/vision/detections``
 (DetectionArray), ``/joint_states``, ``/gripper/joint_states`` + ``/gripper/contacts`` (finger
-angles and contact flags), ``/camera/color/camera_info``. Publishes ``/arm_controller/commands``
-(std_msgs/Float64MultiArray, 6 joint velocities in rad/s), ``/gripper_controller/commands``
-(``[closure]``, 0 open .. 1 closed) and ``/fsm/state`` (FsmState, transient local). Parameters:
-every field of :class:`mindgrasp_fsm.params.FsmParams`, plus ``control_rate`` (Hz) and
-``duration`` (s; > 0 ends the node after that time, for launch tests).
+angles, efforts and contact flags), ``/camera/color/camera_info``. Publishes
+``/arm_controller/commands`` (std_msgs/Float64MultiArray, 6 joint velocities in rad/s),
+``/gripper_controller/commands`` (``[closure]``, 0 open .. 1 closed) and ``/fsm/state``
+(FsmState, transient local). Parameters: every field of :class:`mindgrasp_fsm.params.FsmParams`,
+plus ``control_rate`` (Hz) and ``duration`` (s; > 0 ends the node after that time, for launch
+tests).
 """
 
 from __future__ import annotations
@@ -61,6 +62,7 @@ class FsmNode(rclpy.node.Node):
         self.inputs = FsmInputs(time=0.0)
         self._fingers: np.ndarray | None = None
         self._finger_stamp = 0.0
+        self._finger_efforts: np.ndarray | None = None
         self._contacts: np.ndarray | None = None
         self._errors: dict[str, float] = {}
         self._last_state_msg: tuple | None = None
@@ -141,6 +143,8 @@ class FsmNode(rclpy.node.Node):
 
     def finger_callback(self, msg: JointState) -> None:
         self._fingers = np.asarray(msg.position, dtype=float)
+        efforts = np.asarray(msg.effort, dtype=float)
+        self._finger_efforts = efforts if efforts.size == self._fingers.size else None
         self._finger_stamp = self._stamp_or_now(msg.header)
         self._update_gripper()
 
@@ -153,7 +157,8 @@ class FsmNode(rclpy.node.Node):
             return
         contacts = self._contacts if self._contacts is not None and \
             self._contacts.size == self._fingers.size else None
-        self.inputs.gripper = gripper_from_fingers(self._fingers, self._finger_stamp, contacts)
+        self.inputs.gripper = gripper_from_fingers(self._fingers, self._finger_stamp, contacts,
+                                                   self._finger_efforts)
 
     def info_callback(self, msg: CameraInfo) -> None:
         k = np.asarray(msg.k, dtype=float)

@@ -17,8 +17,8 @@ from  to    when                                                                
 4     2     object off centre before the autonomous approach starts                     no
 4     5     gripper at the grasp pose (grasp policy)                                    yes
 4     6     object lost or out of reach (abort)                                         yes
-5     6     grasp checked by finger contact and lift, or failed after the retries       yes
-5     4     finger contact missing or the object slipped: retry (``grasp_retries``)     yes
+5     6     grasp checked by finger effort and lift, or failed after the retries        yes
+5     4     fingers not loaded or the object slipped: retry (``grasp_retries``)         yes
 6     1     all joints back at the start position (or return timed out)                 yes
 ====  ====  ==========================================================================  =====
 
@@ -36,7 +36,7 @@ import math
 import numpy as np
 
 from mindgrasp_fsm.errors import FsmError
-from mindgrasp_fsm.grasp_policy import GraspPolicy, PolicyStep
+from mindgrasp_fsm.grasp_policy import GraspPolicy, PolicyStep, fingers_loaded
 from mindgrasp_fsm.kinematics import ArmKinematics
 from mindgrasp_fsm.params import FsmParams
 from mindgrasp_fsm.types import (
@@ -315,8 +315,10 @@ class GraspFsm:
         p = self.params
         v = np.zeros(6)
         g = inputs.gripper
-        if (self._gripper.position != p.gripper_open_position and g is not None
-                and (g.fingers_in_contact == 0 or g.contact is False)):
+        loaded = fingers_loaded(g, p.finger_contact_effort) if g is not None else None
+        empty = loaded == 0 if loaded is not None else \
+            g is not None and (g.fingers_in_contact == 0 or g.contact is False)
+        if self._gripper.position != p.gripper_open_position and empty:
             # closed on nothing (the scene was reset under the hand, or the object fell):
             # the fingers only hide the camera's view, so open them
             self._gripper = GripperCommand(p.gripper_open_position, 0.0)

@@ -14,8 +14,10 @@ measurement instead:
    pre-grasp corrected (parallax from the oblique first view is the main error).
 5. ``descend``: straight down to the grasp height.
 6. ``close`` (state 5): force-limited closing until the fingers stall.
-7. ``check_contact``: the fingers must touch something and not be fully closed.
-8. ``lift`` + ``check_lift``: lift and check the contact again; a slip or a miss opens the hand,
+7. ``check_contact``: every finger must push on something (finger effort; a real hand's contact
+   sensor cannot tell the object from the table) and the hand must not be fully closed.
+8. ``lift`` + ``check_lift``: lift and check the finger efforts and opening again (an object
+   that slipped out unloads the fingers); a slip or a miss opens the hand,
    backs off and retries once (``grasp_retries``), from a new measurement.
 
 All motions are joint velocities (rad/s), within joint limits and velocity limits.
@@ -70,6 +72,17 @@ def estimate_object_position(obs_centre: tuple[float, float], distance: float, b
         p = p + ray / norm * (size / 2.0)
     p[2] = table_height + size / 2.0
     return p, surface
+
+
+def fingers_loaded(gripper: GripperState, min_effort: float) -> int | None:
+    """How many fingers push on something (|effort| >= ``min_effort`` N m), or None when the
+    gripper reports no efforts (or ``min_effort`` is 0: use the contact flags)."""
+    if min_effort <= 0 or gripper.efforts is None:
+        return None
+    efforts = np.abs(np.asarray(gripper.efforts, dtype=float))
+    if not np.all(np.isfinite(efforts)):
+        return None
+    return int(np.count_nonzero(efforts >= min_effort))
 
 
 class GraspPolicy:
@@ -326,6 +339,15 @@ class GraspPolicy:
             return True, 'no gripper feedback: grasp not verified'
         if gripper.opening <= self.params.closed_empty_opening:
             return False, f'fingers closed on nothing (opening {gripper.opening:.2f})'
+        loaded = fingers_loaded(gripper, self.params.finger_contact_effort)
+        if loaded is not None:
+            # effort sensing: what a real hand knows (contact flags cannot tell the table apart)
+            efforts = ', '.join(f'{abs(e):.2f}' for e in gripper.efforts or ())
+            if loaded < self.params.min_fingers_in_contact:
+                return False, (f'{loaded} finger(s) push on something (efforts {efforts} N m), '
+                               f'{self.params.min_fingers_in_contact} wanted for a firm grasp')
+            return True, f'{loaded} fingers loaded (efforts {efforts} N m, opening ' \
+                         f'{gripper.opening:.2f})'
         touching = (gripper.contact if gripper.contact is not None
                     else gripper.force >= self.params.contact_min_force)
         if not touching:
@@ -372,7 +394,9 @@ class GraspPolicy:
                 else:
                     self._stall_since = None
                 self._last_opening = (t, gripper.opening)
-                n = gripper.fingers_in_contact
+                n = fingers_loaded(gripper, p.finger_contact_effort)
+                if n is None:
+                    n = gripper.fingers_in_contact
                 if self._hold_since is None and n is not None and n >= p.min_fingers_in_contact:
                     # every finger touches: stop closing and hold a little past this point
                     self._contact_since = self._contact_since if self._contact_since is not None \

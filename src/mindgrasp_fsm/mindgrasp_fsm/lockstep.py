@@ -147,11 +147,13 @@ class LockstepLoop:
                 obj = sim.objects()[target_id]
                 lift = max(lift, float(obj.position[2]) - start_z)
             gs = sim.gripper_state()
+            q, qd = sim.joint_readings()     # what the encoders report (realism: noisy)
             out = fsm.tick(FsmInputs(
                 time=t,
-                joints=JointStateIn(sim.joint_positions(), sim.joint_velocities(), t),
+                joints=JointStateIn(q, qd, t),
                 prediction=prediction, vision=frame,
-                gripper=gripper_from_fingers(gs['positions'], t, gs['contacts']),
+                gripper=gripper_from_fingers(gs['positions'], t, gs['contacts'],
+                                             gs['efforts']),
                 camera=self.camera))
             if int(out.state) != states[-1]:
                 states.append(int(out.state))

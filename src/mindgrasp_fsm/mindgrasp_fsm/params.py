@@ -126,6 +126,11 @@ class FsmParams:
     contact_settle_time: float = 0.05   # s all fingers touch before the closing stops
     contact_min_force: float = 1.0      # N finger force that counts as contact
     min_fingers_in_contact: int = 3     # fingers that must touch for a firm grasp (contact sensing)
+    # N m effort of a finger motor that means "this finger pushes on something" (a finger closing
+    # freely needs < 0.1 N m, one squeezing an object its limit of 1.2-2.4 N m). A real hand
+    # cannot tell the object from the table by contact, so the grasp check counts loaded
+    # fingers; 0 uses the contact flags instead (a simulator's "touches an object")
+    finger_contact_effort: float = 0.4
     closed_empty_opening: float = 0.05  # opening (0 closed .. 1 open) below which the hand is empty
     lift_height: float = 0.12           # m lift after closing
     lift_check_time: float = 0.3        # s held still after the lift before checking

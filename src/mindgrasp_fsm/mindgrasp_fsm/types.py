@@ -116,6 +116,7 @@ class GripperState:
     stamp: float
     contact: bool | None = None     # from contact sensing when available
     fingers_in_contact: int | None = None   # how many fingers touch the object, when sensed
+    efforts: tuple[float, ...] | None = None  # per-finger motor efforts (N m), when sensed
 
 
 @dataclass(frozen=True)

@@ -8,8 +8,9 @@ RGB-D camera driver, served by :class:`~mindgrasp_sim.simulation.Simulation`.
 Subscribes ``/arm_controller/commands`` (std_msgs/Float64MultiArray, 6 joint velocities, rad/s;
 older than ``command_timeout`` s means zero), ``/gripper_controller/commands``
 (Float64MultiArray: [closure] 0 open .. 1 closed, or [thumb, left, right]) and ``/task/target``.
-Publishes ``/joint_states`` (6 arm joints), ``/gripper/joint_states`` (3 fingers),
-``/gripper/contacts`` (std_msgs/UInt8MultiArray, 1 = finger touches an object), ``/ee_pose``
+Publishes ``/joint_states`` (6 arm joints), ``/gripper/joint_states`` (3 fingers: angles, efforts
+in N m), ``/gripper/contacts`` (std_msgs/UInt8MultiArray, 1 = finger touches an object; with
+realism, any surface), ``/ee_pose``
 (geometry_msgs/PoseStamped, TCP in ``world``), ``/camera/color/image_raw`` (rgb8),
 ``/camera/depth/image_raw`` (32FC1, m), ``/camera/color/camera_info``,
 ``/camera/depth/camera_info``, ``/sim/objects`` (visualization_msgs/MarkerArray),
@@ -20,6 +21,10 @@ Publishes ``/joint_states`` (6 arm joints), ``/gripper/joint_states`` (3 fingers
 under ``/trainer_robot/``.
 Services ``/sim/reset`` (ResetSim), ``/sim/load_scene`` (LoadScene) and, in lock-step mode,
 ``/sim/step`` (Step).
+
+Realism (``realism``: ``none`` (default), ``default`` or a profile YAML path; ``realism_seed``):
+the camera images, joint states and finger readings carry the sensor noise and physical spread
+of :mod:`mindgrasp_sim.realism`, the same in every time mode.
 
 Time modes (``time_mode``): ``realtime`` follows the node's clock (the wall clock, or /clock with
 ``use_sim_time``); ``fast`` steps as fast as it can and publishes ``/clock`` (run the other nodes
@@ -63,6 +68,7 @@ _PARAMS = (
     ('training_robot', False), ('gui', False), ('duration', 0.0), ('sim_duration', 0.0),
     ('success_height', 0.22), ('frame_id', 'world'), ('max_catch_up', 0.25),
     ('scene_camera_rate', 0.0), ('scene_camera_width', 320), ('scene_camera_height', 240),
+    ('realism', 'none'), ('realism_seed', 0),
 )  # fmt: skip
 
 
@@ -118,7 +124,8 @@ class SimNode(rclpy.node.Node):
                                     renderer=str(p['camera_renderer'])),
                 physics_hz=float(p['physics_hz']),
                 trainer_robot=bool(p['trainer_robot'] or p['training_robot']), gui=gui,
-                n_objects=None if int(p['n_objects']) < 0 else int(p['n_objects']))
+                n_objects=None if int(p['n_objects']) < 0 else int(p['n_objects']),
+                realism=str(p['realism']), realism_seed=int(p['realism_seed']))
         except SimError as err:
             self.get_logger().error(str(err))
             raise
@@ -196,6 +203,9 @@ class SimNode(rclpy.node.Node):
         self.create_timer(0.5, self.duration_callback)
         self.publish_all()
         robots = ' and the training robot' if 'trainer' in self.robots else ''
+        if self.sim.realism.enabled:
+            robots += (f", realism profile '{self.sim.realism.profile.name}' (seed "
+                       f'{self.sim.realism.seed})')
         self.get_logger().info(
             f"Simulating scene '{self.sim.scene.name}' ({len(self.sim.objects())} objects){robots}"
             f' at {self.sim.physics_hz:.0f} Hz physics, camera {self.sim.camera.width}x'
@@ -389,12 +399,13 @@ class SimNode(rclpy.node.Node):
         sim = self.sim
         hdr, world = self._header(), self._header(self.p['frame_id'])
         for io in self.robots.values():
-            io.pubs['js'].publish(msgs.joint_state(
-                hdr, sim.joint_names, sim.joint_positions(io.name),
-                sim.joint_velocities(io.name), sim.joint_efforts(io.name)))
+            q, v = sim.joint_readings(io.name)     # encoder readings (noisy with realism)
+            io.pubs['js'].publish(msgs.joint_state(hdr, sim.joint_names, q, v,
+                                                   sim.joint_efforts(io.name)))
             state = sim.gripper_state(io.name)
             io.pubs['gripper'].publish(msgs.joint_state(hdr, sim.finger_names,
-                                                        state['positions']))
+                                                        state['positions'],
+                                                        effort=state['efforts']))
             io.pubs['contacts'].publish(UInt8MultiArray(
                 data=state['contacts'].astype(np.uint8)))
             io.pubs['ee'].publish(msgs.pose_stamped(world, *sim.ee_pose(io.name)))

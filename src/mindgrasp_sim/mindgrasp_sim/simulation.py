@@ -15,6 +15,14 @@ each physics step integrates the commanded (clipped) velocity into a joint refer
 torque-limited PD motor tracks, so the arm holds still without drift when the command is zero and
 stops at its position limits. Two simulations with the same seed and command sequence produce
 identical states and images (DIRECT mode, deterministic overlapping pairs).
+
+Realism (off by default): ``realism='default'`` (or a :class:`~mindgrasp_sim.realism.RealismProfile`
+or a YAML path) adds what a real set-up has: noisy depth with invalid pixels, colour noise and
+lighting, a camera mounted off its URDF pose, encoder noise, a lag of the velocity controller,
+objects that differ in mass, friction, size and hue, and finger contacts on any surface. The
+sensor readings (:meth:`Simulation.render_camera`, :meth:`Simulation.joint_readings`,
+:meth:`Simulation.gripper_state`) carry it; the ground truth (:meth:`Simulation.joint_positions`,
+:meth:`Simulation.objects`, :meth:`Simulation.held_object`) stays exact for the bookkeeping.
 """
 
 from __future__ import annotations
@@ -32,6 +40,7 @@ from pybullet_utils.bullet_client import BulletClient
 
 from mindgrasp_sim.control import validate_velocities
 from mindgrasp_sim.errors import SimError
+from mindgrasp_sim.realism import Realism, RealismProfile
 from mindgrasp_sim.robot_model import ARM_JOINTS, FINGER_JOINTS
 from mindgrasp_sim.scene import ObjectSpec, SceneSpec, config_dir, load_scene
 
@@ -124,6 +133,7 @@ class _Robot:
     closure: float = 0.0
     gripper_dirty: bool = True
     holding: bool = False     # zero command already given to the motors: nothing to update
+    v_applied: np.ndarray = field(default_factory=lambda: np.zeros(6))  # after the lag, rad/s
 
 
 def _quat_to_matrix(quat: np.ndarray) -> np.ndarray:
@@ -183,6 +193,12 @@ class Simulation:
         Robot description (default ``config/robots/mindgrasp_arm.urdf``).
     solver_iterations : int
         Constraint solver iterations per step (contacts and motors; 50 holds grasps well).
+    realism : RealismProfile | str | Path | None
+        Sensor noise and physical spread (:mod:`mindgrasp_sim.realism`): a profile, its name
+        (``'default'``, ``'none'``) or a YAML path; None is ``'none'`` (a perfect world).
+    realism_seed : int
+        Seed of the realism draws; with the layout seed and the trial number (resets so far) it
+        fixes every noise sample, so the same seeds give the same images.
     """
 
     joint_names: tuple[str, ...] = ARM_JOINTS
@@ -191,7 +207,9 @@ class Simulation:
     def __init__(self, scene: str | Path = 'set_locations', seed: int = 0,
                  camera: CameraConfig | None = None, physics_hz: float = 240.0,
                  trainer_robot: bool = False, gui: bool = False, n_objects: int | None = None,
-                 urdf: str | Path | None = None, solver_iterations: int = 50) -> None:
+                 urdf: str | Path | None = None, solver_iterations: int = 50,
+                 realism: RealismProfile | str | Path | None = None,
+                 realism_seed: int = 0) -> None:
         if not (isinstance(physics_hz, (int, float)) and math.isfinite(physics_hz)
                 and 30.0 <= physics_hz <= 10000.0):
             msg = f'physics_hz must be a rate in 30..10000 Hz, got {physics_hz!r}; the ' \
@@ -202,6 +220,8 @@ class Simulation:
             msg = f'n_objects must be None or an integer >= 0, got {n_objects!r}.'
             raise SimError(msg)
         self.camera = camera or CameraConfig()
+        self.realism = Realism(realism, realism_seed)
+        self._trial = 0
         self.physics_hz = float(physics_hz)
         self.dt = 1.0 / self.physics_hz
         self.gui = bool(gui)
@@ -396,7 +416,11 @@ class Simulation:
         p = self._p
         for _, body in self._objects:
             p.removeBody(body)
-        self._objects = [(spec, self._spawn(spec)) for spec in self._layout]
+        # per-trial realism draws (camera mount, lighting, encoder offsets, object spread)
+        self.realism.begin_trial(self._layout_seed, self._trial)
+        self._trial += 1
+        specs = [self.realism.spread_object(spec) for spec in self._layout]
+        self._objects = [(spec, self._spawn(spec)) for spec in specs]
         for robot in self._robots.values():
             for i, j in enumerate(self._arm_idx):
                 p.resetJointState(robot.body, j, self.home_pose[i], 0.0)
@@ -404,6 +428,7 @@ class Simulation:
                 p.resetJointState(robot.body, j, FINGER_OPEN, 0.0)
             robot.q_ref = self.home_pose.copy()
             robot.v_cmd = np.zeros(6)
+            robot.v_applied = np.zeros(6)
             robot.closure = 0.0
             robot.gripper_dirty = True
             robot.holding = False
@@ -472,15 +497,26 @@ class Simulation:
             self._p.resetJointState(r.body, j, q[i], 0.0)
         r.q_ref = q.copy()
         r.v_cmd = np.zeros(6)
+        r.v_applied = np.zeros(6)
         r.holding = False
 
     def step(self, n: int = 1) -> None:
         """Advance the physics by ``n`` steps of ``1 / physics_hz`` s."""
         p = self._p
         dt = self.dt
+        lag = self.realism.profile.joints.lag > 0
         for _ in range(int(n)):
-            for r in self._robots.values():
-                if r.v_cmd.any():
+            for name, r in self._robots.items():
+                lagging = lag and name == 'user'     # the training robot is a drawn prompt
+                if lagging and (r.v_cmd.any() or r.v_applied.any()):
+                    # a real velocity controller follows the command with a lag
+                    r.v_applied = self.realism.lagged_velocity(r.v_applied, r.v_cmd, dt)
+                    if not r.v_cmd.any() and np.max(np.abs(r.v_applied)) < 1e-4:
+                        r.v_applied = np.zeros(6)
+                    r.holding = False
+                elif not lagging:
+                    r.v_applied = r.v_cmd
+                if r.v_applied.any():
                     self._track(p, r, dt)
                 elif not r.holding:
                     # stopping: hold the current reference (set once, then left alone)
@@ -505,7 +541,7 @@ class Simulation:
         q = np.array([s[0] for s in p.getJointStates(r.body, self._arm_idx)])
         # keep the reference near the real joints (a blocked arm does not wind up)
         q_ref = np.clip(r.q_ref, q - 0.05, q + 0.05)
-        new_ref = np.clip(q_ref + r.v_cmd * dt, self.lower, self.upper)
+        new_ref = np.clip(q_ref + r.v_applied * dt, self.lower, self.upper)
         v_ff = (new_ref - q_ref) / dt
         r.q_ref = new_ref
         p.setJointMotorControlArray(
@@ -523,6 +559,14 @@ class Simulation:
         """Arm joint velocities (6,) rad/s."""
         r = self._robot(robot)
         return np.array([s[1] for s in self._p.getJointStates(r.body, self._arm_idx)])
+
+    def joint_readings(self, robot: str = 'user') -> tuple[np.ndarray, np.ndarray]:
+        """What the arm's encoders report: joint positions (6,) rad and velocities (6,) rad/s,
+        with the realism profile's encoder noise and offsets (exact without realism)."""
+        q, v = self.joint_positions(robot), self.joint_velocities(robot)
+        if robot != 'user':
+            return q, v     # the training robot is a prompt on screen, not a sensed arm
+        return self.realism.joint_readings(q, v)
 
     def joint_efforts(self, robot: str = 'user') -> np.ndarray:
         """Arm joint motor torques (6,) N m applied in the last step."""
@@ -562,13 +606,29 @@ class Simulation:
         raise SimError(msg)
 
     def gripper_state(self, robot: str = 'user') -> dict:
-        """Gripper state: ``closure`` (commanded, 0..1), ``positions`` (3,) rad, ``contacts`` (3,)
-        bool (finger touches any object), ``names`` (thumb, left, right)."""
+        """Gripper state as the hand senses it: ``closure`` (commanded, 0..1), ``positions``
+        (3,) rad, ``efforts`` (3,) N m (finger motor torques), ``contacts`` (3,) bool, ``names``
+        (thumb, left, right).
+
+        A contact flag means "the finger touches a scene object" without realism; with the
+        realism contact mode ``any`` it means "touches any surface" (the table too), as a real
+        tactile sensor reports it.
+        """
         r = self._robot(robot)
-        touching = self._finger_contacts(r.body)
-        contacts = [any(j in fingers for fingers in touching.values()) for j in self._finger_idx]
+        if self.realism.profile.contacts.mode == 'any':
+            touched = {c[3] for c in self._p.getContactPoints(bodyA=r.body)
+                       if c[2] != r.body and c[3] in self._finger_links}
+            contacts = [j in touched for j in self._finger_idx]
+        else:
+            touching = self._finger_contacts(r.body)
+            contacts = [any(j in fingers for fingers in touching.values())
+                        for j in self._finger_idx]
+        efforts = np.array([s[3] for s in self._p.getJointStates(r.body, self._finger_idx)])
+        if robot == 'user':
+            efforts = self.realism.finger_efforts(efforts)
         return {'closure': r.closure, 'positions': self.finger_positions(robot),
-                'contacts': np.array(contacts, dtype=bool), 'names': FINGER_JOINTS}
+                'efforts': efforts, 'contacts': np.array(contacts, dtype=bool),
+                'names': FINGER_JOINTS}
 
     def objects(self) -> list[SceneObject]:
         """Current state of all scene objects (id = index in the scene layout)."""
@@ -628,13 +688,22 @@ class Simulation:
                       [0.0, 0.0, 1.0]])
         return k, c.width, c.height
 
-    def render_camera(self, robot: str = 'user') -> tuple[np.ndarray, np.ndarray]:
+    def render_camera(self, robot: str = 'user', exact: bool = False
+                      ) -> tuple[np.ndarray, np.ndarray]:
         """Render the eye-in-hand camera: rgb uint8 (H, W, 3) and depth float32 (H, W), metres
-        along the optical axis (``far`` where nothing is hit)."""
+        along the optical axis (``far`` where nothing is hit).
+
+        With a realism profile the image is what the camera delivers: seen from the camera's
+        physical pose (mount error), with colour and depth noise and invalid depth pixels (NaN or
+        0). ``exact=True`` renders the perfect image from the URDF pose.
+        """
         c = self.camera
         p = self._p
         pos, orn = self.camera_pose(robot)
         rot = _quat_to_matrix(orn)
+        sensed = not exact and robot == 'user' and self.realism.enabled
+        if sensed:
+            pos, rot = self.realism.camera_pose(pos, rot)
         target = pos + rot[:, 2]
         up = -rot[:, 1]
         view = p.computeViewMatrix(pos.tolist(), target.tolist(), up.tolist())
@@ -651,6 +720,9 @@ class Simulation:
         if not self._ground_visual:
             self._draw_ground(rgba, depth, depth > c.far * 0.999, pos, rot)
         rgb = rgba[:, :, :3].copy()
+        if sensed:
+            depth = self.realism.depth_image(depth, rgb)
+            rgb = self.realism.colour_image(rgb)
         return rgb, depth
 
     def _draw_ground(self, rgba: np.ndarray, depth: np.ndarray, empty: np.ndarray,
