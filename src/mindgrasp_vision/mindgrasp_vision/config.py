@@ -30,7 +30,8 @@ def resolve_model_path(path: str) -> Path:
 class VisionConfig:
     """All tunables of the vision node; defaults equal ``config/params/vision.yaml``.
 
-    Units: pixels at 128x128 for ``min_pixels``/``morph_kernel`` (scaled for larger images),
+    Units: pixels at 128x128 for ``min_pixels``/``morph_kernel``/``depth_median`` (scaled for
+    larger images),
     metres for ``depth_edge``/``object_size``/``max_depth``, seconds for timeouts.
     """
 
@@ -42,6 +43,7 @@ class VisionConfig:
     depth_edge: float = 0.03
     object_size: float = 0.05
     max_depth: float = 10.0
+    depth_median: int = 3
     size_weight: float = 5.0
     hysteresis: float = 0.1
     switch_frames: int = 3
@@ -110,6 +112,10 @@ class VisionConfig:
 
     def build_pipeline(self, classifier: object | None = None) -> VisionPipeline:
         """A :class:`VisionPipeline` with these parameters (and a loaded classifier, if any)."""
+        from mindgrasp_vision.depth import DepthFilter
+
         return VisionPipeline(self.build_detector(), self.build_ranker(), classifier,
                               shape_min_fraction=float(self.shape_min_fraction),
-                              shape_max_fraction=float(self.shape_max_fraction))
+                              shape_max_fraction=float(self.shape_max_fraction),
+                              depth_filter=DepthFilter(int(self.depth_median),
+                                                       max_depth=float(self.max_depth)))

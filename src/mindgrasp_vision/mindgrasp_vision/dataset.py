@@ -7,6 +7,10 @@ camera looks at the object from 0.12-0.40 m, 20-90 deg above the horizon, from t
 with some roll and off-centre aim. The object is found with the same :class:`ColourDetector` the
 node uses, and :func:`~mindgrasp_vision.shape_cnn.preprocess_depth` makes the network input; the
 label is the target's shape as the simulator knows it. Same seed, same data set.
+
+With a realism profile (``realism='default'``) the images are those of a real camera (depth noise,
+invalid pixels, mount error, lighting, object spread; :mod:`mindgrasp_sim.realism`), and the depth
+goes through the same :class:`~mindgrasp_vision.depth.DepthFilter` as in the vision pipeline.
 """
 
 from __future__ import annotations
@@ -19,6 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from mindgrasp_vision._checks import VisionError
+from mindgrasp_vision.depth import DepthFilter
 from mindgrasp_vision.detector import CameraIntrinsics, ColourDetector, Detection
 from mindgrasp_vision.shape_cnn import SHAPES, Preprocessing, preprocess_depth
 
@@ -175,7 +180,9 @@ def match_detection(dets: list[Detection], colour: str, uv: tuple[float, float]
 
 def collect_shape_dataset(n_images: int, seed: int = 0, config: DatasetConfig = DatasetConfig(),
                           prep: Preprocessing | None = None, image_size: int = 128,
-                          progress: Callable[[int, int], None] | None = None) -> ShapeDataset:
+                          progress: Callable[[int, int], None] | None = None,
+                          realism: object = None, depth_filter: DepthFilter | None = None
+                          ) -> ShapeDataset:
     """Render ``n_images`` labelled depth crops (balanced over the shapes) in the simulator.
 
     Parameters
@@ -192,6 +199,11 @@ def collect_shape_dataset(n_images: int, seed: int = 0, config: DatasetConfig = 
         Camera image width = height (px).
     progress : callable (done, total) | None
         Called after each sample.
+    realism : RealismProfile | str | None
+        Realism profile of the simulated camera (name, path or profile; None: a perfect camera);
+        its draws are seeded by ``seed``.
+    depth_filter : DepthFilter | None
+        Depth clean-up before detection (default: the vision pipeline's, a 3 px median).
     """
     from mindgrasp_sim.simulation import CameraConfig, Simulation
 
@@ -203,7 +215,9 @@ def collect_shape_dataset(n_images: int, seed: int = 0, config: DatasetConfig = 
     first = {'name': 'vision_dataset',
              'objects': [{'shape': 'cube', 'colour': 'red', 'position': [0.5, 0.0]}]}
     sim = Simulation(scene=first, seed=seed,
-                     camera=CameraConfig(width=image_size, height=image_size))
+                     camera=CameraConfig(width=image_size, height=image_size),
+                     realism=realism, realism_seed=seed)
+    depth_filter = depth_filter or DepthFilter()
     try:
         k, _, _ = sim.camera_intrinsics()
         detector = ColourDetector(intrinsics=CameraIntrinsics.from_k(k.ravel()))
@@ -229,6 +243,7 @@ def collect_shape_dataset(n_images: int, seed: int = 0, config: DatasetConfig = 
             if not placer.look_at(target, d, elev, az, roll, aim):
                 continue  # out of reach
             rgb, depth = sim.render_camera()
+            depth = depth_filter(depth)
             u, v, z = placer.project(target)
             if z <= 0.02:
                 continue

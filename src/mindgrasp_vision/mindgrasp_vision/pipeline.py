@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from mindgrasp_vision._checks import VisionError, check_depth, check_rgb
+from mindgrasp_vision.depth import DepthFilter
 from mindgrasp_vision.detector import ColourDetector, Detection
 from mindgrasp_vision.overlay import render_overlay
 from mindgrasp_vision.ranking import ObjectOfInterestRanker
@@ -70,11 +71,15 @@ class VisionPipeline:
     shape_max_fraction : float
         Never classify an object that fills more than this fraction of the image (closer than
         the training views, or between the fingers), even on request.
+    depth_filter : DepthFilter | None
+        Clean-up of the depth image before detection and classification (validity mask, hole
+        filling, median); None uses the depth as it comes.
     """
 
     def __init__(self, detector: ColourDetector | None = None,
                  ranker: ObjectOfInterestRanker | None = None, classifier: object | None = None,
-                 shape_min_fraction: float = 0.04, shape_max_fraction: float = 0.35) -> None:
+                 shape_min_fraction: float = 0.04, shape_max_fraction: float = 0.35,
+                 depth_filter: DepthFilter | None = None) -> None:
         if shape_min_fraction < 0:
             msg = (f"'shape_min_fraction' must be >= 0, got {shape_min_fraction}; use a value "
                    '> 1 to classify only on request.')
@@ -88,6 +93,7 @@ class VisionPipeline:
         self.classifier = classifier
         self.shape_min_fraction = float(shape_min_fraction)
         self.shape_max_fraction = float(shape_max_fraction)
+        self.depth_filter = depth_filter
         self.reset()
 
     def reset(self) -> None:
@@ -120,6 +126,8 @@ class VisionPipeline:
         height, width = rgb.shape[:2]
         if depth is not None:
             depth = check_depth(depth, shape=(height, width))
+            if self.depth_filter is not None:
+                depth = self.depth_filter(depth)
         detections = self.detector.detect(rgb, depth)
         ooi = self.ranker.rank(detections, width, height, mi_class)
         result = FrameResult(detections, ooi, self.ranker.focus(width, height, mi_class),
