@@ -104,18 +104,28 @@ def _register_interface_dir(store: Typestore, package: str, folder: Path) -> Non
 def interface_dir() -> Path:
     """Folder of the ``mindgrasp_msgs`` interface package (``msg/``, ``srv/``, package.xml).
 
-    ``MINDGRASP_MSGS_DIR`` overrides; by default the folder next to this package in the source
-    tree (``src/mindgrasp_msgs``). It is deliberately not a Python package, so that with ROS 2
-    sourced ``import mindgrasp_msgs.msg`` finds the colcon-generated package, not this folder.
+    In order: ``MINDGRASP_MSGS_DIR``; the folder next to this package in the source tree
+    (``src/mindgrasp_msgs``); ``share/mindgrasp_msgs`` of a sourced colcon workspace
+    (``AMENT_PREFIX_PATH``), where rosidl installs the ``.msg``/``.srv`` files. The source folder is
+    deliberately not a Python package, so that with ROS 2 sourced ``import mindgrasp_msgs.msg``
+    finds the colcon-generated package, not this folder.
     """
     override = os.environ.get('MINDGRASP_MSGS_DIR')
-    folder = Path(override) if override else Path(__file__).resolve().parents[2] / 'mindgrasp_msgs'
-    if not (folder / 'msg').is_dir():
-        msg = (f'The mindgrasp_msgs interface folder {folder} has no msg/ directory; install '
-               'the project editable (pip install -e .) or set MINDGRASP_MSGS_DIR to '
-               'src/mindgrasp_msgs.')
-        raise MessageTypeError(msg)
-    return folder
+    if override:
+        candidates = [Path(override)]
+    else:
+        candidates = [Path(__file__).resolve().parents[2] / 'mindgrasp_msgs']
+        candidates += [Path(prefix) / 'share' / 'mindgrasp_msgs'
+                       for prefix in os.environ.get('AMENT_PREFIX_PATH', '').split(os.pathsep)
+                       if prefix]
+    for folder in candidates:
+        if (folder / 'msg').is_dir():
+            return folder
+    msg = (f'The mindgrasp_msgs interface folder was not found (looked in '
+           f'{", ".join(str(c) for c in candidates)}); install the project editable '
+           '(pip install -e .), build mindgrasp_msgs in your colcon workspace, or set '
+           'MINDGRASP_MSGS_DIR to src/mindgrasp_msgs.')
+    raise MessageTypeError(msg)
 
 
 @functools.cache

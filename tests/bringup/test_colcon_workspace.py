@@ -1,0 +1,199 @@
+"""src/ as a ROS 2 workspace: package.xml files valid for catkin_pkg, ament_python packages with
+console scripts for their nodes, and a real ``colcon build`` whose installed executables run.
+
+``colcon build`` runs with colcon-core + colcon-ros from PyPI (test extra), over every package but
+``mindgrasp_msgs`` (an ament_cmake interface package: it needs rosidl, i.e. ROS 2 installed).
+"""
+
+from __future__ import annotations
+
+import ast
+import configparser
+import os
+import re
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from catkin_pkg.package import parse_package
+
+from mindgrasp_bringup.launch_system.actions.node import node_module
+from mindgrasp_testing import spin_until
+
+REPO = Path(__file__).resolve().parents[2]
+SRC = REPO / 'src'
+PACKAGES = sorted(p for p in SRC.iterdir() if (p / 'package.xml').is_file())
+PYTHON_PACKAGES = [p for p in PACKAGES if p.name != 'mindgrasp_msgs']
+
+
+def console_scripts(package_dir: Path) -> dict[str, str]:
+    """``{executable: 'module:function'}`` of a package's setup.py (read, not executed)."""
+    tree = ast.parse((package_dir / 'setup.py').read_text(encoding='utf-8'))
+    scripts: dict[str, str] = {}
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Dict):
+            for key, value in zip(node.keys, node.values, strict=True):
+                if isinstance(key, ast.Constant) and key.value == 'console_scripts':
+                    for item in ast.literal_eval(value):
+                        name, _, target = (s.strip() for s in item.partition('='))
+                        scripts[name] = target
+    return scripts
+
+
+def test_every_package_folder_is_a_ros_package() -> None:
+    folders = sorted(p.name for p in SRC.iterdir() if p.name.startswith('mindgrasp_'))
+    assert folders == [p.name for p in PACKAGES], 'every src/mindgrasp_<x>/ needs a package.xml'
+    assert 'mindgrasp_msgs' in folders
+
+
+@pytest.mark.parametrize('package_dir', PACKAGES, ids=lambda p: p.name)
+def test_package_xml_is_valid_format_3(package_dir: Path) -> None:
+    package = parse_package(package_dir / 'package.xml')  # parses and validates (raises)
+    package.validate()
+    assert package.package_format == 3
+    assert package.name == package_dir.name
+    build_type = package.get_build_type()
+    assert build_type == ('ament_cmake' if package.name == 'mindgrasp_msgs' else 'ament_python')
+    # our own packages it uses are declared (colcon orders the build by them)
+    declared = {d.name for d in package.exec_depends + package.build_depends}
+    imported = set(re.findall(r'^\s*(?:from|import) (mindgrasp_(?!msgs)\w+)',
+                              ''.join(p.read_text(encoding='utf-8')
+                                      for p in (package_dir / package.name).rglob('*.py')),
+                              re.M)) - {package.name} if build_type == 'ament_python' else set()
+    assert imported <= declared, f'{package.name}: declare {sorted(imported - declared)}'
+
+
+@pytest.mark.parametrize('package_dir', PYTHON_PACKAGES, ids=lambda p: p.name)
+def test_ament_python_layout(package_dir: Path) -> None:
+    name = package_dir.name
+    assert (package_dir / 'resource' / name).is_file()
+    assert (package_dir / name / '__init__.py').is_file()
+    config = configparser.ConfigParser()
+    config.read(package_dir / 'setup.cfg')
+    # console scripts go to lib/<package>/, where `ros2 run <package> <executable>` looks
+    assert config['develop']['script_dir'] == f'$base/lib/{name}'
+    assert config['install']['install_scripts'] == f'$base/lib/{name}'
+
+
+@pytest.mark.parametrize('package_dir', PYTHON_PACKAGES, ids=lambda p: p.name)
+def test_every_node_has_a_console_script_our_launcher_resolves(package_dir: Path) -> None:
+    name = package_dir.name
+    scripts = console_scripts(package_dir)
+    nodes = {p.stem for p in (package_dir / name).rglob('*_node.py')
+             if re.search(r'^def main\(', p.read_text(encoding='utf-8'), re.M)}
+    assert nodes <= set(scripts), f'{name}: add console scripts for {sorted(nodes - set(scripts))}'
+    for executable, target in scripts.items():
+        module, _, function = target.partition(':')
+        assert function == 'main'
+        assert (package_dir / Path(*module.split('.'))).with_suffix('.py').is_file(), target
+        if executable.endswith('_node'):
+            # Node(package=, executable=) runs the same code under mindgrasp launch and ros2 launch
+            assert node_module(name, executable) == module
+
+
+def test_launch_files_name_installed_executables() -> None:
+    scripts = {p.name: console_scripts(p) for p in PYTHON_PACKAGES}
+    bringup = SRC / 'mindgrasp_bringup' / 'mindgrasp_bringup'
+    files = [*sorted((bringup / 'launch').glob('*.launch.py')),
+             bringup / 'launch_system' / 'common.py']
+    pairs = set()
+    for path in files:
+        text = path.read_text(encoding='utf-8')
+        pairs |= set(re.findall(r"package='(\w+)',\s*executable='(\w+)'", text))
+        assert "package='mindgrasp_bringup.bag'" not in text
+    assert len(pairs) >= 8
+    for package, executable in sorted(pairs):
+        assert executable in scripts[package], f'{package} has no console script {executable}'
+
+
+# -- a real colcon build ----------------------------------------------------------------------
+
+
+@pytest.fixture(scope='module')
+def workspace(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """``colcon build`` of the Python packages into a temporary workspace (install/, build/)."""
+    colcon = shutil.which('colcon') or str(Path(sys.executable).with_name('colcon'))
+    if not Path(colcon).is_file():
+        pytest.fail('colcon is not installed: pip install -c constraints.txt -e ".[test]"')
+    ws = tmp_path_factory.mktemp('colcon_ws')
+    result = subprocess.run(
+        [colcon, '--log-base', str(ws / 'log'), 'build',
+         '--base-paths', *(str(p) for p in PYTHON_PACKAGES),
+         '--build-base', str(ws / 'build'), '--install-base', str(ws / 'install'),
+         '--event-handlers', 'console_direct-'],
+        cwd=ws, capture_output=True, text=True, timeout=600, check=False)
+    assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
+    return ws
+
+
+def sourced(ws: Path, *command: str) -> list[str]:
+    """``command`` run after sourcing the workspace's setup.sh, as a ROS user does."""
+    return ['bash', '-c', '. "$0/install/setup.sh" && exec "$@"', str(ws), *command]
+
+
+def workspace_env() -> dict[str, str]:
+    """The test's environment without the source tree on PYTHONPATH: the workspace's setup.sh
+    provides the installed packages. mindgrasp_msgs is not built (no rosidl), so its interface
+    files come from the source folder, as MINDGRASP_MSGS_DIR allows."""
+    env = {k: v for k, v in os.environ.items() if k not in ('PYTHONPATH', 'AMENT_PREFIX_PATH')}
+    env['MINDGRASP_MSGS_DIR'] = str(SRC / 'mindgrasp_msgs')
+    env['PATH'] = os.pathsep.join([str(Path(sys.executable).parent), env.get('PATH', '')])
+    return env
+
+
+@pytest.mark.slow
+def test_colcon_installs_executables_and_share_files(workspace: Path) -> None:
+    install = workspace / 'install'
+    for package_dir in PYTHON_PACKAGES:
+        name = package_dir.name
+        share = install / name / 'share'
+        assert (share / 'ament_index' / 'resource_index' / 'packages' / name).is_file()
+        assert (share / name / 'package.xml').is_file()
+        for executable in console_scripts(package_dir):
+            assert os.access(install / name / 'lib' / name / executable, os.X_OK), executable
+    launch = install / 'mindgrasp_bringup' / 'share' / 'mindgrasp_bringup' / 'launch'
+    assert (launch / 'demo.launch.py').is_file()  # ros2 launch mindgrasp_bringup demo.launch.py
+    cli = install / 'mindgrasp_bringup' / 'lib' / 'mindgrasp_bringup' / 'mindgrasp'
+    help_run = subprocess.run(sourced(workspace, str(cli), '--help'), env=workspace_env(),
+                              capture_output=True, text=True, timeout=120, check=False)
+    assert help_run.returncode == 0, help_run.stderr
+    assert 'launch' in help_run.stdout
+    # the sourced workspace's copies are imported, not the source tree or an editable install
+    where = subprocess.run(
+        sourced(workspace, sys.executable, '-c',
+                'import mindgrasp_trainer, mindgrasp_ros; '
+                'print(mindgrasp_trainer.__file__); print(mindgrasp_ros.__file__)'),
+        env=workspace_env(), capture_output=True, text=True, timeout=120, check=True)
+    assert all(line.startswith(str(install)) for line in where.stdout.split()), where.stdout
+
+
+@pytest.mark.slow
+def test_installed_node_runs_against_our_runtime(workspace: Path, rclpy_ctx, tmp_path) -> None:
+    """``ros2 run mindgrasp_trainer graz_node`` (the installed console script, the installed
+    packages): its cues arrive over DDS in this process, and it ends by itself."""
+    from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import Prompt
+
+    from mindgrasp_trainer.ros_common import prompt_qos
+
+    executable = workspace / 'install' / 'mindgrasp_trainer' / 'lib' / 'mindgrasp_trainer'
+    executable /= 'graz_node'
+    log = (tmp_path / 'graz.log').open('wb')
+    proc = subprocess.Popen(
+        sourced(workspace, str(executable), '--ros-args', '-p', 'n_trials:=2', '-p', 'seed:=3',
+                '-p', 'start_delay:=1.0', '-p', 'fixation:=0.2', '-p', 'cue:=0.2',
+                '-p', 'imagery:=0.3', '-p', 'rest_min:=0.1', '-p', 'rest_max:=0.2',
+                '-p', 'display_rate:=0.0'),
+        env=workspace_env(), stdout=log, stderr=subprocess.STDOUT, start_new_session=True)
+    try:
+        node = rclpy_ctx.create_node('colcon_probe')
+        cues: list[object] = []
+        node.create_subscription(Prompt, '/trainer/prompt', cues.append, prompt_qos())
+        assert spin_until(node, lambda: len(cues) > 0, 60.0), (tmp_path / 'graz.log').read_text()
+        assert proc.wait(60) == 0, (tmp_path / 'graz.log').read_text()
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+        log.close()
