@@ -47,6 +47,7 @@ setup(
     license='MIT',
     entry_points={
         'console_scripts': [
+            'display_node = mindgrasp_trainer.display_node:main',
             'graz_node = mindgrasp_trainer.graz_node:main',
             'trainer_node = mindgrasp_trainer.trainer_node:main',
         ],
