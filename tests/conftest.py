@@ -34,16 +34,31 @@ def rclpy_ctx() -> Iterator[object]:
         rclpy.try_shutdown()
 
 
+def ros_args(args: tuple[str, ...], params: dict[str, object]) -> list[str]:
+    """``args`` followed by ``-p name:=value`` for each of ``params`` (in ``--ros-args``)."""
+    out = list(args)
+    if params and '--ros-args' not in out:
+        out.append('--ros-args')
+    for name, value in params.items():
+        text = str(value).lower() if isinstance(value, bool) else str(value)
+        out += ['-p', f'{name}:={text}']
+    return out
+
+
 @pytest.fixture
 def spawn_node(tmp_path: Path) -> Iterator[Callable[..., NodeProcess]]:
-    """Factory: ``spawn_node('mindgrasp_sim.sim_node', '--ros-args', '-p', 'x:=1')``.
+    """Factory: ``spawn_node('mindgrasp_sim.sim_node', '--ros-args', '-p', 'x:=1')``, or with the
+    parameters as keywords: ``spawn_node('mindgrasp_sim.sim_node', x=1, gui=False)``.
 
     Processes inherit the test's ROS_DOMAIN_ID and are stopped at teardown; their output is in
     ``proc.output()`` (and printed when a test fails)."""
     procs: list[NodeProcess] = []
 
-    def start(module: str, *args: str, env: dict[str, str] | None = None) -> NodeProcess:
-        """``module`` is a module name (run with -m) or a path to a .py script."""
+    def start(module: str, *args: str, env: dict[str, str] | None = None,
+              **params: object) -> NodeProcess:
+        """``module`` is a module name (run with -m) or a path to a .py script; ``params`` become
+        ``-p name:=value`` after ``--ros-args`` (booleans as ``true``/``false``)."""
+        args = ros_args(args, params)
         full_env = dict(os.environ)
         full_env.update(env or {})
         full_env.setdefault('PYTHONUNBUFFERED', '1')

@@ -66,6 +66,14 @@ class NodeProcess:
     def wait(self, timeout: float) -> int:
         return self.proc.wait(timeout)
 
+    def poll(self) -> int | None:
+        """The exit code, or None while the process runs."""
+        return self.proc.poll()
+
+    @property
+    def pid(self) -> int:
+        return self.proc.pid
+
     def wait_for_output(self, text: str, timeout: float = 20.0) -> bool:
         """Wait until the process printed ``text`` (e.g. a "ready" line)."""
         deadline = time.monotonic() + timeout

@@ -87,7 +87,6 @@ def test_load_bag_recovers_data_and_cues(bags):
 
 
 def test_load_bag_written_by_the_project_recorder(tmp_path):
-    pytest.importorskip('mindgrasp_bringup.bag.writer')
     rec = make_recording(trials_per_class=1, seed=2)
     loaded = load_bag(write_run_bag(tmp_path / 'rec', rec, drop=(), writer_kind='mindgrasp'))
     np.testing.assert_array_equal(loaded.events, rec.events)

@@ -14,23 +14,28 @@ from mindgrasp_eeg.montage import NAUTILUS_32
 pytestmark = pytest.mark.slow
 
 
-def collect(acq: EEGAcquisition, seconds: float, period: float = 1 / 32):
-    chunks, t_end = [], time.monotonic() + seconds
+def collect(acq: EEGAcquisition, n_samples: int, until=None, timeout: float = 60.0,
+            period: float = 1 / 32):
+    """Poll until ``n_samples`` samples (and ``until()``, if given) or ``timeout`` s: a condition,
+    not a duration, since a loaded machine delivers late."""
+    chunks, t_end = [], time.monotonic() + timeout
     while time.monotonic() < t_end:
         chunks.extend(acq.poll())
+        if sum(len(c.data) for c in chunks) >= n_samples and (until is None or until()):
+            break
         time.sleep(period)
     return chunks
 
 
 def test_acquires_from_a_real_outlet(lsl_source, stream_name) -> None:
-    lsl_source(stream_name, '--duration', '8')
+    lsl_source(stream_name, '--duration', '120')
     acq = EEGAcquisition(stream_name, n_channels=32, sample_rate=250, channel_names=NAUTILUS_32)
-    desc = acq.connect(timeout=5)
+    desc = acq.connect(timeout=30)
     assert desc.channel_names == NAUTILUS_32 and desc.unit == 'microvolts'
-    chunks = collect(acq, 3.0)
+    chunks = collect(acq, 3 * 250)
     data = np.vstack([c.data for c in chunks])
     ts = np.concatenate([c.timestamps for c in chunks])
-    assert 2.5 * 250 <= len(data) <= 3.5 * 250
+    assert len(data) >= 3 * 250
     assert data.dtype == np.float32 and data.shape[1] == 32
     assert 3e-6 < float(np.std(data)) < 50e-6          # microvolts on the wire, volts out
     assert np.all(np.diff(ts) > 0)
@@ -44,7 +49,7 @@ def test_acquires_from_a_real_outlet(lsl_source, stream_name) -> None:
 
 
 def test_resolve_timeout_lists_visible_streams(lsl_source, stream_name) -> None:
-    lsl_source(stream_name, '--duration', '8')
+    lsl_source(stream_name, '--duration', '120')
     acq = EEGAcquisition(stream_name + '_missing')
     with pytest.raises(EEGError, match=rf"No LSL stream with name='{stream_name}_missing'.*"
                                        rf"Visible streams:.*'{stream_name}' \(type 'EEG', 32 ch"):
@@ -52,17 +57,17 @@ def test_resolve_timeout_lists_visible_streams(lsl_source, stream_name) -> None:
 
 
 def test_layout_validation_and_adaptation(lsl_source, stream_name) -> None:
-    lsl_source(stream_name, '--n-channels', '8', '--rate', '160', '--duration', '8')
+    lsl_source(stream_name, '--n-channels', '8', '--rate', '160', '--duration', '120')
     with pytest.raises(EEGError, match=r'has 8 channels, expected 32 .*runs at 160 Hz, expected '
                                        r'250 Hz.*adapt_to_stream'):
-        EEGAcquisition(stream_name, n_channels=32, sample_rate=250).connect(timeout=5)
+        EEGAcquisition(stream_name, n_channels=32, sample_rate=250).connect(timeout=30)
     with pytest.raises(EEGError, match=r"has channels \[E1, E2, .*expected \[X0"):
-        EEGAcquisition(stream_name, channel_names=[f'X{k}' for k in range(8)]).connect(timeout=5)
+        EEGAcquisition(stream_name, channel_names=[f'X{k}' for k in range(8)]).connect(timeout=30)
     acq = EEGAcquisition(stream_name, n_channels=32, sample_rate=250, adapt=True)
-    desc = acq.connect(timeout=5)
+    desc = acq.connect(timeout=30)
     assert desc.n_channels == 8 and desc.sample_rate == 160
     assert any('adopting' in w for w in acq.warnings)
-    chunks = collect(acq, 1.0)
+    chunks = collect(acq, 160)
     assert chunks and chunks[0].data.shape[1] == 8
     acq.close()
 
@@ -70,10 +75,11 @@ def test_layout_validation_and_adaptation(lsl_source, stream_name) -> None:
 @pytest.mark.parametrize('policy', ['replace', 'drop'])
 def test_nan_flat_railed_are_flagged(lsl_source, stream_name, policy) -> None:
     lsl_source(stream_name, '--nan-channel', '3', '--flat-channel', '5', '--railed-channel', '7',
-               '--duration', '8')
+               '--duration', '120')
     acq = EEGAcquisition(stream_name, nan_policy=policy)
-    acq.connect(timeout=5)
-    chunks = collect(acq, 2.5)
+    acq.connect(timeout=30)
+    chunks = collect(acq, 625 if policy == 'replace' else 1,
+                     until=lambda: acq.counters['nonfinite_samples'] > 100)
     status = acq.status()
     assert status.level == WARN
     assert f'NaN/inf on {NAUTILUS_32[3]}' in status.message
@@ -92,10 +98,10 @@ def test_nan_flat_railed_are_flagged(lsl_source, stream_name, policy) -> None:
 
 def test_dropped_and_out_of_order_samples_are_counted(lsl_source, stream_name) -> None:
     lsl_source(stream_name, '--gap-at', '1.0', '--gap-samples', '50', '--disorder-at', '1.5',
-               '--duration', '8')
+               '--duration', '120')
     acq = EEGAcquisition(stream_name, dejitter=False)     # raw amplifier stamps
-    acq.connect(timeout=5)
-    chunks = collect(acq, 2.5)
+    acq.connect(timeout=30)
+    chunks = collect(acq, 2 * 250, until=lambda: acq.counters['out_of_order'] >= 1)
     assert acq.counters['dropped'] == 50
     assert acq.counters['out_of_order'] == 1
     idx = np.concatenate([c.first_index + np.arange(len(c.data)) for c in chunks])
@@ -104,29 +110,29 @@ def test_dropped_and_out_of_order_samples_are_counted(lsl_source, stream_name) -
 
 
 def test_stream_loss_and_reconnection(lsl_source, stream_name) -> None:
-    amp = lsl_source(stream_name, '--duration', '30')
+    amp = lsl_source(stream_name, '--duration', '120')
     acq = EEGAcquisition(stream_name, lost_timeout=0.5)
-    acq.connect(timeout=5)
-    collect(acq, 1.0)
+    acq.connect(timeout=30)
+    collect(acq, 250)
     before = acq.counters['samples']
     amp.kill()
     amp.wait()
     t_kill = time.monotonic()
-    while acq.status().level != ERROR and time.monotonic() - t_kill < 5:
+    while acq.status().level != ERROR and time.monotonic() - t_kill < 60:
         acq.poll()
         time.sleep(0.02)
     detected_after = time.monotonic() - t_kill
     status = acq.status()
     assert status.level == ERROR and 'is lost (the sender closed the connection' in status.message
-    assert detected_after < 1.5                 # a closed connection is reported at once
+    assert detected_after < 5.0                 # a closed connection is reported at once
     time.sleep(0.5)
-    lsl_source(stream_name, '--duration', '30')            # a new amplifier process
+    lsl_source(stream_name, '--duration', '120')            # a new amplifier process
     t_new = time.monotonic()
-    while not acq.connected and time.monotonic() - t_new < 10:
+    while not acq.connected and time.monotonic() - t_new < 60:
         acq.poll()
         time.sleep(0.05)
     assert acq.connected, acq.status().message
-    chunks = collect(acq, 1.0)
+    chunks = collect(acq, 250, until=lambda: acq.counters['samples'] > before + 150)
     assert acq.counters['reconnects'] >= 1 and acq.counters['losses'] >= 1
     assert acq.counters['samples'] > before + 150
     assert acq.counters['dropped'] > 100                  # the outage shows up as a gap
@@ -136,20 +142,22 @@ def test_stream_loss_and_reconnection(lsl_source, stream_name) -> None:
 
 
 def test_stalled_stream_is_lost_after_timeout(lsl_source, stream_name) -> None:
-    lsl_source(stream_name, '--stall-at', '1.0', '--stall-len', '2.5', '--duration', '30')
+    lsl_source(stream_name, '--stall-at', '1.0', '--stall-len', '2.5', '--duration', '120')
     acq = EEGAcquisition(stream_name, lost_timeout=0.5)
-    acq.connect(timeout=5)
+    acq.connect(timeout=30)
     t0 = time.monotonic()
     last_data = t0
-    while acq.status().level != ERROR and time.monotonic() - t0 < 5:
+    while acq.status().level != ERROR and time.monotonic() - t0 < 60:
         if acq.poll():
             last_data = time.monotonic()
         time.sleep(0.01)
-    assert acq.lost and 0.45 < time.monotonic() - last_data < 0.7
-    while not acq.connected and time.monotonic() - t0 < 10:
+    # lost no earlier than lost_timeout (0.5 s) after the last data; the upper bound only says
+    # "before the stream resumes" (2.5 s stall), as this loop may be scheduled late
+    assert acq.lost and 0.45 < time.monotonic() - last_data < 2.0
+    while not acq.connected and time.monotonic() - t0 < 60:
         acq.poll()
         time.sleep(0.05)
-    collect(acq, 0.5)
+    collect(acq, 125)
     assert acq.connected and acq.counters['reconnects'] >= 1 and acq.status().level == OK
     acq.close()
 

@@ -34,7 +34,8 @@ def test_images_round_trip(sim):
     np.testing.assert_array_equal(np.asarray(color.data).reshape(128, 128, 3), rgb)
     back = np.asarray(depth_msg.data, dtype=np.uint8).view('<f4').reshape(128, 128)
     np.testing.assert_array_equal(back, depth)
-    conv = pytest.importorskip('mindgrasp_vision.ros_conversions')
+    from mindgrasp_vision import ros_conversions as conv
+
     np.testing.assert_array_equal(conv.rgb_from_image(color), rgb)
     np.testing.assert_array_equal(conv.depth_from_image(depth_msg), depth)
 
@@ -65,7 +66,8 @@ def test_object_markers(sim):
     assert [m.type for m in markers[:3]] == [1, 3, 2]          # CUBE, CYLINDER, SPHERE
     assert markers[0].scale.x == pytest.approx(0.05) and markers[0].color.r > 0.8
     assert markers[1].pose.position.y == pytest.approx(0.5 * np.sin(np.radians(40)))
-    conv = pytest.importorskip('mindgrasp_eeg.ros_conversions')
+    from mindgrasp_eeg import ros_conversions as conv
+
     seen = conv.markers_to_objects(markers)
     assert [(o.colour, o.shape) for o in seen[:3]] == [
         ('red', 'cube'), ('blue', 'cylinder'), ('yellow', 'sphere')]

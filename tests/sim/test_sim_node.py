@@ -79,26 +79,39 @@ class Probe:
     def command(self, v) -> None:
         self.cmd_pub.publish(self.Float64MultiArray(data=np.asarray(v, dtype=float)))
 
-    def call(self, client, request, timeout: float = 15.0):
+    def call(self, client, request, timeout: float = 60.0):
         assert client.wait_for_service(timeout_sec=timeout), 'service not available'
         future = client.call_async(request)
         assert spin_until(self.rclpy, self.node, future.done, timeout)
         return future.result()
 
-    def drive(self, v, seconds: float, rate: float = 20.0) -> None:
-        """Publish the velocity command at ``rate`` Hz for ``seconds`` (wall)."""
-        end = time.monotonic() + seconds
+    def drive(self, v, until, timeout: float = 60.0, rate: float = 20.0) -> bool:
+        """Publish the velocity command at ``rate`` Hz until ``until()`` (or ``timeout`` s)."""
+        end = time.monotonic() + timeout
         while time.monotonic() < end:
+            if until():
+                return True
             self.command(v)
             spin_for(self.rclpy, self.node, 1.0 / rate)
+        return until()
+
+    def settle(self, n: int = 50, timeout: float = 60.0) -> bool:
+        """Wait for ``n`` more joint states (100 Hz of simulated time)."""
+        k = len(self.joints)
+        return spin_until(self.rclpy, self.node, lambda: len(self.joints) >= k + n, timeout)
+
+    def matched(self, timeout: float = 60.0) -> bool:
+        """The simulator subscribes to our command topics (commands sent now are not lost)."""
+        return spin_until(self.rclpy, self.node, lambda: self.cmd_pub.get_subscription_count()
+                          > 0 and self.grip_pub.get_subscription_count() > 0, timeout)
 
 
 def start(spawn_node, *params: str):
-    args = ['--ros-args', '-p', 'duration:=90.0']
+    args = ['--ros-args', '-p', 'duration:=300.0']
     for p in params:
         args += ['-p', p]
     proc = spawn_node('mindgrasp_sim.sim_node', *args)
-    assert proc.wait_for_output(READY, 40), proc.output()
+    assert proc.wait_for_output(READY, 120), proc.output()
     return proc
 
 
@@ -107,7 +120,7 @@ def test_realtime_node_serves_the_arm_and_camera_contract(rclpy_ctx, spawn_node)
     probe = Probe(rclpy_ctx)
     rclpy, node = rclpy_ctx, probe.node
     assert spin_until(rclpy, node, lambda: len(probe.joints) > 150 and probe.images
-                      and probe.depths and probe.infos and probe.markers, 30), proc.output()
+                      and probe.depths and probe.infos and probe.markers, 120), proc.output()
     # joint states: 6 arm joints at 100 Hz (header stamps 10 ms apart), home pose
     js = probe.joints[-1]
     assert list(js.name) == [f'joint_{i}' for i in range(1, 7)]
@@ -129,32 +142,35 @@ def test_realtime_node_serves_the_arm_and_camera_contract(rclpy_ctx, spawn_node)
     labels = [m.text for m in probe.markers[-1].markers]
     assert labels[:3] == ['red cube', 'blue cylinder', 'yellow sphere'] and len(labels) == 9
     assert probe.poses and probe.poses[-1].header.frame_id == 'world'
-    assert spin_until(rclpy, node, lambda: probe.status)
+    assert spin_until(rclpy, node, lambda: probe.status, 60)
     status = probe.status[-1].status[0]
     values = {kv.key: kv.value for kv in status.values}
     assert status.name == 'sim' and status.level == 0 and values['scene'] == 'set_locations'
     assert float(values['real_time_factor']) > 0.2 and values['time_mode'] == 'realtime'
 
-    # a velocity command from outside moves joint 1 at the commanded rate
+    # a velocity command from outside moves joint 1 at the commanded rate (conditions, not
+    # durations: a loaded machine runs the simulator slower than real time)
+    assert probe.matched()
     q0 = probe.q()[0]
-    probe.drive([0.3, 0, 0, 0, 0, 0], 1.5)
+    assert probe.drive([0.3, 0, 0, 0, 0, 0], lambda: probe.q()[0] - q0 > 0.3), probe.q()
     moving = probe.joints[-1]
     assert moving.velocity[0] == pytest.approx(0.3, abs=0.03)
-    assert probe.q()[0] - q0 == pytest.approx(0.45, abs=0.15)
-    # silence: the command times out (0.25 s) and the arm stops
-    spin_for(rclpy, node, 0.8)
+    # silence: the command times out (0.25 s) and the arm stops, and stays stopped
+    assert spin_until(rclpy, node, lambda: abs(probe.joints[-1].velocity[0]) < 0.01, 60)
+    assert probe.settle()
     q_stop = probe.q()[0]
-    assert abs(probe.joints[-1].velocity[0]) < 0.01
-    spin_for(rclpy, node, 0.5)
+    assert probe.settle()
     assert probe.q()[0] == pytest.approx(q_stop, abs=0.002)
 
     # bad commands: rejected with a warning, the arm holds still
-    probe.drive([0.3, 0, 0, 0, 0, 0], 0.3)
+    assert probe.drive([0.3, 0, 0, 0, 0, 0], lambda: probe.joints[-1].velocity[0] > 0.2)
     probe.command([0.3, 0.0, 0.0])
     probe.command([0.3, 0, float('nan'), 0, 0, 0])
-    spin_for(rclpy, node, 0.4)
+    assert spin_until(rclpy, node, lambda: 'The arm holds still' in proc.output()
+                      and abs(probe.joints[-1].velocity[0]) < 0.01, 60), proc.output()
+    assert probe.settle()
     q_bad = probe.q()[0]
-    spin_for(rclpy, node, 0.4)
+    assert probe.settle()
     assert probe.q()[0] == pytest.approx(q_bad, abs=0.002)
     out = proc.output()
     assert 'Rejected /arm_controller/commands' in out and 'The arm holds still' in out
@@ -162,11 +178,11 @@ def test_realtime_node_serves_the_arm_and_camera_contract(rclpy_ctx, spawn_node)
     # the gripper closes on command
     probe.grip_pub.publish(probe.Float64MultiArray(data=np.array([1.0])))
     # reset: home, objects back
-    spin_for(rclpy, node, 0.5)
     response = probe.call(probe.reset_cli, probe.ResetSim.Request(new_random_draw=False, seed=-1))
     assert response.success, response.message
-    spin_for(rclpy, node, 0.3)
-    np.testing.assert_allclose(probe.q(), [0, 0, 0, np.pi / 2, 1.2, 0], atol=0.003)
+    home = np.array([0, 0, 0, np.pi / 2, 1.2, 0])
+    assert spin_until(rclpy, node, lambda: np.allclose(probe.q(), home, atol=0.003), 60), \
+        probe.q()
     # a new random draw needs a random scene: the error names the fix
     response = probe.call(probe.reset_cli, probe.ResetSim.Request(new_random_draw=True, seed=-1))
     assert not response.success and 'load a random scene' in response.message
@@ -176,7 +192,7 @@ def test_realtime_node_serves_the_arm_and_camera_contract(rclpy_ctx, spawn_node)
                                                                   seed=4))
     assert response.success, response.message
     assert spin_until(rclpy, node, lambda: len(probe.markers) > n_before
-                      and len(probe.markers[-1].markers) == 3)
+                      and len(probe.markers[-1].markers) == 3, 60)
     response = probe.call(probe.load_cli, probe.LoadScene.Request(scene='nowhere', seed=-1))
     assert not response.success and 'Unknown scene' in response.message
     assert not probe.clocks    # realtime mode does not own /clock
@@ -187,32 +203,36 @@ def test_realtime_node_serves_the_arm_and_camera_contract(rclpy_ctx, spawn_node)
 def test_fast_mode_publishes_clock_and_ends_by_itself(rclpy_ctx, spawn_node):
     proc = start(spawn_node, 'time_mode:=fast', 'sim_duration:=10.0')
     probe = Probe(rclpy_ctx)
-    assert spin_until(rclpy_ctx, probe.node, lambda: len(probe.clocks) > 20, 30), proc.output()
-    wall0, clock0 = time.monotonic(), probe.clocks[-1].clock
-    spin_for(rclpy_ctx, probe.node, 1.0)
-    clock1 = probe.clocks[-1].clock
-    simulated = (clock1.sec - clock0.sec) + (clock1.nanosec - clock0.nanosec) * 1e-9
-    assert simulated > 1.2 * (time.monotonic() - wall0)    # faster than real time
-    assert proc.wait(120) == 0
+    assert spin_until(rclpy_ctx, probe.node, lambda: len(probe.clocks) > 20, 120), proc.output()
+    # it ends by itself after 10 s of simulated time; how much faster than real time it runs
+    # depends on the machine's load (measured by benchmarks/, not bounded here)
+    assert proc.wait(300) == 0
     assert 'real-time factor' in proc.output()
+    last = probe.clocks[-1].clock
+    assert last.sec + last.nanosec * 1e-9 <= 10.0 + 1e-6
 
 
 def _lockstep_run(rclpy, spawn_node) -> tuple[np.ndarray, float]:
     proc = start(spawn_node, 'time_mode:=lockstep', 'scene:=random_locations', 'seed:=2')
     probe = Probe(rclpy)
+    # commands published before the simulator subscribed would be lost: wait for the match
+    assert probe.matched()
+    assert probe.step_cli.wait_for_service(timeout_sec=60)
     sequence = [[0.4, 0.2, 0, 0, 0, 0], [0, 0, 0.3, -0.3, 0.5, 0], [-0.2, 0, 0, 0, 0, 1.0]]
     traj = []
     t = None
     for v in sequence:
         probe.command(v)
-        spin_for(rclpy, probe.node, 0.3)      # delivered before the steps (time stands still)
+        # delivered before the steps: the command and the step request leave this participant
+        # in this order over the same loopback path (time stands still meanwhile)
+        spin_for(rclpy, probe.node, 0.3)
         for _ in range(4):
             response = probe.call(probe.step_cli, probe.Step.Request(steps=24))
             assert response.success
             t = response.sim_time.sec + response.sim_time.nanosec * 1e-9
         last = (response.sim_time.sec, response.sim_time.nanosec)
         assert spin_until(rclpy, probe.node, lambda last=last: probe.joints and (
-            probe.joints[-1].header.stamp.sec, probe.joints[-1].header.stamp.nanosec) == last, 5)
+            probe.joints[-1].header.stamp.sec, probe.joints[-1].header.stamp.nanosec) == last, 60)
         traj.append(probe.q())
     probe.node.destroy_node()
     proc.stop()
@@ -237,10 +257,10 @@ def test_training_robot_has_the_same_contract(rclpy_ctx, spawn_node):
 
     probe.node.create_subscription(JointState, '/joint_states', user.append, 100)
     assert spin_until(rclpy_ctx, probe.node, lambda: len(probe.joints) > 20 and probe.poses
-                      and user, 30), proc.output()
+                      and user, 120), proc.output()
+    assert probe.matched()
     q0 = probe.q()
-    probe.drive([0, 0.3, 0, 0, 0, 0], 1.0)
-    assert probe.q()[1] - q0[1] > 0.15
+    assert probe.drive([0, 0.3, 0, 0, 0, 0], lambda: probe.q()[1] - q0[1] > 0.15)
     # the user's arm did not move
     np.testing.assert_allclose(np.asarray(user[-1].position)[1], 0.0, atol=0.003)
     proc.stop()

@@ -15,12 +15,9 @@ STEP = 0.005  # s, the prompt timer's period at rate 200 Hz
 
 @pytest.fixture
 def runner():
-    composition = pytest.importorskip('mindgrasp_ros.composition')
-    try:
-        r = composition.LockstepRunner(start_time_s=100.0)
-    except Exception as err:  # the layer is still being written
-        pytest.skip(f'lock-step composition does not work yet: {err!r}')
-    return r
+    from mindgrasp_ros import composition
+
+    return composition.LockstepRunner(start_time_s=100.0)
 
 
 def run_graz(runner) -> list:
@@ -66,13 +63,11 @@ def test_graz_in_lockstep_hits_the_planned_onsets(runner):
 
 
 def test_same_seed_same_prompts_in_lockstep():
-    composition = pytest.importorskip('mindgrasp_ros.composition')
+    from mindgrasp_ros import composition
+
     runs = []
     for _ in range(2):
-        try:
-            runner = composition.LockstepRunner(start_time_s=100.0)
-        except Exception as err:
-            pytest.skip(f'lock-step composition does not work yet: {err!r}')
+        runner = composition.LockstepRunner(start_time_s=100.0)
         runs.append([(m.phase, m.class_index, m.trial, m.header.stamp.sec,
                       m.header.stamp.nanosec) for m in run_graz(runner)])  # fmt: skip
     assert runs[0] == runs[1]
@@ -80,11 +75,10 @@ def test_same_seed_same_prompts_in_lockstep():
 
 def run_trainer_with_sim() -> tuple[list, dict]:
     """Simulator (training robot) and trainer composed in lock-step; returns prompts, summary."""
-    composition = pytest.importorskip('mindgrasp_ros.composition')
-    sim_node = pytest.importorskip('mindgrasp_sim.sim_node')
     from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import Prompt
 
-    from mindgrasp_ros import rclpy
+    from mindgrasp_ros import composition, rclpy
+    from mindgrasp_sim import sim_node
     from mindgrasp_trainer.trainer_node import TrainerNode
 
     got = []

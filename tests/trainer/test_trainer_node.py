@@ -110,7 +110,7 @@ class StandInRobot:
         self.fsm_pub.publish(self.FsmState(state=self.fsm))
 
 
-def test_trainer_prompts_moves_resets_and_measures(ros, spawn, spin_until, tmp_path):
+def test_trainer_prompts_moves_resets_and_measures(ros, spawn_node, spin_until, tmp_path):
     from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import Prompt
     from mindgrasp_ros.interfaces.std_msgs.msg import Float64
 
@@ -136,7 +136,7 @@ def test_trainer_prompts_moves_resets_and_measures(ros, spawn, spin_until, tmp_p
     # the schedule of this seed exercises both rules
     assert 'training end-effector' in reasons and "user's robot entered the grasp state" in reasons
     log_file = tmp_path / 'trials.csv'
-    proc = spawn('mindgrasp_trainer.trainer_node', seed=seed, log_file=log_file, **PARAMS)
+    proc = spawn_node('mindgrasp_trainer.trainer_node', seed=seed, log_file=log_file, **PARAMS)
     ok = spin_until(node, lambda: prompts and prompts[-1][0].phase == 'end', 60.0)
     out = proc.output()
     assert ok, f'prompts: {[(m.trial, m.phase) for m, _ in prompts]}\n{out}'
@@ -191,7 +191,7 @@ def test_trainer_prompts_moves_resets_and_measures(ros, spawn, spin_until, tmp_p
     node.destroy_node()
 
 
-def test_missing_reset_service_is_reported_and_the_session_goes_on(ros, spawn, spin_until):
+def test_missing_reset_service_is_reported_and_the_session_goes_on(ros, spawn_node, spin_until):
     from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import Prompt
 
     node = ros.node.Node('trainer_stand_in_no_reset')
@@ -205,7 +205,7 @@ def test_missing_reset_service_is_reported_and_the_session_goes_on(ros, spawn, s
     node.create_subscription(Prompt, '/trainer/prompt', prompts.append, tl)
     # seed 0 starts with both hands: the end-effector goes below 0.1 m in trial 1 and stays there
     assert TrainerProtocol(n_trials=2, seed=0).order[0] == 2
-    proc = spawn('mindgrasp_trainer.trainer_node', seed=0, **(PARAMS | {'n_trials': 2}))
+    proc = spawn_node('mindgrasp_trainer.trainer_node', seed=0, **(PARAMS | {'n_trials': 2}))
     assert spin_until(node, lambda: prompts and prompts[-1].phase == 'end', 60.0)
     assert proc.wait(10) == 0
     out = proc.output()
@@ -217,8 +217,8 @@ def test_missing_reset_service_is_reported_and_the_session_goes_on(ros, spawn, s
     node.destroy_node()
 
 
-def test_trainer_without_training_robot_exits_with_the_fix(ros, spawn):
-    proc = spawn('mindgrasp_trainer.trainer_node', robot_timeout=1.0)
+def test_trainer_without_training_robot_exits_with_the_fix(ros, spawn_node):
+    proc = spawn_node('mindgrasp_trainer.trainer_node', robot_timeout=1.0)
     assert proc.wait(30) == 1
     out = proc.output()
     assert 'No message on /trainer_robot/joint_states and /trainer_robot/ee_pose' in out
@@ -235,8 +235,8 @@ def test_trainer_without_training_robot_exits_with_the_fix(ros, spawn):
         ({'rate': 0.0}, "The rate 'rate' must be a positive number of Hz"),
     ],
 )
-def test_trainer_bad_parameter(ros, spawn, params, match):
-    proc = spawn('mindgrasp_trainer.trainer_node', **params)
+def test_trainer_bad_parameter(ros, spawn_node, params, match):
+    proc = spawn_node('mindgrasp_trainer.trainer_node', **params)
     assert proc.wait(30) == 2
     out = proc.output()
     assert match in out, out

@@ -18,8 +18,9 @@ CONTROL_HZ = 50
 
 @pytest.fixture(scope='module')
 def sim():
-    simulation = pytest.importorskip('mindgrasp_sim.simulation')
-    s = simulation.Simulation(trainer_robot=True)
+    from mindgrasp_sim.simulation import Simulation
+
+    s = Simulation(trainer_robot=True)
     yield s
     s.close()
 
