@@ -71,6 +71,26 @@ def test_autonomous_grasp_succeeds_for_each_shape(shape: str, radius: float, ang
     assert out.states == [1, 2, 3, 4, 5, 6, 1]
 
 
+@pytest.mark.slow
+@pytest.mark.parametrize(('shape', 'radius', 'angle', 'seed'), [('cube', 0.45, 60.0, 1),
+                                                                ('cylinder', 0.6, -100.0, 2),
+                                                                ('sphere', 0.3, 150.0, 3)])
+def test_autonomous_grasp_with_the_default_realism_profile(shape: str, radius: float,
+                                                           angle: float, seed: int) -> None:
+    """Noisy depth with invalid pixels, a miscalibrated camera, encoder noise, a lagging arm,
+    an object of other mass/friction/size/hue, contacts on any surface: the grasp still works."""
+    loop, _ = build_loop(FsmParams(lock_duration=0.5), realism='default', realism_seed=seed)
+    try:
+        spec = TrialSpec(0, shape, 'blue', radius, angle, 0.05, -30.0)
+        loop.sim.load_scene(spec.scene())
+        assert loop.sim.realism.enabled and np.isnan(loop.sim.render_camera()[1]).any()
+        out = loop.run(0, timeout=90.0)
+    finally:
+        loop.sim.close()
+    assert out.success, (out.reason, out.states)
+    assert out.lift_height > 0.2
+
+
 def test_kinematic_loop_places_the_gripper_on_the_object() -> None:
     """Pinhole camera + kinematic arm: search, centre, approach, descend onto a point object."""
     params = FsmParams(autonomous=True, lock_duration=0.3)

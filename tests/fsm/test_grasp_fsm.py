@@ -492,3 +492,45 @@ def test_carrying_return_rises_first_and_moves_gently(params: FsmParams) -> None
     assert first_return > 0
     assert outs[-1].state == State.OBJECT_SEARCH   # arrived home
     np.testing.assert_allclose(q, HOME, atol=params.return_tolerance)
+
+
+#: a real hand closed on the table beside the object: every finger "in contact" (the table), but
+#: the finger motors barely loaded; and one squeezing the object (efforts at the motor limits)
+ON_TABLE = GripperState(opening=0.5, force=0.25, stamp=0.0, contact=True, fingers_in_contact=3,
+                        efforts=(0.09, 0.08, 0.08))
+SQUEEZING = GripperState(opening=0.5, force=4.8, stamp=0.0, contact=True, fingers_in_contact=3,
+                         efforts=(2.4, -1.2, -1.2))
+
+
+def test_grasp_check_counts_fingers_loaded_by_effort(params: FsmParams) -> None:
+    """Contact on any surface is not a grasp: the check uses finger efforts when the hand
+    reports them, and lifts before deciding."""
+    fsm = _grasp_fsm(params)
+    outs, _, _ = _drive(fsm, _grasp_pose(), ON_TABLE, 8.0)
+    entered = [o for o in outs if o.state == State.FINAL_APPROACH]
+    assert entered and '0 finger(s) push on something' in entered[0].reason
+    fsm = _grasp_fsm(params)
+    outs, _, _ = _drive(fsm, _grasp_pose(), SQUEEZING, 8.0)
+    assert fsm.outcome == 'holding'
+    assert {'lift', 'check_lift'} <= {o.phase for o in outs}
+
+
+def test_object_lost_in_the_lift_unloads_the_fingers(params: FsmParams) -> None:
+    fsm = _grasp_fsm(params)
+    q = _grasp_pose()
+    outs, q, t = _drive(fsm, q, SQUEEZING, 1.2)
+    assert outs[-1].phase == 'lift'
+    outs, _, _ = _drive(fsm, q, ON_TABLE, 6.0, t0=t)
+    entered = [o for o in outs if o.state == State.FINAL_APPROACH]
+    assert entered and 'slipped after the lift' in entered[0].reason
+
+
+def test_contact_flags_are_used_without_efforts_or_when_asked(params: FsmParams) -> None:
+    from mindgrasp_fsm.grasp_policy import fingers_loaded
+
+    assert fingers_loaded(SQUEEZING, 0.4) == 3 and fingers_loaded(ON_TABLE, 0.4) == 0
+    assert fingers_loaded(HOLDING, 0.4) is None            # no efforts reported
+    assert fingers_loaded(SQUEEZING, 0.0) is None          # finger_contact_effort: 0
+    fsm = _grasp_fsm(dataclasses.replace(params, finger_contact_effort=0.0))
+    _drive(fsm, _grasp_pose(), ON_TABLE, 8.0)
+    assert fsm.outcome == 'holding'                        # a simulator's contact flags

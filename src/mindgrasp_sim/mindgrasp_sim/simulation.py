@@ -197,8 +197,8 @@ class Simulation:
         Sensor noise and physical spread (:mod:`mindgrasp_sim.realism`): a profile, its name
         (``'default'``, ``'none'``) or a YAML path; None is ``'none'`` (a perfect world).
     realism_seed : int
-        Seed of the realism draws; with the layout seed and the trial number (resets so far) it
-        fixes every noise sample, so the same seeds give the same images.
+        Seed of the realism draws; with the layout seed and the trial number (resets since the
+        scene was loaded) it fixes every noise sample, so the same seeds give the same images.
     """
 
     joint_names: tuple[str, ...] = ARM_JOINTS
@@ -392,6 +392,7 @@ class Simulation:
         self.seed = int(spec.seed if seed is None else seed)
         self._layout_seed = self.seed
         self._layout = spec.draw(self._layout_seed, self.n_objects)
+        self._trial = 0      # realism draws depend on the layout seed and the resets since here
         self.reset()
 
     @property

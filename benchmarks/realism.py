@@ -1,0 +1,241 @@
+"""Realism benchmark: grasp success per shape with the realism profile off and on, and sweeps of
+single realism factors.
+
+    python benchmarks/realism.py compare [--trials 90] [--seed 0] [--workers 2] [--profile default]
+    python benchmarks/realism.py sweep [--trials 30] [--seed 0] [--workers 2] [--plot sweep.png]
+
+``compare`` runs the random-locations protocol (one object per trial, random shape, colour, size,
+0.2-0.7 m from the base, autonomous search, approach and grasp) twice on the same placements:
+with a perfect world and with the realism profile (mindgrasp_sim.realism: depth noise and invalid
+pixels, colour noise and lighting, camera mount error, encoder noise and velocity lag, object
+spread, contacts on any surface). Prints success per shape for each (target >= 95 % per shape
+with the default profile) and a plot of both (``--plot``).
+
+``sweep`` varies one factor at a time on top of the profile: the depth noise std x1, x2, x4 and
+the camera mount error (max offset / max rotation) 0 / 0.5 cm 1 deg / 1 cm 1.5 deg / 2 cm 3 deg,
+and prints a table of the success rates (plot with ``--plot``).
+
+Each trial runs in lock-step in-process (the Simulation, VisionPipeline and GraspFsm classes the
+nodes run); trials are spread over ``--workers`` processes and seeded by the trial index, so the
+figures do not depend on the number of workers. The last line is one JSON object.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import math
+import sys
+import time
+from concurrent.futures import ProcessPoolExecutor
+from multiprocessing import get_context
+
+SHAPES = ('cube', 'cylinder', 'sphere')
+
+
+def _run_chunk(profile: dict | None, seed: int, n_trials: int, indices: list[int],
+               timeout: float) -> list[dict]:
+    """Worker: run the trials ``indices`` of ``draw_trials(n_trials, seed)`` with a profile
+    (as a dict; None = no realism). Returns one record per trial."""
+    from mindgrasp_fsm.experiment import build_loop, draw_trials
+    from mindgrasp_fsm.params import FsmParams, default_params_path
+    from mindgrasp_sim.realism import RealismProfile
+
+    realism = None if profile is None else RealismProfile.from_dict(profile)
+    loop, _ = build_loop(FsmParams.from_yaml(default_params_path()), realism=realism,
+                         realism_seed=seed)
+    specs = draw_trials(n_trials, seed)
+    out = []
+    try:
+        for i in indices:
+            spec = specs[i]
+            loop.sim.load_scene(spec.scene(), seed=spec.index)
+            t0 = time.perf_counter()
+            res = loop.run(0, timeout=timeout)
+            out.append({'index': i, 'shape': spec.shape, 'success': bool(res.success),
+                        'time_to_grasp': res.time_to_grasp, 'attempts': res.attempts,
+                        'detected_shape': res.detected_shape, 'reason': res.reason,
+                        'wall_s': time.perf_counter() - t0, 'radius': spec.radius,
+                        'angle_deg': spec.angle_deg})
+    finally:
+        loop.sim.close()
+    return out
+
+
+def _profile_dict(profile: object) -> dict:
+    data = dataclasses.asdict(profile)
+    return {k: ({f: list(v) if isinstance(v, tuple) else v for f, v in val.items()}
+                if isinstance(val, dict) else val) for k, val in data.items()}
+
+
+def run_condition(profile: object | None, trials: int, seed: int, workers: int,
+                  timeout: float) -> list[dict]:
+    """All trials of one condition, spread over ``workers`` processes."""
+    data = None if profile is None else _profile_dict(profile)
+    chunks = [list(range(k, trials, workers)) for k in range(workers)]
+    chunks = [c for c in chunks if c]
+    if len(chunks) == 1:
+        records = _run_chunk(data, seed, trials, chunks[0], timeout)
+    else:
+        with ProcessPoolExecutor(len(chunks), mp_context=get_context('spawn')) as pool:
+            futures = [pool.submit(_run_chunk, data, seed, trials, c, timeout) for c in chunks]
+            records = [r for f in futures for r in f.result()]
+    return sorted(records, key=lambda r: r['index'])
+
+
+def by_shape(records: list[dict]) -> dict[str, tuple[int, int]]:
+    """shape -> (successes, trials)."""
+    return {s: (sum(r['success'] for r in records if r['shape'] == s),
+                sum(r['shape'] == s for r in records)) for s in SHAPES}
+
+
+def _pct(k: int, n: int) -> str:
+    return f'{100 * k / n:5.1f} % ({k:2d}/{n:2d})' if n else '   n/a        '
+
+
+def _failures(name: str, records: list[dict]) -> None:
+    for r in records:
+        if not r['success']:
+            print(f'  {name} trial {r["index"]}: {r["shape"]} r {r["radius"]:.2f} m '
+                  f'{r["angle_deg"]:+.0f} deg, seen as {r["detected_shape"]}: {r["reason"]}')
+
+
+def compare(args: argparse.Namespace) -> dict:
+    from mindgrasp_sim.realism import RealismProfile
+
+    profile = RealismProfile.load(args.profile)
+    t0 = time.perf_counter()
+    off = run_condition(None, args.trials, args.seed, args.workers, args.timeout)
+    on = run_condition(profile, args.trials, args.seed, args.workers, args.timeout)
+    wall = time.perf_counter() - t0
+    s_off, s_on = by_shape(off), by_shape(on)
+    print(f'Grasp success, random locations, {args.trials} trials each (seed {args.seed}), '
+          f"realism off vs profile '{profile.name}':")
+    print(f'  {"shape":9s} {"off":18s} {profile.name}')
+    for s in SHAPES:
+        print(f'  {s:9s} {_pct(*s_off[s])}  {_pct(*s_on[s])}')
+    tot = [sum(r['success'] for r in rs) for rs in (off, on)]
+    print(f'  {"overall":9s} {_pct(tot[0], len(off))}  {_pct(tot[1], len(on))}')
+    ok = [r['time_to_grasp'] for r in on if r['success'] and math.isfinite(r['time_to_grasp'])]
+    if ok:
+        print(f'Time to grasp with realism (simulated): median {sorted(ok)[len(ok) // 2]:.1f} s')
+    print(f'Wall time {wall:.0f} s for {2 * args.trials} trials on {args.workers} worker(s).')
+    _failures('off', off)
+    _failures(profile.name, on)
+    if args.plot:
+        _plot_compare(args.plot, s_off, s_on, profile.name, args.trials)
+    return {'mode': 'compare', 'profile': profile.name, 'trials': args.trials,
+            'seed': args.seed, 'off': s_off, 'on': s_on, 'wall_time_s': wall}
+
+
+def sweep_levels(profile: object) -> list[tuple[str, str, object]]:
+    """(factor, level label, profile) of the one-factor sweeps."""
+    from mindgrasp_sim.realism import CameraMountError
+
+    levels = [('depth noise', f'x{k:g}', profile.scaled(depth=k)) for k in (1.0, 2.0, 4.0)]
+    for cm, deg in ((0.0, 0.0), (0.5, 1.0), (1.0, 1.5), (2.0, 3.0)):
+        mount = CameraMountError(max_offset=cm / 100.0, max_angle_deg=deg)
+        levels.append(('camera mount', f'{cm:g} cm / {deg:g} deg',
+                       dataclasses.replace(profile, camera_mount=mount)))
+    return levels
+
+
+def sweep(args: argparse.Namespace) -> dict:
+    from mindgrasp_sim.realism import RealismProfile
+
+    profile = RealismProfile.load(args.profile)
+    rows = []
+    t0 = time.perf_counter()
+    done: dict[object, list[dict]] = {}
+    for factor, label, p in sweep_levels(profile):
+        key = json.dumps(_profile_dict(p), sort_keys=True)
+        if key not in done:     # x1 and the profile's own mount error are the same runs
+            done[key] = run_condition(p, args.trials, args.seed, args.workers, args.timeout)
+        records = done[key]
+        rows.append((factor, label, by_shape(records),
+                     sum(r['success'] for r in records), len(records)))
+        print(f'  {factor:13s} {label:18s} ' + '  '.join(
+            f'{s} {_pct(*rows[-1][2][s])}' for s in SHAPES)
+            + f'  all {_pct(rows[-1][3], rows[-1][4])}', flush=True)
+    wall = time.perf_counter() - t0
+    print(f"One-factor sweeps on profile '{profile.name}', {args.trials} trials per level "
+          f'(seed {args.seed}), {wall:.0f} s wall time.')
+    if args.plot:
+        _plot_sweep(args.plot, rows, profile.name, args.trials)
+    return {'mode': 'sweep', 'profile': profile.name, 'trials': args.trials, 'seed': args.seed,
+            'rows': [{'factor': f, 'level': lvl, 'by_shape': b, 'successes': k, 'trials': n}
+                     for f, lvl, b, k, n in rows], 'wall_time_s': wall}
+
+
+def _plot_compare(path: str, s_off: dict, s_on: dict, name: str, trials: int) -> None:
+    import matplotlib
+
+    matplotlib.use('Agg')
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(5, 3.2))
+    x = range(len(SHAPES))
+    for k, (label, s) in enumerate((('realism off', s_off), (f'realism {name}', s_on))):
+        ax.bar([i + (k - 0.5) * 0.38 for i in x],
+               [100 * s[sh][0] / max(s[sh][1], 1) for sh in SHAPES], 0.36, label=label)
+    ax.axhline(95, color='k', lw=0.8, ls='--', label='target 95 %')
+    ax.set_xticks(list(x), SHAPES)
+    ax.set_ylim(0, 105)
+    ax.set_ylabel('grasp success (%)')
+    ax.set_title(f'Random locations, {trials} trials per condition')
+    ax.legend(loc='lower right', fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    print(f'Plot: {path}')
+
+
+def _plot_sweep(path: str, rows: list, name: str, trials: int) -> None:
+    import matplotlib
+
+    matplotlib.use('Agg')
+    import matplotlib.pyplot as plt
+
+    factors = list(dict.fromkeys(r[0] for r in rows))
+    fig, axes = plt.subplots(1, len(factors), figsize=(4.5 * len(factors), 3.2), sharey=True)
+    for ax, factor in zip(axes, factors, strict=True):
+        sel = [r for r in rows if r[0] == factor]
+        labels = [r[1] for r in sel]
+        for s in SHAPES:
+            ax.plot(labels, [100 * r[2][s][0] / max(r[2][s][1], 1) for r in sel], 'o-', label=s)
+        ax.plot(labels, [100 * r[3] / max(r[4], 1) for r in sel], 'k^--', label='all')
+        ax.axhline(95, color='grey', lw=0.8, ls=':')
+        ax.set_title(f'{factor} (rest: {name})')
+        ax.set_ylim(0, 105)
+        ax.tick_params(axis='x', labelsize=8)
+    axes[0].set_ylabel('grasp success (%)')
+    axes[0].legend(fontsize=8, loc='lower left')
+    fig.suptitle(f'One factor at a time, {trials} trials per level', fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    print(f'Plot: {path}')
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument('mode', choices=('compare', 'sweep'))
+    parser.add_argument('--trials', type=int, default=None,
+                        help='trials per condition (default 90 compare, 30 sweep)')
+    parser.add_argument('--seed', type=int, default=0)
+    parser.add_argument('--workers', type=int, default=1)
+    parser.add_argument('--profile', default='default', help='realism profile name or YAML path')
+    parser.add_argument('--timeout', type=float, default=120.0, help='simulated s per trial')
+    parser.add_argument('--plot', default='', help='write a PNG plot here')
+    args = parser.parse_args()
+    if args.trials is None:
+        args.trials = 90 if args.mode == 'compare' else 30
+    if args.trials < 1 or args.workers < 1:
+        print('realism.py: --trials and --workers must be >= 1.', file=sys.stderr)
+        return 2
+    summary = compare(args) if args.mode == 'compare' else sweep(args)
+    print(json.dumps(summary))
+    return 0
+
+
+if __name__ == '__main__':
+    raise SystemExit(main())
