@@ -36,6 +36,10 @@ def test_cli_rejects_bad_arguments(capsys: pytest.CaptureFixture[str]) -> None:
     assert '--trials must be >= 1' in capsys.readouterr().err
     assert cli.main(_parse(['--timeout', '-1'])) == 2
     assert '--timeout must be > 0' in capsys.readouterr().err
+    assert cli.main(_parse(['--trials', '1', '--realism', 'realistic'])) == 2
+    err = capsys.readouterr().err
+    assert "--realism: Unknown realism profile 'realistic'; use one of ['default', 'none']" in err
+    assert err.count('\n') == 1
 
 
 def test_cli_bad_params_file(tmp_path, capsys: pytest.CaptureFixture[str]) -> None:

@@ -3,7 +3,8 @@
 Each trial places one object (random shape and colour) 0.2-0.7 m from the base; the controller
 turns left until it sees it, centres it, approaches and grasps it without BCI input, as in the
 MIndGrasp paper. Prints success per shape and overall and the mean and median time to grasp;
-``--json`` adds one JSON object as the last line.
+``--json`` adds one JSON object as the last line. ``--realism default`` (or a profile YAML) runs
+the trials with sensor noise and physical spread (mindgrasp_sim.realism), seeded by ``--seed``.
 """
 
 from __future__ import annotations
@@ -26,6 +27,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help='simulated seconds per trial before it counts as failed (default 120)')
     parser.add_argument('--shape-model', default=None,
                         help="depth shape CNN (default the vision default; 'none' to disable)")
+    parser.add_argument('--realism', default='none',
+                        help='sensor noise and physical spread: none (default), default or a '
+                             'profile YAML path (mindgrasp_sim.realism)')
     parser.add_argument('--quiet', action='store_true', help='no line per trial')
 
 
@@ -63,6 +67,14 @@ def main(args: argparse.Namespace) -> int:
     except FsmError as exc:
         print(f'mindgrasp experiment random-locations: {exc}', file=sys.stderr)
         return 2
+    from mindgrasp_sim.errors import SimError
+    from mindgrasp_sim.realism import RealismProfile
+
+    try:
+        realism = RealismProfile.load(args.realism)
+    except SimError as exc:
+        print(f'mindgrasp experiment random-locations: --realism: {exc}', file=sys.stderr)
+        return 2
 
     def progress(rec: object) -> None:
         if args.quiet:
@@ -74,9 +86,10 @@ def main(args: argparse.Namespace) -> int:
               f'({rec.attempts} attempt(s); {rec.reason})', flush=True)
 
     summary = run_random_locations(args.trials, args.seed, params, timeout=args.timeout,
-                                   shape_model=args.shape_model, progress=progress)
+                                   shape_model=args.shape_model, progress=progress,
+                                   realism=realism)
     print(f'Random locations: {summary["trials"]} trials, seed {args.seed}, shape model '
-          f'{summary["shape_model"]}')
+          f'{summary["shape_model"]}, realism {summary["realism"]}')
     for shape, rate in summary['success_by_shape'].items():
         c = summary['counts_by_shape'][shape]
         print(f'  {shape:8s} {_fmt_rate(rate)}  ({c["successes"]}/{c["trials"]})')
