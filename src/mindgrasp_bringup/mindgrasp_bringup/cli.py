@@ -38,6 +38,7 @@ COMMANDS: dict[str, str | dict[str, str]] = {
         'list': 'mindgrasp_bringup.commands.param_list',
         'get': 'mindgrasp_bringup.commands.param_get',
         'set': 'mindgrasp_bringup.commands.param_set',
+        'describe': 'mindgrasp_bringup.commands.param_describe',
     },
     'eeg': {
         'virtual-amp': 'mindgrasp_eeg.virtual_amp_cli',

@@ -98,13 +98,14 @@ def run_composed(components: Sequence[Component], *, num_threads: int | None = N
                  duration_s: float = 0.0) -> int:
     """Create every component in this process and spin them with a MultiThreadedExecutor.
 
-    Ends on Ctrl-C, after ``duration_s`` (> 0), or when a node says it is finished through a
-    ``done`` attribute (the convention of our nodes' ``duration`` parameter), as a launch ends
-    when one of its processes ends. Returns 1 when a node reports an ``error``, else 0.
+    Ends on Ctrl-C, after ``duration_s`` (> 0), or when a node completes its ``done`` Future (the
+    skeleton of :mod:`mindgrasp_ros.node_main`), as a launch ends when one of its processes ends.
+    Returns 1 when a node failed (``done`` holds an exception), else 0.
     """
     import time
 
     from mindgrasp_ros import rclpy
+    from mindgrasp_ros.node_main import error_text, is_done
 
     if not rclpy.ok():
         rclpy.init()
@@ -118,7 +119,7 @@ def run_composed(components: Sequence[Component], *, num_threads: int | None = N
         deadline = time.monotonic() + duration_s if duration_s > 0 else None
         while rclpy.ok() and (deadline is None or time.monotonic() < deadline):
             executor.spin_once(timeout_sec=0.1)
-            if any(getattr(node, 'done', False) for node in nodes):
+            if any(is_done(node) for node in nodes):
                 break
     except KeyboardInterrupt:
         pass
@@ -127,9 +128,9 @@ def run_composed(components: Sequence[Component], *, num_threads: int | None = N
         for node in reversed(nodes):
             node.destroy_node()
         rclpy.try_shutdown()
-    failed = [n.get_name() for n in nodes if getattr(n, 'error', None) is not None]
-    for name in failed:
-        print(f'[{name}] ERROR: {next(n.error for n in nodes if n.get_name() == name)}')
+    failed = [(n.get_name(), error_text(n)) for n in nodes if error_text(n) is not None]
+    for name, reason in failed:
+        print(f'[{name}] ERROR: {reason}')
     return 1 if failed else 0
 
 

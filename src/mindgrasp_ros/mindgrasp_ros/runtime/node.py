@@ -37,7 +37,7 @@ from mindgrasp_ros.runtime.names import (
     validate_namespace,
     validate_node_name,
 )
-from mindgrasp_ros.runtime.parameter import Parameter
+from mindgrasp_ros.runtime.parameter import Parameter, parameter_value_to_python
 from mindgrasp_ros.runtime.qos import (
     QoSProfile,
     as_profile,
@@ -379,6 +379,10 @@ class Node:
             declared_type, value = value, None
         elif isinstance(value, Parameter):
             value = value.value
+        elif type(value).__name__ == 'ParameterValue':
+            # rclpy accepts an rcl_interfaces/ParameterValue: its type field gives the type,
+            # which an empty list alone cannot
+            declared_type, value = Parameter.Type(value.type), parameter_value_to_python(value)
         if declared_type is None and value is not None:
             # the default's type is the parameter's type; an int override of a float
             # default stays a float (rclpy would silently make it an int)
@@ -515,7 +519,9 @@ class Node:
                 continue
             desc = self._descriptors[p.name]
             if desc.read_only:
-                return result_cls(successful=False, reason=f"parameter '{p.name}' is read-only")
+                return result_cls(successful=False,
+                                  reason=f"parameter '{p.name}' is read-only: restart the node "
+                                  'with the new value to change it')
             declared = Parameter.Type(desc.type)
             value = p.value
             if (declared != Parameter.Type.NOT_SET and p.type_ != declared

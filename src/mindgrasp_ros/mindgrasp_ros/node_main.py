@@ -1,0 +1,187 @@
+"""The one node skeleton: every node's ``main()`` is ``return run_node(NodeClass, args)``.
+
+A node module reads like demo_nodes_py's ``talker_qos.py``::
+
+    from mindgrasp_ros import rclpy
+    from mindgrasp_ros.node_main import end_after, run_node
+
+
+    class Ticker(rclpy.node.Node):
+        def __init__(self, **kwargs) -> None:
+            super().__init__('ticker', **kwargs)
+            self.done = rclpy.task.Future()     # the node ends itself by completing this
+            self.count = 0
+            self.create_timer(0.1, self.timer_callback)
+            end_after(self, 5.0)                # optional: end after 5 s of ROS time
+
+        def timer_callback(self) -> None:
+            self.count += 1
+            if self.count == 10:                # or after a number of cycles
+                self.done.set_result(0)
+
+
+    def main(args: list[str] | None = None) -> int:
+        return run_node(Ticker, args)
+
+Exit codes (one convention for every node, as the launcher reports them):
+
+- ``0`` the node finished its work (``done`` completed with ``0`` or ``None``) or was stopped
+  (Ctrl-C, SIGTERM, ``rclpy.shutdown()`` from elsewhere);
+- ``1`` the node failed while running: ``done`` completed with an exception (its message is printed
+  as one line ``[node] ERROR: ...``) or with a non-zero exit code;
+- ``2`` the node refused to start: its constructor raised a parameter error (rclpy's
+  ``ParameterException`` family, :class:`~mindgrasp_ros.params.ParameterError`) or one of the
+  ``errors`` the caller names (the package's own error class); one line, no traceback.
+
+A node that must do something on the way out (stop the arm, log a count) overrides
+``destroy_node()`` and calls ``super().destroy_node()``, as in rclpy; ``rclpy.ok()`` there tells
+whether it may still publish.
+
+Works with the real rclpy (``MINDGRASP_RMW=rclpy``) and with our runtime: only rclpy's public API
+is used (``init``, executors, ``task.Future``, ``executors.ExternalShutdownException``).
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Callable
+from typing import Any
+
+from mindgrasp_ros import rclpy
+
+__all__ = ['EXIT_FAILED', 'EXIT_OK', 'EXIT_REFUSED', 'NodeFailure', 'end_after', 'error_text',
+           'exit_code', 'fail', 'is_done', 'run_node']
+
+EXIT_OK = 0       #: finished or stopped
+EXIT_FAILED = 1   #: failed while running
+EXIT_REFUSED = 2  #: refused to start (bad parameter or argument)
+
+
+class NodeFailure(Exception):
+    """The reason a node failed while running; ``fail(node, reason)`` completes ``done`` with it."""
+
+
+def _parameter_errors() -> tuple[type[BaseException], ...]:
+    from mindgrasp_ros.params import ParameterError
+
+    errors: list[type[BaseException]] = [ParameterError]
+    exceptions = getattr(rclpy, 'exceptions', None)
+    if exceptions is None:  # pragma: no cover - real rclpy imports it lazily
+        import importlib
+
+        exceptions = importlib.import_module(f'{rclpy.__name__}.exceptions')
+    errors.append(exceptions.ParameterException)
+    # rclpy's InvalidParameterTypeException is not a ParameterException subclass
+    for name in ('InvalidParameterTypeException', 'InvalidParameterValueException',
+                 'ParameterUninitializedException'):
+        cls = getattr(exceptions, name, None)
+        if isinstance(cls, type):
+            errors.append(cls)
+    return tuple(errors)
+
+
+def _external_shutdown() -> type[BaseException]:
+    cls = getattr(rclpy.executors, 'ExternalShutdownException', None)
+    return cls if isinstance(cls, type) else KeyboardInterrupt
+
+
+def end_after(node: Any, duration_sec: float) -> Any:
+    """Complete ``node.done`` with 0 after ``duration_sec`` s of the node's clock (ROS time; sim
+    time with ``use_sim_time``); nothing when ``duration_sec`` <= 0. Returns the timer or None.
+
+    This is the ``--number_of_cycles`` of demo_nodes_py for our nodes' ``duration`` parameter:
+    launch tests and demos end by themselves.
+    """
+    if not duration_sec or duration_sec <= 0:
+        return None
+    timer = None
+
+    def callback() -> None:
+        timer.cancel()
+        if not node.done.done():
+            node.done.set_result(EXIT_OK)
+
+    timer = node.create_timer(float(duration_sec), callback)
+    return timer
+
+
+def fail(node: Any, reason: str) -> None:
+    """End ``node`` with exit code 1 and ``reason`` (one line, printed by :func:`run_node`)."""
+    node.get_logger().error(reason)
+    if not node.done.done():
+        node.done.set_exception(NodeFailure(reason))
+
+
+def is_done(node: Any) -> bool:
+    """True once ``node.done`` (a Future) has completed; False for a node without one."""
+    done = getattr(node, 'done', None)
+    if isinstance(done, bool):   # nodes not yet on the skeleton  # TODO(skeleton): remove
+        return done
+    return bool(done is not None and done.done())
+
+
+def exit_code(node: Any) -> int:
+    """The exit code a completed ``node.done`` stands for (0 while it runs)."""
+    if not is_done(node):
+        return EXIT_OK
+    if node.done.exception() is not None:
+        return EXIT_FAILED
+    result = node.done.result()
+    return int(result) if isinstance(result, int) and not isinstance(result, bool) else EXIT_OK
+
+
+def error_text(node: Any) -> str | None:
+    """The failure reason of a node whose ``done`` holds an exception, else None."""
+    if isinstance(getattr(node, 'done', None), bool):   # TODO(skeleton): remove
+        return getattr(node, 'error', None)
+    if is_done(node) and node.done.exception() is not None:
+        return str(node.done.exception())
+    return None
+
+
+def run_node(node_class: Callable[[], Any], args: list[str] | None = None, *,
+             errors: tuple[type[BaseException], ...] = (), linger_sec: float = 0.0) -> int:
+    """Init, construct ``node_class()``, spin until Ctrl-C or ``node.done``, clean up.
+
+    Returns the exit code (see the module docstring).
+
+    Args:
+        node_class: the Node subclass (or any factory returning a node); constructed after
+            ``rclpy.init`` so it reads ``--ros-args`` parameters and remappings.
+        args: command line (default ``sys.argv``), with ``--ros-args ...``.
+        errors: the package's own error classes that mean "cannot start with this input" when the
+            constructor raises them (exit 2, one line).
+        linger_sec: after ``done`` completes, keep spinning this long (s) so reliable readers
+            receive the last messages (a session's "end" prompt).
+    """
+    rclpy.init(args=args if args is not None else sys.argv)
+    node = None
+    label = getattr(node_class, '__name__', 'node')
+    code = EXIT_OK
+    try:
+        try:
+            node = node_class()
+        except (*_parameter_errors(), *errors) as exc:
+            print(f'[{label}] ERROR: {exc}', file=sys.stderr, flush=True)
+            return EXIT_REFUSED
+        label = node.get_name()
+        done = getattr(node, 'done', None)
+        if done is None:
+            done = node.done = rclpy.task.Future()
+        # one executor for the node's lifetime: no add/remove per spin (rclpy.spin_once does that)
+        executor = rclpy.executors.SingleThreadedExecutor()
+        executor.add_node(node)
+        executor.spin_until_future_complete(done)
+        if done.done() and linger_sec > 0 and rclpy.ok():
+            executor.spin_until_future_complete(rclpy.task.Future(), timeout_sec=linger_sec)
+        code = exit_code(node)
+        reason = error_text(node)
+        if reason is not None:
+            print(f'[{label}] ERROR: {reason}', file=sys.stderr, flush=True)
+    except (KeyboardInterrupt, _external_shutdown()):
+        code = EXIT_OK
+    finally:
+        if node is not None:
+            node.destroy_node()
+        rclpy.try_shutdown()
+    return code
