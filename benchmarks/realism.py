@@ -3,6 +3,7 @@ single realism factors.
 
     python benchmarks/realism.py compare [--trials 90] [--seed 0] [--workers 2] [--profile default]
     python benchmarks/realism.py sweep [--trials 30] [--seed 0] [--workers 2] [--plot sweep.png]
+    python benchmarks/realism.py cnn [--images 150] [--model models/vision/shape_cnn]
 
 ``compare`` runs the random-locations protocol (one object per trial, random shape, colour, size,
 0.2-0.7 m from the base, autonomous search, approach and grasp) twice on the same placements:
@@ -14,6 +15,9 @@ with the default profile) and a plot of both (``--plot``).
 ``sweep`` varies one factor at a time on top of the profile: the depth noise std x1, x2, x4 and
 the camera mount error (max offset / max rotation) 0 / 0.5 cm 1 deg / 1 cm 1.5 deg / 2 cm 3 deg,
 and prints a table of the success rates (plot with ``--plot``).
+
+``cnn`` measures the depth shape CNN's accuracy on simulator views collected with the realism
+profile and without it (independent images, seed + 1000 as ``mindgrasp train vision`` uses).
 
 Each trial runs in lock-step in-process (the Simulation, VisionPipeline and GraspFsm classes the
 nodes run); trials are spread over ``--workers`` processes and seeded by the trial index, so the
@@ -168,6 +172,32 @@ def sweep(args: argparse.Namespace) -> dict:
                      for f, lvl, b, k, n in rows], 'wall_time_s': wall}
 
 
+def cnn(args: argparse.Namespace) -> dict:
+    import numpy as np
+
+    from mindgrasp_sim.realism import RealismProfile
+    from mindgrasp_vision.config import DEFAULT_SHAPE_MODEL, resolve_model_path
+    from mindgrasp_vision.dataset import collect_shape_dataset
+    from mindgrasp_vision.shape_cnn import SHAPES as CNN_SHAPES
+    from mindgrasp_vision.shape_cnn import ShapeClassifier
+
+    model = args.model or DEFAULT_SHAPE_MODEL
+    clf = ShapeClassifier.load(resolve_model_path(model))
+    profile = RealismProfile.load(args.profile)
+    out = {'mode': 'cnn', 'model': model, 'images': args.images, 'seed': args.seed + 1000}
+    for name, realism in (('none', None), (profile.name, profile)):
+        t0 = time.perf_counter()
+        data = collect_shape_dataset(args.images, seed=args.seed + 1000, realism=realism)
+        pred = clf.predict_proba(data.x).argmax(1)
+        acc = float(np.mean(pred == data.y))
+        per = {s: float(np.mean(pred[data.y == i] == i)) for i, s in enumerate(CNN_SHAPES)}
+        out[name] = {'accuracy': acc, 'by_shape': per}
+        print(f'Shape CNN {model} on {args.images} views, realism {name}: {100 * acc:.1f} % ('
+              + ', '.join(f'{s} {100 * a:.1f} %' for s, a in per.items())
+              + f'); {time.perf_counter() - t0:.0f} s', flush=True)
+    return out
+
+
 def _plot_compare(path: str, s_off: dict, s_on: dict, name: str, trials: int) -> None:
     import matplotlib
 
@@ -218,7 +248,7 @@ def _plot_sweep(path: str, rows: list, name: str, trials: int) -> None:
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument('mode', choices=('compare', 'sweep'))
+    parser.add_argument('mode', choices=('compare', 'sweep', 'cnn'))
     parser.add_argument('--trials', type=int, default=None,
                         help='trials per condition (default 90 compare, 30 sweep)')
     parser.add_argument('--seed', type=int, default=0)
@@ -226,13 +256,15 @@ def main() -> int:
     parser.add_argument('--profile', default='default', help='realism profile name or YAML path')
     parser.add_argument('--timeout', type=float, default=120.0, help='simulated s per trial')
     parser.add_argument('--plot', default='', help='write a PNG plot here')
+    parser.add_argument('--images', type=int, default=150, help='cnn: test views per condition')
+    parser.add_argument('--model', default='', help='cnn: shape model (default the vision one)')
     args = parser.parse_args()
     if args.trials is None:
         args.trials = 90 if args.mode == 'compare' else 30
     if args.trials < 1 or args.workers < 1:
         print('realism.py: --trials and --workers must be >= 1.', file=sys.stderr)
         return 2
-    summary = compare(args) if args.mode == 'compare' else sweep(args)
+    summary = {'compare': compare, 'sweep': sweep, 'cnn': cnn}[args.mode](args)
     print(json.dumps(summary))
     return 0
 

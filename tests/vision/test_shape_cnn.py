@@ -157,6 +157,19 @@ def test_committed_model_on_held_out_simulator_views():
 
 
 @pytest.mark.slow
+def test_committed_model_on_noisy_depth_images():
+    """Views from a realistic camera (mindgrasp_sim.realism 'default': depth noise, invalid
+    pixels, mount error, lighting, object spread), through the pipeline's depth filter."""
+    from mindgrasp_vision.dataset import collect_shape_dataset
+
+    clf = ShapeClassifier.load(resolve_model_path(DEFAULT_SHAPE_MODEL))
+    noisy = collect_shape_dataset(45, seed=4243, realism='default')
+    assert np.isnan(noisy.x).sum() == 0          # the network input is always complete
+    accuracy = clf.score(noisy.x, noisy.y)
+    assert accuracy >= 0.9, f'accuracy on noisy depth {accuracy:.3f}'
+
+
+@pytest.mark.slow
 def test_data_set_is_seeded_balanced_and_labelled_from_the_scene():
     from mindgrasp_vision.dataset import collect_shape_dataset
 

@@ -5,6 +5,7 @@ acquisition, MI classifier, vision and the grasp controller, recorded to the run
     mindgrasp launch demo trials:=0                # trials until Ctrl-C
     mindgrasp launch demo duration:=120 gui:=true targets:='blue cylinder, red cube' trials:=2
     mindgrasp launch demo display:=window           # with the participant's screen
+    mindgrasp launch demo realism:=default          # noisy camera, miscalibrated, lagging arm
     mindgrasp launch demo --show-args
 
 The task, as in the paper's set-locations experiment: the trial manager names the object to grasp
@@ -40,6 +41,10 @@ def generate_launch_description() -> LaunchDescription:
         DeclareLaunchArgument('seed', default_value='0',
                               description='seed of the scene, the virtual subject and the '
                                           'synthetic EEG (same seed, same run)'),
+        DeclareLaunchArgument('realism', default_value='none',
+                              description='simulator realism: none, default or a profile YAML '
+                                          'path (noisy camera, miscalibration, arm lag, object '
+                                          'spread; mindgrasp_sim.realism), seeded by seed'),
         DeclareLaunchArgument('eeg_stream', default_value='MIndGrasp-VirtualAmp',
                               description='LSL stream name of the virtual amplifier (unique per '
                                           'host when several demos run at once)'),
@@ -67,7 +72,9 @@ def generate_launch_description() -> LaunchDescription:
              on_exit=Shutdown()),  # trials:=N done: the demo ends
         # 1 simulator: arm, gripper, objects, RGB-D camera (the arm contract of ros2_control)
         *[Node(package='mindgrasp_sim', executable='sim_node', name='sim',
-               parameters=[*config_files('sim', 'demo'), {'gui': gui, 'seed': seed, **scene}],
+               parameters=[*config_files('sim', 'demo'),
+                           {'gui': gui, 'seed': seed, 'realism': LaunchConfiguration('realism'),
+                            'realism_seed': seed, **scene}],
                condition=condition) for condition, scene in sim_scene_camera()],
         # 2 virtual amplifier: synthetic EEG of the virtual subject as an LSL stream
         Node(package='mindgrasp_eeg', executable='virtual_amp_node', name='virtual_amp',

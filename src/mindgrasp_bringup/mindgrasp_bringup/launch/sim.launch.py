@@ -5,6 +5,7 @@ the arm contract of a ros2_control forward velocity controller (drive it from ou
     mindgrasp launch sim scene:=random_locations seed:=3 camera:=640x480@30
     mindgrasp launch sim time_mode:=fast                   # + /clock; others on use_sim_time
     mindgrasp launch sim trainer_robot:=true gui:=true duration:=60
+    mindgrasp launch sim realism:=default realism_seed:=3  # a real camera's noise, a real arm's lag
     mindgrasp topic hz /joint_states                       # in another shell
 
 Parameters: config/params/sim.yaml, then the launch arguments below.
@@ -42,6 +43,11 @@ def generate_launch_description() -> LaunchDescription:
                                           '(/trainer_robot/...)'),
         DeclareLaunchArgument('gui', default_value='false', choices=['true', 'false'],
                               description='open the PyBullet window (needs a display)'),
+        DeclareLaunchArgument('realism', default_value='none',
+                              description='sensor noise and physical spread: none, default or a '
+                                          'profile YAML path (mindgrasp_sim.realism)'),
+        DeclareLaunchArgument('realism_seed', default_value='0',
+                              description='seed of the realism draws'),
         Node(package='mindgrasp_sim', executable='sim_node', name='sim',
              parameters=[*config_files('sim'),
                          {'scene': LaunchConfiguration('scene'),
@@ -49,5 +55,7 @@ def generate_launch_description() -> LaunchDescription:
                           'time_mode': LaunchConfiguration('time_mode'),
                           'camera_width': width, 'camera_height': height, 'camera_rate': rate,
                           'trainer_robot': LaunchConfiguration('trainer_robot'),
-                          'gui': LaunchConfiguration('gui')}]),
+                          'gui': LaunchConfiguration('gui'),
+                          'realism': LaunchConfiguration('realism'),
+                          'realism_seed': LaunchConfiguration('realism_seed')}]),
     ])
