@@ -66,23 +66,15 @@ def test_hardware_has_drivers_and_no_simulator() -> None:
                                    'record:=false']).plan()
 
 
-def test_replay_plays_the_bag_last_without_the_rerun_outputs() -> None:
-    procs = processes('replay', 'bag:=/data/run/bag', 'rate:=2')
-    assert list(procs) == ['recorder', 'classifier', 'fsm', 'bag_player']
-    player = procs['bag_player']
-    assert player.module == 'mindgrasp_bringup.bag.player_node' and player.shutdown_on_exit
-    assert player.parameters['bag'] == '/data/run/bag' and player.parameters['rate'] == 2
-    assert player.parameters['exclude_regex'] == \
-        '^/(bci/prediction|fsm/|arm_controller/|gripper_controller/)'
-    assert procs['fsm'].parameters['use_sim_time'] is False
-    procs = processes('replay', 'bag:=b', 'clock:=true')
-    assert procs['fsm'].parameters['use_sim_time'] is True and procs['bag_player'].parameters[
-        'clock'] is True
-    assert processes('replay', 'bag:=b', 'model:=x.json')['classifier'].parameters[
-        'model'] == 'x.json'
-    procs = processes('replay', 'bag:=b', 'vision:=true')
-    assert 'vision' in procs and procs['bag_player'].parameters['exclude_regex'].endswith(
-        '|vision/)')
+def test_replay_runs_the_lockstep_replay_process_with_its_arguments() -> None:
+    procs = processes('replay', 'bag:=/data/run')
+    assert list(procs) == ['recorder', 'replay']
+    node = procs['replay']
+    assert node.module == 'mindgrasp_bringup.replay.replay_node' and node.shutdown_on_exit
+    assert node.parameters['bag'] == '/data/run' and node.parameters['controller'] is False
+    procs = processes('replay', 'bag:=b', 'controller:=true', 'model:=x.json')
+    assert procs['replay'].parameters['controller'] is True
+    assert procs['replay'].parameters['model'] == 'x.json'
 
 
 def test_trainer_and_graz_end_with_their_prompter() -> None:

@@ -18,10 +18,12 @@ from collections.abc import Sequence
 #: command -> module, or command -> {verb: module}
 COMMANDS: dict[str, str | dict[str, str]] = {
     'launch': 'mindgrasp_bringup.commands.launch',
+    'replay': 'mindgrasp_bringup.commands.replay',
     'bag': {
         'record': 'mindgrasp_bringup.commands.bag_record',
         'play': 'mindgrasp_bringup.commands.bag_play',
         'info': 'mindgrasp_bringup.commands.bag_info',
+        'reindex': 'mindgrasp_bringup.commands.bag_reindex',
     },
     'topic': {
         'list': 'mindgrasp_bringup.commands.topic_list',

@@ -207,6 +207,9 @@ class ClassifierNode(rclpy.node.Node):
         if dec is not None:
             values['adaptive_updates'] = str(dec.n_updates)
             values['window_samples'] = f'{dec.samples_buffered}/{dec.n_window}'
+            if dec.segment_start is not None:
+                # where the causal filter started: a replay starts there to decide identically
+                values['segment_start_sample'] = str(dec.segment_start)
         item = DiagnosticStatus(level=level, name='classifier', message=message,
                                 hardware_id='', values=[KeyValue(key=k, value=v)
                                                         for k, v in sorted(values.items())])

@@ -232,6 +232,14 @@ class MiDecoder:
         self._bad_channels: list[str] = []
 
     @property
+    def segment_start(self) -> int | None:
+        """Stream index of the first sample of the current segment (filter start), or None.
+
+        A replay that starts its decoder on the same sample reproduces every window exactly.
+        """
+        return self._segment_start
+
+    @property
     def samples_buffered(self) -> int:
         """Samples of the current segment available for the next window (at most one window)."""
         if self._next_index is None or self._segment_start is None:

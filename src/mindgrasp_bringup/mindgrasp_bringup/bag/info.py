@@ -70,4 +70,5 @@ def format_info(summary: dict[str, Any]) -> str:
     if not summary['topics']:
         lines.append('Topic information: (no topics)')
     lines += [f'Note: {note}' for note in summary['notes']]
+    lines += [f'Damage: {damage}' for damage in summary.get('damage', [])]
     return '\n'.join(lines)

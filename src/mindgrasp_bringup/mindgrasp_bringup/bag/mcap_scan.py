@@ -26,7 +26,7 @@ from mcap.stream_reader import StreamReader
 from .errors import BagError
 
 __all__ = ['ChannelInfo', 'McapContents', 'is_finished', 'iter_mcap_messages', 'read_mcap_contents',
-           'recover_mcap']
+           'recover_mcap', 'verify_mcap']
 
 MAGIC = b'\x89MCAP0\r\n'
 _RECORD_HEADER = struct.Struct('<BQ')
@@ -57,6 +57,7 @@ class McapContents:
     end_ns: int = 0
     complete: bool = True        # False: no summary (writer killed), contents from a scan
     stopped_at: str = ''         # why a scan stopped before the end of the file
+    damaged: list[str] = field(default_factory=list)  # corrupt records skipped by a scan
     compression: str = ''
 
 
@@ -90,10 +91,16 @@ def _records(path: Path, f: io.BufferedReader, size: int,
     while offset + _RECORD_HEADER.size <= size:
         head = f.read(_RECORD_HEADER.size)
         opcode, length = _RECORD_HEADER.unpack(head)
-        end = offset + _RECORD_HEADER.size + length
+        start, end = offset, offset + _RECORD_HEADER.size + length
+        if not (0x01 <= opcode <= 0x10 or opcode >= 0x80):
+            contents.stopped_at = (f'bytes at {start} are not an MCAP record (opcode '
+                                   f'0x{opcode:02x}): the file is corrupt from there')
+            return
         if end > size:
-            contents.stopped_at = (f'record at byte {offset} is cut off at the end of the file '
-                                   f'({end - size} bytes missing)')
+            contents.stopped_at = (f'record at byte {start} is cut off at the end of the file '
+                                   f'({end - size} bytes missing)' if end - size < size else
+                                   f'record at byte {start} has an impossible length '
+                                   f'({length} bytes): the file is corrupt from there')
             return
         body = f.read(length)
         offset = end
@@ -105,8 +112,11 @@ def _records(path: Path, f: io.BufferedReader, size: int,
         except (EndOfFile, StopIteration):
             pass
         except (McapError, ValueError, struct.error, UnicodeDecodeError) as exc:
-            contents.stopped_at = f'record at byte {offset} is corrupt ({exc})'
-            return
+            # framing intact, content not (a flipped bit fails the chunk CRC): skip this record,
+            # the ones after it are still readable
+            contents.damaged.append(f'record at byte {start} (opcode 0x{opcode:02x}, '
+                                    f'{length} bytes) is corrupt ({exc})')
+            continue
         if opcode == 0x02:  # footer: nothing of interest follows
             return
 
@@ -238,3 +248,30 @@ def recover_mcap(path: Path) -> int:
         writer.finish()
     os.replace(tmp, path)
     return count
+
+
+def verify_mcap(path: Path) -> list[str]:
+    """Damage found by reading every record of an MCAP file, as sentences with byte offsets.
+
+    Checks what a summary-based reader never looks at: every record's framing, every chunk's CRC
+    (bit flips), and that the file ends with its footer and closing magic. [] when sound.
+    """
+    path = Path(path)
+    contents = McapContents(path)
+    footer = False
+    with path.open('rb') as f:
+        size = path.stat().st_size
+        head = f.read(8)
+        if head[:8] != MAGIC:
+            return [f'{path.name}: not an MCAP file (bad magic bytes at byte 0).']
+        for record in _records(path, f, size, contents):
+            if isinstance(record, Footer):
+                footer = True
+    problems = [f'{path.name}: {d}; it was skipped.' for d in contents.damaged]
+    if contents.stopped_at:
+        problems.append(f'{path.name}: {contents.stopped_at}; the records before it are '
+                        'readable (`mindgrasp bag reindex` keeps them).')
+    elif not footer:
+        problems.append(f'{path.name}: ends at byte {size} without a footer (the recorder was '
+                        'killed); run `mindgrasp bag reindex` to finish it.')
+    return problems

@@ -13,6 +13,7 @@ import threading
 from typing import Any
 
 from mindgrasp_bringup.bag.errors import BagError
+from mindgrasp_bringup.bag.paths import resolve_bag
 from mindgrasp_bringup.bag.player import Player, PlayStats, parse_remaps, type_problem
 from mindgrasp_bringup.bag.qos import adapted_qos
 from mindgrasp_bringup.bag.reader import BagReader, TopicInfo
@@ -32,14 +33,15 @@ class PlayerNode(rclpy.node.Node):
         self.declare_parameters('', [
             ('bag', ''), ('rate', 1.0), ('loop', False), ('start_offset', 0.0),
             ('topics', ['']), ('regex', ''), ('exclude_regex', ''), ('remap', ['']),
-            ('clock', False), ('clock_frequency', 40.0), ('delay', 0.0), ('priority', 0)])
+            ('clock', False), ('clock_frequency', 40.0), ('delay', 0.0), ('priority', 0),
+            ('progress', False)])
         v = {name: self.get_parameter(name).value for name in (
             'bag', 'rate', 'loop', 'start_offset', 'topics', 'regex', 'exclude_regex', 'remap',
-            'clock', 'clock_frequency', 'delay', 'priority')}
+            'clock', 'clock_frequency', 'delay', 'priority', 'progress')}
         if not v['bag']:
             msg = 'The parameter bag is empty; pass the bag directory with -p bag:=<path>.'
             raise BagError(msg)
-        self.reader = BagReader(v['bag']).open()
+        self.reader = BagReader(resolve_bag(v['bag'])).open()  # a run directory or its bag
         for note in self.reader.notes:
             self.get_logger().warning(note)
         topics = [t for t in (v['topics'] or []) if t] or None
@@ -61,6 +63,7 @@ class PlayerNode(rclpy.node.Node):
                 message_class(CLOCK_TYPE), '/clock', clock_qos, raw=True)
         self.delay = float(v['delay'])
         self.priority = int(v['priority'])
+        self.progress = bool(v['progress'])
         self.stats: PlayStats | None = None
         self.error: str | None = None
         self.stop_event = threading.Event()
@@ -94,8 +97,16 @@ class PlayerNode(rclpy.node.Node):
         clock_class, time_class = store.types[CLOCK_TYPE], store.types[TIME_TYPE]
         publishers = self.publishers_   # keyed by output topic, as the player reports them
 
+        from tqdm import tqdm
+
+        total = sum(info.message_count for info in self.reader.topics.values()
+                    if self.remap.get(info.name, info.name) in publishers)
+        bar = tqdm(total=None if self.player.loop else total, unit='msg', desc='bag play',
+                   disable=not self.progress, file=sys.stderr)
+
         def publish(topic: str, data: bytes) -> None:
             publishers[topic].publish(data)
+            bar.update(1)
 
         def publish_clock(ns: int) -> None:
             sec, nanosec = divmod(ns, 1_000_000_000)
@@ -113,6 +124,8 @@ class PlayerNode(rclpy.node.Node):
         except BagError as exc:
             self.error = str(exc)
             self.get_logger().error(self.error)
+        finally:
+            bar.close()
 
 
 def main(args: list[str] | None = None) -> int:

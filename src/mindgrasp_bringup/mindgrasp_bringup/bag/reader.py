@@ -155,6 +155,8 @@ class BagReader:
         start, end = 2**63 - 1, 0
         for path in files:
             contents = read_mcap_contents(path)
+            for damage in contents.damaged:
+                self.notes.append(f'{path.name}: a {damage}; it was skipped.')
             if contents.stopped_at:
                 self.notes.append(
                     f'{path.name}: reading stopped because the {contents.stopped_at}.')

@@ -10,7 +10,8 @@ from mindgrasp_bringup.bag.ros_glue import param_args
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Options in the manner of ``ros2 bag play``."""
-    parser.add_argument('bag', help='bag directory (holding metadata.yaml), or an .mcap/.db3 file')
+    parser.add_argument('bag', help='run directory (runs/<run>), bag directory (holding '
+                                    'metadata.yaml), or an .mcap/.db3 file')
     parser.add_argument('-r', '--rate', type=float, default=1.0,
                         help='playback speed factor (default: 1.0, real time)')
     parser.add_argument('-l', '--loop', action='store_true', help='play again from the start')
@@ -30,6 +31,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--delay', type=float, default=0.5,
                         help='wait this many seconds after creating publishers, so subscribers '
                              'match before the first message (default: 0.5)')
+    parser.add_argument('--no-progress', action='store_true',
+                        help='no progress bar (the summary line is printed at the end)')
 
 
 def main(args: argparse.Namespace) -> int:
@@ -53,5 +56,5 @@ def main(args: argparse.Namespace) -> int:
         'regex': args.regex, 'exclude_regex': args.exclude_regex,
         'remap': list(args.remap) or [''], 'clock': args.clock > 0,
         'clock_frequency': float(args.clock or 40.0), 'delay': float(args.delay),
-        'priority': int(args.priority)}
+        'priority': int(args.priority), 'progress': not args.no_progress}
     return player_node.main(['mindgrasp-bag-play', *param_args(params)])

@@ -1,0 +1,33 @@
+"""Replay a recorded run as an experiment on recorded data (:mod:`.engine`) and compare what the
+re-run nodes decide with what they decided live (:mod:`.report`).
+
+Entry points: ``mindgrasp replay RUN`` (:mod:`mindgrasp_bringup.commands.replay`) and
+``mindgrasp launch replay bag:=RUN`` (:mod:`.replay_node`).
+"""
+
+from .engine import ReplayConfig, ReplayResult, replay
+from .report import compare, write_report
+
+__all__ = ['ReplayConfig', 'ReplayResult', 'compare', 'replay', 'run_replay', 'write_report']
+
+
+def run_replay(cfg: ReplayConfig) -> ReplayResult:
+    """Replay and write the comparison report (``result.summary``, ``result.report_path``)."""
+    from mindgrasp_bringup.bag.typestore import typestore
+
+    result = replay(cfg)
+    write_report(result, typestore())
+    return result
+
+
+def summary_line(result: ReplayResult) -> str:
+    """One line: agreement per topic and where the report is."""
+    s = result.summary
+    pred = s['topics']['/bci/prediction']
+    parts = [f'predictions {pred["agree"]}/{pred["comparable"]} agree '
+             f'({100 * (pred["agreement"] or 0):.1f} %)']
+    state = s['topics'].get('/fsm/state')
+    if state is not None:
+        parts.append(f'controller states {100 * (state["agreement"] or 0):.1f} % (open loop)')
+    return f'Replayed {", ".join(result.nodes)}: ' + '; '.join(parts) + \
+        f'; report: {result.report_path}'

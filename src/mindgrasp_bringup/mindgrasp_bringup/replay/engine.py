@@ -1,0 +1,266 @@
+"""Replay a recorded run as an experiment: its recorded inputs drive the same node classes again.
+
+    result = replay(ReplayConfig('runs/20261122T174209Z_demo', controller=True))
+    result.report_path      # runs/<run>/replays/<time>/report.md
+
+Why it reproduces exactly: the chosen nodes (the classifier; the controller when asked) run in
+one process under :class:`~mindgrasp_ros.composition.LockstepRunner` on the bag's clock. Every
+recorded input message (the /eeg/raw chunks with their stamps and sample indices, exactly as
+recorded, never re-chunked) is published at its recorded time, and the graph runs until it is
+quiescent before the next one, so nothing is lost or reordered and no wall-clock time enters a
+decision. The classifier decides on windows of a global sample grid and stamps them from the
+chunk stamps; it starts its causal filter on the sample the live classifier started on (from the
+recorded ``/bci/status`` ``segment_start_sample``), and a later restart of the live filter (a
+chunk it lost) is reproduced by leaving out the chunk before it. With the same model and
+parameters (the run's params.yaml), the replayed predictions equal the recorded ones.
+
+The controller is replayed open loop: its commands go nowhere, and the joint states, camera
+images and detections it reads are the recorded ones, which followed the recorded arm.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from mindgrasp_bringup.bag.errors import BagError
+from mindgrasp_bringup.bag.paths import resolve_bag, run_dir_of
+from mindgrasp_bringup.bag.qos import adapted_qos
+from mindgrasp_bringup.bag.reader import BagReader
+from mindgrasp_bringup.bag.ros_glue import qos_profile
+from mindgrasp_bringup.bag.typestore import typestore as default_typestore
+from mindgrasp_bringup.bag.writer import BagWriter
+
+__all__ = ['COMPARED_TOPICS', 'NODES', 'ReplayConfig', 'ReplayResult', 'replay']
+
+#: nodes a replay can re-run: key -> (node module, node name in params.yaml)
+NODES = {'classifier': ('mindgrasp_classifier.classifier_node', 'classifier'),
+         'controller': ('mindgrasp_fsm.fsm_node', 'fsm')}
+#: outputs compared recorded vs replayed: topic -> type
+COMPARED_TOPICS = {'/bci/prediction': 'mindgrasp_msgs/msg/MIPrediction',
+                   '/fsm/state': 'mindgrasp_msgs/msg/FsmState'}
+EEG_TOPIC = '/eeg/raw'
+EEG_TYPE = 'mindgrasp_msgs/msg/EEGChunk'
+STATUS_TOPIC = '/bci/status'
+#: never fed from the bag: the runner owns /clock; graph topics
+_NOT_FED = ('/clock', '/parameter_events', '/rosout')
+
+
+@dataclass
+class ReplayConfig:
+    """What to replay and how.
+
+    Attributes:
+        run: Run directory (``runs/<run>``) or its bag folder.
+        controller: Re-run the controller too (open loop), not only the classifier.
+        model: Classifier model file; '' = the one the run used (its params.yaml).
+        params: Extra parameter overrides per node key (``{'classifier': {'min_certainty':
+            0.6}}``).
+        output: Report directory; default ``<run>/replays/<UTC time>``.
+        max_step_s: Longest clock step (s) between recorded messages, so node timers keep
+            their cadence (the controller's control loop).
+        progress: Show a tqdm progress bar on stderr.
+    """
+
+    run: str | Path
+    controller: bool = False
+    model: str = ''
+    params: dict[str, dict[str, Any]] = field(default_factory=dict)
+    output: str | Path | None = None
+    max_step_s: float | None = None
+    progress: bool = True
+
+
+@dataclass
+class ReplayResult:
+    """Recorded and replayed outputs: topic -> [(log time ns, CDR bytes)]; where it is written."""
+
+    bag: Path
+    run_dir: Path | None
+    output: Path
+    nodes: list[str]
+    recorded: dict[str, list[tuple[int, bytes]]]
+    replayed: dict[str, list[tuple[int, bytes]]]
+    fed: dict[str, int]                   # topic -> messages fed
+    skipped_eeg_chunks: int               # chunks left out to reproduce the live filter starts
+    first_fed_eeg_ns: int | None          # stamp of the first EEG chunk fed (ns)
+    last_fed_eeg_ns: int | None           # stamp of the last sample fed (ns)
+    start_ns: int
+    end_ns: int
+    notes: list[str] = field(default_factory=list)
+    report_path: Path | None = None
+    summary: dict[str, Any] = field(default_factory=dict)
+
+
+def _node_params(run_dir: Path | None, name: str) -> dict[str, Any]:
+    if run_dir is None:
+        return {}
+    try:
+        data = yaml.safe_load((run_dir / 'params.yaml').read_text()) or {}
+    except (OSError, yaml.YAMLError):
+        return {}
+    for key in (f'/{name}', name):
+        section = data.get(key)
+        if isinstance(section, dict):
+            return dict(section.get('ros__parameters') or {})
+    return {}
+
+
+def _segment_starts(reader: BagReader, store: Any) -> list[int]:
+    """Samples where the live classifier (re)started its filter, in order (from /bci/status)."""
+    if STATUS_TOPIC not in reader.topics:
+        return []
+    starts: list[int] = []
+    for _, _, data in reader.messages([STATUS_TOPIC]):
+        msg = store.deserialize_cdr(data, 'diagnostic_msgs/msg/DiagnosticArray')
+        for status in msg.status:
+            if status.name != 'classifier':
+                continue
+            for kv in status.values:
+                if kv.key == 'segment_start_sample':
+                    value = int(kv.value)
+                    if not starts or value > starts[-1]:
+                        starts.append(value)
+    return starts
+
+
+def _stamp_ns(header: Any) -> int:
+    return int(header.stamp.sec) * 1_000_000_000 + int(header.stamp.nanosec)
+
+
+def replay(cfg: ReplayConfig) -> ReplayResult:
+    """Run the replay; the comparison report is written by :func:`.report.write_report`.
+
+    Raises:
+        BagError: the run or bag cannot be read, or has nothing to replay.
+    """
+    from mindgrasp_ros import rclpy
+    from mindgrasp_ros.composition import Component, LockstepRunner
+
+    bag = resolve_bag(cfg.run)
+    run_dir = run_dir_of(bag)
+    store = default_typestore()
+    keys = ['classifier', 'controller'] if cfg.controller else ['classifier']
+    stamp = dt.datetime.now(dt.timezone.utc).strftime('%Y%m%dT%H%M%SZ')
+    base = run_dir if run_dir is not None else bag.resolve().parent
+    output = Path(cfg.output) if cfg.output else base / 'replays' / stamp
+    reader = BagReader(bag).open()
+    try:
+        if EEG_TOPIC not in reader.topics or not reader.topics[EEG_TOPIC].message_count:
+            msg = (f'The bag {bag} has no {EEG_TOPIC} messages, so the classifier has nothing to '
+                   'decode; replay a run recorded with the EEG (record:=true, the default).')
+            raise BagError(msg)
+        recorded = {topic: [(t, d) for _, t, d in reader.messages([topic])]
+                    for topic in COMPARED_TOPICS if topic in reader.topics}
+        starts = _segment_starts(reader, store)
+        output.mkdir(parents=True, exist_ok=False)
+        (output / 'params').mkdir()
+        runner = LockstepRunner(start_time_s=0.0)
+        # the bag's clock: ns exactly (start_time_s would round through a float)
+        runner._time_ns = reader.start_ns
+        try:
+            nodes = []
+            for key in keys:
+                module, name = NODES[key]
+                params = _node_params(run_dir, name)
+                params.update(cfg.params.get(key, {}))
+                if key == 'classifier' and cfg.model:
+                    params['model'] = str(cfg.model)
+                params.pop('use_sim_time', None)  # the runner puts every node on the bag clock
+                params['duration'] = 0.0          # end with the bag, not after a live duration
+                path = output / 'params' / f'{name}.yaml'
+                path.write_text(yaml.safe_dump({f'/{name}': {'ros__parameters': params}},
+                                               sort_keys=True))
+                nodes.append(runner.add(Component(module, ['--params-file', str(path)])))
+            outputs = {p.topic_name for n in nodes for p in n.publishers}
+            inputs = {s.topic_name for n in nodes for s in n.subscriptions}
+            feed = sorted(t for t in inputs if t in reader.topics and t not in outputs
+                          and t not in _NOT_FED)
+            collect = [t for t in COMPARED_TOPICS if t in outputs]
+            io = runner.add(rclpy.node.Node, 'replay_io')
+            replayed: dict[str, list[tuple[int, bytes]]] = {t: [] for t in collect}
+            for topic in collect:
+                def keep(data: bytes, _info: Any = None, topic: str = topic) -> None:
+                    replayed[topic].append((runner._time_ns, bytes(data)))
+                io.create_subscription(COMPARED_TOPICS[topic], topic, keep,
+                                       qos_profile(rclpy, {'reliability': 'reliable',
+                                                           'durability': 'volatile',
+                                                           'depth': 10000}), raw=True)
+            pubs = {}
+            for topic in feed:
+                info = reader.topics[topic]
+                qos = adapted_qos(info.offered_qos_profiles)
+                qos['depth'] = 10000
+                pubs[topic] = io.create_publisher(info.type, topic, qos_profile(rclpy, qos),
+                                                  raw=True)
+            runner.spin_until_quiescent()
+            result = ReplayResult(bag, run_dir, output, keys, recorded, replayed,
+                                  dict.fromkeys(feed, 0), 0, None, None, reader.start_ns,
+                                  reader.end_ns)
+            max_step = cfg.max_step_s or (0.01 if cfg.controller else 0.1)
+            _feed(runner, reader, pubs, store, starts, result, max_step, cfg.progress)
+        finally:
+            runner.close()
+    finally:
+        reader.close()
+    if not starts:
+        result.notes.append('The recording has no classifier filter start (/bci/status '
+                            'segment_start_sample, recorded by newer classifiers); the replayed '
+                            'classifier started on the first recorded EEG chunk.')
+    _write_replayed_bag(output / 'replayed_bag', result, store)
+    return result
+
+
+def _feed(runner: Any, reader: BagReader, pubs: dict[str, Any], store: Any, starts: list[int],
+          result: ReplayResult, max_step_s: float, progress: bool) -> None:
+    """Publish every recorded input at its recorded time; the graph settles after each."""
+    from tqdm import tqdm
+
+    max_step_ns = max(1, round(max_step_s * 1e9))
+    total = sum(reader.topics[t].message_count for t in pubs)
+    later_starts = set(starts[1:])
+
+    def advance(t_ns: int) -> None:
+        while runner._time_ns < t_ns:
+            runner.step(min(max_step_ns, t_ns - runner._time_ns) / 1e9)
+
+    bar = tqdm(total=total, unit='msg', desc='replay', disable=not progress, file=sys.stderr,
+               leave=True)
+    try:
+        for topic, t_ns, data in reader.messages(list(pubs)):
+            bar.update(1)
+            if topic == EEG_TOPIC:
+                chunk = store.deserialize_cdr(data, EEG_TYPE)
+                first, n = int(chunk.first_sample_index), int(chunk.n_samples)
+                if starts and first + n <= starts[0]:
+                    result.skipped_eeg_chunks += 1   # before the live classifier started
+                    continue
+                if first + n in later_starts:
+                    result.skipped_eeg_chunks += 1   # the live classifier lost it and restarted
+                    continue
+                stamp = _stamp_ns(chunk.header)
+                if result.first_fed_eeg_ns is None:
+                    result.first_fed_eeg_ns = stamp
+                rate = float(chunk.sample_rate) or 1.0
+                result.last_fed_eeg_ns = stamp + round((n - 1) / rate * 1e9)
+            advance(t_ns)
+            pubs[topic].publish(data)
+            result.fed[topic] += 1
+            runner.spin_until_quiescent()
+        advance(reader.end_ns + 1_000_000_000)  # one more second: the last timers run
+    finally:
+        bar.close()
+
+
+def _write_replayed_bag(path: Path, result: ReplayResult, store: Any) -> None:
+    """The replayed outputs as a rosbag2 bag (Foxglove, ``mindgrasp bag info``)."""
+    with BagWriter(path, typestore=store) as writer:
+        for topic, messages in result.replayed.items():
+            writer.add_topic(topic, COMPARED_TOPICS[topic])
+            for t_ns, data in messages:
+                writer.write(topic, t_ns, data)

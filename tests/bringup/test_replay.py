@@ -1,0 +1,88 @@
+"""Replay as an experiment on recorded data: a real demo run (processes, DDS, LSL, PyBullet, MCAP)
+is replayed; the classifier's replayed predictions equal the recorded ones, the controller is
+replayed open loop, and the report has every file."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+import uuid
+from pathlib import Path
+
+import pytest
+from launch_fixtures.runner import launch_env, run_launch
+
+from mindgrasp_bringup.bag import BagWriter
+
+pytestmark = pytest.mark.slow
+
+REPORT_FILES = ('report.md', 'comparison.json', 'predictions.csv', 'timeline.png',
+                'replayed_bag/metadata.yaml', 'params/classifier.yaml')
+
+
+@pytest.fixture(scope='module')
+def demo_run(tmp_path_factory) -> Path:
+    """A short live demo: every node in its own process, recorded to run/bag."""
+    run_dir = tmp_path_factory.mktemp('replay') / 'run'
+    stream = f'mg-replay-test-{uuid.uuid4().hex[:8]}'  # LSL names are host-wide
+    result = run_launch('demo', 'duration:=35', 'trials:=0', f'eeg_stream:={stream}',
+                        '--sigint-timeout', '20', '--run-dir', str(run_dir), timeout=400)
+    assert result.returncode == 0, result.stderr[-4000:]
+    return run_dir
+
+
+def _mindgrasp(*args: str, timeout: float = 600) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', *args],
+                          capture_output=True, text=True, env=launch_env(), timeout=timeout)
+
+
+def test_replayed_predictions_equal_the_recorded_ones(demo_run, tmp_path):
+    out = tmp_path / 'report'
+    done = _mindgrasp('replay', str(demo_run), '--json', '-o', str(out), '--min-agreement', '1')
+    assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-3000:]
+    summary = json.loads(done.stdout.strip().splitlines()[-1])
+    pred = summary['topics']['/bci/prediction']
+    assert pred['comparable'] >= 20, pred          # several seconds of decoded EEG
+    assert summary['prediction_agreement'] == 1.0, pred
+    assert pred['agree'] == pred['comparable'] and pred['missing'] == 0
+    assert pred['max_certainty_difference'] == 0.0   # the same windows, bit for bit
+    assert summary['report_path'] == str(out / 'report.md')
+    for name in REPORT_FILES:
+        assert (out / name).exists(), name
+    assert 'Replayed classifier: predictions' in done.stdout
+    assert '100.0 %' in (out / 'report.md').read_text()
+
+
+def test_launch_replay_with_the_controller_reports_it_open_loop(demo_run, tmp_path):
+    out = tmp_path / 'report'
+    result = run_launch('replay', f'bag:={demo_run / "bag"}', 'controller:=true',
+                        f'output:={out}', 'record:=false', timeout=600)
+    assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
+    summary = json.loads((out / 'comparison.json').read_text())
+    assert summary['open_loop'] is True and summary['nodes'] == ['classifier', 'controller']
+    state = summary['topics']['/fsm/state']
+    assert state['open_loop'] is True and state['replayed_messages'] > 0
+    assert summary['prediction_agreement'] == 1.0
+    report = (out / 'report.md').read_text()
+    assert '## Controller replayed open loop' in report
+    assert 'the joint states, camera images and detections it read are the recorded ones' \
+        in report
+    for name in (*REPORT_FILES, 'states.csv', 'params/fsm.yaml'):
+        assert (out / name).exists(), name
+
+
+def test_replay_bad_input_is_one_clear_line(tmp_path):
+    done = _mindgrasp('replay', str(tmp_path / 'nothing'))
+    assert done.returncode == 2
+    assert done.stderr.strip().splitlines() == [
+        f'mindgrasp replay: {tmp_path / "nothing"} does not exist; pass a run directory '
+        '(runs/<run>) or its bag folder (runs/<run>/bag).']
+    done = _mindgrasp('replay', str(tmp_path), '-p', 'vision.x:=1')
+    assert done.returncode == 2 and 'is not NODE.NAME:=VALUE' in done.stderr
+    with BagWriter(tmp_path / 'bag') as writer:   # a bag without EEG
+        writer.add_topic('/chatter', 'std_msgs/msg/String')
+        writer.write('/chatter', 1, bytes([0, 1, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0]))
+    done = _mindgrasp('replay', str(tmp_path / 'bag'), '--no-progress')
+    assert done.returncode == 2 and 'has no /eeg/raw messages' in done.stderr
+    assert 'Traceback' not in done.stderr
