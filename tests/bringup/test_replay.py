@@ -5,15 +5,19 @@ replayed open loop, and the report has every file."""
 from __future__ import annotations
 
 import json
+import signal
 import subprocess
 import sys
+import threading
+import time
 import uuid
 from pathlib import Path
 
 import pytest
-from launch_fixtures.runner import launch_env, run_launch
+from launch_fixtures.runner import launch_cmd, launch_env, run_launch
 
 from mindgrasp_bringup.bag import BagWriter
+from mindgrasp_bringup.bag.mcap_scan import read_mcap_contents
 
 pytestmark = pytest.mark.slow
 
@@ -23,12 +27,32 @@ REPORT_FILES = ('report.md', 'comparison.json', 'predictions.csv', 'timeline.png
 
 @pytest.fixture(scope='module')
 def demo_run(tmp_path_factory) -> Path:
-    """A short live demo: every node in its own process, recorded to run/bag."""
+    """A live demo (every node in its own process, recorded to run/bag), stopped with Ctrl-C once
+    the bag holds a few seconds of predictions: start-up takes long on a loaded machine."""
     run_dir = tmp_path_factory.mktemp('replay') / 'run'
     stream = f'mg-replay-test-{uuid.uuid4().hex[:8]}'  # LSL names are host-wide
-    result = run_launch('demo', 'duration:=35', 'trials:=0', f'eeg_stream:={stream}',
-                        '--sigint-timeout', '20', '--run-dir', str(run_dir), timeout=400)
-    assert result.returncode == 0, result.stderr[-4000:]
+    proc = subprocess.Popen(launch_cmd('demo', 'duration:=400', 'trials:=0',
+                                       f'eeg_stream:={stream}', '--sigint-timeout', '20',
+                                       '--run-dir', str(run_dir)),
+                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                            env=launch_env())
+    lines: list[str] = []
+    threading.Thread(target=lambda: lines.extend(proc.stdout), daemon=True).start()
+    try:
+        deadline = time.monotonic() + 300
+        predictions = 0
+        while time.monotonic() < deadline and proc.poll() is None and predictions < 80:
+            time.sleep(2.0)
+            if any('Subscribed to /bci/prediction' in line for line in lines):
+                contents = read_mcap_contents(run_dir / 'bag' / 'bag_0.mcap')
+                predictions = sum(n for cid, n in contents.channel_counts.items()
+                                  if contents.channels[cid].topic == '/bci/prediction')
+        assert predictions >= 80, ''.join(lines[-50:])
+    finally:
+        if proc.poll() is None:
+            proc.send_signal(signal.SIGINT)
+        proc.wait(180)
+    assert (run_dir / 'summary.yaml').exists(), ''.join(lines[-50:])
     return run_dir
 
 
@@ -43,7 +67,7 @@ def test_replayed_predictions_equal_the_recorded_ones(demo_run, tmp_path):
     assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-3000:]
     summary = json.loads(done.stdout.strip().splitlines()[-1])
     pred = summary['topics']['/bci/prediction']
-    assert pred['comparable'] >= 20, pred          # several seconds of decoded EEG
+    assert pred['comparable'] >= 60, pred          # several seconds of decoded EEG
     assert summary['prediction_agreement'] == 1.0, pred
     assert pred['agree'] == pred['comparable'] and pred['missing'] == 0
     assert pred['max_certainty_difference'] == 0.0   # the same windows, bit for bit
