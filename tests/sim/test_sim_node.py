@@ -328,3 +328,57 @@ def test_bad_realism_profile_exits_with_the_fix(spawn_node):
     proc = spawn_node('mindgrasp_sim.sim_node', '--ros-args', '-p', 'realism:=realistic')
     assert proc.wait(60) == 2
     assert "Unknown realism profile 'realistic'; use one of ['default', 'none']" in proc.output()
+
+
+def test_tf_tree_and_robot_description_as_robot_state_publisher(rclpy_ctx, spawn_node):
+    """/robot_description (latched), /tf_static and /tf: the tree composed from world to the TCP
+    equals the /ee_pose of the same instant (PyBullet's link state), and the camera topics name a
+    frame of that tree."""
+    from mindgrasp_ros.interfaces.std_msgs.msg import String
+    from mindgrasp_ros.interfaces.tf2_msgs.msg import TFMessage
+    from scipy.spatial.transform import Rotation
+
+    proc = start(spawn_node)
+    rclpy = rclpy_ctx
+    probe = Probe(rclpy)
+    node = probe.node
+    latched = rclpy.qos.QoSProfile(depth=1, reliability=rclpy.qos.ReliabilityPolicy.RELIABLE,
+                                   durability=rclpy.qos.DurabilityPolicy.TRANSIENT_LOCAL)
+    descriptions, static, dynamic = [], [], []
+    node.create_subscription(String, '/robot_description', descriptions.append, latched)
+    node.create_subscription(TFMessage, '/tf_static', static.append, latched)
+    node.create_subscription(TFMessage, '/tf', dynamic.append, 100)
+    # move the arm, so the check is not at the home pose only
+    probe.drive([0.3, -0.2, 0.2, 0.1, -0.3, 0.4], 1.0)
+    assert spin_until(rclpy, node, lambda: descriptions and static and len(dynamic) > 20
+                      and len(probe.poses) > 20 and probe.images, 30), proc.output()
+    urdf = descriptions[-1].data
+    assert '<robot' in urdf and 'camera_color_optical_frame' in urdf
+
+    def key(stamp) -> int:
+        return stamp.sec * 1_000_000_000 + stamp.nanosec
+
+    poses = {key(p.header.stamp): p for p in probe.poses}
+    tf_msg = next(m for m in reversed(dynamic) if key(m.transforms[0].header.stamp) in poses)
+    edges = {t.child_frame_id: t for m in static for t in m.transforms}
+    edges.update({t.child_frame_id: t for t in tf_msg.transforms})
+    # compose world -> tcp along the tree
+    frame, pos, rot = 'tcp', np.zeros(3), Rotation.identity()
+    chain = []
+    while frame in edges:
+        t = edges[frame].transform
+        step = Rotation.from_quat([t.rotation.x, t.rotation.y, t.rotation.z, t.rotation.w])
+        pos = np.array([t.translation.x, t.translation.y, t.translation.z]) + step.apply(pos)
+        rot = step * rot
+        chain.append(frame)
+        frame = edges[frame].header.frame_id
+    assert frame == 'world' and 'link_3' in chain, chain
+    ee = poses[key(tf_msg.transforms[0].header.stamp)].pose
+    np.testing.assert_allclose(pos, [ee.position.x, ee.position.y, ee.position.z], atol=1e-4)
+    want = Rotation.from_quat([ee.orientation.x, ee.orientation.y, ee.orientation.z,
+                               ee.orientation.w])
+    assert (want.inv() * rot).magnitude() < 1e-3
+    # the fingers are in the tree too, and the camera images name a frame of it
+    assert {'finger_thumb', 'finger_left', 'finger_right'} <= set(edges)
+    assert probe.images[-1].header.frame_id in edges
+    assert proc.stop() == 0

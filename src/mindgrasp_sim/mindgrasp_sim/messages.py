@@ -9,14 +9,16 @@ from __future__ import annotations
 import numpy as np
 from mindgrasp_ros.interfaces.builtin_interfaces.msg import Time
 from mindgrasp_ros.interfaces.diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
-from mindgrasp_ros.interfaces.geometry_msgs.msg import PoseStamped
+from mindgrasp_ros.interfaces.geometry_msgs.msg import PoseStamped, TransformStamped
 from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import GraspResult
 from mindgrasp_ros.interfaces.sensor_msgs.msg import CameraInfo, Image, JointState
 from mindgrasp_ros.interfaces.std_msgs.msg import Header
+from mindgrasp_ros.interfaces.tf2_msgs.msg import TFMessage
 from mindgrasp_ros.interfaces.visualization_msgs.msg import Marker, MarkerArray
 
 from mindgrasp_sim.simulation import SceneObject
 from mindgrasp_sim.task import TaskEvent
+from mindgrasp_sim.tf_tree import Transform
 
 #: visualization_msgs/Marker types of the object shapes
 MARKER_TYPE = {'cube': Marker.CUBE, 'sphere': Marker.SPHERE, 'cylinder': Marker.CYLINDER,
@@ -25,7 +27,7 @@ OPTICAL_FRAME = 'camera_color_optical_frame'
 
 __all__ = ['MARKER_TYPE', 'OPTICAL_FRAME', 'camera_info', 'grasp_result', 'header',
            'image_messages', 'joint_state', 'object_markers', 'pose_stamped', 'rgb_image', 'stamp',
-           'status']
+           'status', 'tf_message']
 
 
 def stamp(ns: int) -> Time:
@@ -114,3 +116,16 @@ def status(hdr: Header, ok: bool, message: str, values: dict[str, object]) -> Di
     item = DiagnosticStatus(level=level, name='sim', message=message, hardware_id='pybullet',
                             values=[KeyValue(key=k, value=str(v)) for k, v in values.items()])
     return DiagnosticArray(header=hdr, status=[item])
+
+
+def tf_message(time_msg: Time, transforms: list[Transform]) -> TFMessage:
+    """tf2_msgs/TFMessage: one TransformStamped (parent -> child, m, quaternion xyzw) each."""
+    out = []
+    for t in transforms:
+        msg = TransformStamped(header=Header(stamp=time_msg, frame_id=t.parent),
+                               child_frame_id=t.child)
+        tr, q = msg.transform.translation, msg.transform.rotation
+        tr.x, tr.y, tr.z = (float(v) for v in t.translation)
+        q.x, q.y, q.z, q.w = (float(v) for v in t.rotation)
+        out.append(msg)
+    return TFMessage(transforms=out)

@@ -19,6 +19,11 @@ realism, any surface), ``/ee_pose``
 (diagnostic_msgs/DiagnosticArray: scene, simulated time, real-time factor, collisions). With
 ``trainer_robot:=true`` (alias ``training_robot``) the training robot has the same arm topics
 under ``/trainer_robot/``.
+As robot_state_publisher would for a real arm: ``/robot_description`` (std_msgs/String, the URDF,
+transient local), ``/tf_static`` (``world`` -> ``base_link`` and the URDF's fixed joints: camera
+optical frame, TCP) and ``/tf`` (the URDF's moving joints, arm and fingers, from the published
+joint states at the joint-state rate); camera topics carry the frame ``camera_color_optical_frame``
+of that tree, and the objects are the markers on ``/sim/objects`` (in ``world``).
 Services ``/sim/reset`` (ResetSim), ``/sim/load_scene`` (LoadScene) and, in lock-step mode,
 ``/sim/step`` (Step).
 
@@ -47,7 +52,13 @@ from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import GraspResult, TaskTarget
 from mindgrasp_ros.interfaces.mindgrasp_msgs.srv import LoadScene, ResetSim, Step
 from mindgrasp_ros.interfaces.rosgraph_msgs.msg import Clock
 from mindgrasp_ros.interfaces.sensor_msgs.msg import CameraInfo, Image, JointState
-from mindgrasp_ros.interfaces.std_msgs.msg import Float64MultiArray, Header, UInt8MultiArray
+from mindgrasp_ros.interfaces.std_msgs.msg import (
+    Float64MultiArray,
+    Header,
+    String,
+    UInt8MultiArray,
+)
+from mindgrasp_ros.interfaces.tf2_msgs.msg import TFMessage
 from mindgrasp_ros.interfaces.visualization_msgs.msg import MarkerArray
 
 from mindgrasp_ros import rclpy
@@ -56,6 +67,7 @@ from mindgrasp_sim.control import CommandGate, gripper_closure
 from mindgrasp_sim.errors import SimError
 from mindgrasp_sim.simulation import CameraConfig, Simulation
 from mindgrasp_sim.task import TaskMonitor
+from mindgrasp_sim.tf_tree import TfTree, Transform
 
 TIME_MODES = ('realtime', 'fast', 'lockstep')
 
@@ -201,6 +213,7 @@ class SimNode(rclpy.node.Node):
             # commands and requests (works under main() and in a composed process alike)
             self.create_timer(0.0, self.fast_callback)
         self.create_timer(0.5, self.duration_callback)
+        self._publish_robot_description(latched)
         self.publish_all()
         robots = ' and the training robot' if 'trainer' in self.robots else ''
         if self.sim.realism.enabled:
@@ -386,6 +399,20 @@ class SimNode(rclpy.node.Node):
     def _header(self, frame_id: str = '') -> Header:
         return msgs.header(self._stamp(), frame_id)
 
+    def _publish_robot_description(self, latched: rclpy.qos.QoSProfile) -> None:
+        """/robot_description and /tf_static once (latched), and the /tf publisher, with the QoS
+        of robot_state_publisher and tf2_ros' broadcasters."""
+        urdf = self.sim.urdf.read_text(encoding='utf-8')
+        self.tf_tree = TfTree(urdf)
+        self.create_publisher(String, '/robot_description', latched).publish(String(data=urdf))
+        # the arm stands at the world origin (the simulation loads it there)
+        base = Transform(self.p['frame_id'], self.tf_tree.root, np.zeros(3),
+                         np.array([0.0, 0.0, 0.0, 1.0]))
+        self.tf_static_pub = self.create_publisher(TFMessage, '/tf_static', latched)
+        self.tf_static_pub.publish(msgs.tf_message(self._stamp(),
+                                                   [base, *self.tf_tree.static_transforms()]))
+        self.tf_pub = self.create_publisher(TFMessage, '/tf', rclpy.qos.QoSProfile(depth=100))
+
     def publish_all(self) -> None:
         self.publish_states()
         self.publish_camera()
@@ -409,6 +436,10 @@ class SimNode(rclpy.node.Node):
             io.pubs['contacts'].publish(UInt8MultiArray(
                 data=state['contacts'].astype(np.uint8)))
             io.pubs['ee'].publish(msgs.pose_stamped(world, *sim.ee_pose(io.name)))
+            if io.name == 'user':  # the tree robot_state_publisher makes of these joint states
+                positions = dict(zip(sim.joint_names, q, strict=True))
+                positions.update(zip(sim.finger_names, state['positions'], strict=True))
+                self.tf_pub.publish(msgs.tf_message(hdr.stamp, self.tf_tree.transforms(positions)))
 
     def publish_camera(self) -> None:
         """Colour and depth images of the user's eye-in-hand camera, with camera_info."""
