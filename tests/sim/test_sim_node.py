@@ -349,7 +349,8 @@ def test_tf_tree_and_robot_description_as_robot_state_publisher(rclpy_ctx, spawn
     node.create_subscription(TFMessage, '/tf_static', static.append, latched)
     node.create_subscription(TFMessage, '/tf', dynamic.append, 100)
     # move the arm, so the check is not at the home pose only
-    probe.drive([0.3, -0.2, 0.2, 0.1, -0.3, 0.4], 1.0)
+    assert probe.drive([0.3, -0.2, 0.2, 0.1, -0.3, 0.4],
+                       lambda: bool(probe.joints) and probe.q()[0] > 0.15), proc.output()
     assert spin_until(rclpy, node, lambda: descriptions and static and len(dynamic) > 20
                       and len(probe.poses) > 20 and probe.images, 30), proc.output()
     urdf = descriptions[-1].data
