@@ -62,6 +62,10 @@ COMMANDS: dict[str, str | dict[str, str]] = {
     'trainer': {
         'schedule': 'mindgrasp_trainer.schedule_cli',
     },
+    'session': {
+        'run': 'mindgrasp_trainer.session_cli',
+        'resume': 'mindgrasp_trainer.session_cli',
+    },
 }
 
 

@@ -11,6 +11,7 @@ A parameter file maps node names to ``ros__parameters`` (nested maps are paramet
 
 from __future__ import annotations
 
+import os
 import re
 from collections.abc import Mapping
 from pathlib import Path
@@ -151,7 +152,11 @@ def config_files(*names: str) -> list[Path]:
     """The existing files among ``config/params/<name>.yaml``, in order.
 
     Launch files pass them first in ``parameters=[...]`` (later entries win); a package without a
-    parameter file yet runs on its node's declared defaults.
+    parameter file yet runs on its node's declared defaults. The files named in
+    ``$MINDGRASP_PARAMS_FILES`` follow (``mindgrasp session`` passes each phase's settings so).
     """
     files = [PARAMS_DIR / f'{name}.yaml' for name in names]
-    return [f for f in files if f.is_file()]
+    # extra ROS parameter files (os.pathsep-separated), e.g. a session phase's settings; each
+    # node reads its own section of them, after the package defaults
+    extra = [Path(f) for f in os.environ.get('MINDGRASP_PARAMS_FILES', '').split(os.pathsep) if f]
+    return [f for f in files if f.is_file()] + extra

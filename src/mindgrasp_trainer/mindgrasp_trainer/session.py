@@ -1,0 +1,403 @@
+"""Calibration sessions: the phases of a plan run in order, each one recorded launch, with the
+classifier retrained between phases, all kept in one subject folder.
+
+A plan is a YAML file (``plans/graded.yaml`` is the paper's graded protocol)::
+
+    name: graded
+    training: {min_trials: 5, cv: 5}      # mindgrasp train classifier settings
+    phases:
+      - {name: graz, kind: graz, trials: 40}
+      - {name: graz_feedback, kind: graz, trials: 40, feedback: true}
+      - {name: trainer, kind: trainer, trials: 40}
+      - {name: test, kind: test, trials: 20}
+
+Phase keys: ``name``, ``kind`` (graz | trainer | test), ``trials``, ``feedback`` (graz), ``train``
+(retrain after the phase; default true for graz and trainer), ``duration`` (s, 0 none), ``args``
+(more launch arguments), ``params`` (ROS parameters per node name, e.g.
+``{graz_prompter: {fixation: 0.5}}``).
+
+The subject folder::
+
+    subjects/<ID>/<session>/
+        session.yaml            the plan, and per phase: status, run folder, model, figures
+        01_graz/                the phase's run directory (bag, logs, params, display PNGs)
+        models/after_01_graz.json/.npz
+        report.yaml, report.md  accuracy per phase, Trainer distances per trial, grasp figures
+
+An interrupted phase is moved aside (``01_graz.interrupted-1``) and run again on resume; finished
+phases are kept. No ROS imports: each phase runs ``mindgrasp launch`` as a child process.
+"""
+
+from __future__ import annotations
+
+import csv
+import datetime as dt
+import math
+import os
+import re
+import subprocess
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from mindgrasp_trainer.protocol import TrainerError
+
+__all__ = ['PLAN_DIR', 'Phase', 'Plan', 'Session', 'SessionError', 'check_subject', 'load_plan']
+
+PLAN_DIR = Path(__file__).with_name('plans')
+KINDS = {'graz': 'graz', 'trainer': 'trainer', 'test': 'demo'}   # phase kind -> launch profile
+PHASE_KEYS = {'name', 'kind', 'trials', 'feedback', 'train', 'duration', 'args', 'params'}
+PLAN_KEYS = {'name', 'description', 'training', 'phases'}
+TRAINING_KEYS = {'min_trials', 'cv', 'pipeline', 'tmin', 'tmax', 'seed'}
+
+
+class SessionError(TrainerError):
+    """A bad plan, subject ID or session state; the message names the problem and the fix."""
+
+
+def check_subject(subject: str) -> str:
+    """A subject ID is a folder name: letters, digits, ``-`` and ``_`` only."""
+    if not re.fullmatch(r'[A-Za-z0-9][A-Za-z0-9_-]{0,63}', subject or ''):
+        msg = (f'The subject ID {subject!r} is not usable as a folder name; use letters, digits, '
+               "'-' and '_' only (no '/', '..' or spaces), e.g. S01.")
+        raise SessionError(msg)
+    return subject
+
+
+@dataclass
+class Phase:
+    """One phase of a plan (see the module docstring for the keys)."""
+
+    name: str
+    kind: str
+    trials: int
+    feedback: bool = False
+    train: bool = True
+    duration: float = 0.0
+    args: dict[str, str] = field(default_factory=dict)
+    params: dict[str, dict[str, Any]] = field(default_factory=dict)
+
+    @property
+    def profile(self) -> str:
+        return KINDS[self.kind]
+
+
+@dataclass
+class Plan:
+    name: str
+    phases: list[Phase]
+    training: dict[str, Any]
+    source: dict[str, Any]
+
+
+def load_plan(plan: str) -> Plan:
+    """A plan by name (``plans/<name>.yaml``) or path; unknown phases or keys are errors."""
+    path = Path(plan)
+    if not path.suffix:
+        path = PLAN_DIR / f'{plan}.yaml'
+    if not path.is_file():
+        known = ', '.join(sorted(p.stem for p in PLAN_DIR.glob('*.yaml')))
+        msg = f'No plan {plan!r}: give a plan name ({known}) or the path of a plan YAML file.'
+        raise SessionError(msg)
+    try:
+        data = yaml.safe_load(path.read_text(encoding='utf-8')) or {}
+    except yaml.YAMLError as err:
+        msg = f'The plan {path} is not valid YAML: {err}'.replace('\n', ' ')
+        raise SessionError(msg) from None
+    where = f'plan {path.name}'
+    if not isinstance(data, dict) or not isinstance(data.get('phases'), list) or \
+            not data['phases']:
+        msg = f"The {where} needs a non-empty list 'phases'; see {PLAN_DIR / 'graded.yaml'}."
+        raise SessionError(msg)
+    _unknown(set(data) - PLAN_KEYS, where, PLAN_KEYS)
+    training = dict(data.get('training') or {})
+    _unknown(set(training) - TRAINING_KEYS, f'{where} training', TRAINING_KEYS)
+    phases, names = [], set()
+    for i, raw in enumerate(data['phases'], start=1):
+        if not isinstance(raw, dict):
+            msg = f'Phase {i} of the {where} is not a mapping of keys; write e.g. ' \
+                  '{name: graz, kind: graz, trials: 40}.'
+            raise SessionError(msg)
+        _unknown(set(raw) - PHASE_KEYS, f'{where} phase {i}', PHASE_KEYS)
+        kind = raw.get('kind')
+        if kind not in KINDS:
+            msg = (f'Phase {i} of the {where} has the unknown kind {kind!r}; use one of '
+                   f"{', '.join(KINDS)}.")
+            raise SessionError(msg)
+        name = str(raw.get('name') or kind)
+        check_name = re.fullmatch(r'[A-Za-z0-9_-]+', name)
+        if not check_name or name in names:
+            msg = f'Phase {i} of the {where}: the name {name!r} is not a unique folder name.'
+            raise SessionError(msg)
+        names.add(name)
+        trials = raw.get('trials', 40)
+        if not isinstance(trials, int) or trials < 1:
+            msg = f'Phase {name} of the {where}: trials must be a positive integer, not {trials!r}.'
+            raise SessionError(msg)
+        phases.append(Phase(
+            name=name, kind=kind, trials=trials, feedback=bool(raw.get('feedback', False)),
+            train=bool(raw.get('train', kind != 'test')),
+            duration=float(raw.get('duration', 0.0)), args={
+                str(k): str(v) for k, v in (raw.get('args') or {}).items()},
+            params=dict(raw.get('params') or {})))
+    return Plan(str(data.get('name') or path.stem), phases, training, data)
+
+
+def _unknown(keys: set, where: str, allowed: set) -> None:
+    if keys:
+        msg = (f"The {where} has unknown key(s) {', '.join(sorted(map(str, keys)))}; allowed: "
+               f"{', '.join(sorted(allowed))}.")
+        raise SessionError(msg)
+
+
+def _now() -> str:
+    return dt.datetime.now(dt.timezone.utc).strftime('%Y-%m-%dT%H:%M:%SZ')
+
+
+class Session:
+    """A subject's session folder and the loop over its plan's phases.
+
+    Parameters
+    ----------
+    root : Path
+        Folder of all subjects (``subjects``).
+    subject : str
+        Subject ID (a folder name).
+    session : str
+        Session name (a folder name), e.g. a date.
+    launch_args : dict
+        Launch arguments for every phase (``amp``, ``eeg_stream``, ``display``, ``seed``, ...).
+    """
+
+    def __init__(self, root: Path, subject: str, session: str,
+                 launch_args: dict[str, str] | None = None) -> None:
+        self.subject = check_subject(subject)
+        self.session = check_subject(session)
+        self.dir = Path(root) / self.subject / self.session
+        self.launch_args = dict(launch_args or {})
+        self.log_path = self.dir / 'session.yaml'
+
+    # ------------------------------------------------------------------ log
+    def read_log(self) -> dict[str, Any]:
+        if not self.log_path.is_file():
+            msg = (f'There is no session to resume in {self.dir} (no session.yaml); start one '
+                   f'with mindgrasp session run --subject {self.subject} --plan graded.')
+            raise SessionError(msg)
+        return yaml.safe_load(self.log_path.read_text(encoding='utf-8'))
+
+    def write_log(self, log: dict[str, Any]) -> None:
+        tmp = self.log_path.with_suffix('.yaml.tmp')
+        tmp.write_text(yaml.safe_dump(log, sort_keys=False), encoding='utf-8')
+        os.replace(tmp, self.log_path)
+
+    def start(self, plan: Plan) -> dict[str, Any]:
+        """Create the folder and session.yaml for ``plan``; refuses an existing session."""
+        if self.log_path.exists():
+            msg = (f'The session {self.dir} exists already; continue it with mindgrasp session '
+                   f'resume --subject {self.subject} --session {self.session}, or name a new '
+                   'one with --session.')
+            raise SessionError(msg)
+        self.dir.mkdir(parents=True, exist_ok=True)
+        log = {'subject': self.subject, 'session': self.session, 'plan': plan.source,
+               'launch_args': self.launch_args, 'started': _now(),
+               'phases': [{'name': p.name, 'kind': p.kind, 'status': 'pending'}
+                          for p in plan.phases]}
+        self.write_log(log)
+        return log
+
+    # ------------------------------------------------------------------ loop
+    def run(self, plan: Plan, log: dict[str, Any], out=print) -> int:
+        """Run every phase that is not done; returns 0 when all are done."""
+        self.launch_args = {**log.get('launch_args', {}), **self.launch_args}
+        model = ''
+        for i, (phase, entry) in enumerate(zip(plan.phases, log['phases'], strict=True),
+                                           start=1):
+            if entry['status'] == 'done':
+                model = entry.get('model', model) or model
+                continue
+            run_dir = self.dir / f'{i:02d}_{phase.name}'
+            if run_dir.exists():   # an interrupted attempt: keep it, run the phase again
+                k = 1
+                while run_dir.with_name(f'{run_dir.name}.interrupted-{k}').exists():
+                    k += 1
+                run_dir.rename(run_dir.with_name(f'{run_dir.name}.interrupted-{k}'))
+                out(f'Phase {phase.name}: the interrupted attempt is kept as '
+                    f'{run_dir.name}.interrupted-{k}; running it again.')
+            entry.update(status='running', run_dir=run_dir.name, started=_now(),
+                         model_used=model)
+            self.write_log(log)
+            out(f'[{i}/{len(plan.phases)}] {phase.name}: {phase.kind}, {phase.trials} trials'
+                f"{', feedback' if phase.feedback else ''}"
+                f"{', model ' + model if model else ''} -> {run_dir}")
+            code = self._launch(phase, run_dir, model, i)
+            entry.update(exit_code=code, ended=_now())
+            if code != 0:
+                entry['status'] = 'failed'
+                self.write_log(log)
+                out(f'Phase {phase.name} failed (exit code {code}); see {run_dir}/logs. Resume '
+                    f'with mindgrasp session resume --subject {self.subject} --session '
+                    f'{self.session}.')
+                return 1
+            entry.update(self._phase_figures(phase, run_dir))
+            if phase.train:
+                try:
+                    entry.update(self._retrain(plan, log, i))
+                except SessionError as err:
+                    entry['status'] = 'failed'
+                    entry['error'] = str(err)
+                    self.write_log(log)
+                    out(str(err))
+                    return 1
+                model = entry['model']
+                out(f'  retrained on {entry["train_runs"]} run(s): cross-validated accuracy '
+                    f'{100 * entry["cv_accuracy"]:.1f} % -> {model}')
+            entry['status'] = 'done'
+            self.write_log(log)
+        log['ended'] = _now()
+        self.write_log(log)
+        report = self.write_report(log)
+        out(report)
+        return 0
+
+    def _launch(self, phase: Phase, run_dir: Path, model: str, index: int) -> int:
+        args = {**self.launch_args}
+        args.update(trials=str(phase.trials))
+        display = args.get('display', 'off')
+        if display != 'off':
+            args.update(display_png_dir=str(run_dir / 'display'),
+                        display_label=f'{phase.name} ({phase.kind})')
+        if model:
+            args['model'] = str(self.dir / model)
+        if phase.kind == 'graz':
+            args['feedback'] = 'true' if phase.feedback else 'false'
+            if not phase.feedback:
+                args.pop('model', None)
+        if phase.kind == 'trainer':
+            args.pop('feedback', None)
+        if phase.kind == 'test':
+            args.setdefault('targets', '')
+            args.setdefault('subject', 'pursue')
+        if phase.kind != 'test':
+            args.pop('targets', None)
+            if args.get('subject') == 'pursue':
+                args.pop('subject')
+        if phase.duration > 0:
+            args['duration'] = str(phase.duration)
+        args.update(phase.args)
+        env = dict(os.environ)
+        params = {name: dict(values) for name, values in phase.params.items()}
+        if display != 'off':
+            # the participant display's PNG per prompt phase is the record of the screen; frames
+            # on topics would fill the bag (1.8 MB each), and the prompter's own screen is unused
+            params.setdefault('participant_display', {}).setdefault('image_rate', 0.0)
+            params.setdefault('graz_prompter', {}).setdefault('display_rate', 0.0)
+        if display == 'headless':  # frames for the record, not for a person: 10 Hz is plenty
+            params.setdefault('participant_display', {}).setdefault('rate', 10.0)
+        if phase.kind == 'trainer':
+            params.setdefault('trainer', {})['log_file'] = str(run_dir / 'trainer_trials.csv')
+        if params:
+            pfile = self.dir / f'params_{index:02d}_{phase.name}.yaml'
+            pfile.write_text(yaml.safe_dump({n: {'ros__parameters': v} for n, v in
+                                             params.items()}, sort_keys=False), encoding='utf-8')
+            env['MINDGRASP_PARAMS_FILES'] = str(pfile)
+        cmd = [sys.executable, '-m', 'mindgrasp_bringup', 'launch', phase.profile,
+               '--run-dir', str(run_dir), *(f'{k}:={v}' for k, v in args.items())]
+        return subprocess.call(cmd, env=env)
+
+    # ------------------------------------------------------------------ figures
+    def _retrain(self, plan: Plan, log: dict[str, Any], upto: int) -> dict[str, Any]:
+        from mindgrasp_classifier.data import load_inputs
+        from mindgrasp_classifier.errors import ClassifierError
+        from mindgrasp_classifier.training import TrainingConfig, train
+
+        t = plan.training
+        runs = [self.dir / e['run_dir'] for p, e in zip(plan.phases[:upto], log['phases'],
+                                                        strict=False)
+                if p.train and e.get('run_dir')]
+        name = log['phases'][upto - 1]['name']
+        cfg = TrainingConfig(pipeline=t.get('pipeline', 'mdm'), tmin=float(t.get('tmin', 0.5)),
+                             tmax=float(t.get('tmax', 2.5)), cv_folds=max(int(t.get('cv', 5)), 2),
+                             min_trials=int(t.get('min_trials', 5)), seed=int(t.get('seed', 0)))
+        try:
+            recordings = load_inputs(bags=[str(r) for r in runs])
+            model, report = train(recordings, cfg, cross_validate=True)
+            path = model.save(self.dir / 'models' / f'after_{upto:02d}_{name}')
+        except ClassifierError as err:
+            msg = (f'The session stops after phase {name}: {err} Give the phase more trials in '
+                   f"the plan (or lower training: min_trials), then resume.")
+            raise SessionError(msg) from None
+        return {'model': str(Path(path).relative_to(self.dir)),
+                'cv_accuracy': float(report['accuracy']), 'train_runs': len(runs),
+                'trials_per_class': {str(k): int(v) for k, v in
+                                     report.get('trials_per_class', {}).items()}}
+
+    def _phase_figures(self, phase: Phase, run_dir: Path) -> dict[str, Any]:
+        """Trainer distances per trial (CSV of the trainer node) or grasp results (bag)."""
+        if phase.kind == 'trainer':
+            path = run_dir / 'trainer_trials.csv'
+            if not path.is_file():
+                return {}
+            with path.open(encoding='utf-8') as f:
+                rows = list(csv.DictReader(f))
+            dist = [float(r['mean_ee_distance_m']) for r in rows if r['mean_ee_distance_m']]
+            return {'trainer_trials': [
+                {'trial': int(r['trial']), 'class': r['class_name'],
+                 'mean_ee_distance_m': float(r['mean_ee_distance_m'] or 'nan'),
+                 'aborted': r['aborted']} for r in rows],
+                'mean_ee_distance_m': sum(dist) / len(dist) if dist else math.nan}
+        if phase.kind == 'test':
+            results = _grasp_results(run_dir / 'bag')
+            n = len(results)
+            correct = sum(1 for r in results if r['success']
+                          and r['grasped'] == r['desired'])
+            return {'grasps': results, 'n_grasp_trials': n, 'n_correct_grasps': correct}
+        return {}
+
+    def write_report(self, log: dict[str, Any]) -> str:
+        """report.yaml and report.md; returns the Markdown."""
+        lines = [f"# Session {log['session']} of subject {log['subject']}", '',
+                 f"Plan: {log['plan'].get('name', '')}, started {log.get('started')}, ended "
+                 f"{log.get('ended', '-')}.", '', '| phase | kind | status | model after | '
+                 'cross-validated accuracy | figures |', '|---|---|---|---|---|---|']
+        for e in log['phases']:
+            acc = f"{100 * e['cv_accuracy']:.1f} %" if 'cv_accuracy' in e else '-'
+            fig = ''
+            if 'mean_ee_distance_m' in e:
+                fig = f"Trainer distance {100 * e['mean_ee_distance_m']:.1f} cm (mean)"
+            if 'n_grasp_trials' in e:
+                fig = f"{e['n_correct_grasps']}/{e['n_grasp_trials']} correct grasps"
+            lines.append(f"| {e['name']} | {e['kind']} | {e['status']} | "
+                         f"{e.get('model', '-')} | {acc} | {fig} |")
+        for e in log['phases']:
+            if e.get('trainer_trials'):
+                lines += ['', f"## Trainer end-effector distance per trial ({e['name']})", '',
+                          '| trial | class | mean distance (cm) | aborted |', '|---|---|---|---|']
+                lines += [f"| {t['trial']} | {t['class']} | {100 * t['mean_ee_distance_m']:.1f}"
+                          f" | {t['aborted']} |" for t in e['trainer_trials']]
+        text = '\n'.join(lines) + '\n'
+        (self.dir / 'report.md').write_text(text, encoding='utf-8')
+        (self.dir / 'report.yaml').write_text(yaml.safe_dump(
+            {'subject': log['subject'], 'session': log['session'], 'phases': log['phases']},
+            sort_keys=False), encoding='utf-8')
+        return text
+
+
+def _grasp_results(bag: Path) -> list[dict[str, Any]]:
+    """Every /task/result of a run's bag: trial, desired and grasped object, success."""
+    if not bag.is_dir():
+        return []
+    from mindgrasp_bringup.bag.reader import BagReader
+    from mindgrasp_ros.typesupport import typestore
+
+    store = typestore()
+    out = []
+    with BagReader(bag) as reader:
+        for _, _, data in reader.messages(['/task/result']):
+            m = store.deserialize_cdr(data, 'mindgrasp_msgs/msg/GraspResult')
+            out.append({'trial': int(m.trial), 'desired': m.desired_object,
+                        'grasped': m.grasped_object, 'success': bool(m.success),
+                        'duration_s': round(float(m.duration), 2)})
+    return out

@@ -1,0 +1,90 @@
+"""Run a calibration session: the phases of a plan, retraining between them, one subject folder.
+
+    mindgrasp session run --subject S01 --plan graded            # virtual subject, headless
+    mindgrasp session run --subject S01 --plan graded --amp lsl --eeg-stream MyAmp \
+        --display fullscreen                                     # a person, a real amplifier
+    mindgrasp session run --subject S01 --plan my_plan.yaml
+    mindgrasp session resume --subject S01                       # after an interruption
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime as dt
+import os
+import sys
+from pathlib import Path
+
+from mindgrasp_trainer.session import Session, SessionError, check_subject, load_plan
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Options of ``mindgrasp session run`` and ``resume`` (the verb is the first argument)."""
+    parser.formatter_class = argparse.RawDescriptionHelpFormatter
+    parser.epilog = __doc__
+    parser.add_argument('--subject', required=True, help='subject ID (letters, digits, - and _)')
+    parser.add_argument('--session', default=None,
+                        help='session name (run: a new UTC timestamp; resume: the latest)')
+    parser.add_argument('--root', default='subjects', help='folder of all subjects (subjects)')
+    parser.add_argument('--plan', default='graded',
+                        help='plan name (graded, quick) or a plan YAML file (run only)')
+    parser.add_argument('--amp', choices=['virtual', 'lsl'], default=None,
+                        help='EEG source: virtual subject (default) or an LSL amplifier')
+    parser.add_argument('--eeg-stream', default=None, help='LSL stream name of the amplifier')
+    parser.add_argument('--display', choices=['off', 'window', 'fullscreen', 'headless'],
+                        default=None, help="the participant's screen (default headless)")
+    parser.add_argument('--seed', type=int, default=None, help='seed of every phase (0)')
+
+
+def _launch_args(args: argparse.Namespace) -> dict[str, str]:
+    out = {}
+    for key, name in (('amp', 'amp'), ('eeg_stream', 'eeg_stream'), ('display', 'display'),
+                      ('seed', 'seed')):
+        value = getattr(args, key)
+        if value is not None:
+            out[name] = str(value)
+    return out
+
+
+def main(args: argparse.Namespace) -> int:
+    verb = args.verb
+    try:
+        check_subject(args.subject)
+        root = Path(args.root)
+        if verb == 'run':
+            plan = load_plan(args.plan)
+            name = args.session or dt.datetime.now(dt.timezone.utc).strftime('%Y%m%dT%H%M%SZ')
+            # the virtual amplifier's LSL stream is host-wide: a name of its own per session
+            stream = f'MIndGrasp-{args.subject}-{os.getpid()}'
+            session = Session(root, args.subject, name,
+                              {'display': 'headless', 'seed': '0', 'eeg_stream': stream,
+                               **_launch_args(args)})
+            log = session.start(plan)
+        else:
+            name = args.session
+            if name is None:
+                found = sorted(p.parent.name for p in (root / args.subject).glob('*/session.yaml'))
+                if not found:
+                    msg = (f'No session of subject {args.subject} under {root}; start one with '
+                           f'mindgrasp session run --subject {args.subject} --plan graded.')
+                    raise SessionError(msg)
+                name = found[-1]
+            session = Session(root, args.subject, name, _launch_args(args))
+            log = session.read_log()
+            plan_file = session.dir / 'plan.yaml'
+            import yaml
+
+            plan_file.write_text(yaml.safe_dump(log['plan'], sort_keys=False), encoding='utf-8')
+            plan = load_plan(str(plan_file))
+            done = [e['name'] for e in log['phases'] if e['status'] == 'done']
+            print(f'Resuming {session.dir}: done {", ".join(done) or "nothing yet"}.')
+    except SessionError as err:
+        print(f'mindgrasp session {verb}: {err}', file=sys.stderr)
+        return 2
+    print(f'Session {session.dir} ({plan.name}: {", ".join(p.name for p in plan.phases)})')
+    try:
+        return session.run(plan, log)
+    except KeyboardInterrupt:
+        print(f'Interrupted; finished phases are kept. Continue with: mindgrasp session resume '
+              f'--subject {args.subject} --session {session.session}', file=sys.stderr)
+        return 130

@@ -1,0 +1,114 @@
+"""Calibration sessions: plans, subject IDs, and a virtual-subject session of a small plan run
+end to end through real launches (an interruption in phase 2, then resume)."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+import yaml
+
+from mindgrasp_trainer.session import SessionError, check_subject, load_plan
+
+
+def mindgrasp(*args: str, cwd: Path) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', *args], cwd=cwd,
+                          capture_output=True, text=True, timeout=120)
+
+
+def test_the_graded_plan_is_the_papers_protocol():
+    plan = load_plan('graded')
+    assert [(p.kind, p.trials, p.feedback) for p in plan.phases] == [
+        ('graz', 40, False), ('graz', 40, True), ('trainer', 40, False), ('test', 20, False)]
+    assert [p.train for p in plan.phases] == [True, True, True, False]
+
+
+@pytest.mark.parametrize(('text', 'message'), [
+    ('phases:\n  - {kind: bogus}\n', "unknown kind 'bogus'; use one of graz, trainer, test"),
+    ('phases:\n  - {kind: graz, fixation: 1}\n', 'unknown key.s. fixation; allowed: args'),
+    ('phases:\n  - {kind: graz, trials: 0}\n', 'trials must be a positive integer'),
+    ('phases: []\n', "needs a non-empty list 'phases'"),
+    ('training: {folds: 3}\nphases:\n  - {kind: graz}\n', 'training has unknown key.s. folds'),
+])
+def test_bad_plans_are_refused_with_the_fix(tmp_path, text, message):
+    path = tmp_path / 'plan.yaml'
+    path.write_text(text)
+    with pytest.raises(SessionError, match=message):
+        load_plan(str(path))
+
+
+@pytest.mark.parametrize('subject', ['../S01', 'a/b', '', 'S 01', '.hidden'])
+def test_subject_ids_with_path_characters_are_refused(subject):
+    with pytest.raises(SessionError, match='not usable as a folder name'):
+        check_subject(subject)
+
+
+def test_cli_bad_input_is_one_line_and_exit_code_2(tmp_path):
+    res = mindgrasp('session', 'run', '--subject', '../x', cwd=tmp_path)
+    assert res.returncode == 2 and 'not usable as a folder name' in res.stderr
+    assert 'Traceback' not in res.stderr
+    res = mindgrasp('session', 'run', '--subject', 'S1', '--plan', 'nope', cwd=tmp_path)
+    assert res.returncode == 2 and "No plan 'nope'" in res.stderr
+    res = mindgrasp('session', 'resume', '--subject', 'S1', cwd=tmp_path)
+    assert res.returncode == 2 and 'No session of subject S1' in res.stderr
+
+
+def _log(folder: Path) -> dict:
+    return yaml.safe_load((folder / 'session.yaml').read_text())
+
+
+@pytest.mark.slow
+def test_virtual_session_runs_every_phase_retrains_and_resumes(tmp_path):
+    """The quick plan (Graz, Graz with feedback, Trainer) with the virtual subject; interrupted in
+    phase 2, resumed: every run, a model per phase, the report."""
+    folder = tmp_path / 'subjects' / 'V1' / 's1'
+    env = os.environ | {'PYTHONUNBUFFERED': '1'}
+    log = (tmp_path / 'run.log').open('w')
+    proc = subprocess.Popen(
+        [sys.executable, '-m', 'mindgrasp_bringup', 'session', 'run', '--subject', 'V1',
+         '--session', 's1', '--plan', 'quick'], cwd=tmp_path, env=env, stdout=log,
+        stderr=subprocess.STDOUT, start_new_session=True)
+    deadline = time.monotonic() + 400
+    # interrupt once phase 2's launch has started (its run directory exists)
+    while time.monotonic() < deadline and proc.poll() is None:
+        if (folder / '02_graz_feedback' / 'launch.yaml').exists():
+            break
+        time.sleep(0.2)
+    out = (tmp_path / 'run.log').read_text
+    assert (folder / '02_graz_feedback').is_dir(), out()
+    first = _log(folder)['phases'][0]
+    assert first['status'] == 'done' and (folder / first['model']).is_file(), out()
+    time.sleep(3.0)
+    os.killpg(proc.pid, signal.SIGINT)
+    assert proc.wait(120) == 130, out()
+    assert _log(folder)['phases'][1]['status'] == 'running'
+
+    res = subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', 'session', 'resume',
+                          '--subject', 'V1'], cwd=tmp_path, env=env, capture_output=True,
+                         text=True, timeout=600)
+    assert res.returncode == 0, res.stdout[-3000:] + res.stderr[-3000:]
+    assert 'Resuming' in res.stdout and 'done graz' in res.stdout
+    final = _log(folder)
+    assert [e['status'] for e in final['phases']] == ['done'] * 3
+    assert final['phases'][0]['started'] == first['started']      # phase 1 was not run again
+    assert (folder / '02_graz_feedback.interrupted-1').is_dir()     # the interrupted attempt kept
+    for i, e in enumerate(final['phases'], start=1):
+        run = folder / e['run_dir']
+        assert (run / 'bag' / 'metadata.yaml').is_file()
+        assert (folder / e['model']).is_file() and e['model'].startswith(f'models/after_0{i}')
+        assert 0.0 <= e['cv_accuracy'] <= 1.0
+        assert list((run / 'display').glob('*.png'))                # the participant's frames
+    # each phase after the first used the model of the phase before
+    assert final['phases'][1]['model_used'] == final['phases'][0]['model']
+    assert final['phases'][2]['model_used'] == final['phases'][1]['model']
+    trainer = final['phases'][2]
+    assert len(trainer['trainer_trials']) == 6
+    assert 0.0 < trainer['mean_ee_distance_m'] < 1.0
+    report = (folder / 'report.md').read_text()
+    assert 'cross-validated accuracy' in report and 'Trainer end-effector distance' in report
+    assert (folder / 'report.yaml').is_file()
