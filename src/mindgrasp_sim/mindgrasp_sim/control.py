@@ -72,6 +72,11 @@ class CommandGate:
             return np.zeros(self.n_joints)
         return self._cmd.copy()
 
+    def shift(self, seconds: float) -> None:
+        """Move the command's time by ``seconds`` (s): when the clock skips ahead, a command that
+        was fresh before the skip stays as fresh after it."""
+        self._stamp += float(seconds)
+
     def clear(self) -> None:
         """Forget the command (e.g. after a reset)."""
         self._cmd = np.zeros(self.n_joints)

@@ -290,6 +290,10 @@ class SimNode(rclpy.node.Node):
                 'behind', 5.0, f'The simulation is {due:.2f} s behind its clock; skipping '
                 'ahead. Lower camera_width/height or camera_rate, or use time_mode:=fast.')
             self._set_t0(self._t0 + due - cap)
+            for io in self.robots.values():
+                # commands that arrived during the lag were stamped before the skip; without
+                # this they would all be stale after it, and an overloaded sim ignores its arms
+                io.gate.shift(due - cap)
             due = cap
         n = int(due * self.sim.physics_hz)
         if n > 0:
