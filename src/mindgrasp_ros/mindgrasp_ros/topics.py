@@ -139,6 +139,12 @@ SIM_OBJECTS = _t('/sim/objects', 'visualization_msgs/msg/MarkerArray', LATCHED,
 SIM_STATUS = _t('/sim/status', 'diagnostic_msgs/msg/DiagnosticArray', RELIABLE, 'sim', 'all')
 VIRTUAL_SUBJECT_INTENT = _t('/virtual_subject/intent', 'std_msgs/msg/String', LATCHED,
                             'virtual amplifier', 'recorder', 'the imagined class')
+SCENE_IMAGE = _t('/scene/image_raw', 'sensor_msgs/msg/Image', SENSOR,
+                 'sim', 'participant display', 'rgb8, third-person view (scene_camera_rate > 0)')
+DISPLAY_FLIP = _t('/display/flip', 'mindgrasp_msgs/msg/Prompt', Qos(depth=50),
+                  'participant display', 'recorder, labels', 'stamp = when the phase was drawn')
+DISPLAY_IMAGE = _t('/display/image', 'sensor_msgs/msg/Image', SENSOR,
+                   'participant display (headless)', 'viewers', "rgb8, the participant's frame")
 CLOCK = _t('/clock', 'rosgraph_msgs/msg/Clock', Qos(reliability='best_effort', depth=1),
            'sim (fast mode) or bag play', 'all')
 
@@ -158,7 +164,8 @@ TOPICS: dict[str, Topic] = {t.name: t for t in (
     TRAINER_EE_DISTANCE, COLOR_IMAGE, DEPTH_IMAGE, COLOR_INFO, DEPTH_INFO, JOINT_STATES,
     ARM_COMMANDS, GRIPPER_COMMANDS, GRIPPER_JOINT_STATES, GRIPPER_CONTACTS, EE_POSE,
     VISION_DETECTIONS, VISION_OVERLAY, FSM_STATE, TASK_TARGET, TASK_RESULT, SIM_OBJECTS,
-    SIM_STATUS, VIRTUAL_SUBJECT_INTENT, CLOCK, *TRAINER_ROBOT_TOPICS)}
+    SIM_STATUS, VIRTUAL_SUBJECT_INTENT, SCENE_IMAGE, DISPLAY_FLIP, DISPLAY_IMAGE, CLOCK,
+    *TRAINER_ROBOT_TOPICS)}
 
 
 def topic(name: str) -> Topic:

@@ -49,6 +49,8 @@ __all__ = ['PLAN_DIR', 'Phase', 'Plan', 'Session', 'SessionError', 'check_subjec
 
 PLAN_DIR = Path(__file__).with_name('plans')
 KINDS = {'graz': 'graz', 'trainer': 'trainer', 'test': 'demo'}   # phase kind -> launch profile
+#: the node whose end ends a phase's launch (on_exit=Shutdown), per phase kind
+PROMPTERS = {'graz': 'graz_prompter', 'trainer': 'trainer', 'test': 'trial_manager'}
 PHASE_KEYS = {'name', 'kind', 'trials', 'feedback', 'train', 'duration', 'args', 'params'}
 PLAN_KEYS = {'name', 'description', 'training', 'phases'}
 TRAINING_KEYS = {'min_trials', 'cv', 'pipeline', 'tmin', 'tmax', 'seed'}
@@ -232,8 +234,14 @@ class Session:
             out(f'[{i}/{len(plan.phases)}] {phase.name}: {phase.kind}, {phase.trials} trials'
                 f"{', feedback' if phase.feedback else ''}"
                 f"{', model ' + model if model else ''} -> {run_dir}")
-            code = self._launch(phase, run_dir, model, i)
+            scale = next((float(e['certainty_q75']) for e in reversed(log['phases'][:i - 1])
+                          if e.get('model') == model and 'certainty_q75' in e), 0.0)
+            code = self._launch(phase, run_dir, model, i, scale)
             entry.update(exit_code=code, ended=_now())
+            code, note = _phase_outcome(phase, run_dir, code)
+            if note:
+                entry['note'] = note
+                out(f'Phase {phase.name}: {note}')
             if code != 0:
                 entry['status'] = 'failed'
                 self.write_log(log)
@@ -262,7 +270,8 @@ class Session:
         out(report)
         return 0
 
-    def _launch(self, phase: Phase, run_dir: Path, model: str, index: int) -> int:
+    def _launch(self, phase: Phase, run_dir: Path, model: str, index: int,
+                certainty_scale: float = 0.0) -> int:
         args = {**self.launch_args}
         args.update(trials=str(phase.trials))
         display = args.get('display', 'off')
@@ -294,6 +303,9 @@ class Session:
             # on topics would fill the bag (1.8 MB each), and the prompter's own screen is unused
             params.setdefault('participant_display', {}).setdefault('image_rate', 0.0)
             params.setdefault('graz_prompter', {}).setdefault('display_rate', 0.0)
+        if certainty_scale > 0:
+            params.setdefault('participant_display', {}).setdefault('max_certainty',
+                                                                    round(certainty_scale, 4))
         if display == 'headless':  # frames for the record, not for a person: 10 Hz is plenty
             params.setdefault('participant_display', {}).setdefault('rate', 10.0)
         if phase.kind == 'trainer':
@@ -331,6 +343,8 @@ class Session:
             raise SessionError(msg) from None
         return {'model': str(Path(path).relative_to(self.dir)),
                 'cv_accuracy': float(report['accuracy']), 'train_runs': len(runs),
+                # the feedback bar fills at the 75th percentile of the model's certainty
+                'certainty_q75': max(float(c['q75']) for c in report['certainty'].values()),
                 'trials_per_class': {str(k): int(v) for k, v in
                                      report.get('trials_per_class', {}).items()}}
 
@@ -383,6 +397,24 @@ class Session:
             {'subject': log['subject'], 'session': log['session'], 'phases': log['phases']},
             sort_keys=False), encoding='utf-8')
         return text
+
+
+def _phase_outcome(phase: Phase, run_dir: Path, code: int) -> tuple[int, str]:
+    """Whether a phase's launch counts as done: its prompter finished (exit code 0), no node died,
+    and the run was recorded. A node that needed SIGTERM to stop after the prompter had finished
+    (a slow shutdown on a loaded machine) loses nothing and is only noted."""
+    summary_path = run_dir / 'summary.yaml'
+    if code == 0 or not summary_path.is_file():
+        return code, ''
+    summary = yaml.safe_load(summary_path.read_text(encoding='utf-8')) or {}
+    procs = {p.get('label'): p for p in summary.get('processes', [])}
+    prompter = procs.get(PROMPTERS[phase.kind], {})
+    died = [label for label, p in procs.items() if p.get('how') == 'died']
+    if (prompter.get('how') == 'finished' and prompter.get('returncode') == 0 and not died
+            and (run_dir / 'bag' / 'metadata.yaml').is_file()):
+        slow = [f"{label} ({p.get('how')})" for label, p in procs.items() if not p.get('clean')]
+        return 0, f"all trials ran; slow to stop: {', '.join(slow)}"
+    return code, ''
 
 
 def _grasp_results(bag: Path) -> list[dict[str, Any]]:
