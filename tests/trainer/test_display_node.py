@@ -50,7 +50,7 @@ def xvfb(tmp_path):
     proc.wait(10)
 
 
-def test_graz_cues_are_drawn_stamped_and_saved(ros, spawn, spin_until, tmp_path):
+def test_graz_cues_are_drawn_stamped_and_saved(ros, spawn_node, spin_until, tmp_path):
     from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import MIPrediction, Prompt
 
     from mindgrasp_trainer.ros_common import prompt_qos
@@ -61,10 +61,10 @@ def test_graz_cues_are_drawn_stamped_and_saved(ros, spawn, spin_until, tmp_path)
     node.create_subscription(Prompt, '/display/flip', flips.append, 50)
     pred_pub = node.create_publisher(MIPrediction, '/bci/prediction', 10)
     png = tmp_path / 'png'
-    display = spawn('mindgrasp_trainer.display_node', headless=True, png_dir=str(png),
+    display = spawn_node('mindgrasp_trainer.display_node', headless=True, png_dir=str(png),
                     rate=10.0, width=640, height=400, feedback='always', duration=120.0)
     assert spin_until(node, lambda: 'display ready' in display.output(), 60), display.output()
-    graz = spawn('mindgrasp_trainer.graz_node', n_trials=2, classes='[1]', seed=0,
+    graz = spawn_node('mindgrasp_trainer.graz_node', n_trials=2, classes='[1]', seed=0,
                  fixation=0.5, cue=1.0, imagery=1.0, rest_min=0.3, rest_max=0.3, start_delay=1.0,
                  display_rate=0.0)
 
@@ -91,7 +91,7 @@ def test_graz_cues_are_drawn_stamped_and_saved(ros, spawn, spin_until, tmp_path)
     assert len(xs) > 100 and np.median(xs) > 320
 
 
-def test_trainer_phase_in_a_window_under_xvfb_shows_both_robots(ros, spawn, spin_until,
+def test_trainer_phase_in_a_window_under_xvfb_shows_both_robots(ros, spawn_node, spin_until,
                                                                 tmp_path, xvfb, monkeypatch):
     from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import Prompt
 
@@ -100,11 +100,11 @@ def test_trainer_phase_in_a_window_under_xvfb_shows_both_robots(ros, spawn, spin
     flips = []
     node.create_subscription(Prompt, '/display/flip', flips.append, 50)
     png = tmp_path / 'png'
-    spawn('mindgrasp_sim.sim_node', trainer_robot=True, scene_camera_rate=5.0,
+    spawn_node('mindgrasp_sim.sim_node', trainer_robot=True, scene_camera_rate=5.0,
           scene_camera_width=320, scene_camera_height=240, camera_rate=2.0, duration=120.0)
-    display = spawn('mindgrasp_trainer.display_node', png_dir=str(png), rate=5.0,
+    display = spawn_node('mindgrasp_trainer.display_node', png_dir=str(png), rate=5.0,
                     width=800, height=480, duration=120.0, phase_label='Trainer', n_trials=1)
-    trainer = spawn('mindgrasp_trainer.trainer_node', n_trials=1, classes='[0]', seed=0,
+    trainer = spawn_node('mindgrasp_trainer.trainer_node', n_trials=1, classes='[0]', seed=0,
                     turn_speed=0.8, move_duration=2.5, wait_duration=1.5, start_delay=3.0,
                     robot_timeout=60.0)
     assert spin_until(node, lambda: any(f.phase == 'end' for f in flips), 120), (
@@ -119,7 +119,7 @@ def test_trainer_phase_in_a_window_under_xvfb_shows_both_robots(ros, spawn, spin
     assert np.count_nonzero(np.all(scene < 60, axis=2)) > 300
 
 
-def test_test_phase_shows_the_camera_with_the_green_box_and_the_target(ros, spawn, spin_until):
+def test_test_phase_shows_the_camera_with_the_green_box_and_the_target(ros, spawn_node, spin_until):
     from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import TaskTarget
     from mindgrasp_ros.interfaces.sensor_msgs.msg import Image
 
@@ -131,9 +131,9 @@ def test_test_phase_shows_the_camera_with_the_green_box_and_the_target(ros, spaw
                                  durability=ros.qos.DurabilityPolicy.TRANSIENT_LOCAL)
     target_pub = node.create_publisher(TaskTarget, '/task/target', latched)
     target_pub.publish(TaskTarget(trial=1, object_id=0, colour='red', shape='cube'))
-    spawn('mindgrasp_sim.sim_node', camera_rate=5.0, duration=120.0)
-    spawn('mindgrasp_vision.vision_node')
-    spawn('mindgrasp_trainer.display_node', headless=True, rate=5.0, image_rate=2.0,
+    spawn_node('mindgrasp_sim.sim_node', camera_rate=5.0, duration=120.0)
+    spawn_node('mindgrasp_vision.vision_node')
+    spawn_node('mindgrasp_trainer.display_node', headless=True, rate=5.0, image_rate=2.0,
           width=800, height=480, layout='test', duration=120.0)
 
     def box_frame() -> bool:
@@ -149,10 +149,10 @@ def test_test_phase_shows_the_camera_with_the_green_box_and_the_target(ros, spaw
     assert np.count_nonzero(np.all(img == (220, 40, 40), axis=2)) >= 34 * 34   # red swatch
 
 
-def test_no_display_gives_one_clear_line_and_exit_code_2(spawn, monkeypatch):
+def test_no_display_gives_one_clear_line_and_exit_code_2(spawn_node, monkeypatch):
     monkeypatch.setenv('DISPLAY', '')
     monkeypatch.delenv('WAYLAND_DISPLAY', raising=False)
-    proc = spawn('mindgrasp_trainer.display_node')
+    proc = spawn_node('mindgrasp_trainer.display_node')
     assert proc.wait(60) == 2
     out = proc.output()
     assert 'No display is available' in out and '--headless' in out

@@ -43,42 +43,52 @@ from __future__ import annotations
 import math
 import sys
 import time
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 from pathlib import Path
 
 import cv2
 import numpy as np
 from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import FsmState, MIPrediction, Prompt, TaskTarget
+from mindgrasp_ros.interfaces.rcl_interfaces.msg import SetParametersResult
 from mindgrasp_ros.interfaces.sensor_msgs.msg import Image
 from mindgrasp_ros.interfaces.std_msgs.msg import Float64
 
 from mindgrasp_ros import rclpy
+from mindgrasp_ros import topics as tp
+from mindgrasp_ros.node_main import end_after, run_node
+from mindgrasp_ros.params import declare_params, param
+from mindgrasp_trainer.display import FEEDBACK_MODES
 from mindgrasp_trainer.protocol import PromptEvent, TrainerError
-from mindgrasp_trainer.ros_common import check_rate, prompt_qos
-from mindgrasp_trainer.screen import ParticipantScreen, ScreenState
+from mindgrasp_trainer.screen import LAYOUTS, ParticipantScreen, ScreenState
 from mindgrasp_trainer.window import Window
 
 
 @dataclass
 class DisplayParams:
-    """ROS parameters of the display node (units: Hz, px, s)."""
+    """ROS parameters of the display node."""
 
-    rate: float = 30.0              # frames per second (Hz)
-    width: int = 1024               # frame size (px)
-    height: int = 600
-    fullscreen: bool = False        # take the whole screen (Esc ends)
-    headless: bool = False          # draw off-screen; frames to /display/image and png_dir
-    layout: str = 'auto'            # auto | graz | trainer | test | idle
-    phase_label: str = ''           # banner text, e.g. 'Graz with feedback'; '' from the prompts
-    n_trials: int = 0               # trials planned in this phase, for the banner (0 unknown)
-    feedback: str = 'move'          # Graz feedback bar: off | move | always
-    max_certainty: float = 1.0      # certainty that fills the feedback bar
-    prediction_timeout: float = 1.0  # s; older predictions are not shown
-    late_threshold: float = 0.02    # s; a flip later than this after its prompt is logged
-    image_rate: float = 2.0         # Hz of /display/image when headless (0 off)
-    png_dir: str = ''               # folder for PNG frames ('' none)
-    png_rate: float = 0.0           # PNG frames per second besides one per prompt phase
-    duration: float = 0.0           # s; end after this long (0 = until stopped)
+    rate: float = param(30.0, 'frames per second', unit='Hz', min=0.5, max=240.0)
+    width: int = param(1024, 'frame width', unit='px', min=320, max=7680)
+    height: int = param(600, 'frame height', unit='px', min=240, max=4320)
+    fullscreen: bool = param(False, 'take the whole screen (Esc ends)')
+    headless: bool = param(False, 'draw off-screen; frames to /display/image and png_dir')
+    layout: str = param('auto', 'screen layout; auto follows the prompts and targets',
+                        choices=LAYOUTS[:-1])
+    phase_label: str = param('', "banner text, e.g. 'Graz with feedback'; '' from the prompts")
+    n_trials: int = param(0, 'trials planned in this phase, for the banner (0 unknown)', min=0)
+    feedback: str = param('move', 'when the Graz feedback bar shows', choices=FEEDBACK_MODES,
+                          live=True)
+    max_certainty: float = param(1.0, 'certainty that fills the feedback bar', min=1e-6,
+                                 live=True)
+    prediction_timeout: float = param(1.0, 'older predictions are not shown', unit='s', min=0.0)
+    late_threshold: float = param(0.02, 'a prompt drawn later than this after its stamp is '
+                                  'logged', unit='s', min=0.0)
+    image_rate: float = param(2.0, 'rate of /display/image when headless (0 off)', unit='Hz',
+                              min=0.0, max=240.0)
+    png_dir: str = param('', "folder for PNG frames ('' none)")
+    png_rate: float = param(0.0, 'PNG frames per second besides one per prompt phase',
+                            unit='Hz', min=0.0, max=240.0)
+    duration: float = param(0.0, 'end after this long (0 = until stopped)', unit='s', min=0.0)
 
 
 def _image_to_rgb(msg: Image) -> np.ndarray | None:
@@ -101,30 +111,21 @@ class DisplayNode(rclpy.node.Node):
 
     def __init__(self, **kwargs) -> None:
         super().__init__('participant_display', **kwargs)
-        defaults = DisplayParams()
-        self.declare_parameters('', [(f.name, getattr(defaults, f.name))
-                                     for f in fields(DisplayParams)])
-        p = DisplayParams(**{f.name: self.get_parameter(f.name).value
-                             for f in fields(DisplayParams)})
-        self.p = p
-        try:
-            rate = check_rate('rate', p.rate)
-            self.image_rate = check_rate('image_rate', p.image_rate, allow_zero=True)
-            self.png_rate = check_rate('png_rate', p.png_rate, allow_zero=True)
-            self.screen = ParticipantScreen(int(p.width), int(p.height), p.layout, p.feedback,
-                                            float(p.max_certainty))
-            self.png_dir = Path(p.png_dir) if p.png_dir else None
-            if self.png_dir is not None:
-                try:
-                    self.png_dir.mkdir(parents=True, exist_ok=True)
-                except OSError as err:
-                    msg = f"Cannot create 'png_dir' {p.png_dir!r}: {err}; give a writable folder."
-                    raise TrainerError(msg) from None
-            self.window = Window(int(p.width), int(p.height), bool(p.fullscreen),
-                                 bool(p.headless), 'MIndGrasp participant display')
-        except TrainerError as err:
-            self.get_logger().error(str(err))
-            raise
+        p = self.p = declare_params(self, DisplayParams)
+        # a TrainerError here (no display, unwritable png_dir) ends the node with exit code 2
+        # and its one-line message (run_node)
+        self.screen = ParticipantScreen(int(p.width), int(p.height), p.layout, p.feedback,
+                                        float(p.max_certainty))
+        self.png_dir = Path(p.png_dir) if p.png_dir else None
+        if self.png_dir is not None:
+            try:
+                self.png_dir.mkdir(parents=True, exist_ok=True)
+            except OSError as err:
+                msg = f"Cannot create 'png_dir' {p.png_dir!r}: {err}; give a writable folder."
+                raise TrainerError(msg) from None
+        self.window = Window(int(p.width), int(p.height), bool(p.fullscreen), bool(p.headless),
+                             'MIndGrasp participant display')
+        rate = float(p.rate)
         self.period = 1.0 / rate
         self.state = ScreenState(phase_label=str(p.phase_label), n_trials=int(p.n_trials))
         self.prediction: tuple[int, float] | None = None
@@ -136,27 +137,23 @@ class DisplayNode(rclpy.node.Node):
         self.last_image = -math.inf
         self.frame_ns: list[int] = []         # monotonic ns of the flips since the last check
         self.late_count = 0
-        self.started = time.monotonic()
-        self.done = rclpy.task.Future()
+        self.done = rclpy.task.Future()  # completed when the display ends (duration, Esc)
 
-        sensor = rclpy.qos.qos_profile_sensor_data
-        latched = rclpy.qos.QoSProfile(
-            depth=1, reliability=rclpy.qos.ReliabilityPolicy.RELIABLE,
-            durability=rclpy.qos.DurabilityPolicy.TRANSIENT_LOCAL)
-        fsm_qos = rclpy.qos.QoSProfile(
-            depth=10, reliability=rclpy.qos.ReliabilityPolicy.RELIABLE,
-            durability=rclpy.qos.DurabilityPolicy.TRANSIENT_LOCAL)
-        self.flip_pub = self.create_publisher(Prompt, '/display/flip', 50)
-        self.image_pub = self.create_publisher(Image, '/display/image', sensor)
-        self.create_subscription(Prompt, '/trainer/prompt', self.prompt_callback, prompt_qos())
-        self.create_subscription(MIPrediction, '/bci/prediction', self.prediction_callback, 10)
-        self.create_subscription(Image, '/scene/image_raw', self.scene_callback, sensor)
-        self.create_subscription(Image, '/vision/overlay', self.overlay_callback, sensor)
-        self.create_subscription(FsmState, '/fsm/state', self.fsm_callback, fsm_qos)
-        self.create_subscription(TaskTarget, '/task/target', self.target_callback, latched)
-        self.create_subscription(Float64, '/trainer/ee_distance', self.distance_callback, 10)
+        self.flip_pub = self.create_publisher(Prompt, tp.DISPLAY_FLIP.name, tp.DISPLAY_FLIP.qos)
+        self.image_pub = self.create_publisher(Image, tp.DISPLAY_IMAGE.name, tp.DISPLAY_IMAGE.qos)
+        for topic, msg_type, callback in (
+                (tp.TRAINER_PROMPT, Prompt, self.prompt_callback),
+                (tp.BCI_PREDICTION, MIPrediction, self.prediction_callback),
+                (tp.SCENE_IMAGE, Image, self.scene_callback),
+                (tp.VISION_OVERLAY, Image, self.overlay_callback),
+                (tp.FSM_STATE, FsmState, self.fsm_callback),
+                (tp.TASK_TARGET, TaskTarget, self.target_callback),
+                (tp.TRAINER_EE_DISTANCE, Float64, self.distance_callback)):
+            self.create_subscription(msg_type, topic.name, callback, topic.qos)
         self.create_timer(self.period, self.frame_callback)
         self.create_timer(5.0, self.check_frame_times)
+        end_after(self, float(p.duration))
+        self.add_on_set_parameters_callback(self.live_parameters_callback)
         mode = 'headless' if p.headless else ('full screen' if p.fullscreen else 'window')
         self.get_logger().info(
             f'Participant display ready: {p.width}x{p.height} px at {rate:g} Hz, {mode}, '
@@ -167,6 +164,16 @@ class DisplayNode(rclpy.node.Node):
         return self.done.done()
 
     # ------------------------------------------------------------------ inputs
+    def live_parameters_callback(self, params: list) -> SetParametersResult:
+        # declare_params validates the live parameters (feedback, max_certainty); the screen
+        # takes the new values
+        for param_ in params:
+            if param_.name == 'feedback':
+                self.screen.feedback = str(param_.value)
+            elif param_.name == 'max_certainty':
+                self.screen.max_certainty = float(param_.value)
+        return SetParametersResult(successful=True)
+
     def prompt_callback(self, msg: Prompt) -> None:
         self.state.prompt = PromptEvent(_stamp_ns(msg.header.stamp) * 1e-9, msg.phase,
                                         int(msg.trial), int(msg.class_index),
@@ -202,9 +209,6 @@ class DisplayNode(rclpy.node.Node):
             self.get_logger().info('The display window was closed; the display ends.')
             self.done.set_result(0)
             return
-        if self.p.duration > 0 and time.monotonic() - self.started >= self.p.duration:
-            self.done.set_result(0)
-            return
         self.draw()
 
     def draw(self) -> None:
@@ -230,7 +234,8 @@ class DisplayNode(rclpy.node.Node):
                     f'{1e3 * float(self.p.late_threshold):.0f} ms); /display/flip has the drawn '
                     'time.')
         now = time.monotonic()
-        if self.p.headless and self.image_rate > 0 and now - self.last_image >= 1 / self.image_rate:
+        image_rate = float(self.p.image_rate)
+        if self.p.headless and image_rate > 0 and now - self.last_image >= 1 / image_rate:
             self.last_image = now
             msg = Image(height=frame.shape[0], width=frame.shape[1], encoding='rgb8',
                         is_bigendian=0, step=frame.shape[1] * 3, data=frame.reshape(-1))
@@ -238,7 +243,7 @@ class DisplayNode(rclpy.node.Node):
             msg.header.frame_id = 'participant_display'
             self.image_pub.publish(msg)
         if self.png_dir is not None and (
-                prompts or (self.png_rate > 0 and now - self.last_png >= 1 / self.png_rate)):
+                prompts or (self.p.png_rate > 0 and now - self.last_png >= 1 / self.p.png_rate)):
             self.last_png = now
             self.write_png(frame, prompts[-1] if prompts else None)
 
@@ -266,6 +271,9 @@ class DisplayNode(rclpy.node.Node):
                 "'rate' or the frame size.")
 
     def destroy_node(self) -> None:
+        self.get_logger().info(
+            f'Participant display drew {self.frame_count} frames, {self.late_count} late '
+            f'prompt(s), {self.png_count} PNG file(s).')
         self.window.close()
         super().destroy_node()
 
@@ -290,24 +298,7 @@ def _cli_flags(args: list[str]) -> list[str]:
 
 def main(args: list[str] | None = None) -> int:
     argv = _cli_flags(sys.argv[1:] if args is None else args)
-    rclpy.init(args=[sys.argv[0], *argv])
-    try:
-        node = DisplayNode()
-    except TrainerError:
-        rclpy.shutdown()
-        return 2
-    try:
-        rclpy.spin_until_future_complete(node, node.done)
-    except KeyboardInterrupt:
-        pass
-    finally:
-        node.get_logger().info(
-            f'Participant display drew {node.frame_count} frames, {node.late_count} late '
-            f'prompt(s), {node.png_count} PNG file(s).')
-        node.destroy_node()
-        if rclpy.ok():
-            rclpy.shutdown()
-    return 0
+    return run_node(DisplayNode, [sys.argv[0], *argv], errors=(TrainerError,))
 
 
 if __name__ == '__main__':
