@@ -22,10 +22,8 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import sys
 import time
-from pathlib import Path
 
 import numpy as np
 from threadpoolctl import threadpool_limits
@@ -40,7 +38,6 @@ from mindgrasp_classifier.training import (
     train,
 )
 
-REPO = Path(__file__).resolve().parents[1]
 TASKS = {'4 classes': ([4, 6], [8, 10], None),
          'left/right': ([4], [8], [0, 1]),
          'hands/feet': ([6], [10], [2, 3])}
@@ -166,7 +163,6 @@ def main(argv: list[str] | None = None) -> int:
                         help='also train on all 64 EEGMMIDB channels (slow)')
     parser.add_argument('--seconds', type=float, default=30.0, help='streamed seconds per timing')
     args = parser.parse_args(argv)
-    os.environ.setdefault('MNE_DATASETS_EEGBCI_PATH', str(REPO.parent / 'shared' / 'data'))
     threadpool_limits(limits=1)   # as the classifier node (parameter blas_threads)
     result: dict = {}
     if not args.skip_accuracy:

@@ -3,7 +3,7 @@ single realism factors.
 
     python benchmarks/realism.py compare [--trials 90] [--seed 0] [--workers 2] [--profile default]
     python benchmarks/realism.py sweep [--trials 30] [--seed 0] [--workers 2] [--plot sweep.png]
-    python benchmarks/realism.py cnn [--images 150] [--model models/vision/shape_cnn]
+    python benchmarks/realism.py cnn [--images 150] [--model my_models/shape_cnn]
 
 ``compare`` runs the random-locations protocol (one object per trial, random shape, colour, size,
 0.2-0.7 m from the base, autonomous search, approach and grasp) twice on the same placements:
@@ -176,13 +176,13 @@ def cnn(args: argparse.Namespace) -> dict:
     import numpy as np
 
     from mindgrasp_sim.realism import RealismProfile
-    from mindgrasp_vision.config import DEFAULT_SHAPE_MODEL, resolve_model_path
+    from mindgrasp_vision.config import DEFAULT_SHAPE_MODEL
     from mindgrasp_vision.dataset import collect_shape_dataset
     from mindgrasp_vision.shape_cnn import SHAPES as CNN_SHAPES
     from mindgrasp_vision.shape_cnn import ShapeClassifier
 
     model = args.model or DEFAULT_SHAPE_MODEL
-    clf = ShapeClassifier.load(resolve_model_path(model))
+    clf = ShapeClassifier.load(model)
     profile = RealismProfile.load(args.profile)
     out = {'mode': 'cnn', 'model': model, 'images': args.images, 'seed': args.seed + 1000}
     for name, realism in (('none', None), (profile.name, profile)):

@@ -19,7 +19,7 @@ import time
 
 import numpy as np
 
-from mindgrasp_vision.config import DEFAULT_SHAPE_MODEL, resolve_model_path
+from mindgrasp_common.resources import resource_path
 from mindgrasp_vision.detector import CameraIntrinsics, ColourDetector
 from mindgrasp_vision.overlay import render_overlay
 from mindgrasp_vision.ranking import ObjectOfInterestRanker
@@ -72,7 +72,7 @@ def bench_resolution(width: int, height: int, n: int) -> dict[str, dict[str, flo
 
 def bench_cnn(n: int) -> dict[str, object]:
     """Time preprocessing + one forward pass of the shape CNN (batch 1, 1 thread)."""
-    path = resolve_model_path(DEFAULT_SHAPE_MODEL)
+    path = resource_path('mindgrasp_vision', 'models') / 'shape_cnn'
     if path.with_suffix('.pt').is_file():
         clf, source = ShapeClassifier.load(path, num_threads=1), str(path)
     else:   # timing does not depend on the weights

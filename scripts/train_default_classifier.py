@@ -1,31 +1,30 @@
 """Train the demo's default MI model on the virtual subject's calibration session.
 
-    .venv/bin/python scripts/train_default_classifier.py [--out models/default_classifier]
+    .venv/bin/python scripts/train_default_classifier.py [--out my_models/default_classifier]
 
 The virtual subject (mindgrasp_eeg.synthetic + mindgrasp_eeg.subject, the same generator and head
 model as ``mindgrasp_eeg.virtual_amp_node`` with its default ``head_seed`` 0) follows a Graz-BCI
 calibration: per trial 2 s fixation, a 4 s cue of a random class, 2 s rest; 20 trials per class
 in random order. The model (MDM, motor-strip channels of the 32-channel 10-20 montage, 250 Hz,
-8-30 Hz, 1 s windows every 1/16 s) is written as models/default_classifier.{json,npz}, with the
-cross-validated accuracy in its provenance. Same seeds, same model.
+8-30 Hz, 1 s windows every 1/16 s) is written as mindgrasp_classifier's
+models/default_classifier.{json,npz}, with the cross-validated accuracy in its provenance. Same
+seeds, same model.
 """
 
 from __future__ import annotations
 
 import argparse
 import sys
-from pathlib import Path
 
 import numpy as np
 
 from mindgrasp_classifier._cli_common import format_report
 from mindgrasp_classifier.data import Recording
 from mindgrasp_classifier.training import TrainingConfig, train
+from mindgrasp_common.resources import resource_path
 from mindgrasp_eeg.montage import NAUTILUS_32, NAUTILUS_RATE, NO_CLASS
 from mindgrasp_eeg.subject import VirtualSubject
 from mindgrasp_eeg.synthetic import SyntheticEEG
-
-REPO = Path(__file__).resolve().parents[1]
 
 
 def calibration_session(trials_per_class: int = 20, seed: int = 100, head_seed: int = 0,
@@ -64,7 +63,8 @@ def calibration_session(trials_per_class: int = 20, seed: int = 100, head_seed: 
 def main(argv: list[str] | None = None) -> int:
     """Generate the calibration, train, write the model."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument('--out', default=str(REPO / 'models' / 'default_classifier'))
+    parser.add_argument('--out', default=str(resource_path('mindgrasp_classifier', 'models')
+                                             / 'default_classifier'))
     parser.add_argument('--trials-per-class', type=int, default=20)
     parser.add_argument('--seed', type=int, default=100)
     parser.add_argument('--head-seed', type=int, default=0)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
 import time
@@ -12,14 +13,14 @@ import pylsl
 import pytest
 
 from mindgrasp_eeg import EEGError
-from mindgrasp_eeg.player import eegbci_path, expand_sources, load_recording
+from mindgrasp_eeg.player import expand_sources, load_recording
 
 FS = 160.0
 
 
 def eegbci_file(run: int) -> str:
     """S001 run file via MNE's loader, from the local copy only (tests never download)."""
-    root = eegbci_path()
+    root = os.environ.get('MNE_DATASETS_EEGBCI_PATH')
     local = (Path(root) / 'MNE-eegbci-data/files/eegmmidb/1.0.0/S001' / f'S001R{run:02d}.edf'
              if root else None)
     if local is None or not local.is_file():

@@ -1,8 +1,8 @@
 """Synthetic inputs for GraspFsm tests: frames, predictions, a kinematic arm and a pinhole camera.
 
 The kinematic arm integrates the commanded joint velocities (no physics); the camera projects a
-point object through the real robot model (config/robots/mindgrasp_arm.urdf), so the grasp policy's
-geometry is checked without PyBullet.
+point object through the real robot model (mindgrasp_sim/urdf/mindgrasp_arm.urdf), so the grasp
+policy's geometry is checked without PyBullet.
 """
 
 from __future__ import annotations

@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 from sim_helpers import colour_mask
 
+from mindgrasp_common.resources import resource_path
 from mindgrasp_sim.errors import SimError
 from mindgrasp_sim.robot_model import ArmSpec, build_urdf
-from mindgrasp_sim.scene import config_dir
 from mindgrasp_sim.simulation import CameraConfig, Simulation, top_down_quat
 
 
@@ -36,7 +36,7 @@ def fk_tcp(q: np.ndarray, spec: ArmSpec | None = None) -> np.ndarray:
 
 
 def test_committed_urdf_is_the_generated_one():
-    committed = (config_dir() / 'robots' / 'mindgrasp_arm.urdf').read_text()
+    committed = resource_path('mindgrasp_sim', 'urdf', 'mindgrasp_arm.urdf').read_text()
     assert committed == build_urdf(), 'regenerate with python -m mindgrasp_sim.robot_model'
 
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from mindgrasp_common.resources import resource_path
 from mindgrasp_vision import VisionError
 from mindgrasp_vision.config import VisionConfig
 from mindgrasp_vision.pipeline import VisionPipeline
@@ -88,10 +89,9 @@ def test_config_builds_the_pipeline_and_rejects_unknown_parameters():
 
 
 def test_parameter_file_matches_the_defaults():
-    from pathlib import Path
 
     import yaml
 
-    path = Path(__file__).resolve().parents[2] / 'config' / 'params' / 'vision.yaml'
+    path = resource_path('mindgrasp_vision', 'param', 'vision.yaml')
     params = yaml.safe_load(path.read_text())['vision']['ros__parameters']
     assert VisionConfig.from_mapping(params) == VisionConfig()

@@ -7,8 +7,9 @@ import json
 import numpy as np
 import pytest
 
+from mindgrasp_common.resources import resource_path
 from mindgrasp_vision import VisionError
-from mindgrasp_vision.config import DEFAULT_SHAPE_MODEL, resolve_model_path
+from mindgrasp_vision.config import DEFAULT_SHAPE_MODEL
 from mindgrasp_vision.shape_cnn import (
     SHAPES,
     Preprocessing,
@@ -143,7 +144,7 @@ def test_committed_model_on_held_out_simulator_views():
     """The committed model (``mindgrasp train vision``) on views it was not trained on."""
     from mindgrasp_vision.dataset import collect_shape_dataset
 
-    path = resolve_model_path(DEFAULT_SHAPE_MODEL)
+    path = resource_path('mindgrasp_vision', 'models') / 'shape_cnn'
     if not path.with_suffix('.pt').is_file():
         pytest.fail(f'{path}.pt is missing; run `mindgrasp train vision` and commit the model.')
     clf = ShapeClassifier.load(path)
@@ -162,7 +163,7 @@ def test_committed_model_on_noisy_depth_images():
     pixels, mount error, lighting, object spread), through the pipeline's depth filter."""
     from mindgrasp_vision.dataset import collect_shape_dataset
 
-    clf = ShapeClassifier.load(resolve_model_path(DEFAULT_SHAPE_MODEL))
+    clf = ShapeClassifier.load(DEFAULT_SHAPE_MODEL)
     noisy = collect_shape_dataset(45, seed=4243, realism='default')
     assert np.isnan(noisy.x).sum() == 0          # the network input is always complete
     accuracy = clf.score(noisy.x, noisy.y)

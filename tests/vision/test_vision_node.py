@@ -3,16 +3,16 @@
 from __future__ import annotations
 
 import time
-from pathlib import Path
 
 import numpy as np
 import pytest
 
+from mindgrasp_common.resources import resource_path
 from mindgrasp_vision.ros_conversions import image_from_rgb
 
 pytestmark = pytest.mark.slow
 
-PARAMS = str(Path(__file__).resolve().parents[2] / 'config' / 'params' / 'vision.yaml')
+PARAMS = str(resource_path('mindgrasp_vision', 'param', 'vision.yaml'))
 
 
 def _spin_until(rclpy, node, predicate, timeout: float) -> bool:

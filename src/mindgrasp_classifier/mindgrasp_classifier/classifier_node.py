@@ -2,7 +2,7 @@
 
     python -m mindgrasp_classifier.classifier_node --ros-args -p model:=models/my_model.json
     python -m mindgrasp_classifier.classifier_node --ros-args \
-        --params-file config/params/classifier.yaml
+        --params-file src/mindgrasp_classifier/mindgrasp_classifier/param/classifier.yaml
 
 One prediction per window step (1/16 s by default), stamped with the ROS time of the window's last
 sample. While the window fills, or when the window holds NaN or flat channels, no prediction is
@@ -16,7 +16,6 @@ All decoding is done by :class:`~mindgrasp_classifier.decoder.MiDecoder`.
 from __future__ import annotations
 
 import sys
-from pathlib import Path
 
 import numpy as np
 from mindgrasp_ros.interfaces.diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
@@ -31,29 +30,16 @@ from mindgrasp_classifier.decoder import (
     check_classes,
 )
 from mindgrasp_classifier.errors import ClassifierError
-from mindgrasp_classifier.model import CLASS_NAMES, MiModel
+from mindgrasp_classifier.model import CLASS_NAMES, DEFAULT_MODEL, MiModel
 from mindgrasp_ros import rclpy
 
-#: The demo model trained by scripts/train_default_classifier.py.
-DEFAULT_MODEL = Path(__file__).resolve().parents[3] / 'models' / 'default_classifier.json'
-
 PARAMETERS = [
-    ('model', str(DEFAULT_MODEL)), ('classes', list(CLASS_NAMES)),
+    ('model', DEFAULT_MODEL), ('classes', list(CLASS_NAMES)),
     ('adaptation', 'none'), ('adaptation_rate', 0.005), ('min_certainty', 0.5),
     ('recenter', 'fixed'), ('recenter_rate', 0.005), ('label_tmin', 0.5), ('label_tmax', 2.5),
     ('flat_threshold', 1e-8), ('status_period', 1.0), ('frame_id', 'eeg'), ('duration', 0.0),
     ('blas_threads', 1),
 ]
-
-
-def resolve_model_path(path: str) -> Path:
-    """A relative model path is taken from the working directory, else from the repository root
-    (so ``models/default_classifier.json`` works from anywhere)."""
-    p = Path(path).expanduser()
-    if p.is_absolute() or p.exists() or p.with_suffix('.json').exists():
-        return p
-    repo = DEFAULT_MODEL.parents[1] / p
-    return repo if repo.exists() or repo.with_suffix('.json').exists() else p
 
 
 class ClassifierNode(rclpy.node.Node):
@@ -66,7 +52,6 @@ class ClassifierNode(rclpy.node.Node):
         if self.p['blas_threads'] > 0:
             # small matrices: multi-threaded BLAS only adds latency, worst on a busy machine
             threadpool_limits(limits=int(self.p['blas_threads']))
-        self.p['model'] = str(resolve_model_path(self.p['model']))
         self.model = MiModel.load(self.p['model'])
         if self.p['classes']:
             check_classes(self.model, self.p['classes'])

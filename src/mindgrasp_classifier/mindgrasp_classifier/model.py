@@ -23,10 +23,13 @@ from pyriemann.geometry.covariance import covariances
 from mindgrasp_classifier.errors import ClassifierError
 from mindgrasp_classifier.pipelines import _DistanceClassifier, classifier_from_arrays
 from mindgrasp_classifier.preprocessing import oas_covariances
+from mindgrasp_common.resources import ResourceNotFoundError, resolve_path
 
 #: MIndGrasp class names by class index (MIPrediction constants).
 CLASS_NAMES: tuple[str, ...] = ('left_hand', 'right_hand', 'both_hands', 'both_feet')
 FORMAT = 'mindgrasp-mi-model'
+#: the demo model trained by scripts/train_default_classifier.py
+DEFAULT_MODEL = 'package://mindgrasp_classifier/models/default_classifier.json'
 FORMAT_VERSION = 1
 #: Internal unit: microvolts (input in volts), so covariance entries are O(1..1e3).
 SCALE_V_TO_UV = 1e6
@@ -172,7 +175,16 @@ class MiModel:
 
     @classmethod
     def load(cls, path: str | Path) -> MiModel:
-        """Read a model written by :meth:`save`; clear errors for missing/corrupt/foreign files."""
+        """Read a model written by :meth:`save`; clear errors for missing/corrupt/foreign files.
+
+        ``path``: the .json (or its stem), relative to the working directory, or a data file of
+        this package (``models/default_classifier.json``), or ``package://<package>/<path>``.
+        """
+        try:
+            path = resolve_path(path, 'mindgrasp_classifier', ('.json',))
+        except ResourceNotFoundError as exc:
+            msg = f'{exc} Give the path of a model written by `mindgrasp train classifier`.'
+            raise ClassifierError(msg) from None
         json_path, _ = model_paths(path)
         if not json_path.is_file():
             msg = (f'The model file {json_path} does not exist; train one with '

@@ -51,15 +51,6 @@ class Recording:
         return len(self.data) / self.sample_rate
 
 
-def eegbci_path() -> str | None:
-    """Where MNE's EEGBCI loader looks: ``$MNE_DATASETS_EEGBCI_PATH``, else the workspace copy."""
-    env = os.environ.get('MNE_DATASETS_EEGBCI_PATH')
-    if env:
-        return env
-    shared = Path(__file__).resolve().parents[4] / 'shared' / 'data'
-    return str(shared) if shared.is_dir() else None
-
-
 def expand_sources(sources: Sequence[str]) -> list[str]:
     """Turn ``eegbci:<subject>:<runs>`` entries into file paths (others unchanged)."""
     out: list[str] = []
@@ -77,8 +68,8 @@ def expand_sources(sources: Sequence[str]) -> list[str]:
             raise EEGError(msg) from exc
         import mne
 
-        paths = mne.datasets.eegbci.load_data(subj, run_list, path=eegbci_path(),
-                                              update_path=False, verbose='error')
+        # MNE finds the data itself: $MNE_DATASETS_EEGBCI_PATH, else its config, else ~/mne_data
+        paths = mne.datasets.eegbci.load_data(subj, run_list, update_path=False, verbose='error')
         out.extend(str(p) for p in paths)
     return out
 

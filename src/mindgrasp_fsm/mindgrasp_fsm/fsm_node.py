@@ -1,6 +1,7 @@
 """The ``fsm`` node: the six-state MIndGrasp controller on ROS topics.
 
-Run: ``python -m mindgrasp_fsm.fsm_node --ros-args --params-file config/params/fsm.yaml``
+Run: ``python -m mindgrasp_fsm.fsm_node --ros-args --params-file
+src/mindgrasp_fsm/mindgrasp_fsm/param/fsm.yaml``
 
 Subscribes ``/bci/prediction`` (mindgrasp_msgs/MIPrediction), ``/vision/detections``
 (DetectionArray), ``/joint_states``, ``/gripper/joint_states`` + ``/gripper/contacts`` (finger
@@ -44,7 +45,7 @@ def _seconds(stamp: object) -> float:
 
 
 class FsmNode(rclpy.node.Node):
-    """Thin ROS wrapper round :class:`GraspFsm` (parameters: config/params/fsm.yaml)."""
+    """Thin ROS wrapper round :class:`GraspFsm` (parameters: mindgrasp_fsm/param/fsm.yaml)."""
 
     def __init__(self, **kwargs: object) -> None:
         super().__init__('fsm', **kwargs)

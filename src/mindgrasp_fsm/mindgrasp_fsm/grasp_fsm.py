@@ -72,7 +72,7 @@ class GraspFsm:
     Parameters
     ----------
     params : FsmParams
-        Gains and thresholds (``config/params/fsm.yaml``).
+        Gains and thresholds (``mindgrasp_fsm/param/fsm.yaml``).
     kinematics : ArmKinematics or None
         Robot model for the autonomous final approach (camera pose and grasp IK). Without it the
         controller aborts state 4 and returns to start.
@@ -88,15 +88,15 @@ class GraspFsm:
     @classmethod
     def from_params(cls, params: FsmParams | None = None) -> GraspFsm:
         """Controller with the robot model named by ``params.urdf_file`` (URDF)."""
-        from pathlib import Path
-
+        from mindgrasp_common.resources import ResourceNotFoundError, resolve_path
         from mindgrasp_fsm.kinematics import UrdfKinematics
-        from mindgrasp_fsm.params import default_params_path
 
         params = params or FsmParams()
-        urdf = Path(params.urdf_file).expanduser()
-        if not urdf.is_absolute():
-            urdf = default_params_path().parents[2] / urdf
+        try:
+            urdf = resolve_path(params.urdf_file, 'mindgrasp_fsm')
+        except ResourceNotFoundError as exc:
+            msg = f'Cannot read the robot description {params.urdf_file}: {exc}'
+            raise FsmError(msg) from None
         kinematics = UrdfKinematics(str(urdf), params.joint_names, params.tool_link,
                                     params.camera_link)
         return cls(params, kinematics)

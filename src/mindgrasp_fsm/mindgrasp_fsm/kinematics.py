@@ -81,7 +81,7 @@ class UrdfKinematics:
     Parameters
     ----------
     urdf_path : str or Path
-        Robot description (e.g. ``config/robots/mindgrasp_arm.urdf``).
+        Robot description (e.g. ``mindgrasp_sim/urdf/mindgrasp_arm.urdf``).
     joint_names : sequence of str
         The six arm joints, base to wrist.
     tool_link, camera_link : str

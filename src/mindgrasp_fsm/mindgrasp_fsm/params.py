@@ -1,8 +1,8 @@
 """Gains and thresholds of the grasp controller, loadable from a ROS-format parameter file.
 
-Every number the controller uses lives here, with its unit; ``config/params/fsm.yaml`` holds the
-same names under ``fsm: ros__parameters:``. Per-shape values are flat names prefixed by the shape
-(``cube_approach_height``), so they are plain ROS parameters.
+Every number the controller uses lives here, with its unit; ``mindgrasp_fsm/param/fsm.yaml`` holds
+the same names under ``fsm: ros__parameters:``. Per-shape values are flat names prefixed by the
+shape (``cube_approach_height``), so they are plain ROS parameters.
 """
 
 from __future__ import annotations
@@ -14,6 +14,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from mindgrasp_common.resources import resource_path
+from mindgrasp_common.robot import URDF_URI
 from mindgrasp_fsm.errors import FsmError
 
 SHAPES = ('cube', 'cylinder', 'sphere')
@@ -25,11 +27,11 @@ class FsmParams:
 
     # --- general -------------------------------------------------------------------------------
     autonomous: bool = False            # no BCI: search left, approach and grasp on vision alone
-    urdf_file: str = 'config/robots/mindgrasp_arm.urdf'  # URDF for FK / IK (repo-relative)
+    urdf_file: str = URDF_URI           # URDF for FK / IK: a path or a package:// URI
     tool_link: str = 'tcp'              # grasp point between the fingertips
     camera_link: str = 'camera_color_optical_frame'
     joint_names: list[str] = field(default_factory=lambda: [f'joint_{i}' for i in range(1, 7)])
-    # start pose (rad) of config/robots/mindgrasp_arm.urdf: long arm up, short arm forward, wrist
+    # start pose (rad) of the URDF: long arm up, short arm forward, wrist
     # pitched so the camera looks down at the objects (the paper: all straight except joint 5)
     home_position: list[float] = field(
         default_factory=lambda: [0.0, 0.0, 0.0, math.pi / 2, 1.2, 0.0])
@@ -160,7 +162,7 @@ class FsmParams:
             values = getattr(self, name)
             if len(values) != 6:
                 msg = (f"The parameter '{name}' must have 6 entries (one per arm joint), got "
-                       f'{len(values)}; list all six joints in config/params/fsm.yaml.')
+                       f'{len(values)}; list all six joints in mindgrasp_fsm/param/fsm.yaml.')
                 raise FsmError(msg)
         for i, (lo, hi) in enumerate(zip(self.joint_lower_limits, self.joint_upper_limits,
                                          strict=True)):
@@ -211,7 +213,7 @@ class FsmParams:
         unknown = sorted(set(values) - known)
         if unknown:
             msg = (f'Unknown controller parameter(s) {unknown}; check the spelling against '
-                   'config/params/fsm.yaml.')
+                   'mindgrasp_fsm/param/fsm.yaml.')
             raise FsmError(msg)
         defaults = cls()
         kwargs: dict[str, Any] = {}
@@ -245,10 +247,10 @@ class FsmParams:
             if isinstance(section, dict) and 'ros__parameters' in section:
                 return cls.from_dict(section['ros__parameters'] or {})
         msg = (f"{path} has no '{node_name}: ros__parameters:' section; add one (see "
-               'config/params/fsm.yaml).')
+               'mindgrasp_fsm/param/fsm.yaml).')
         raise FsmError(msg)
 
 
 def default_params_path() -> Path:
-    """``config/params/fsm.yaml`` of the source tree."""
-    return Path(__file__).resolve().parents[3] / 'config' / 'params' / 'fsm.yaml'
+    """This package's ``param/fsm.yaml``."""
+    return resource_path('mindgrasp_fsm', 'param', 'fsm.yaml')

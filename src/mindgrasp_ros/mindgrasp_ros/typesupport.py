@@ -13,6 +13,7 @@ are passed to it directly and it constructs our classes when deserialising.
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import hashlib
 import json
@@ -28,6 +29,7 @@ from rosbags.typesys.base import Nodetype
 from rosbags.typesys.msg import get_types_from_msg
 from rosbags.typesys.store import Typestore
 
+from mindgrasp_common.resources import ResourceNotFoundError, resource_path
 from mindgrasp_ros.errors import RosError
 
 __all__ = [
@@ -46,7 +48,6 @@ class MessageTypeError(RosError):
     """An unknown message type, or a message of the wrong class."""
 
 
-_DATA_DIR = Path(__file__).resolve().parent / 'interface_data'
 
 _NUMPY_DTYPES = {
     'bool': np.bool_, 'byte': np.uint8, 'char': np.uint8, 'int8': np.int8, 'uint8': np.uint8,
@@ -104,17 +105,19 @@ def _register_interface_dir(store: Typestore, package: str, folder: Path) -> Non
 def interface_dir() -> Path:
     """Folder of the ``mindgrasp_msgs`` interface package (``msg/``, ``srv/``, package.xml).
 
-    In order: ``MINDGRASP_MSGS_DIR``; the folder next to this package in the source tree
-    (``src/mindgrasp_msgs``); ``share/mindgrasp_msgs`` of a sourced colcon workspace
-    (``AMENT_PREFIX_PATH``), where rosidl installs the ``.msg``/``.srv`` files. The source folder is
-    deliberately not a Python package, so that with ROS 2 sourced ``import mindgrasp_msgs.msg``
-    finds the colcon-generated package, not this folder.
+    In order: ``MINDGRASP_MSGS_DIR``; ``interface_data/mindgrasp_msgs`` of this package, a link
+    to the interface package ``src/mindgrasp_msgs`` (installs copy it); ``share/mindgrasp_msgs`` of
+    a sourced colcon workspace (``AMENT_PREFIX_PATH``), where rosidl installs the ``.msg``/``.srv``
+    files. The source folder is deliberately not a Python package, so that with ROS 2 sourced
+    ``import mindgrasp_msgs.msg`` finds the colcon-generated package, not this folder.
     """
     override = os.environ.get('MINDGRASP_MSGS_DIR')
     if override:
         candidates = [Path(override)]
     else:
-        candidates = [Path(__file__).resolve().parents[2] / 'mindgrasp_msgs']
+        candidates = []
+        with contextlib.suppress(ResourceNotFoundError):
+            candidates.append(resource_path('mindgrasp_ros', 'interface_data', 'mindgrasp_msgs'))
         candidates += [Path(prefix) / 'share' / 'mindgrasp_msgs'
                        for prefix in os.environ.get('AMENT_PREFIX_PATH', '').split(os.pathsep)
                        if prefix]
@@ -141,7 +144,8 @@ def typestore() -> Typestore:
     store.types = dict(store.types)
     store.cache = {}
     for package in _EXTRA_SERVICE_FILES:
-        _register_interface_dir(store, package, _DATA_DIR / package)
+        _register_interface_dir(store, package, resource_path('mindgrasp_ros', 'interface_data',
+                                                              package))
     _register_interface_dir(store, 'mindgrasp_msgs', interface_dir())
     for name in list(store.fielddefs):
         store.types[name] = _make_message_class(store, name)

@@ -49,6 +49,7 @@ from typing import Any
 import numpy as np
 import yaml
 
+from mindgrasp_common.resources import resource_path
 from mindgrasp_sim.errors import SimError
 
 __all__ = ['CameraMountError', 'ColourNoise', 'ContactSensing', 'DepthNoise', 'JointNoise',
@@ -59,7 +60,7 @@ _SPLIT = 0xFFFFFFFF
 
 def profile_dir() -> Path:
     """Folder of the packaged profiles (``default.yaml``, ``none.yaml``)."""
-    return Path(__file__).resolve().parent / 'realism_profiles'
+    return resource_path('mindgrasp_sim', 'realism_profiles')
 
 
 @dataclass(frozen=True)

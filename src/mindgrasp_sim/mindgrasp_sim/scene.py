@@ -1,6 +1,6 @@
 """Scene descriptions: which objects stand where (ROS-free).
 
-A scene is a YAML file (``config/scenes/<name>.yaml``)::
+A scene is a YAML file (``mindgrasp_sim/scenes/<name>.yaml``, or any path)::
 
     name: set_locations
     seed: 0
@@ -35,6 +35,7 @@ from typing import Any
 import numpy as np
 import yaml
 
+from mindgrasp_common.resources import resource_path
 from mindgrasp_sim.errors import SimError
 
 SHAPES = ('cube', 'cylinder', 'sphere', 'mesh')
@@ -56,14 +57,9 @@ _DEFAULTS = {
 }
 
 
-def config_dir() -> Path:
-    """The project's ``config/`` folder (env ``MINDGRASP_CONFIG_DIR`` overrides)."""
-    import os
-
-    env = os.environ.get('MINDGRASP_CONFIG_DIR')
-    if env:
-        return Path(env)
-    return Path(__file__).resolve().parents[3] / 'config'
+def scenes_dir() -> Path:
+    """The scenes shipped with this package (``mindgrasp_sim/scenes/*.yaml``)."""
+    return resource_path('mindgrasp_sim', 'scenes')
 
 
 @dataclass(frozen=True)
@@ -277,12 +273,12 @@ def resolve_scene_path(scene: str | Path) -> Path:
     if path.suffix in ('.yaml', '.yml') or path.is_file():
         if not path.is_file():
             msg = f'Scene file {str(path)!r} does not exist; give an existing YAML path or one ' \
-                  f'of the names in {config_dir() / "scenes"}.'
+                  f'of the names in {scenes_dir()}.'
             raise SimError(msg)
         return path
-    candidate = config_dir() / 'scenes' / f'{scene}.yaml'
+    candidate = scenes_dir() / f'{scene}.yaml'
     if not candidate.is_file():
-        known = sorted(p.stem for p in (config_dir() / 'scenes').glob('*.yaml'))
+        known = sorted(p.stem for p in scenes_dir().glob('*.yaml'))
         msg = f'Unknown scene {str(scene)!r}; use one of {known} or a path to a scene YAML file.'
         raise SimError(msg)
     return candidate
@@ -333,5 +329,5 @@ def load_scene(scene: str | Path | dict) -> SceneSpec:
                      random=random, defaults=defaults, source=source)
 
 
-__all__ = ['COLOURS', 'SHAPES', 'ObjectSpec', 'SceneSpec', 'config_dir', 'load_scene',
-           'parse_object', 'resolve_scene_path']
+__all__ = ['COLOURS', 'SHAPES', 'ObjectSpec', 'SceneSpec', 'load_scene',
+           'parse_object', 'resolve_scene_path', 'scenes_dir']

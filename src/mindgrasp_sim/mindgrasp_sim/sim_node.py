@@ -3,7 +3,8 @@ RGB-D camera driver, served by :class:`~mindgrasp_sim.simulation.Simulation`.
 
     python -m mindgrasp_sim.sim_node --ros-args -p scene:=random_locations -p seed:=3
     python -m mindgrasp_sim.sim_node --ros-args -p time_mode:=fast -p sim_duration:=60.0
-    python -m mindgrasp_sim.sim_node --ros-args --params-file config/params/sim.yaml
+    python -m mindgrasp_sim.sim_node --ros-args \
+        --params-file src/mindgrasp_sim/mindgrasp_sim/param/sim.yaml
 
 Subscribes ``/arm_controller/commands`` (std_msgs/Float64MultiArray, 6 joint velocities, rad/s;
 older than ``command_timeout`` s means zero), ``/gripper_controller/commands``

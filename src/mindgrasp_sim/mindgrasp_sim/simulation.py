@@ -38,11 +38,13 @@ import numpy as np
 import pybullet as pb
 from pybullet_utils.bullet_client import BulletClient
 
+from mindgrasp_common.resources import ResourceNotFoundError, resolve_path
+from mindgrasp_common.robot import URDF_URI
 from mindgrasp_sim.control import validate_velocities
 from mindgrasp_sim.errors import SimError
 from mindgrasp_sim.realism import Realism, RealismProfile
 from mindgrasp_sim.robot_model import ARM_JOINTS, FINGER_JOINTS
-from mindgrasp_sim.scene import ObjectSpec, SceneSpec, config_dir, load_scene
+from mindgrasp_sim.scene import ObjectSpec, SceneSpec, load_scene
 
 #: home pose (rad): long arm up, short arm forward, wrist pitched so the camera looks down at the
 #: objects 0.5 m in front of the base (the paper: "all joints straight except joint 5")
@@ -176,7 +178,8 @@ class Simulation:
     Parameters
     ----------
     scene : str | Path
-        ``'set_locations'``, ``'random_locations'`` (names in ``config/scenes``) or a YAML path.
+        ``'set_locations'``, ``'random_locations'`` (names in ``mindgrasp_sim/scenes``) or a
+        YAML path.
     seed : int
         Seed of the random object layout (random scenes); same seed, same layout.
     camera : CameraConfig | None
@@ -190,7 +193,8 @@ class Simulation:
     n_objects : int | None
         Number of random objects (random scenes); None: the scene file's number.
     urdf : str | Path | None
-        Robot description (default ``config/robots/mindgrasp_arm.urdf``).
+        Robot description: a path or ``package://`` URI (default
+        ``package://mindgrasp_sim/urdf/mindgrasp_arm.urdf``).
     solver_iterations : int
         Constraint solver iterations per step (contacts and motors; 50 holds grasps well).
     realism : RealismProfile | str | Path | None
@@ -227,7 +231,10 @@ class Simulation:
         self.gui = bool(gui)
         self.n_objects = n_objects
         self.home_pose = np.array(HOME_POSE, dtype=float)
-        self.urdf = Path(urdf) if urdf else config_dir() / 'robots' / 'mindgrasp_arm.urdf'
+        try:
+            self.urdf = resolve_path(urdf or URDF_URI, 'mindgrasp_sim')
+        except ResourceNotFoundError as exc:
+            raise SimError(f'{exc} Give an existing URDF.') from None
         if not self.urdf.is_file():
             msg = f'Robot description {str(self.urdf)!r} does not exist; give an existing URDF.'
             raise SimError(msg)

@@ -43,11 +43,12 @@ from typing import Any
 
 import yaml
 
+from mindgrasp_common.resources import resource_path
 from mindgrasp_trainer.protocol import TrainerError
 
 __all__ = ['PLAN_DIR', 'Phase', 'Plan', 'Session', 'SessionError', 'check_subject', 'load_plan']
 
-PLAN_DIR = Path(__file__).with_name('plans')
+PLAN_DIR = resource_path('mindgrasp_trainer', 'plans')
 KINDS = {'graz': 'graz', 'trainer': 'trainer', 'test': 'demo'}   # phase kind -> launch profile
 #: the node whose end ends a phase's launch (on_exit=Shutdown), per phase kind
 PROMPTERS = {'graz': 'graz_prompter', 'trainer': 'trainer', 'test': 'trial_manager'}

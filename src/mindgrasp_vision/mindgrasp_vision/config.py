@@ -4,31 +4,21 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import asdict, dataclass, field, fields
-from pathlib import Path
 
 from mindgrasp_vision._checks import VisionError
 from mindgrasp_vision.detector import DEFAULT_COLOURS, ColourDetector
 from mindgrasp_vision.pipeline import VisionPipeline
 from mindgrasp_vision.ranking import ObjectOfInterestRanker
 
-__all__ = ['DEFAULT_SHAPE_MODEL', 'VisionConfig', 'resolve_model_path']
+__all__ = ['DEFAULT_SHAPE_MODEL', 'VisionConfig']
 
-#: the committed shape model (``models/vision/shape_cnn.pt`` + ``.json``), relative to the repo root
-DEFAULT_SHAPE_MODEL = 'models/vision/shape_cnn'
-_REPO_ROOT = Path(__file__).resolve().parents[3]
-
-
-def resolve_model_path(path: str) -> Path:
-    """A model path as given, else relative to the repository root (where models/ lives)."""
-    p = Path(path).expanduser()
-    if p.is_absolute() or p.with_suffix('.json').exists():
-        return p
-    return _REPO_ROOT / p
+#: the committed shape model (``shape_cnn.pt`` + ``.json`` in this package's ``models/``)
+DEFAULT_SHAPE_MODEL = 'package://mindgrasp_vision/models/shape_cnn'
 
 
 @dataclass
 class VisionConfig:
-    """All tunables of the vision node; defaults equal ``config/params/vision.yaml``.
+    """All tunables of the vision node; defaults equal ``param/vision.yaml``.
 
     Units: pixels at 128x128 for ``min_pixels``/``morph_kernel``/``depth_median`` (scaled for
     larger images),
@@ -108,7 +98,7 @@ class VisionConfig:
             return None
         from mindgrasp_vision.shape_cnn import ShapeClassifier
 
-        return ShapeClassifier.load(resolve_model_path(self.shape_model))
+        return ShapeClassifier.load(self.shape_model)
 
     def build_pipeline(self, classifier: object | None = None) -> VisionPipeline:
         """A :class:`VisionPipeline` with these parameters (and a loaded classifier, if any)."""

@@ -22,6 +22,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from mindgrasp_common.resources import ResourceNotFoundError, resolve_path
 from mindgrasp_vision._checks import VisionError, check_depth
 
 __all__ = ['SHAPES', 'Preprocessing', 'ShapeClassifier', 'build_model', 'preprocess_depth']
@@ -361,10 +362,18 @@ class ShapeClassifier:
 
     @classmethod
     def load(cls, path: str | Path, num_threads: int = 1) -> ShapeClassifier:
-        """Load a model saved by :meth:`save` (``path`` with or without .pt/.json suffix)."""
+        """Load a model saved by :meth:`save` (``path`` with or without .pt/.json suffix).
+
+        ``path``: relative to the working directory, a data file of this package
+        (``models/shape_cnn``) or ``package://<package>/<path>``.
+        """
         import torch
 
-        base = Path(path)
+        try:
+            base = resolve_path(path, 'mindgrasp_vision', ('.pt', '.json'))
+        except ResourceNotFoundError as exc:
+            msg = f'{exc} Train a model with `mindgrasp train vision`.'
+            raise VisionError(msg) from None
         if base.suffix in ('.pt', '.json'):
             base = base.with_suffix('')
         pt, js = base.with_suffix('.pt'), base.with_suffix('.json')

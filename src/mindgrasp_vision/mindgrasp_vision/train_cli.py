@@ -11,7 +11,7 @@ validation and test images too, so the reported accuracy is that on noisy depth 
 
 Example::
 
-    mindgrasp train vision --n-images 600 --seed 0 --output models/vision/shape_cnn
+    mindgrasp train vision --n-images 600 --seed 0 --output my_models/shape_cnn
     mindgrasp train vision --realism default --n-images 900
 """
 
@@ -26,8 +26,9 @@ from pathlib import Path
 
 import numpy as np
 
+from mindgrasp_common.resources import resource_path
 from mindgrasp_vision._checks import VisionError
-from mindgrasp_vision.config import DEFAULT_SHAPE_MODEL, resolve_model_path
+from mindgrasp_vision.config import DEFAULT_SHAPE_MODEL
 
 __all__ = ['add_arguments', 'main', 'split_indices']
 
@@ -159,8 +160,8 @@ def main(args: argparse.Namespace) -> int:
             figures['test_images'] = len(test)
             figures['test_accuracy'] = float(np.mean(tpred == test.y))
             figures['test_confusion'] = _confusion(test.y, tpred, len(SHAPES))
-        output = resolve_model_path(args.output) if args.output == DEFAULT_SHAPE_MODEL \
-            else Path(args.output)
+        output = resource_path('mindgrasp_vision', 'models') / 'shape_cnn' \
+            if args.output == DEFAULT_SHAPE_MODEL else Path(args.output)
         pt, js = clf.save(output, training=figures)
     except VisionError as exc:
         print(f'mindgrasp train vision: {exc}', file=sys.stderr)

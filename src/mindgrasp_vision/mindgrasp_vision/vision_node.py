@@ -2,7 +2,8 @@
 
 Run::
 
-    python -m mindgrasp_vision.vision_node --ros-args --params-file config/params/vision.yaml
+    python -m mindgrasp_vision.vision_node --ros-args \
+        --params-file src/mindgrasp_vision/mindgrasp_vision/param/vision.yaml
 
 Subscribes /camera/color/image_raw (rgb8), /camera/depth/image_raw (32FC1 m), /camera/color/
 camera_info, /bci/prediction (a left/right hand prediction shifts the ranking focus) and /fsm/state
@@ -46,7 +47,7 @@ def _stamp_ns(header: object) -> int:
 
 
 class VisionNode(rclpy.node.Node):
-    """Thin ROS wrapper round :class:`VisionPipeline` (parameters: config/params/vision.yaml)."""
+    """Thin ROS wrapper round :class:`VisionPipeline` (parameters: param/vision.yaml)."""
 
     def __init__(self, **kwargs: object) -> None:
         super().__init__('vision', **kwargs)

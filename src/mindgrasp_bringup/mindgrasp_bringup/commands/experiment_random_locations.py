@@ -22,7 +22,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--json', action='store_true',
                         help='print one JSON object with the figures as the last line')
     parser.add_argument('--params-file', default=None,
-                        help='controller parameters (ROS YAML, default config/params/fsm.yaml)')
+                        help='controller parameters (ROS YAML, default: mindgrasp_fsm '
+                             'param/fsm.yaml)')
     parser.add_argument('--timeout', type=float, default=120.0,
                         help='simulated seconds per trial before it counts as failed (default 120)')
     parser.add_argument('--shape-model', default=None,

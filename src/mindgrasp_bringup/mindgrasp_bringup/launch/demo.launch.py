@@ -12,8 +12,8 @@ The task, as in the paper's set-locations experiment: the trial manager names th
 on /task/target (latched), where the virtual subject (subject:=pursue) reads what to imagine and
 the simulator which grasp counts; after each grasp it resets the scene and starts the next trial.
 
-Parameters: config/params/<package>.yaml of each package, then config/params/demo.yaml (the demo's
-own settings), then the launch arguments below (later entries win).
+Parameters: param/<package>.yaml of each package, then mindgrasp_bringup/param/demo.yaml (the
+demo's own settings), then the launch arguments below (later entries win).
 """
 
 
@@ -56,7 +56,7 @@ def generate_launch_description() -> LaunchDescription:
         DeclareLaunchArgument('model', default_value='',
                               description='classifier model (.json written by mindgrasp train '
                                           'classifier); empty: the one in '
-                                          'config/params/classifier.yaml'),
+                                          'mindgrasp_classifier/param/classifier.yaml'),
         DeclareLaunchArgument('targets', default_value='red cube, blue cylinder, yellow sphere',
                               description='objects to grasp in turn, comma-separated ("red cube, '
                                           'blue sphere"); empty: drawn at random from the scene'),

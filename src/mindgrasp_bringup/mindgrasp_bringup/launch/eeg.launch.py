@@ -8,7 +8,8 @@
 
 The acquisition node publishes /eeg/raw and /eeg/status; the run directory records them. With
 adapt:=true (the default here) the node adopts the stream's channel count, rate and names with a
-warning; adapt:=false holds the stream to config/params/eeg.yaml (32 ch, 250 Hz, g.Nautilus names).
+warning; adapt:=false holds the stream to mindgrasp_eeg/param/eeg.yaml (32 ch, 250 Hz, g.Nautilus
+names).
 """
 
 from mindgrasp_bringup.launch_api import (

@@ -41,7 +41,7 @@ def generate_launch_description() -> LaunchDescription:
         DeclareLaunchArgument('model', default_value='',
                               description='classifier model for feedback:=true (.json written '
                                           'by mindgrasp train classifier); empty: the one in '
-                                          'config/params/classifier.yaml'),
+                                          'mindgrasp_classifier/param/classifier.yaml'),
         *eeg_source_nodes(config_files('eeg'), seed, 'follow'),
         GroupAction(classifier_nodes(config_files('classifier')),
                     condition=IfCondition(LaunchConfiguration('feedback'))),

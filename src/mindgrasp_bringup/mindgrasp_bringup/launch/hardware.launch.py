@@ -41,7 +41,7 @@ def generate_launch_description() -> LaunchDescription:
         DeclareLaunchArgument('model', default_value='',
                               description='classifier model (.json written by mindgrasp train '
                                           'classifier); empty: the one in '
-                                          'config/params/classifier.yaml'),
+                                          'mindgrasp_classifier/param/classifier.yaml'),
         DeclareLaunchArgument('camera_driver', default_value='',
                               description='camera driver started like arm_driver (empty: the '
                                           'arm driver or another system publishes the camera)'),

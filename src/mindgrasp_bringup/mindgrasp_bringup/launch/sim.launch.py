@@ -8,7 +8,7 @@ the arm contract of a ros2_control forward velocity controller (drive it from ou
     mindgrasp launch sim realism:=default realism_seed:=3  # a real camera's noise, a real arm's lag
     mindgrasp topic hz /joint_states                       # in another shell
 
-Parameters: config/params/sim.yaml, then the launch arguments below.
+Parameters: mindgrasp_sim/param/sim.yaml, then the launch arguments below.
 """
 
 from mindgrasp_bringup.launch_api import (
@@ -29,7 +29,8 @@ def generate_launch_description() -> LaunchDescription:
     rate = PythonExpression(["float('", camera, "'.split('@')[1])"])
     return LaunchDescription([
         DeclareLaunchArgument('scene', default_value='set_locations',
-                              description='scene name in config/scenes/ or a scene YAML path'),
+                              description='scene name in mindgrasp_sim/scenes/ or a scene YAML '
+                                          'path'),
         DeclareLaunchArgument('seed', default_value='0',
                               description='layout seed of random scenes'),
         DeclareLaunchArgument('time_mode', default_value='realtime',

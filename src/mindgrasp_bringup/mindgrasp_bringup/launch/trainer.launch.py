@@ -42,7 +42,7 @@ def generate_launch_description() -> LaunchDescription:
         DeclareLaunchArgument('model', default_value='',
                               description='classifier model (.json written by mindgrasp train '
                                           'classifier); empty: the one in '
-                                          'config/params/classifier.yaml'),
+                                          'mindgrasp_classifier/param/classifier.yaml'),
         *[Node(package='mindgrasp_sim', executable='sim_node', name='sim',
                parameters=[*config_files('sim'),
                            {'gui': LaunchConfiguration('gui'), 'seed': seed,

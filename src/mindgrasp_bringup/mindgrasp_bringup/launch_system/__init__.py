@@ -47,8 +47,7 @@ from mindgrasp_bringup.launch_system.description import (
     profiles,
 )
 from mindgrasp_bringup.launch_system.errors import LaunchError
-from mindgrasp_bringup.launch_system.params import PARAMS_DIR, config_files
-from mindgrasp_bringup.launch_system.rundir import PROJECT_ROOT
+from mindgrasp_bringup.launch_system.params import config_files
 from mindgrasp_bringup.launch_system.service import LaunchService
 from mindgrasp_bringup.launch_system.substitutions import (
     EnvironmentVariable,
@@ -61,7 +60,7 @@ from mindgrasp_bringup.launch_system.substitutions import (
 )
 
 __all__ = [
-    'PARAMS_DIR', 'PROJECT_ROOT', 'Action', 'DeclareLaunchArgument', 'EnvironmentVariable',
+    'Action', 'DeclareLaunchArgument', 'EnvironmentVariable',
     'ExecuteProcess', 'GroupAction', 'IfCondition', 'IncludeLaunchDescription',
     'LaunchConfiguration', 'LaunchConfigurationEquals', 'LaunchConfigurationNotEquals',
     'LaunchContext', 'LaunchDescription', 'LaunchError', 'LaunchService', 'LogInfo', 'Node',

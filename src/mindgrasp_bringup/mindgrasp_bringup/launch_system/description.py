@@ -17,12 +17,14 @@ from mindgrasp_bringup.launch_system.substitutions import (
     Substitution,
     perform_substitutions,
 )
+from mindgrasp_common.resources import resource_path
 
 if TYPE_CHECKING:
     from mindgrasp_bringup.launch_system.context import LaunchContext
 
-#: the profiles: src/mindgrasp_bringup/launch/<profile>.launch.py
-PROFILE_DIR = Path(__file__).resolve().parent.parent / 'launch'
+#: the profiles: mindgrasp_bringup/launch/<profile>.launch.py (share/mindgrasp_bringup/launch
+#: in a colcon install)
+PROFILE_DIR = resource_path('mindgrasp_bringup', 'launch')
 LAUNCH_SUFFIX = '.launch.py'
 
 

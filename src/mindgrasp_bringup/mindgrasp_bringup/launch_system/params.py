@@ -11,6 +11,7 @@ A parameter file maps node names to ``ros__parameters`` (nested maps are paramet
 
 from __future__ import annotations
 
+import contextlib
 import os
 import re
 from collections.abc import Mapping
@@ -20,6 +21,7 @@ from typing import Any
 import yaml
 
 from mindgrasp_bringup.launch_system.errors import LaunchError
+from mindgrasp_common.resources import ResourceNotFoundError, resource_path
 
 PARAMS_KEY = 'ros__parameters'
 _SCALARS = (bool, int, float, str, bytes)
@@ -144,19 +146,26 @@ def dump_parameters(per_node: Mapping[str, Mapping[str, Any]]) -> str:
     return yaml.safe_dump(doc, sort_keys=False, default_flow_style=None, width=100)
 
 
-#: config/params of the repository (src layout: <root>/src/mindgrasp_bringup/launch_system/)
-PARAMS_DIR = Path(__file__).resolve().parents[4] / 'config' / 'params'
+#: the package whose ``param/<name>.yaml`` holds the parameters of each name; names not listed
+#: (launch profiles: demo, hardware, replay, ...) are files of mindgrasp_bringup
+PARAMETER_FILE_OWNERS: dict[str, str] = {
+    name: f'mindgrasp_{name}' for name in ('eeg', 'classifier', 'vision', 'fsm', 'sim', 'trainer')}
 
 
 def config_files(*names: str) -> list[Path]:
-    """The existing files among ``config/params/<name>.yaml``, in order.
+    """The existing parameter files among ``<package>/param/<name>.yaml``, in order.
 
-    Launch files pass them first in ``parameters=[...]`` (later entries win); a package without a
-    parameter file yet runs on its node's declared defaults. The files named in
-    ``$MINDGRASP_PARAMS_FILES`` follow (``mindgrasp session`` passes each phase's settings so).
+    Launch files pass them first in ``parameters=[...]`` (later entries win); a name without a
+    parameter file (a profile without overrides) is skipped, so its nodes run on their defaults.
+    The files named in ``$MINDGRASP_PARAMS_FILES`` follow (``mindgrasp session`` passes each
+    phase's settings so).
     """
-    files = [PARAMS_DIR / f'{name}.yaml' for name in names]
+    files = []
+    for name in names:
+        package = PARAMETER_FILE_OWNERS.get(name, 'mindgrasp_bringup')
+        with contextlib.suppress(ResourceNotFoundError):
+            files.append(resource_path(package, 'param', f'{name}.yaml'))
     # extra ROS parameter files (os.pathsep-separated), e.g. a session phase's settings; each
     # node reads its own section of them, after the package defaults
     extra = [Path(f) for f in os.environ.get('MINDGRASP_PARAMS_FILES', '').split(os.pathsep) if f]
-    return [f for f in files if f.is_file()] + extra
+    return files + extra

@@ -29,9 +29,8 @@ from typing import Any
 import yaml
 
 from mindgrasp_bringup.launch_system.errors import LaunchError
+from mindgrasp_common.resources import resource_path
 
-#: the repository root (src layout: <root>/src/mindgrasp_bringup/launch_system/rundir.py)
-PROJECT_ROOT = Path(__file__).resolve().parents[4]
 DIST_NAME = 'mindgrasp-ros'
 _ENV_KEYS = ('ROS_DOMAIN_ID', 'ROS_AUTOMATIC_DISCOVERY_RANGE', 'ROS_STATIC_PEERS',
              'RMW_IMPLEMENTATION', 'MINDGRASP_RMW', 'CYCLONEDDS_URI', 'ROS_DISTRO')
@@ -73,9 +72,14 @@ def create_run_dir(profile: str, run_dir: str | Path | None = None,
     return path.resolve()
 
 
+def _source_dir() -> Path:
+    """Where the running code lives (git finds the checkout enclosing it, if any)."""
+    return resource_path('mindgrasp_bringup')
+
+
 def _git(*args: str) -> str | None:
     try:
-        out = subprocess.run(['git', '-C', str(PROJECT_ROOT), *args], capture_output=True,
+        out = subprocess.run(['git', '-C', str(_source_dir()), *args], capture_output=True,
                              text=True, timeout=10, check=False)
     except (OSError, subprocess.TimeoutExpired):
         return None
@@ -86,7 +90,7 @@ def git_info() -> dict[str, Any]:
     """Revision, branch and whether the working tree has uncommitted changes."""
     revision = _git('rev-parse', 'HEAD')
     if revision is None:
-        return {'revision': None, 'note': f'{PROJECT_ROOT} is not a git checkout'}
+        return {'revision': None, 'note': f'{_source_dir()} is not in a git checkout'}
     status = _git('status', '--porcelain', '--untracked-files=no')
     return {'revision': revision, 'branch': _git('rev-parse', '--abbrev-ref', 'HEAD'),
             'dirty': bool(status), 'describe': _git('describe', '--always', '--dirty')}
