@@ -5,7 +5,7 @@ it (``mindgrasp_fsm/config/fsm.yaml``, ``mindgrasp_sim/scenes/set_locations.yaml
 :func:`resource_path`::
 
     from mindgrasp_common.resources import resource_path
-    fsm_yaml = resource_path('mindgrasp_fsm', 'config', 'fsm.yaml')
+    fsm_yaml = resource_path('mindgrasp_fsm', 'param', 'fsm.yaml')
 
 Lookup order:
 
@@ -71,7 +71,7 @@ def resource_path(package: str, *parts: str) -> Path:
         Python / ROS package name, e.g. ``'mindgrasp_fsm'``.
     *parts : str
         Path inside the package, as one string with ``/`` or as separate parts
-        (``'config/fsm.yaml'`` or ``'config', 'fsm.yaml'``); none: the package's data folder.
+        (``'param/fsm.yaml'`` or ``'param', 'fsm.yaml'``); none: the package's data folder.
 
     Returns
     -------
