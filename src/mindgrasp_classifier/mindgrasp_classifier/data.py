@@ -17,6 +17,7 @@ import numpy as np
 
 from mindgrasp_classifier.errors import ClassifierError
 from mindgrasp_classifier.model import CLASS_NAMES, class_index
+from mindgrasp_common.mi import NO_CLASS
 
 #: EEGMMIDB run -> {annotation: MIndGrasp class} (../shared/data/EEGMMIDB-README.md).
 EEGMMIDB_RUNS: dict[int, dict[str, int]] = {
@@ -25,7 +26,7 @@ EEGMMIDB_RUNS: dict[int, dict[str, int]] = {
 }
 EEGMMIDB_IMAGERY_RUNS = (4, 6, 8, 10, 12, 14)
 _EEGMMIDB_NAME = re.compile(r'^S(\d{3})R(\d{2})\.edf$', re.IGNORECASE)
-NO_CLASS = 255
+
 
 
 @dataclass

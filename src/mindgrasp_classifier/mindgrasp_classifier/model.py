@@ -23,10 +23,11 @@ from pyriemann.geometry.covariance import covariances
 from mindgrasp_classifier.errors import ClassifierError
 from mindgrasp_classifier.pipelines import _DistanceClassifier, classifier_from_arrays
 from mindgrasp_classifier.preprocessing import oas_covariances
+from mindgrasp_common.errors import CommonError
+from mindgrasp_common.mi import CLASS_NAMES
+from mindgrasp_common.mi import class_index as mi_class_index
 from mindgrasp_common.resources import ResourceNotFoundError, resolve_path
 
-#: MIndGrasp class names by class index (MIPrediction constants).
-CLASS_NAMES: tuple[str, ...] = ('left_hand', 'right_hand', 'both_hands', 'both_feet')
 FORMAT = 'mindgrasp-mi-model'
 #: the demo model trained by scripts/train_default_classifier.py
 DEFAULT_MODEL = 'package://mindgrasp_classifier/models/default_classifier.json'
@@ -37,17 +38,10 @@ SCALE_V_TO_UV = 1e6
 
 def class_index(name_or_index: str | int) -> int:
     """MIndGrasp class index from a name (``left_hand``) or index; raises on unknown names."""
-    if isinstance(name_or_index, (int, np.integer)):
-        if 0 <= int(name_or_index) < len(CLASS_NAMES):
-            return int(name_or_index)
-    else:
-        key = str(name_or_index).strip().lower().replace(' ', '_').replace('-', '_')
-        if key.isdigit() and int(key) < len(CLASS_NAMES):
-            return int(key)
-        if key in CLASS_NAMES:
-            return CLASS_NAMES.index(key)
-    msg = f'Unknown MI class {name_or_index!r}; use one of {list(CLASS_NAMES)} or 0-3.'
-    raise ClassifierError(msg)
+    try:
+        return mi_class_index(name_or_index)
+    except CommonError as exc:
+        raise ClassifierError(str(exc)) from None
 
 
 def library_versions() -> dict[str, str]:

@@ -1,4 +1,4 @@
-"""Channel montage and motor-imagery class names shared by the EEG package.
+"""Channel montage of the EEG package, and the motor-imagery classes (from mindgrasp_common).
 
 The default montage is the 32-channel g.tec g.Nautilus 10-20 layout used in the MIndGrasp paper;
 names follow MNE's ``standard_1020`` spelling so ``mne.channels.make_standard_montage`` finds every
@@ -6,6 +6,11 @@ position.
 """
 
 from __future__ import annotations
+
+from mindgrasp_common.mi import CLASS_NAMES, NO_CLASS, MiClass, class_name
+
+__all__ = ['BOTH_FEET', 'BOTH_HANDS', 'CLASS_NAMES', 'LEFT_HAND', 'NAUTILUS_32', 'NAUTILUS_RATE',
+           'NO_CLASS', 'RIGHT_HAND', 'class_name']
 
 #: 32 channels of a g.Nautilus-like 10-20 cap, in stream order.
 NAUTILUS_32: tuple[str, ...] = (
@@ -17,15 +22,5 @@ NAUTILUS_32: tuple[str, ...] = (
 #: Default sampling rate of the g.Nautilus in the paper (Hz).
 NAUTILUS_RATE = 250.0
 
-#: Motor-imagery classes (index = ``MIPrediction.class_index``).
-CLASS_NAMES: tuple[str, ...] = ('left_hand', 'right_hand', 'both_hands', 'both_feet')
-LEFT_HAND, RIGHT_HAND, BOTH_HANDS, BOTH_FEET = 0, 1, 2, 3
-#: ``Prompt.NO_CLASS``: fixation / rest.
-NO_CLASS = 255
-
-
-def class_name(index: int | None) -> str:
-    """Name of a class index; ``'rest'`` for ``None`` or :data:`NO_CLASS`."""
-    if index is None or index == NO_CLASS:
-        return 'rest'
-    return CLASS_NAMES[index]
+#: Motor-imagery class indices (``MIPrediction.class_index``), as plain ints
+LEFT_HAND, RIGHT_HAND, BOTH_HANDS, BOTH_FEET = (int(c) for c in MiClass)

@@ -26,14 +26,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from mindgrasp_common.geometry import wrap_angle
+from mindgrasp_common.states import State
+
 from . import EEGError
 from .montage import BOTH_FEET, BOTH_HANDS, LEFT_HAND, NO_CLASS, RIGHT_HAND
 
 MODES = ('noise', 'follow', 'pursue')
 
-# FsmState constants (mindgrasp_msgs/FsmState)
-OBJECT_SEARCH, CENTER_OBJECT, INITIAL_APPROACH = 1, 2, 3
-FINAL_APPROACH, GRASP_OBJECT, RETURN_TO_START = 4, 5, 6
 
 
 @dataclass(frozen=True)
@@ -51,11 +51,6 @@ class SceneObject:
     def label(self) -> str:
         """``"<colour> <shape>"`` as in ``FsmState.object_of_interest``."""
         return f'{self.colour} {self.shape}'
-
-
-def wrap_angle(a: float) -> float:
-    """Wrap an angle (rad) to [-pi, pi)."""
-    return (a + math.pi) % (2.0 * math.pi) - math.pi
 
 
 def find_target(objects: Sequence[SceneObject], object_id: int = -1, colour: str = '',
@@ -98,12 +93,13 @@ def pursue_class(target: SceneObject | None, base_yaw: float, fsm_state: int,
         approach), 3 both feet (back away from a wrong object), None (rest: the controller is
         autonomous or there is nothing to do).
     """
-    if target is None or fsm_state in (FINAL_APPROACH, GRASP_OBJECT, RETURN_TO_START):
+    if target is None or fsm_state in (State.FINAL_APPROACH, State.GRASP_OBJECT,
+                                        State.RETURN_TO_START):
         return None
     wrong = bool(object_of_interest) and object_of_interest != target.label
-    if fsm_state == CENTER_OBJECT:
+    if fsm_state == State.CENTER_OBJECT:
         return BOTH_FEET if wrong else None
-    if fsm_state == INITIAL_APPROACH and wrong:
+    if fsm_state == State.INITIAL_APPROACH and wrong:
         return BOTH_FEET
     error = wrap_angle(math.atan2(target.y, target.x) - base_yaw)
     if error > heading_tolerance:

@@ -11,10 +11,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from mindgrasp_common.robot import FINGER_CLOSED, FINGER_OPEN
 from mindgrasp_fsm.types import GripperState, ObjectObservation, VisionFrame
-
-#: finger joint angles (rad) of the simulated hand for open and closed (mindgrasp_sim.simulation)
-FINGER_OPEN, FINGER_CLOSED = -0.55, 1.25
 
 
 def observation_from_detection(det: object) -> ObjectObservation:

@@ -30,7 +30,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mindgrasp_fsm.kinematics import ArmKinematics, wrap_angle
+from mindgrasp_common.geometry import wrap_angle
+from mindgrasp_fsm.kinematics import ArmKinematics
 from mindgrasp_fsm.params import FsmParams
 from mindgrasp_fsm.types import CameraModel, GripperCommand, GripperState, VisionFrame
 

@@ -12,6 +12,7 @@ from __future__ import annotations
 from typing import Protocol
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 
 class ArmKinematics(Protocol):
@@ -33,39 +34,6 @@ class ArmKinematics(Protocol):
         gripper pointing straight down and the finger closing axis turned by ``yaw`` (rad) about
         the vertical; ``None`` when no solution within 1 cm exists."""
         ...
-
-
-def rotation_z(angle: float) -> np.ndarray:
-    """3x3 rotation about z by ``angle`` (rad)."""
-    c, s = np.cos(angle), np.sin(angle)
-    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-
-
-def wrap_angle(angle: float) -> float:
-    """Angle wrapped to [-pi, pi)."""
-    return float((angle + np.pi) % (2 * np.pi) - np.pi)
-
-
-def rotation_rpy(roll: float, pitch: float, yaw: float) -> np.ndarray:
-    """URDF fixed-axis roll-pitch-yaw to a 3x3 rotation (Rz(yaw) Ry(pitch) Rx(roll))."""
-    cr, sr, cp, sp, cy, sy = (np.cos(roll), np.sin(roll), np.cos(pitch), np.sin(pitch),
-                              np.cos(yaw), np.sin(yaw))
-    return np.array([
-        [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
-        [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
-        [-sp, cp * sr, cp * cr],
-    ])
-
-
-def _axis_angle(axis: np.ndarray, angle: float) -> np.ndarray:
-    x, y, z = axis
-    c, s = np.cos(angle), np.sin(angle)
-    k = 1 - c
-    return np.array([
-        [c + x * x * k, x * y * k - z * s, x * z * k + y * s],
-        [y * x * k + z * s, c + y * y * k, y * z * k - x * s],
-        [z * x * k - y * s, z * y * k + x * s, c + z * z * k],
-    ])
 
 
 def _transform(xyz: np.ndarray, rot: np.ndarray) -> np.ndarray:
@@ -113,7 +81,9 @@ class UrdfKinematics:
             joints[j.find('child').get('link')] = {
                 'name': j.get('name'), 'type': j.get('type'),
                 'parent': j.find('parent').get('link'),
-                'origin': _transform(xyz, rotation_rpy(*rpy)), 'axis': axis / np.linalg.norm(axis),
+                # URDF rpy: fixed-axis roll, pitch, yaw (Rz(yaw) Ry(pitch) Rx(roll))
+                'origin': _transform(xyz, Rotation.from_euler('xyz', rpy).as_matrix()),
+                'axis': axis / np.linalg.norm(axis),
                 'lower': float(limit.get('lower', -np.pi)) if limit is not None else -np.pi,
                 'upper': float(limit.get('upper', np.pi)) if limit is not None else np.pi,
             }
@@ -144,12 +114,19 @@ class UrdfKinematics:
     def link_pose(self, q: np.ndarray, link: str) -> np.ndarray:
         """4x4 pose of ``link`` in the base frame at joints ``q`` (rad)."""
         t = np.eye(4)
+        rotations = iter(self._joint_rotations(q, link))
         for joint in self._chains[link]:
             t = t @ joint['origin']
             if joint['type'] in ('revolute', 'continuous'):
-                angle = float(q[self._index[joint['name']]])
-                t = t @ _transform(np.zeros(3), _axis_angle(joint['axis'], angle))
+                t[:3, :3] = t[:3, :3] @ next(rotations)
         return t
+
+    def _joint_rotations(self, q: np.ndarray, link: str) -> np.ndarray:
+        """Rotations (n_moving, 3, 3) of the moving joints on the chain to ``link`` at ``q``,
+        in chain order (one scipy call for all of them)."""
+        chain = [j for j in self._chains[link] if j['type'] in ('revolute', 'continuous')]
+        rotvecs = np.array([j['axis'] * float(q[self._index[j['name']]]) for j in chain])
+        return Rotation.from_rotvec(rotvecs).as_matrix()
 
     def camera_pose(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Camera optical frame: position (3,) m and rotation (3, 3) in the base frame."""
@@ -169,14 +146,14 @@ class UrdfKinematics:
     def _fk_jacobian(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Tool pose (4x4) and the geometric Jacobian (6, 6) [linear; angular] at ``q``."""
         t = np.eye(4)
-        axes, _origins = [], []
+        axes = []
+        rotations = iter(self._joint_rotations(q, self.tool_link))
         for joint in self._chains[self.tool_link]:
             t = t @ joint['origin']
-            if joint['type'] in ('revolute', 'continuous') and joint['name'] in self._index:
+            if joint['type'] in ('revolute', 'continuous'):
                 axes.append((self._index[joint['name']], t[:3, :3] @ joint['axis'],
                              t[:3, 3].copy()))
-                angle = float(q[self._index[joint['name']]])
-                t = t @ _transform(np.zeros(3), _axis_angle(joint['axis'], angle))
+                t[:3, :3] = t[:3, :3] @ next(rotations)
         jac = np.zeros((6, 6))
         p = t[:3, 3]
         for i, z, o in axes:
@@ -215,7 +192,8 @@ class UrdfKinematics:
     def _error(t: np.ndarray, position: np.ndarray, rotation: np.ndarray) -> np.ndarray:
         dp = np.asarray(position) - t[:3, 3]
         r = rotation @ t[:3, :3].T
-        # rotation vector of r (small-angle safe)
+        # rotation vector of r (small-angle safe), written out: this runs in every IK iteration
+        # and scipy's Rotation.from_matrix (which re-orthonormalises) costs ~10x more here
         angle = np.arccos(np.clip((np.trace(r) - 1) / 2, -1.0, 1.0))
         if angle < 1e-9:
             dr = np.zeros(3)

@@ -18,9 +18,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from mindgrasp_common.geometry import wrap_angle
 from mindgrasp_fsm.conversions import gripper_from_fingers, vision_frame_from_result
 from mindgrasp_fsm.grasp_fsm import GraspFsm
-from mindgrasp_fsm.kinematics import wrap_angle
 from mindgrasp_fsm.types import CameraModel, FsmInputs, JointStateIn, MiClass, Prediction, State
 
 #: an object counts as grasped when it is held above this height (m; original MIndGrasp code)

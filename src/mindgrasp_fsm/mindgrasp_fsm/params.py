@@ -15,7 +15,14 @@ from pathlib import Path
 from typing import Any
 
 from mindgrasp_common.resources import resource_path
-from mindgrasp_common.robot import URDF_URI
+from mindgrasp_common.robot import (
+    ARM_JOINTS,
+    ARM_LOWER_LIMITS,
+    ARM_MAX_VELOCITY,
+    ARM_UPPER_LIMITS,
+    HOME_POSE,
+    URDF_URI,
+)
 from mindgrasp_fsm.errors import FsmError
 
 SHAPES = ('cube', 'cylinder', 'sphere')
@@ -30,18 +37,14 @@ class FsmParams:
     urdf_file: str = URDF_URI           # URDF for FK / IK: a path or a package:// URI
     tool_link: str = 'tcp'              # grasp point between the fingertips
     camera_link: str = 'camera_color_optical_frame'
-    joint_names: list[str] = field(default_factory=lambda: [f'joint_{i}' for i in range(1, 7)])
+    joint_names: list[str] = field(default_factory=lambda: list(ARM_JOINTS))
     # start pose (rad) of the URDF: long arm up, short arm forward, wrist
     # pitched so the camera looks down at the objects (the paper: all straight except joint 5)
-    home_position: list[float] = field(
-        default_factory=lambda: [0.0, 0.0, 0.0, math.pi / 2, 1.2, 0.0])
-    joint_lower_limits: list[float] = field(
-        default_factory=lambda: [-3.05, -1.75, -2.6, -2.6, -2.4, -3.05])  # rad
-    joint_upper_limits: list[float] = field(
-        default_factory=lambda: [3.05, 1.75, 2.6, 2.6, 2.4, 3.05])  # rad
+    home_position: list[float] = field(default_factory=lambda: list(HOME_POSE))  # rad
+    joint_lower_limits: list[float] = field(default_factory=lambda: list(ARM_LOWER_LIMITS))  # rad
+    joint_upper_limits: list[float] = field(default_factory=lambda: list(ARM_UPPER_LIMITS))  # rad
     joint_limit_margin: float = 0.02    # rad kept clear of each limit
-    max_joint_velocity: list[float] = field(
-        default_factory=lambda: [1.0, 1.0, 1.3, 1.3, 1.6, 1.6])  # rad/s
+    max_joint_velocity: list[float] = field(default_factory=lambda: list(ARM_MAX_VELOCITY))  # rad/s
     control_period: float = 0.02        # s, nominal tick (used to stop short of joint limits)
     lock_duration: float = 1.0          # s all joints held between states (paper: locks)
     watchdog_timeout: float = 0.3       # s, oldest acceptable prediction / joint state

@@ -1,52 +1,22 @@
-"""Plain data types exchanged with :class:`mindgrasp_fsm.grasp_fsm.GraspFsm` (no ROS)."""
+"""Plain data types exchanged with :class:`mindgrasp_fsm.grasp_fsm.GraspFsm` (no ROS); the
+shared ones (predictions, camera model, states, MI classes) come from :mod:`mindgrasp_common`."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from enum import IntEnum
 
 import numpy as np
 
-CLASS_NAMES = ('left_hand', 'right_hand', 'both_hands', 'both_feet')
+from mindgrasp_common.mi import CLASS_NAMES, MiClass
+from mindgrasp_common.states import STATE_NAMES, State
+from mindgrasp_common.types import CameraModel, Prediction
 
-
-class State(IntEnum):
-    """The paper's six FSM states (same numbers as mindgrasp_msgs/FsmState)."""
-
-    OBJECT_SEARCH = 1
-    CENTER_OBJECT = 2
-    INITIAL_APPROACH = 3
-    FINAL_APPROACH = 4
-    GRASP_OBJECT = 5
-    RETURN_TO_START = 6
-
-
-STATE_NAMES = {
-    State.OBJECT_SEARCH: 'Object Search',
-    State.CENTER_OBJECT: 'Center Object',
-    State.INITIAL_APPROACH: 'Initial Approach',
-    State.FINAL_APPROACH: 'Final Approach',
-    State.GRASP_OBJECT: 'Grasp Object',
-    State.RETURN_TO_START: 'Return to Start',
-}
-
-
-class MiClass(IntEnum):
-    """Motor-imagery classes (mindgrasp_msgs/MIPrediction)."""
-
-    LEFT_HAND = 0
-    RIGHT_HAND = 1
-    BOTH_HANDS = 2
-    BOTH_FEET = 3
-
-
-@dataclass(frozen=True)
-class Prediction:
-    """Latest MI decision. ``stamp``: time of the last decoded sample (s, controller clock)."""
-
-    class_index: int
-    certainty: float
-    stamp: float
+# shared with the other packages (defined in mindgrasp_common), used here by the controller
+__all__ = [
+    'CLASS_NAMES', 'STATE_NAMES', 'CameraModel', 'FsmInputs', 'FsmOutput', 'GripperCommand',
+    'GripperState', 'JointStateIn', 'MiClass', 'ObjectObservation', 'Prediction', 'State',
+    'VisionFrame',
+]
 
 
 @dataclass(frozen=True)
@@ -77,34 +47,6 @@ class VisionFrame:
     image_height: int
     object_of_interest: ObjectObservation | None = None
     n_detections: int = 0
-
-
-@dataclass(frozen=True)
-class CameraModel:
-    """Pinhole intrinsics of the eye-in-hand camera (sensor_msgs/CameraInfo K), pixels."""
-
-    width: int
-    height: int
-    fx: float
-    fy: float
-    cx: float
-    cy: float
-
-    @classmethod
-    def from_k(cls, width: int, height: int, k: np.ndarray) -> CameraModel:
-        """From a row-major 3x3 (or 9-vector) K matrix."""
-        k = np.asarray(k, dtype=float).reshape(3, 3)
-        return cls(int(width), int(height), float(k[0, 0]), float(k[1, 1]), float(k[0, 2]),
-                   float(k[1, 2]))
-
-    def scaled_to(self, width: int, height: int) -> CameraModel:
-        """Intrinsics for an image of another size (same field of view)."""
-        sx, sy = width / self.width, height / self.height
-        return CameraModel(width, height, self.fx * sx, self.fy * sy, self.cx * sx, self.cy * sy)
-
-    def backproject(self, u: float, v: float, depth: float) -> np.ndarray:
-        """Point (m, optical frame: x right, y down, z forward) at pixel (u, v) and depth z."""
-        return np.array([(u - self.cx) / self.fx * depth, (v - self.cy) / self.fy * depth, depth])
 
 
 @dataclass(frozen=True)

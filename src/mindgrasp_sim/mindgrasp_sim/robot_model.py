@@ -27,10 +27,18 @@ import math
 import sys
 from dataclasses import dataclass, field
 
-#: names of the six arm joints, base to wrist
-ARM_JOINTS = ('joint_1', 'joint_2', 'joint_3', 'joint_4', 'joint_5', 'joint_6')
-#: names of the three finger joints (thumb first)
-FINGER_JOINTS = ('finger_thumb_joint', 'finger_left_joint', 'finger_right_joint')
+from mindgrasp_common.robot import (
+    ARM_EFFORT,
+    ARM_JOINTS,
+    ARM_LOWER_LIMITS,
+    ARM_MAX_VELOCITY,
+    ARM_UPPER_LIMITS,
+    FINGER_JOINTS,
+    FINGER_LOWER_LIMIT,
+    FINGER_UPPER_LIMIT,
+)
+
+__all__ = ['ARM_JOINTS', 'FINGER_JOINTS', 'ArmSpec', 'build_urdf']
 
 
 @dataclass
@@ -54,12 +62,12 @@ class ArmSpec:
     finger_thickness: float = 0.012
     tcp_offset: float = 0.07
     masses: tuple[float, ...] = (4.0, 1.2, 1.8, 0.5, 0.9, 0.3, 0.45, 0.04)
-    lower: tuple[float, ...] = (-3.05, -1.75, -2.6, -2.6, -2.4, -3.05)
-    upper: tuple[float, ...] = (3.05, 1.75, 2.6, 2.6, 2.4, 3.05)
-    velocity: tuple[float, ...] = (1.0, 1.0, 1.3, 1.3, 1.6, 1.6)
-    effort: tuple[float, ...] = (60.0, 80.0, 40.0, 30.0, 12.0, 6.0)
-    finger_lower: float = -0.6
-    finger_upper: float = 1.3
+    lower: tuple[float, ...] = ARM_LOWER_LIMITS
+    upper: tuple[float, ...] = ARM_UPPER_LIMITS
+    velocity: tuple[float, ...] = ARM_MAX_VELOCITY
+    effort: tuple[float, ...] = ARM_EFFORT
+    finger_lower: float = FINGER_LOWER_LIMIT
+    finger_upper: float = FINGER_UPPER_LIMIT
     finger_velocity: float = 1.5
     finger_effort: float = 1.2         # per finger (N m); the thumb gets twice this
     colour: tuple[float, float, float, float] = (0.85, 0.85, 0.88, 1.0)

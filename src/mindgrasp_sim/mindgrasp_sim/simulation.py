@@ -37,20 +37,23 @@ from pathlib import Path
 import numpy as np
 import pybullet as pb
 from pybullet_utils.bullet_client import BulletClient
+from scipy.spatial.transform import Rotation
 
+from mindgrasp_common.geometry import top_down_quat
 from mindgrasp_common.resources import ResourceNotFoundError, resolve_path
-from mindgrasp_common.robot import URDF_URI
+from mindgrasp_common.robot import (
+    ARM_JOINTS,
+    FINGER_CLOSED,
+    FINGER_JOINTS,
+    FINGER_OPEN,
+    HOME_POSE,
+    URDF_URI,
+)
 from mindgrasp_sim.control import validate_velocities
 from mindgrasp_sim.errors import SimError
 from mindgrasp_sim.realism import Realism, RealismProfile
-from mindgrasp_sim.robot_model import ARM_JOINTS, FINGER_JOINTS
 from mindgrasp_sim.scene import ObjectSpec, SceneSpec, load_scene
 
-#: home pose (rad): long arm up, short arm forward, wrist pitched so the camera looks down at the
-#: objects 0.5 m in front of the base (the paper: "all joints straight except joint 5")
-HOME_POSE = (0.0, 0.0, 0.0, math.pi / 2, 1.2, 0.0)
-#: finger joint angles (rad) for closure 0 (open) and 1 (closed)
-FINGER_OPEN, FINGER_CLOSED = -0.55, 1.25
 #: PD motor position gain (pybullet's per-step error fraction): stiff, so gravity sag < 1 mrad
 ARM_POSITION_GAIN = 0.8
 GROUND_RGBA = (0.78, 0.77, 0.74, 1.0)
@@ -136,40 +139,6 @@ class _Robot:
     gripper_dirty: bool = True
     holding: bool = False     # zero command already given to the motors: nothing to update
     v_applied: np.ndarray = field(default_factory=lambda: np.zeros(6))  # after the lag, rad/s
-
-
-def _quat_to_matrix(quat: np.ndarray) -> np.ndarray:
-    return np.array(pb.getMatrixFromQuaternion(quat), dtype=float).reshape(3, 3)
-
-
-def top_down_quat(yaw: float = 0.0) -> np.ndarray:
-    """Quaternion (xyzw) of a gripper pointing straight down whose thumb points along ``yaw``
-    (rad, world frame) rotated by pi, i.e. the thumb is on the side facing the base when ``yaw`` is
-    the object's bearing from the base."""
-    # gripper z = world -z; gripper x = -(cos yaw, sin yaw, 0) (towards the base)
-    x = -np.array([math.cos(yaw), math.sin(yaw), 0.0])
-    z = np.array([0.0, 0.0, -1.0])
-    y = np.cross(z, x)
-    m = np.column_stack([x, y, z])
-    return _matrix_to_quat(m)
-
-
-def _matrix_to_quat(m: np.ndarray) -> np.ndarray:
-    tr = m[0, 0] + m[1, 1] + m[2, 2]
-    if tr > 0:
-        s = math.sqrt(tr + 1.0) * 2
-        q = [(m[2, 1] - m[1, 2]) / s, (m[0, 2] - m[2, 0]) / s, (m[1, 0] - m[0, 1]) / s, 0.25 * s]
-    elif m[0, 0] > m[1, 1] and m[0, 0] > m[2, 2]:
-        s = math.sqrt(1.0 + m[0, 0] - m[1, 1] - m[2, 2]) * 2
-        q = [0.25 * s, (m[0, 1] + m[1, 0]) / s, (m[0, 2] + m[2, 0]) / s, (m[2, 1] - m[1, 2]) / s]
-    elif m[1, 1] > m[2, 2]:
-        s = math.sqrt(1.0 + m[1, 1] - m[0, 0] - m[2, 2]) * 2
-        q = [(m[0, 1] + m[1, 0]) / s, 0.25 * s, (m[1, 2] + m[2, 1]) / s, (m[0, 2] - m[2, 0]) / s]
-    else:
-        s = math.sqrt(1.0 + m[2, 2] - m[0, 0] - m[1, 1]) * 2
-        q = [(m[0, 2] + m[2, 0]) / s, (m[1, 2] + m[2, 1]) / s, 0.25 * s, (m[1, 0] - m[0, 1]) / s]
-    q = np.array(q)
-    return q / np.linalg.norm(q)
 
 
 class Simulation:
@@ -708,7 +677,7 @@ class Simulation:
         c = self.camera
         p = self._p
         pos, orn = self.camera_pose(robot)
-        rot = _quat_to_matrix(orn)
+        rot = Rotation.from_quat(orn).as_matrix()
         sensed = not exact and robot == 'user' and self.realism.enabled
         if sensed:
             pos, rot = self.realism.camera_pose(pos, rot)

@@ -1,4 +1,5 @@
-"""Shared pieces of the cue protocols: class names, prompt events, balanced class orders.
+"""Shared pieces of the cue protocols: prompt events, balanced class orders (class names and
+``NO_CLASS`` from mindgrasp_common).
 
 No ROS imports: the Graz-BCI schedule and the MIndGrasp Trainer use these, and so do offline tools
 that label recorded EEG from prompts.
@@ -11,6 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from mindgrasp_common.mi import CLASS_NAMES, NO_CLASS
+
 __all__ = [
     'CLASS_NAMES',
     'NO_CLASS',
@@ -20,12 +23,6 @@ __all__ = [
     'balanced_order',
     'check_classes',
 ]
-
-#: Motor-imagery classes, index -> name (same order as mindgrasp_msgs/MIPrediction).
-CLASS_NAMES: tuple[str, ...] = ('left_hand', 'right_hand', 'both_hands', 'both_feet')
-
-#: class_index of a prompt that asks for no class (fixation, rest, end); Prompt.NO_CLASS.
-NO_CLASS = 255
 
 #: Phase names of mindgrasp_msgs/Prompt.
 PHASES: tuple[str, ...] = ('fixation', 'cue', 'move', 'wait', 'rest', 'end')

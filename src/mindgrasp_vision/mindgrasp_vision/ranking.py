@@ -13,14 +13,14 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+from mindgrasp_common.mi import MiClass
 from mindgrasp_vision._checks import VisionError
 from mindgrasp_vision.detector import Detection
 
 __all__ = ['LEFT_HAND', 'RIGHT_HAND', 'ObjectOfInterestRanker']
 
-#: MI class indices of mindgrasp_msgs/MIPrediction that shift the focus
-LEFT_HAND = 0
-RIGHT_HAND = 1
+#: MI classes that shift the focus (mindgrasp_common.mi)
+LEFT_HAND, RIGHT_HAND = int(MiClass.LEFT_HAND), int(MiClass.RIGHT_HAND)
 
 
 @dataclass
