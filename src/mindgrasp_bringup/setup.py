@@ -48,6 +48,7 @@ setup(
     entry_points={
         'console_scripts': [
             'trial_manager_node = mindgrasp_bringup.trial_manager_node:main',
+            'foxglove_bridge_node = mindgrasp_bringup.foxglove_bridge_node:main',
             'recorder_node = mindgrasp_bringup.bag.recorder_node:main',
             'player_node = mindgrasp_bringup.bag.player_node:main',
             'mindgrasp = mindgrasp_bringup.cli:main',

@@ -1,0 +1,144 @@
+"""Live view node: the graph's topics over the Foxglove WebSocket protocol, for the experimenter.
+
+    ros2 run mindgrasp_bringup foxglove_bridge_node          # or: mindgrasp launch demo
+    python -m mindgrasp_bringup.foxglove_bridge_node --ros-args -p port:=8766
+
+Open Foxglove (desktop app, or app.foxglove.dev in a browser on this machine), "Open connection",
+``ws://localhost:8765``; the layout ``config/foxglove/mindgrasp_live.json`` of mindgrasp_bringup
+shows the camera with its overlay, the 3D scene (TF + URDF from /robot_description), the EEG
+traces, the prediction certainty and the controller state.
+
+Like foxglove_bridge (its parameter names ``port``, ``address``, ``topic_whitelist``): every topic
+that has a publisher and matches a ``topic_whitelist`` regex is subscribed with the publishers' QoS
+(transient local for /robot_description and /tf_static, best effort for the camera), taking raw CDR,
+and advertised with its ROS 2 schema. Only topics a client subscribed are forwarded; a slow client
+loses its oldest messages beyond ``message_backlog_size``, the graph never waits for it. Listens on
+loopback only unless ``address`` says otherwise. A port in use ends the node with exit code 2 and
+one line naming the fix.
+"""
+
+from __future__ import annotations
+
+import re
+import time
+from dataclasses import dataclass
+from typing import Any
+
+from mindgrasp_bringup.bag.qos import adapted_qos, qos_to_dict, resubscribe_qos
+from mindgrasp_bringup.bag.ros_glue import message_class, qos_profile
+from mindgrasp_bringup.live_view import DEFAULT_PORT, FoxgloveServer, LiveViewError
+from mindgrasp_ros import rclpy
+from mindgrasp_ros.node_main import run_node
+from mindgrasp_ros.params import ParameterError, declare_params, param
+from mindgrasp_ros.typesupport import message_definition
+
+#: ROS graph topics nobody needs in the view
+_EXCLUDED = ('/rosout', '/parameter_events')
+
+
+@dataclass
+class BridgeParams:
+    """Parameters of the live view node (names as foxglove_bridge's)."""
+
+    port: int = param(DEFAULT_PORT, 'TCP port of the WebSocket server (0: any free port)',
+                      min=0, max=65535)
+    address: str = param('127.0.0.1', 'address to listen on (loopback: this machine only)')
+    # param() returns a dataclasses.field with a default_factory for lists
+    topic_whitelist: list[str] = param(['.*'], 'regexes of the topics to serve')  # noqa: RUF009
+    message_backlog_size: int = param(
+        1024, 'messages queued per client before its oldest are dropped', min=1)
+    discovery_period: float = param(1.0, 'how often new topics are looked for', unit='s',
+                                    min=0.05)
+    duration: float = param(0.0, 'end after this long (0: run until stopped)', unit='s', min=0.0)
+
+    def __post_init__(self) -> None:
+        for pattern in self.topic_whitelist:
+            try:
+                re.compile(pattern)
+            except re.error as exc:
+                msg = (f"topic_whitelist entry {pattern!r} is not a regular expression ({exc}); "
+                       f"fix it, e.g. topic_whitelist:=\"['/camera/.*', '/tf']\".")
+                raise ParameterError(msg) from None
+
+
+class FoxgloveBridgeNode(rclpy.node.Node):
+    """Subscribes to the graph's topics as they appear and forwards them to Foxglove clients."""
+
+    def __init__(self, **kwargs: Any) -> None:
+        super().__init__('foxglove_bridge', **kwargs)
+        self.params = declare_params(self, BridgeParams)
+        self.done = rclpy.task.Future()
+        self.whitelist = [re.compile(p) for p in self.params.topic_whitelist]
+        self.server = FoxgloveServer(self.params.address, self.params.port,
+                                     message_backlog_size=self.params.message_backlog_size)
+        self._subscriptions: dict[str, Any] = {}
+        self._requested: dict[str, dict[str, Any]] = {}
+        self.get_logger().info(f'Live view on {self.server.url}: open it in Foxglove '
+                               '(Open connection > Foxglove WebSocket).')
+        self.create_timer(self.params.discovery_period, self.discover_callback)
+        # latched topics (URDF, /tf_static, controller state) reach clients that join later
+        self.create_timer(0.1, self.server.resend_latched)
+        if self.params.duration > 0:
+            self.create_timer(self.params.duration, self.duration_callback)
+        self.discover_callback()
+
+    def _wanted(self, topic: str) -> bool:
+        return topic not in _EXCLUDED and any(p.fullmatch(topic) for p in self.whitelist)
+
+    def discover_callback(self) -> None:
+        """Advertise and subscribe every new wanted topic that has a publisher; re-match QoS."""
+        for topic, types in self.get_topic_names_and_types():
+            if not self._wanted(topic):
+                continue
+            offered = [qos_to_dict(i.qos_profile)
+                       for i in self.get_publishers_info_by_topic(topic)]
+            if topic in self._subscriptions:
+                again = resubscribe_qos(self._requested[topic], offered, default_depth=10)
+                if again is not None:
+                    self._subscribe(topic, types[0], again)
+                continue
+            if not offered:
+                continue
+            try:
+                definition = message_definition(types[0])
+            except Exception as exc:  # a type our typestore does not know: skip, say why
+                self.get_logger().warning(f'Not serving {topic}: its type {types[0]} is unknown '
+                                          f'here ({exc}).')
+                self._subscriptions[topic] = None
+                self._requested[topic] = {}
+                continue
+            qos = adapted_qos(offered, default_depth=10)
+            latched = qos['durability'] == 'transient_local'
+            self.server.add_channel(topic, types[0], definition,
+                                    latched_depth=qos['depth'] if latched else 0)
+            self._subscribe(topic, types[0], qos)
+
+    def _subscribe(self, topic: str, type_name: str, qos: dict[str, Any]) -> None:
+        old = self._subscriptions.get(topic)
+        if old is not None:
+            self.destroy_subscription(old)
+        self._requested[topic] = qos
+
+        def forward(data: bytes, topic: str = topic) -> None:
+            self.server.log(topic, data, time.time_ns())
+
+        self._subscriptions[topic] = self.create_subscription(
+            message_class(type_name), topic, forward, qos_profile(rclpy, qos), raw=True)
+
+    def duration_callback(self) -> None:
+        self.done.set_result(0)
+
+    def destroy_node(self) -> None:
+        sent = sum(t.messages for t in self.server.topics.values())
+        self.get_logger().info(f'Live view served {len(self.server.topics)} topic(s), '
+                               f'{sent} message(s) to clients.')
+        self.server.stop()
+        super().destroy_node()
+
+
+def main(args: list[str] | None = None) -> int:
+    return run_node(FoxgloveBridgeNode, args, errors=(LiveViewError,))
+
+
+if __name__ == '__main__':
+    raise SystemExit(main())

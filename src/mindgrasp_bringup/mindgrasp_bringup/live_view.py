@@ -1,0 +1,164 @@
+"""The Foxglove live view: ROS 2 topics served over the Foxglove WebSocket protocol (ROS-free).
+
+:class:`FoxgloveServer` wraps the ``foxglove-sdk`` WebSocket server. Each ROS topic becomes one
+channel with its ROS 2 schema (``ros2msg`` encoding: the full message definition with its
+dependencies, as rosbag2 stores it in MCAP) and CDR messages, so the Foxglove app decodes them as
+it decodes a ROS 2 bag or ``foxglove_bridge``::
+
+    server = FoxgloveServer(host='127.0.0.1', port=8765)     # LiveViewError: port in use
+    server.add_channel('/fsm/state', 'mindgrasp_msgs/msg/FsmState', definition_text)
+    server.log('/fsm/state', cdr_bytes, time_ns)              # never blocks
+    server.stop()
+
+A slow client never slows the caller: :meth:`log` hands the message to the SDK, which queues at most
+``message_backlog_size`` messages per client and drops that client's oldest ones beyond it.
+"""
+
+from __future__ import annotations
+
+import collections
+import ipaddress
+import queue
+from dataclasses import dataclass, field
+
+__all__ = ['DEFAULT_PORT', 'FoxgloveServer', 'LiveViewError']
+
+#: the Foxglove app's default WebSocket address is ws://localhost:8765
+DEFAULT_PORT = 8765
+
+
+class LiveViewError(Exception):
+    """The live view cannot start (port in use, bad address); the message says the fix."""
+
+
+@dataclass
+class _Topic:
+    channel: object
+    type_name: str
+    messages: int = 0        #: messages handed to the server
+    skipped: int = 0         #: messages not serialised for anyone (no client subscribed)
+    #: latched topics (transient local): the last messages, sent again to a new subscriber
+    latched: collections.deque = field(default_factory=lambda: collections.deque(maxlen=0))
+
+
+class _Listener:
+    """foxglove ServerListener: notes the channels a client subscribed, for latched resends."""
+
+    def __init__(self) -> None:
+        self.subscribed: queue.SimpleQueue[str] = queue.SimpleQueue()
+
+    def on_subscribe(self, client: object, channel: object) -> None:
+        self.subscribed.put(channel.topic)  # type: ignore[attr-defined]
+
+
+class FoxgloveServer:
+    """A Foxglove WebSocket server with one channel per ROS topic.
+
+    Parameters
+    ----------
+    host : str
+        Address to listen on; loopback (``127.0.0.1``) by default so only this machine sees the
+        data. Another address exposes the EEG and camera to the network.
+    port : int
+        TCP port (0: any free port, see :attr:`port`).
+    message_backlog_size : int
+        Messages queued per client before its oldest are dropped (a slow client loses frames,
+        the graph does not wait).
+    """
+
+    def __init__(self, host: str = '127.0.0.1', port: int = DEFAULT_PORT, *,
+                 message_backlog_size: int = 1024, name: str = 'MIndGrasp-ROS') -> None:
+        import foxglove
+
+        try:
+            ipaddress.ip_address(host)
+        except ValueError:
+            msg = (f"The live view address {host!r} is not an IP address; use 127.0.0.1 "
+                   f"(this machine only) or 0.0.0.0 (every interface).")
+            raise LiveViewError(msg) from None
+        if not 0 <= int(port) <= 65535:
+            msg = f'The live view port {port} is not a TCP port; give 1-65535 (0: any free one).'
+            raise LiveViewError(msg)
+        self._foxglove = foxglove
+        self._context = foxglove.Context()  # our own: channels of other code stay out
+        self._listener = _Listener()
+        try:
+            self._server = foxglove.start_server(
+                name=name, host=host, port=int(port), context=self._context,
+                message_backlog_size=int(message_backlog_size),
+                supported_encodings=['cdr'], server_listener=self._listener)
+        except RuntimeError as exc:
+            if 'in use' in str(exc).lower():
+                msg = (f'The live view port {port} on {host} is in use (another live view or '
+                       f'foxglove_bridge?): stop it, or pick another port with '
+                       f'live_view_port:=<port> (node parameter port:=<port>).')
+            else:
+                msg = f'The live view cannot listen on {host}:{port}: {exc}.'
+            raise LiveViewError(msg) from None
+        self.host = host
+        self.topics: dict[str, _Topic] = {}
+
+    @property
+    def port(self) -> int:
+        """The TCP port the server listens on."""
+        return int(self._server.port)
+
+    @property
+    def url(self) -> str:
+        """``ws://<host>:<port>``, what to open in Foxglove."""
+        host = 'localhost' if self.host in ('127.0.0.1', '0.0.0.0') else self.host
+        return f'ws://{host}:{self.port}'
+
+    def add_channel(self, topic: str, type_name: str, definition: str, *,
+                    latched_depth: int = 0) -> None:
+        """Advertise ``topic`` with its type (``pkg/msg/Type``) and ros2msg definition text.
+
+        ``latched_depth`` > 0 (a transient-local topic such as /robot_description): its last
+        messages are kept and sent again when a client subscribes (see :meth:`resend_latched`).
+        """
+        if topic in self.topics:
+            return
+        schema = self._foxglove.Schema(name=type_name, encoding='ros2msg',
+                                       data=definition.encode('utf-8'))
+        channel = self._foxglove.Channel(topic, schema=schema, message_encoding='cdr',
+                                         context=self._context)
+        self.topics[topic] = _Topic(channel, type_name,
+                                    latched=collections.deque(maxlen=max(0, latched_depth)))
+
+    def wanted(self, topic: str) -> bool:
+        """Whether a client is subscribed to ``topic`` (else logging it is wasted work)."""
+        entry = self.topics.get(topic)
+        return entry is not None and bool(entry.channel.has_sinks())
+
+    def log(self, topic: str, cdr: bytes, time_ns: int) -> None:
+        """Send one CDR message (with its 4-byte encapsulation header) to the subscribed
+        clients; ``time_ns``: receive time (ns since the epoch). Never blocks."""
+        entry = self.topics[topic]
+        if entry.latched.maxlen:
+            entry.latched.append((bytes(cdr), int(time_ns)))
+        if not entry.channel.has_sinks():
+            entry.skipped += 1
+            return
+        entry.channel.log(bytes(cdr), log_time=int(time_ns))
+        entry.messages += 1
+
+    def resend_latched(self) -> int:
+        """Send the kept messages of latched topics that a client subscribed since the last
+        call (as a transient-local subscriber would get them); returns how many were sent. Call
+        it periodically from the thread that calls :meth:`log`."""
+        sent = 0
+        while True:
+            try:
+                topic = self._listener.subscribed.get_nowait()
+            except queue.Empty:
+                return sent
+            entry = self.topics.get(topic)
+            for data, time_ns in list(entry.latched) if entry is not None else []:
+                entry.channel.log(data, log_time=time_ns)
+                sent += 1
+
+    def stop(self) -> None:
+        """Close the channels and the server (clients see the connection end)."""
+        for entry in self.topics.values():
+            entry.channel.close()
+        self._server.stop()

@@ -1,0 +1,126 @@
+"""The Foxglove live view: the bridge node in its own process, this test's topics over real DDS,
+and a WebSocket client speaking the Foxglove protocol that subscribes, receives and decodes the
+messages with the advertised ros2msg schemas."""
+
+from __future__ import annotations
+
+import json
+import re
+import socket
+import struct
+import time
+
+import numpy as np
+import pytest
+from mcap_ros2._dynamic import generate_dynamic
+from websockets.sync.client import connect
+
+pytestmark = pytest.mark.slow
+
+MODULE = 'mindgrasp_bringup.foxglove_bridge_node'
+SUBPROTOCOLS = ['foxglove.sdk.v1', 'foxglove.websocket.v1']
+
+
+def _start_bridge(spawn_node, **params):
+    proc = spawn_node(MODULE, port=0, discovery_period=0.2, **params)
+    assert proc.wait_for_output('Live view on ws://', 60), proc.output()
+    port = int(re.search(r'Live view on ws://localhost:(\d+)', proc.output()).group(1))
+    return proc, port
+
+
+def test_client_receives_camera_eeg_and_state_with_their_schemas(rclpy_ctx, spawn_node) -> None:
+    from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import EEGChunk, FsmState
+    from mindgrasp_ros.interfaces.sensor_msgs.msg import Image
+    from mindgrasp_ros.interfaces.std_msgs.msg import String
+
+    rclpy = rclpy_ctx
+    proc, port = _start_bridge(spawn_node)
+    node = rclpy.create_node('live_view_probe')
+    latched = rclpy.qos.QoSProfile(depth=1, reliability=rclpy.qos.ReliabilityPolicy.RELIABLE,
+                                   durability=rclpy.qos.DurabilityPolicy.TRANSIENT_LOCAL)
+    pubs = {
+        '/camera/color/image_raw': node.create_publisher(
+            Image, '/camera/color/image_raw', rclpy.qos.qos_profile_sensor_data),
+        '/eeg/raw': node.create_publisher(EEGChunk, '/eeg/raw', 10),
+        '/fsm/state': node.create_publisher(FsmState, '/fsm/state', latched),
+        '/robot_description': node.create_publisher(String, '/robot_description', latched),
+    }
+    rgb = np.arange(4 * 6 * 3, dtype=np.uint8)
+    messages = {
+        '/camera/color/image_raw': Image(height=4, width=6, encoding='rgb8', step=18, data=rgb),
+        '/eeg/raw': EEGChunk(sample_rate=250.0, channel_names=['C3', 'C4'], n_samples=2,
+                             unit='V', data=np.array([1e-6, 2e-6, 3e-6, 4e-6], np.float32)),
+        '/fsm/state': FsmState(state=2, state_name='CENTER_OBJECT', object_of_interest='red cube'),
+        '/robot_description': String(data='<robot name="arm"/>'),
+    }
+    for topic in ('/fsm/state', '/robot_description'):   # latched: published once
+        pubs[topic].publish(messages[topic])
+
+    channels: dict[int, dict] = {}
+    received: dict[str, object] = {}
+    subscribed: dict[int, str] = {}
+    with connect(f'ws://127.0.0.1:{port}', subprotocols=SUBPROTOCOLS, proxy=None,
+                 open_timeout=30) as ws:
+        deadline = time.monotonic() + 60.0
+        while time.monotonic() < deadline and len(received) < len(messages):
+            for topic in ('/camera/color/image_raw', '/eeg/raw'):   # streams
+                pubs[topic].publish(messages[topic])
+            rclpy.spin_once(node, timeout_sec=0.01)
+            try:
+                frame = ws.recv(timeout=0.1)
+            except TimeoutError:
+                continue
+            if isinstance(frame, str):
+                op = json.loads(frame)
+                if op['op'] == 'advertise':
+                    wanted = []
+                    for ch in op['channels']:
+                        channels[ch['id']] = ch
+                        if ch['topic'] in messages:
+                            sub_id = len(subscribed) + 1
+                            subscribed[sub_id] = ch['topic']
+                            wanted.append({'id': sub_id, 'channelId': ch['id']})
+                    if wanted:
+                        ws.send(json.dumps({'op': 'subscribe', 'subscriptions': wanted}))
+                continue
+            opcode, sub_id, _log_time = struct.unpack_from('<BIQ', frame)
+            assert opcode == 1  # message data
+            topic = subscribed[sub_id]
+            ch = next(c for c in channels.values() if c['topic'] == topic)
+            decode = generate_dynamic(ch['schemaName'], ch['schema'])[ch['schemaName']]
+            received[topic] = decode(bytes(frame[13:]))
+        assert set(received) == set(messages), (sorted(received), proc.output())
+    # advertised as ROS 2 schemas with CDR messages, decoded by the schema text alone
+    by_topic = {c['topic']: c for c in channels.values()}
+    assert by_topic['/eeg/raw']['schemaName'] == 'mindgrasp_msgs/msg/EEGChunk'
+    assert by_topic['/eeg/raw']['schemaEncoding'] == 'ros2msg'
+    assert by_topic['/eeg/raw']['encoding'] == 'cdr'
+    image = received['/camera/color/image_raw']
+    assert (image.width, image.height, image.encoding) == (6, 4, 'rgb8')
+    assert bytes(image.data) == rgb.tobytes()
+    eeg = received['/eeg/raw']
+    assert list(eeg.channel_names) == ['C3', 'C4']
+    np.testing.assert_allclose(eeg.data, [1e-6, 2e-6, 3e-6, 4e-6], rtol=1e-6)
+    state = received['/fsm/state']
+    assert (state.state, state.state_name, state.object_of_interest) == (
+        2, 'CENTER_OBJECT', 'red cube')
+    assert received['/robot_description'].data == '<robot name="arm"/>'
+    assert proc.stop() == 0
+
+
+def test_port_in_use_exits_2_with_the_fix(spawn_node) -> None:
+    with socket.socket() as busy:
+        busy.bind(('127.0.0.1', 0))
+        busy.listen()
+        port = busy.getsockname()[1]
+        proc = spawn_node(MODULE, port=port)
+        assert proc.wait(60) == 2, proc.output()
+    assert f'The live view port {port} on 127.0.0.1 is in use' in proc.output()
+    assert 'Traceback' not in proc.output()
+
+
+def test_bad_whitelist_regex_exits_2(spawn_node) -> None:
+    proc = spawn_node(MODULE, '--ros-args', '-p', 'topic_whitelist:=["(unclosed"]', '-p',
+                      'port:=0')
+    assert proc.wait(60) == 2, proc.output()
+    assert 'is not a regular expression' in proc.output()
