@@ -49,6 +49,7 @@ setup(
         'console_scripts': [
             'trial_manager_node = mindgrasp_bringup.trial_manager_node:main',
             'foxglove_bridge_node = mindgrasp_bringup.foxglove_bridge_node:main',
+            'replay_node = mindgrasp_bringup.replay.replay_node:main',
             'recorder_node = mindgrasp_bringup.bag.recorder_node:main',
             'player_node = mindgrasp_bringup.bag.player_node:main',
             'mindgrasp = mindgrasp_bringup.cli:main',

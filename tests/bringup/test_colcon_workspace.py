@@ -26,6 +26,9 @@ REPO = Path(__file__).resolve().parents[2]
 SRC = REPO / 'src'
 PACKAGES = sorted(p for p in SRC.iterdir() if (p / 'package.xml').is_file())
 PYTHON_PACKAGES = [p for p in PACKAGES if p.name != 'mindgrasp_msgs']
+#: imports that package.xml cannot declare: colcon refuses dependency cycles
+UNDECLARED = {('mindgrasp_trainer', 'mindgrasp_bringup'):
+              'session.py reads bags with BagReader lazily; bringup depends on the trainer'}
 
 
 def console_scripts(package_dir: Path) -> dict[str, str]:
@@ -62,6 +65,7 @@ def test_package_xml_is_valid_format_3(package_dir: Path) -> None:
                               ''.join(p.read_text(encoding='utf-8')
                                       for p in (package_dir / package.name).rglob('*.py')),
                               re.M)) - {package.name} if build_type == 'ament_python' else set()
+    imported -= {dep for pkg, dep in UNDECLARED if pkg == package.name}
     assert imported <= declared, f'{package.name}: declare {sorted(imported - declared)}'
 
 

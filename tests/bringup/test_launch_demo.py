@@ -27,14 +27,16 @@ def test_demo_runs_headless_ends_cleanly_and_records_the_session(tmp_path: Path)
     # generous stop timeout: this machine may be loaded by other test runs
     # one trial: the virtual subject (pursue) must drive the arm to grasp the red cube; the
     # trial manager then ends the launch (duration is only a safety net)
+    # the live view on a free port: several test runs share this host
     result = run_launch('demo', 'duration:=150', f'eeg_stream:={stream}', 'trials:=1',
+                        'live_view_port:=0',
                         "targets:=red cube", '--sigint-timeout', '20', '--run-dir', str(run_dir),
                         timeout=400)
     assert result.returncode == 0, result.stderr[-4000:]
     summary = yaml.safe_load((run_dir / 'summary.yaml').read_text())
     assert {p['label'] for p in summary['processes']} == {
         'recorder', 'trial_manager', 'sim', 'virtual_amp', 'eeg_acquisition', 'classifier',
-        'vision', 'fsm'}
+        'vision', 'fsm', 'foxglove_bridge'}
     log = (run_dir / 'logs' / 'trial_manager.log').read_text()
     assert 'Trial 1 (red cube): correct object grasped' in log, log[-2000:]
     for label in ('sim', 'eeg_acquisition', 'classifier', 'vision', 'fsm'):

@@ -21,7 +21,9 @@ def test_mine_and_the_helpers_profiles_exist() -> None:
 def test_demo_starts_every_node_after_the_recorder() -> None:
     procs = processes('demo', 'seed:=4', 'eeg_stream:=amp-x')
     assert list(procs) == ['recorder', 'trial_manager', 'sim', 'virtual_amp', 'eeg_acquisition',
-                           'classifier', 'vision', 'fsm']
+                           'classifier', 'vision', 'fsm', 'foxglove_bridge']
+    assert procs['foxglove_bridge'].parameters['port'] == 8765
+    assert 'foxglove_bridge' not in processes('demo', 'live_view:=false')
     assert procs['trial_manager'].parameters['targets'] == 'red cube, blue cylinder, yellow sphere'
     assert procs['trial_manager'].parameters['n_trials'] == 3
     assert procs['trial_manager'].parameters['seed'] == 4

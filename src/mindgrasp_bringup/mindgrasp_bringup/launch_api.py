@@ -66,6 +66,8 @@ _HELPERS = {
     'display_arguments': 'mindgrasp_bringup.launch_system.common',
     'display_nodes': 'mindgrasp_bringup.launch_system.common',
     'sim_scene_camera': 'mindgrasp_bringup.launch_system.common',
+    'live_view_arguments': 'mindgrasp_bringup.launch_system.common',
+    'live_view_nodes': 'mindgrasp_bringup.launch_system.common',
 }
 
 __all__ = ['own_launcher', 'using_real_launch', *_SOURCES, *_HELPERS]

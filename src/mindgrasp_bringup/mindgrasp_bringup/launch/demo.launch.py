@@ -6,7 +6,9 @@ acquisition, MI classifier, vision and the grasp controller, recorded to the run
     mindgrasp launch demo duration:=120 gui:=true targets:='blue cylinder, red cube' trials:=2
     mindgrasp launch demo display:=window           # with the participant's screen
     mindgrasp launch demo realism:=default          # noisy camera, miscalibrated, lagging arm
+    mindgrasp launch demo live_view:=false          # without the Foxglove live view
     mindgrasp launch demo --show-args
+    ros2 launch mindgrasp_bringup demo.launch.py    # the same, in a sourced ROS 2 workspace
 
 The task, as in the paper's set-locations experiment: the trial manager names the object to grasp
 on /task/target (latched), where the virtual subject (subject:=pursue) reads what to imagine and
@@ -27,6 +29,8 @@ from mindgrasp_bringup.launch_api import (
     config_files,
     display_arguments,
     display_nodes,
+    live_view_arguments,
+    live_view_nodes,
     sim_scene_camera,
 )
 
@@ -64,6 +68,7 @@ def generate_launch_description() -> LaunchDescription:
                               description='grasp trials before the demo ends (0: until duration '
                                           'or Ctrl-C)'),
         *display_arguments(),
+        *live_view_arguments(),
         # 0 the trials: which object to grasp, reset between grasps
         Node(package='mindgrasp_bringup', executable='trial_manager_node', name='trial_manager',
              parameters=[*config_files('demo'),
@@ -94,4 +99,6 @@ def generate_launch_description() -> LaunchDescription:
         # 6 controller: predictions + detections -> arm and gripper commands
         Node(package='mindgrasp_fsm', executable='fsm_node', name='fsm',
              parameters=config_files('fsm', 'demo')),
+        # 7 live view for the experimenter: Foxglove at ws://localhost:8765
+        *live_view_nodes(),
     ])

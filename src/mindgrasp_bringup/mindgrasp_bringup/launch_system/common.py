@@ -92,3 +92,26 @@ def sim_scene_camera(display_rate: float = 5.0) -> list[tuple[object, dict]]:
     return [(la.LaunchConfigurationEquals('display', 'off'), {'scene_camera_rate': 0.0}),
             (la.LaunchConfigurationNotEquals('display', 'off'),
              {'scene_camera_rate': display_rate})]
+
+
+def live_view_arguments() -> list[Any]:
+    """``live_view:=true|false`` and ``live_view_port:=8765``, for :func:`live_view_nodes`."""
+    return [
+        la.DeclareLaunchArgument('live_view', default_value='true', choices=['true', 'false'],
+                                 description='serve the topics to Foxglove on '
+                                             'ws://localhost:<live_view_port> (loopback only)'),
+        la.DeclareLaunchArgument('live_view_port', default_value='8765',
+                                 description='TCP port of the live view (0: any free port, '
+                                             'printed in its log)'),
+    ]
+
+
+def live_view_nodes() -> list[Any]:
+    """The Foxglove bridge (``foxglove_bridge``) when ``live_view:=true``; declare
+    :func:`live_view_arguments` in the profile."""
+    return [
+        la.Node(package='mindgrasp_bringup', executable='foxglove_bridge_node',
+                name='foxglove_bridge',
+                parameters=[{'port': la.LaunchConfiguration('live_view_port')}],
+                condition=la.IfCondition(la.LaunchConfiguration('live_view'))),
+    ]
