@@ -124,3 +124,19 @@ def test_bad_whitelist_regex_exits_2(spawn_node) -> None:
                       'port:=0')
     assert proc.wait(60) == 2, proc.output()
     assert 'is not a regular expression' in proc.output()
+
+
+def test_committed_layout_is_the_generated_one_and_shows_demo_topics() -> None:
+    from mindgrasp_bringup.live_layout import LAYOUT_FILE, TOPICS, build_layout
+    from mindgrasp_common.resources import resource_path
+
+    # shipped as package data (and to share/mindgrasp_bringup/ by colcon)
+    assert resource_path('mindgrasp_bringup', 'foxglove/mindgrasp_live.json') == LAYOUT_FILE
+    text = LAYOUT_FILE.read_text(encoding='utf-8')
+    assert text.strip() == build_layout(), 'run python -m mindgrasp_bringup.live_layout'
+    layout = json.loads(text)
+    assert layout['version'] == 1
+    used = set(re.findall(r'"(/[a-z_/]+)', text))
+    assert used <= set(TOPICS), used - set(TOPICS)
+    assert {'/vision/overlay', '/robot_description', '/eeg/raw', '/bci/prediction',
+            '/fsm/state'} <= used

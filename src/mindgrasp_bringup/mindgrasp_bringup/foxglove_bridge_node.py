@@ -4,15 +4,16 @@
     python -m mindgrasp_bringup.foxglove_bridge_node --ros-args -p port:=8766
 
 Open Foxglove (desktop app, or app.foxglove.dev in a browser on this machine), "Open connection",
-``ws://localhost:8765``; the layout ``config/foxglove/mindgrasp_live.json`` of mindgrasp_bringup
+``ws://localhost:8765``; the layout ``foxglove/mindgrasp_live.json`` of mindgrasp_bringup
 shows the camera with its overlay, the 3D scene (TF + URDF from /robot_description), the EEG
 traces, the prediction certainty and the controller state.
 
 Like foxglove_bridge (its parameter names ``port``, ``address``, ``topic_whitelist``): every topic
-that has a publisher and matches a ``topic_whitelist`` regex is subscribed with the publishers' QoS
-(transient local for /robot_description and /tf_static, best effort for the camera), taking raw CDR,
-and advertised with its ROS 2 schema. Only topics a client subscribed are forwarded; a slow client
-loses its oldest messages beyond ``message_backlog_size``, the graph never waits for it. Listens on
+that has a publisher and matches a ``topic_whitelist`` regex is advertised with its ROS 2 schema;
+the node subscribes to it (raw CDR, with the publishers' QoS: transient local for
+/robot_description and /tf_static, best effort for the camera) only while a client watches it, so
+an unwatched live view costs the graph nothing. A slow client loses its oldest messages beyond
+``message_backlog_size``; the graph never waits for it. Listens on
 loopback only unless ``address`` says otherwise. A port in use ends the node with exit code 2 and
 one line naming the fix.
 """
@@ -71,13 +72,13 @@ class FoxgloveBridgeNode(rclpy.node.Node):
         self.whitelist = [re.compile(p) for p in self.params.topic_whitelist]
         self.server = FoxgloveServer(self.params.address, self.params.port,
                                      message_backlog_size=self.params.message_backlog_size)
-        self._subscriptions: dict[str, Any] = {}
-        self._requested: dict[str, dict[str, Any]] = {}
+        self._types: dict[str, str] = {}                   # advertised topic -> type
+        self._subscriptions: dict[str, Any] = {}           # watched topic -> subscription
+        self._requested: dict[str, dict[str, Any]] = {}    # watched topic -> QoS
         self.get_logger().info(f'Live view on {self.server.url}: open it in Foxglove '
                                '(Open connection > Foxglove WebSocket).')
         self.create_timer(self.params.discovery_period, self.discover_callback)
-        # latched topics (URDF, /tf_static, controller state) reach clients that join later
-        self.create_timer(0.1, self.server.resend_latched)
+        self.create_timer(0.05, self.clients_callback)
         if self.params.duration > 0:
             self.create_timer(self.params.duration, self.duration_callback)
         self.discover_callback()
@@ -86,34 +87,48 @@ class FoxgloveBridgeNode(rclpy.node.Node):
         return topic not in _EXCLUDED and any(p.fullmatch(topic) for p in self.whitelist)
 
     def discover_callback(self) -> None:
-        """Advertise and subscribe every new wanted topic that has a publisher; re-match QoS."""
+        """Advertise every new wanted topic that has a publisher; re-match QoS of watched ones."""
         for topic, types in self.get_topic_names_and_types():
-            if not self._wanted(topic):
+            if not self._wanted(topic) or topic in self._types:
+                if self._subscriptions.get(topic) is not None:
+                    offered = [qos_to_dict(i.qos_profile)
+                               for i in self.get_publishers_info_by_topic(topic)]
+                    again = resubscribe_qos(self._requested[topic], offered, default_depth=10)
+                    if again is not None:
+                        self._subscribe(topic, again)
                 continue
             offered = [qos_to_dict(i.qos_profile)
                        for i in self.get_publishers_info_by_topic(topic)]
-            if topic in self._subscriptions:
-                again = resubscribe_qos(self._requested[topic], offered, default_depth=10)
-                if again is not None:
-                    self._subscribe(topic, types[0], again)
-                continue
             if not offered:
                 continue
+            self._types[topic] = types[0]
             try:
                 definition = message_definition(types[0])
             except Exception as exc:  # a type our typestore does not know: skip, say why
                 self.get_logger().warning(f'Not serving {topic}: its type {types[0]} is unknown '
                                           f'here ({exc}).')
-                self._subscriptions[topic] = None
-                self._requested[topic] = {}
                 continue
             qos = adapted_qos(offered, default_depth=10)
             latched = qos['durability'] == 'transient_local'
             self.server.add_channel(topic, types[0], definition,
                                     latched_depth=qos['depth'] if latched else 0)
-            self._subscribe(topic, types[0], qos)
 
-    def _subscribe(self, topic: str, type_name: str, qos: dict[str, Any]) -> None:
+    def clients_callback(self) -> None:
+        """Subscribe to a topic when a client starts watching it, drop it when nobody does."""
+        for event, topic in self.server.subscription_events():
+            if topic not in self.server.topics:
+                continue
+            if event == 'subscribe':
+                if self._subscriptions.get(topic) is None:
+                    offered = [qos_to_dict(i.qos_profile)
+                               for i in self.get_publishers_info_by_topic(topic)]
+                    self._subscribe(topic, adapted_qos(offered, default_depth=10))
+                else:  # already watched: latched data goes to the new client too
+                    self.server.resend_latched(topic)
+            elif not self.server.wanted(topic) and self._subscriptions.get(topic) is not None:
+                self.destroy_subscription(self._subscriptions.pop(topic))
+
+    def _subscribe(self, topic: str, qos: dict[str, Any]) -> None:
         old = self._subscriptions.get(topic)
         if old is not None:
             self.destroy_subscription(old)
@@ -123,7 +138,7 @@ class FoxgloveBridgeNode(rclpy.node.Node):
             self.server.log(topic, data, time.time_ns())
 
         self._subscriptions[topic] = self.create_subscription(
-            message_class(type_name), topic, forward, qos_profile(rclpy, qos), raw=True)
+            message_class(self._types[topic]), topic, forward, qos_profile(rclpy, qos), raw=True)
 
     def duration_callback(self) -> None:
         self.done.set_result(0)

@@ -12,6 +12,8 @@ it decodes a ROS 2 bag or ``foxglove_bridge``::
 
 A slow client never slows the caller: :meth:`log` hands the message to the SDK, which queues at most
 ``message_backlog_size`` messages per client and drops that client's oldest ones beyond it.
+:meth:`subscription_events` tells which channels clients (un)subscribed, so the caller subscribes
+to a ROS topic only while someone watches it (as foxglove_bridge does).
 """
 
 from __future__ import annotations
@@ -42,13 +44,16 @@ class _Topic:
 
 
 class _Listener:
-    """foxglove ServerListener: notes the channels a client subscribed, for latched resends."""
+    """foxglove ServerListener: queues client (un)subscriptions for the caller's thread."""
 
     def __init__(self) -> None:
-        self.subscribed: queue.SimpleQueue[str] = queue.SimpleQueue()
+        self.events: queue.SimpleQueue[tuple[str, str]] = queue.SimpleQueue()
 
     def on_subscribe(self, client: object, channel: object) -> None:
-        self.subscribed.put(channel.topic)  # type: ignore[attr-defined]
+        self.events.put(('subscribe', channel.topic))  # type: ignore[attr-defined]
+
+    def on_unsubscribe(self, client: object, channel: object) -> None:
+        self.events.put(('unsubscribe', channel.topic))  # type: ignore[attr-defined]
 
 
 class FoxgloveServer:
@@ -142,20 +147,25 @@ class FoxgloveServer:
         entry.channel.log(bytes(cdr), log_time=int(time_ns))
         entry.messages += 1
 
-    def resend_latched(self) -> int:
-        """Send the kept messages of latched topics that a client subscribed since the last
-        call (as a transient-local subscriber would get them); returns how many were sent. Call
-        it periodically from the thread that calls :meth:`log`."""
-        sent = 0
+    def subscription_events(self) -> list[tuple[str, str]]:
+        """``('subscribe' | 'unsubscribe', topic)`` of the clients since the last call (the SDK
+        reports them from its own thread; call this from the thread that calls :meth:`log`)."""
+        out = []
         while True:
             try:
-                topic = self._listener.subscribed.get_nowait()
+                out.append(self._listener.events.get_nowait())
             except queue.Empty:
-                return sent
-            entry = self.topics.get(topic)
-            for data, time_ns in list(entry.latched) if entry is not None else []:
-                entry.channel.log(data, log_time=time_ns)
-                sent += 1
+                return out
+
+    def resend_latched(self, topic: str) -> int:
+        """Send the kept messages of a latched topic again (a client subscribed to it after they
+        were logged, as a transient-local subscriber would get them); returns how many."""
+        entry = self.topics.get(topic)
+        if entry is None:
+            return 0
+        for data, time_ns in list(entry.latched):
+            entry.channel.log(data, log_time=time_ns)
+        return len(entry.latched)
 
     def stop(self) -> None:
         """Close the channels and the server (clients see the connection end)."""

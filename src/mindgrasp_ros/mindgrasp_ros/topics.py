@@ -136,6 +136,13 @@ TASK_RESULT = _t('/task/result', 'mindgrasp_msgs/msg/GraspResult', RELIABLE,
                  'sim', 'trial manager, recorder')
 SIM_OBJECTS = _t('/sim/objects', 'visualization_msgs/msg/MarkerArray', LATCHED,
                  'sim', 'trial manager, virtual subject, viewers')
+ROBOT_DESCRIPTION = _t('/robot_description', 'std_msgs/msg/String', LATCHED,
+                       'sim (or robot_state_publisher)', 'viewers (RViz, Foxglove)', 'URDF')
+TF = _t('/tf', 'tf2_msgs/msg/TFMessage', Qos(depth=100),
+        'sim (or robot_state_publisher)', 'viewers',
+        'arm and finger joints, at the joint-state rate')
+TF_STATIC = _t('/tf_static', 'tf2_msgs/msg/TFMessage', LATCHED,
+               'sim (or robot_state_publisher)', 'viewers', 'world->base_link, camera, TCP')
 SIM_STATUS = _t('/sim/status', 'diagnostic_msgs/msg/DiagnosticArray', RELIABLE, 'sim', 'all')
 VIRTUAL_SUBJECT_INTENT = _t('/virtual_subject/intent', 'std_msgs/msg/String', LATCHED,
                             'virtual amplifier', 'recorder', 'the imagined class')
@@ -164,7 +171,8 @@ TOPICS: dict[str, Topic] = {t.name: t for t in (
     TRAINER_EE_DISTANCE, COLOR_IMAGE, DEPTH_IMAGE, COLOR_INFO, DEPTH_INFO, JOINT_STATES,
     ARM_COMMANDS, GRIPPER_COMMANDS, GRIPPER_JOINT_STATES, GRIPPER_CONTACTS, EE_POSE,
     VISION_DETECTIONS, VISION_OVERLAY, FSM_STATE, TASK_TARGET, TASK_RESULT, SIM_OBJECTS,
-    SIM_STATUS, VIRTUAL_SUBJECT_INTENT, SCENE_IMAGE, DISPLAY_FLIP, DISPLAY_IMAGE, CLOCK,
+    ROBOT_DESCRIPTION, TF, TF_STATIC, SIM_STATUS, VIRTUAL_SUBJECT_INTENT, SCENE_IMAGE,
+    DISPLAY_FLIP, DISPLAY_IMAGE, CLOCK,
     *TRAINER_ROBOT_TOPICS)}
 
 

@@ -63,6 +63,7 @@ from mindgrasp_ros.interfaces.tf2_msgs.msg import TFMessage
 from mindgrasp_ros.interfaces.visualization_msgs.msg import MarkerArray
 
 from mindgrasp_ros import rclpy
+from mindgrasp_ros.topics import ROBOT_DESCRIPTION, TF, TF_STATIC
 from mindgrasp_sim import messages as msgs
 from mindgrasp_sim.control import CommandGate, gripper_closure
 from mindgrasp_sim.errors import SimError
@@ -214,7 +215,7 @@ class SimNode(rclpy.node.Node):
             # commands and requests (works under main() and in a composed process alike)
             self.create_timer(0.0, self.fast_callback)
         self.create_timer(0.5, self.duration_callback)
-        self._publish_robot_description(latched)
+        self._publish_robot_description()
         self.publish_all()
         robots = ' and the training robot' if 'trainer' in self.robots else ''
         if self.sim.realism.enabled:
@@ -404,19 +405,20 @@ class SimNode(rclpy.node.Node):
     def _header(self, frame_id: str = '') -> Header:
         return msgs.header(self._stamp(), frame_id)
 
-    def _publish_robot_description(self, latched: rclpy.qos.QoSProfile) -> None:
+    def _publish_robot_description(self) -> None:
         """/robot_description and /tf_static once (latched), and the /tf publisher, with the QoS
-        of robot_state_publisher and tf2_ros' broadcasters."""
+        of robot_state_publisher and tf2_ros' broadcasters (mindgrasp_ros.topics)."""
         urdf = self.sim.urdf.read_text(encoding='utf-8')
         self.tf_tree = TfTree(urdf)
-        self.create_publisher(String, '/robot_description', latched).publish(String(data=urdf))
+        self.create_publisher(String, ROBOT_DESCRIPTION.name, ROBOT_DESCRIPTION.qos).publish(
+            String(data=urdf))
         # the arm stands at the world origin (the simulation loads it there)
         base = Transform(self.p['frame_id'], self.tf_tree.root, np.zeros(3),
                          np.array([0.0, 0.0, 0.0, 1.0]))
-        self.tf_static_pub = self.create_publisher(TFMessage, '/tf_static', latched)
+        self.tf_static_pub = self.create_publisher(TFMessage, TF_STATIC.name, TF_STATIC.qos)
         self.tf_static_pub.publish(msgs.tf_message(self._stamp(),
                                                    [base, *self.tf_tree.static_transforms()]))
-        self.tf_pub = self.create_publisher(TFMessage, '/tf', rclpy.qos.QoSProfile(depth=100))
+        self.tf_pub = self.create_publisher(TFMessage, TF.name, TF.qos)
 
     def publish_all(self) -> None:
         self.publish_states()
