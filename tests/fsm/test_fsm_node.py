@@ -103,3 +103,62 @@ def test_node_graph_sim_vision_fsm_selects_and_approaches(rclpy_ctx, spawn_node)
     assert entered.object_of_interest.startswith('red')
     assert entered.previous_state == FsmState.CENTER_OBJECT
     node.destroy_node()
+
+
+def _mindgrasp(*args: str):
+    import subprocess
+    import sys
+
+    return subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', *args],
+                          capture_output=True, text=True, timeout=120)
+
+
+def test_fsm_parameters_live_change_refusal_and_read_only(rclpy_ctx, spawn_node) -> None:
+    """`mindgrasp param set /fsm watchdog_timeout -1` is refused with the range; a valid value
+    takes effect in the running controller; the robot model is read-only."""
+    rclpy = rclpy_ctx
+    from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import FsmState
+    from mindgrasp_ros.interfaces.sensor_msgs.msg import JointState
+
+    from mindgrasp_ros.topics import FSM_STATE, JOINT_STATES
+
+    proc = spawn_node('mindgrasp_fsm.fsm_node', '--ros-args', '-p', 'duration:=300.0')
+    assert proc.wait_for_output('Grasp controller ready', 60.0), proc.output()
+    out = _mindgrasp('param', 'describe', '/fsm', 'watchdog_timeout', 'urdf_file')
+    assert out.returncode == 0, out.stderr
+    assert 'Description: oldest acceptable prediction / joint state; older inputs stop every ' \
+        'joint [s]' in out.stdout and 'Min value: 0.01\n    Max value: 10.0' in out.stdout
+    assert 'Parameter name: urdf_file\n  Type: string' in out.stdout
+    out = _mindgrasp('param', 'set', '/fsm', 'watchdog_timeout', '-1')
+    assert out.returncode == 1, out.stdout
+    assert 'Setting parameter failed' in out.stderr and 'must be within [0.01, 10.0]' in out.stderr
+    out = _mindgrasp('param', 'set', '/fsm', 'urdf_file', '/tmp/other.urdf')
+    assert out.returncode == 1 and "'urdf_file' is read-only" in out.stderr, out.stderr
+
+    node = rclpy.node.Node('fsm_param_driver')
+    states: list[object] = []
+    node.create_subscription(FsmState, FSM_STATE.name, states.append, FSM_STATE.qos)
+    js_pub = node.create_publisher(JointState, JOINT_STATES.name, JOINT_STATES.qos)
+    assert spin_until(node, lambda: js_pub.get_subscription_count() > 0, 60.0)
+    js = JointState(name=[f'joint_{i}' for i in range(1, 7)], position=np.array(HOME),
+                    velocity=np.zeros(6))
+    js.header.stamp = node.get_clock().now().to_msg()
+    js_pub.publish(js)   # once: the joint states then grow old
+    assert spin_until(node, lambda: bool(states) and 'limit 0.30 s' in states[-1].reason, 60.0), \
+        ([s.reason for s in states[-3:]], proc.output())
+    out = _mindgrasp('param', 'set', '/fsm', 'watchdog_timeout', '1.5')
+    assert out.returncode == 0 and 'Set parameter successful' in out.stdout, out.stderr
+    assert spin_until(node, lambda: 'limit 1.50 s' in states[-1].reason, 60.0), \
+        ([s.reason for s in states[-3:]], proc.output())
+    assert _mindgrasp('param', 'get', '/fsm', 'watchdog_timeout').stdout.strip() == \
+        'Double value is: 1.5'
+    node.destroy_node()
+    assert proc.stop() == 0, proc.output()
+
+
+def test_fsm_bad_parameter_refuses_to_start(spawn_node) -> None:
+    proc = spawn_node('mindgrasp_fsm.fsm_node', '--ros-args', '-p', 'recenter_threshold:=0.01')
+    assert proc.wait(60) == 2
+    out = proc.output()
+    assert "'recenter_threshold' (0.01) must exceed 'center_tolerance'" in out, out
+    assert 'Traceback' not in out

@@ -3,5 +3,5 @@
 from __future__ import annotations
 
 
-class FsmError(Exception):
+class FsmError(ValueError):
     """Bad input or configuration of the grasp controller; the message names the problem and fix."""

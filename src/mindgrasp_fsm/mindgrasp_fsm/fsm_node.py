@@ -8,15 +8,15 @@ Subscribes ``/bci/prediction`` (mindgrasp_msgs/MIPrediction), ``/vision/detectio
 angles, efforts and contact flags), ``/camera/color/camera_info``. Publishes
 ``/arm_controller/commands`` (std_msgs/Float64MultiArray, 6 joint velocities in rad/s),
 ``/gripper_controller/commands`` (``[closure]``, 0 open .. 1 closed) and ``/fsm/state``
-(FsmState, transient local). Parameters: every field of :class:`mindgrasp_fsm.params.FsmParams`,
-plus ``control_rate`` (Hz) and ``duration`` (s; > 0 ends the node after that time, for launch
-tests).
+(FsmState, transient local). Topic names and QoS: :mod:`mindgrasp_ros.topics`. Parameters: every
+field of :class:`mindgrasp_fsm.params.FsmParams` (``mindgrasp param describe /fsm <name>`` shows
+unit, range and whether a change applies live), plus ``duration`` (s; > 0 ends the node after
+that time, for launch tests).
 """
 
 from __future__ import annotations
 
 import sys
-import time
 
 import numpy as np
 from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import DetectionArray, FsmState, MIPrediction
@@ -36,12 +36,19 @@ from mindgrasp_fsm.types import (
     Prediction,
 )
 from mindgrasp_ros import rclpy
-
-_RELIABLE = 10
-
-
-def _seconds(stamp: object) -> float:
-    return int(stamp.sec) + int(stamp.nanosec) * 1e-9
+from mindgrasp_ros.node_main import declare_duration, run_node
+from mindgrasp_ros.params import declare_params
+from mindgrasp_ros.topics import (
+    ARM_COMMANDS,
+    BCI_PREDICTION,
+    COLOR_INFO,
+    FSM_STATE,
+    GRIPPER_COMMANDS,
+    GRIPPER_CONTACTS,
+    GRIPPER_JOINT_STATES,
+    JOINT_STATES,
+    VISION_DETECTIONS,
+)
 
 
 class FsmNode(rclpy.node.Node):
@@ -49,52 +56,39 @@ class FsmNode(rclpy.node.Node):
 
     def __init__(self, **kwargs: object) -> None:
         super().__init__('fsm', **kwargs)
-        defaults = FsmParams().to_dict()
-        self.declare_parameters('', [*defaults.items(), ('control_rate', 50.0),
-                                     ('duration', 0.0)])
-        values = {name: self.get_parameter(name).value for name in defaults}
-        self.params = FsmParams.from_dict(values)      # FsmError ends the node with the reason
-        rate = float(self.get_parameter('control_rate').value)
-        if not rate > 0:
-            msg = f"The parameter 'control_rate' must be > 0 Hz, got {rate}; use e.g. 50.0."
-            raise FsmError(msg)
-        self.params.control_period = 1.0 / rate
+        # one FsmParams object, shared with the controller: live changes apply at the next tick
+        self.params = declare_params(self, FsmParams)
         self.fsm = GraspFsm.from_params(self.params)
         self.inputs = FsmInputs(time=0.0)
         self._fingers: np.ndarray | None = None
         self._finger_stamp = 0.0
         self._finger_efforts: np.ndarray | None = None
         self._contacts: np.ndarray | None = None
-        self._errors: dict[str, float] = {}
         self._last_state_msg: tuple | None = None
         self._last_state_pub = -1e9
-        self.done = False
+        self.done = rclpy.task.Future()
         self.ticks = 0
 
-        self.arm_pub = self.create_publisher(Float64MultiArray, '/arm_controller/commands',
-                                             _RELIABLE)
-        self.gripper_pub = self.create_publisher(Float64MultiArray,
-                                                 '/gripper_controller/commands', _RELIABLE)
-        latched = rclpy.qos.QoSProfile(
-            depth=1, reliability=rclpy.qos.ReliabilityPolicy.RELIABLE,
-            durability=rclpy.qos.DurabilityPolicy.TRANSIENT_LOCAL)
-        self.state_pub = self.create_publisher(FsmState, '/fsm/state', latched)
-        self.create_subscription(MIPrediction, '/bci/prediction', self.prediction_callback,
-                                 _RELIABLE)
-        self.create_subscription(DetectionArray, '/vision/detections', self.detections_callback,
-                                 _RELIABLE)
-        self.create_subscription(JointState, '/joint_states', self.joint_state_callback, _RELIABLE)
-        self.create_subscription(JointState, '/gripper/joint_states', self.finger_callback,
-                                 _RELIABLE)
-        self.create_subscription(UInt8MultiArray, '/gripper/contacts', self.contacts_callback,
-                                 _RELIABLE)
-        self.create_subscription(CameraInfo, '/camera/color/camera_info', self.info_callback,
-                                 rclpy.qos.qos_profile_sensor_data)
+        self.arm_pub = self.create_publisher(Float64MultiArray, ARM_COMMANDS.name, ARM_COMMANDS.qos)
+        self.gripper_pub = self.create_publisher(Float64MultiArray, GRIPPER_COMMANDS.name,
+                                                 GRIPPER_COMMANDS.qos)
+        self.state_pub = self.create_publisher(FsmState, FSM_STATE.name, FSM_STATE.qos)
+        self.create_subscription(MIPrediction, BCI_PREDICTION.name, self.prediction_callback,
+                                 BCI_PREDICTION.qos)
+        self.create_subscription(DetectionArray, VISION_DETECTIONS.name,
+                                 self.detections_callback, VISION_DETECTIONS.qos)
+        self.create_subscription(JointState, JOINT_STATES.name, self.joint_state_callback,
+                                 JOINT_STATES.qos)
+        self.create_subscription(JointState, GRIPPER_JOINT_STATES.name, self.finger_callback,
+                                 GRIPPER_JOINT_STATES.qos)
+        self.create_subscription(UInt8MultiArray, GRIPPER_CONTACTS.name, self.contacts_callback,
+                                 GRIPPER_CONTACTS.qos)
+        self.create_subscription(CameraInfo, COLOR_INFO.name, self.info_callback, COLOR_INFO.qos)
         self.create_timer(self.params.control_period, self.control_callback)
-        self._start = self._now()
-        self._duration = float(self.get_parameter('duration').value)
+        declare_duration(self)
         mode = 'autonomous' if self.params.autonomous else 'BCI'
-        self.get_logger().info(f'Grasp controller ready ({mode} mode, {rate:.0f} Hz, lock '
+        self.get_logger().info(f'Grasp controller ready ({mode} mode, '
+                               f'{1.0 / self.params.control_period:.0f} Hz, lock '
                                f'{self.params.lock_duration:.1f} s, watchdog '
                                f'{self.params.watchdog_timeout:.2f} s).')
 
@@ -103,14 +97,8 @@ class FsmNode(rclpy.node.Node):
         return self.get_clock().now().nanoseconds * 1e-9
 
     def _stamp_or_now(self, header: object) -> float:
-        t = _seconds(header.stamp)
+        t = rclpy.time.Time.from_msg(header.stamp).nanoseconds * 1e-9
         return t if t > 0 else self._now()   # unstamped messages: time of receipt
-
-    def _error(self, key: str, text: str) -> None:
-        now = time.monotonic()
-        if now - self._errors.get(key, -1e9) >= 5.0:   # the same problem at most every 5 s
-            self._errors[key] = now
-            self.get_logger().error(text)
 
     # ------------------------------------------------------------------ callbacks
     def prediction_callback(self, msg: MIPrediction) -> None:
@@ -119,8 +107,9 @@ class FsmNode(rclpy.node.Node):
 
     def detections_callback(self, msg: DetectionArray) -> None:
         if msg.image_width == 0 or msg.image_height == 0:
-            self._error('detections', 'Received /vision/detections with a zero image size; '
-                        'the vision node must fill image_width and image_height.')
+            self.get_logger().error('Received /vision/detections with a zero image size; the '
+                                    'vision node must fill image_width and image_height.',
+                                    throttle_duration_sec=5.0)
             return
         self.inputs.vision = vision_frame_from_msg(msg, self._stamp_or_now(msg.header))
 
@@ -129,14 +118,16 @@ class FsmNode(rclpy.node.Node):
         try:
             idx = [names.index(n) for n in self.params.joint_names]
         except ValueError:
-            self._error('joints', f'/joint_states names {names} lack one of the controller '
-                        f'joints {self.params.joint_names}; set joint_names to match the arm.')
+            self.get_logger().error(f'/joint_states names {names} lack one of the controller '
+                                    f'joints {self.params.joint_names}; set joint_names to '
+                                    'match the arm.', throttle_duration_sec=5.0)
             return
         pos = np.asarray(msg.position, dtype=float)
         vel = np.asarray(msg.velocity, dtype=float)
         if pos.size != len(names):
-            self._error('joints', f'/joint_states has {len(names)} names but {pos.size} '
-                        'positions; the arm driver must send one position per joint.')
+            self.get_logger().error(f'/joint_states has {len(names)} names but {pos.size} '
+                                    'positions; the arm driver must send one position per '
+                                    'joint.', throttle_duration_sec=5.0)
             return
         v = vel[idx] if vel.size == len(names) else np.zeros(len(idx))
         # NaN positions are passed on: the controller's watchdog stops the arm and says why
@@ -164,17 +155,14 @@ class FsmNode(rclpy.node.Node):
     def info_callback(self, msg: CameraInfo) -> None:
         k = np.asarray(msg.k, dtype=float)
         if k.size != 9 or k[0] <= 0 or k[4] <= 0 or msg.width == 0:
-            self._error('camera_info', f'camera_info K {k.tolist()} is not a pinhole matrix '
-                        '(9 values, fx, fy > 0); check the camera driver.')
+            self.get_logger().error(f'camera_info K {k.tolist()} is not a pinhole matrix '
+                                    '(9 values, fx, fy > 0); check the camera driver.',
+                                    throttle_duration_sec=5.0)
             return
         self.inputs.camera = CameraModel.from_k(int(msg.width), int(msg.height), k)
 
     def control_callback(self) -> None:
         now = self._now()
-        if self._duration > 0 and now - self._start >= self._duration:
-            self.arm_pub.publish(Float64MultiArray(data=np.zeros(6)))
-            self.done = True
-            return
         self.inputs.time = now
         out = self.fsm.tick(self.inputs)
         self.ticks += 1
@@ -199,28 +187,17 @@ class FsmNode(rclpy.node.Node):
         self.state_pub.publish(msg)
 
 
+    def destroy_node(self) -> None:
+        """Stop the arm (when the context still runs) and say how long the controller ran."""
+        if rclpy.ok():
+            self.arm_pub.publish(Float64MultiArray(data=np.zeros(6)))
+        self.get_logger().info(f'Controller ran {self.ticks} ticks.')
+        super().destroy_node()
+
+
 def main(args: list[str] | None = None) -> int:
     """Run the controller until Ctrl-C or the ``duration`` parameter; arm stopped on exit."""
-    rclpy.init(args=args if args is not None else sys.argv)
-    try:
-        node = FsmNode()
-    except FsmError as exc:
-        print(f'fsm: {exc}', file=sys.stderr)
-        rclpy.shutdown()
-        return 2
-    try:
-        while rclpy.ok() and not node.done:
-            rclpy.spin_once(node, timeout_sec=0.1)
-    except KeyboardInterrupt:
-        pass
-    finally:
-        if rclpy.ok():
-            node.arm_pub.publish(Float64MultiArray(data=np.zeros(6)))
-        node.get_logger().info(f'Controller ran {node.ticks} ticks.')
-        node.destroy_node()
-        if rclpy.ok():
-            rclpy.shutdown()
-    return 0
+    return run_node(FsmNode, args, errors=(FsmError,))
 
 
 if __name__ == '__main__':

@@ -10,7 +10,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -24,130 +24,232 @@ from mindgrasp_common.robot import (
     URDF_URI,
 )
 from mindgrasp_fsm.errors import FsmError
+from mindgrasp_ros.params import param
 
 SHAPES = ('cube', 'cylinder', 'sphere')
 
 
 @dataclass
 class FsmParams:
-    """Parameters of :class:`mindgrasp_fsm.grasp_fsm.GraspFsm` (SI units: s, rad, rad/s, m, N)."""
+    """Parameters of :class:`mindgrasp_fsm.grasp_fsm.GraspFsm` (SI units: s, rad, rad/s, m, N).
 
-    # --- general -------------------------------------------------------------------------------
-    autonomous: bool = False            # no BCI: search left, approach and grasp on vision alone
-    urdf_file: str = URDF_URI           # URDF for FK / IK: a path or a package:// URI
-    tool_link: str = 'tcp'              # grasp point between the fingertips
-    camera_link: str = 'camera_color_optical_frame'
-    joint_names: list[str] = field(default_factory=lambda: list(ARM_JOINTS))
-    # start pose (rad) of the URDF: long arm up, short arm forward, wrist
-    # pitched so the camera looks down at the objects (the paper: all straight except joint 5)
-    home_position: list[float] = field(default_factory=lambda: list(HOME_POSE))  # rad
-    joint_lower_limits: list[float] = field(default_factory=lambda: list(ARM_LOWER_LIMITS))  # rad
-    joint_upper_limits: list[float] = field(default_factory=lambda: list(ARM_UPPER_LIMITS))  # rad
-    joint_limit_margin: float = 0.02    # rad kept clear of each limit
-    max_joint_velocity: list[float] = field(default_factory=lambda: list(ARM_MAX_VELOCITY))  # rad/s
-    control_period: float = 0.02        # s, nominal tick (used to stop short of joint limits)
-    lock_duration: float = 1.0          # s all joints held between states (paper: locks)
-    watchdog_timeout: float = 0.3       # s, oldest acceptable prediction / joint state
-    camera_timeout: float = 0.5         # s without detections -> hold still
+    Each field is a ROS parameter of the fsm node (:func:`mindgrasp_ros.params.param`: unit,
+    range, description); ``live`` ones take effect at the next tick when set while it runs.
+    """
+
+    # --- general (read-only: the robot model and timer are built at start) ---------------------
+    autonomous: bool = param(False, 'no BCI: search left, approach and grasp on vision alone')
+    urdf_file: str = param(URDF_URI, 'URDF for forward / inverse kinematics: a path or a '
+                           'package:// URI')
+    tool_link: str = param('tcp', 'URDF link of the grasp point between the fingertips')
+    camera_link: str = param('camera_color_optical_frame',
+                             'URDF link of the camera optical frame')
+    joint_names: list[str] = param(list(ARM_JOINTS), 'the 6 arm joints in /joint_states')
+    # start pose of the URDF: long arm up, short arm forward, wrist pitched so the camera looks
+    # down at the objects (the paper: all straight except joint 5)
+    home_position: list[float] = param(list(HOME_POSE), 'start pose, 6 joints', unit='rad')
+    joint_lower_limits: list[float] = param(list(ARM_LOWER_LIMITS), 'lower joint limits',
+                                            unit='rad')
+    joint_upper_limits: list[float] = param(list(ARM_UPPER_LIMITS), 'upper joint limits',
+                                            unit='rad')
+    joint_limit_margin: float = param(0.02, 'kept clear of each joint limit', unit='rad',
+                                      min=0.0, max=0.5, live=True)
+    max_joint_velocity: list[float] = param(list(ARM_MAX_VELOCITY), 'velocity limit per joint',
+                                            unit='rad/s')
+    control_period: float = param(0.02, 'control tick (the node ticks at 1 / control_period)',
+                                  unit='s', min=0.001, max=1.0)
+    lock_duration: float = param(1.0, 'all joints held between states (paper: locks)', unit='s',
+                                 min=0.001, max=30.0, live=True)
+    watchdog_timeout: float = param(0.3, 'oldest acceptable prediction / joint state; older '
+                                    'inputs stop every joint', unit='s', min=0.01, max=10.0,
+                                    live=True)
+    camera_timeout: float = param(0.5, 'without detections for this long the arm holds still',
+                                  unit='s', min=0.01, max=10.0, live=True)
     # --- BCI -----------------------------------------------------------------------------------
-    certainty_threshold: float = 0.5    # below: the default slow approach in state 3
-    certainty_cap: float = 2.0          # certainty is unbounded (Eq. 1); velocities scale to this
+    certainty_threshold: float = param(0.5, 'certainty below which state 3 uses the default '
+                                       'slow approach', min=0.0, max=100.0, live=True)
+    certainty_cap: float = param(2.0, 'certainty that gives full speed (certainty is unbounded, '
+                                 'Eq. 1)', min=0.01, max=100.0, live=True)
     # --- state 1: object search ----------------------------------------------------------------
-    search_gain: float = 0.3            # rad/s of joint 1 per unit certainty (left +, right -)
-    autonomous_search_velocity: float = 0.8  # rad/s of joint 1 (turn left)
-    # rad added to joint 5 of home for each sweep of the autonomous search (0.15: the view spans
+    search_gain: float = param(0.3, 'joint 1 velocity per unit certainty (left +, right -)',
+                               unit='rad/s', min=0.0, max=3.0, live=True)
+    autonomous_search_velocity: float = param(0.8, 'joint 1 velocity of the autonomous search '
+                                              '(turn left)', unit='rad/s', min=0.0, max=3.0,
+                                              live=True)
+    # added to joint 5 of home for each sweep of the autonomous search (0.15: the view spans
     # 0.15-0.75 m from the base)
-    autonomous_search_tilts: list[float] = field(default_factory=lambda: [0.15, 0.15, 0.3, 0.0])
-    search_confirm_time: float = 0.2    # s an object must be seen before it is taken
-    search_ignore_angle: float = 1.0    # rad joint 1 turns away from an object it could not centre
+    autonomous_search_tilts: list[float] = param(
+        [0.15, 0.15, 0.3, 0.0], 'joint 5 tilt added to home for each autonomous sweep',
+        unit='rad', live=True)
+    search_confirm_time: float = param(0.2, 'an object must be seen this long before it is '
+                                       'taken', unit='s', min=0.0, max=10.0, live=True)
+    search_ignore_angle: float = param(1.0, 'joint 1 turns this far away from an object it '
+                                       'could not centre', unit='rad', min=0.0, max=6.3,
+                                       live=True)
     # BCI mode: after an object could not be centred, both-hands MI does not select again until
-    # joint 1 has turned this far (rad) or this long has passed (s); the user turns first
-    bci_reselect_angle: float = 0.1
-    # BCI mode: both-hands must be decoded without a break for this long (s) before it selects
-    # the object in view; one misdecoded window of a left/right intent must not start a grasp
-    bci_select_dwell: float = 0.5
-    bci_reselect_delay: float = 3.0
+    # joint 1 has turned this far or this long has passed; the user turns first
+    bci_reselect_angle: float = param(0.1, 'joint 1 turn before both-hands re-selects an object '
+                                      'that could not be centred', unit='rad', min=0.0,
+                                      max=6.3, live=True)
+    # BCI mode: both-hands must be decoded without a break for this long before it selects the
+    # object in view; one misdecoded window of a left/right intent must not start a grasp
+    bci_select_dwell: float = param(0.5, 'unbroken both-hands predictions before an object is '
+                                    'selected', unit='s', min=0.0, max=10.0, live=True)
+    bci_reselect_delay: float = param(3.0, 'after this long an object that could not be centred '
+                                      'may be selected again', unit='s', min=0.0, max=60.0,
+                                      live=True)
     # --- state 2: center object ----------------------------------------------------------------
-    center_gain_joint1: float = 1.5     # rad/s per unit normalised x error (error / width)
-    center_gain_joint5: float = 1.5     # rad/s per unit normalised y error (error / height)
-    center_sign_joint1: float = -1.0    # object right of centre -> turn right (joint 1 negative)
-    center_sign_joint5: float = 1.0     # object below centre -> tilt camera down
-    center_tolerance: float = 0.04      # normalised error counted as centred
-    center_hold_time: float = 0.2       # s centred before leaving state 2
-    recenter_threshold: float = 0.18    # normalised error in states 3/4 that enters state 2
-    center_timeout: float = 10.0        # s; then go on anyway (object still visible)
+    center_gain_joint1: float = param(1.5, 'joint 1 velocity per unit normalised x error '
+                                      '(error / width)', unit='rad/s', min=0.0, max=10.0,
+                                      live=True)
+    center_gain_joint5: float = param(1.5, 'joint 5 velocity per unit normalised y error '
+                                      '(error / height)', unit='rad/s', min=0.0, max=10.0,
+                                      live=True)
+    center_sign_joint1: float = param(-1.0, 'object right of centre -> turn right (joint 1 '
+                                      'negative)', min=-1.0, max=1.0, live=True)
+    center_sign_joint5: float = param(1.0, 'object below centre -> tilt the camera down',
+                                      min=-1.0, max=1.0, live=True)
+    center_tolerance: float = param(0.04, 'normalised error counted as centred', min=0.001,
+                                    max=0.5, live=True)
+    center_hold_time: float = param(0.2, 'centred this long before leaving state 2', unit='s',
+                                    min=0.0, max=10.0, live=True)
+    recenter_threshold: float = param(0.18, 'normalised error in states 3/4 that enters state 2',
+                                      min=0.001, max=1.0, live=True)
+    center_timeout: float = param(10.0, 'then go on anyway (object still visible)', unit='s',
+                                  min=0.1, max=120.0, live=True)
     # --- state 3: initial approach -------------------------------------------------------------
-    approach_joint: int = 2             # joint (1-based) that moves the long arm
-    approach_sign: float = 1.0          # sign of the approach joint velocity that goes forward
-    approach_gain: float = 0.2          # rad/s of the approach joint per unit certainty
-    retreat_gain: float = 0.2           # rad/s backwards per unit certainty (both feet)
-    turn_gain: float = 0.3              # rad/s of joint 1 per unit certainty (left/right)
-    default_approach_velocity: float = 0.12  # rad/s, no class above threshold / autonomous
-    approach_center_gain: float = 1.0   # centring gain (x joint 1, y joint 5) while approaching
-    final_approach_pixel_fraction: float = 0.15  # object fills this much -> final approach
-    final_approach_distance: float = 0.40  # m camera-object distance -> final approach
-    object_lost_timeout: float = 1.5    # s without the object of interest -> back to search
+    approach_joint: int = param(2, 'joint (1-based) that moves the long arm', min=1, max=6)
+    approach_sign: float = param(1.0, 'sign of the approach joint velocity that goes forward',
+                                 min=-1.0, max=1.0, live=True)
+    approach_gain: float = param(0.2, 'approach joint velocity per unit certainty',
+                                 unit='rad/s', min=0.0, max=3.0, live=True)
+    retreat_gain: float = param(0.2, 'backwards velocity per unit certainty (both feet)',
+                                unit='rad/s', min=0.0, max=3.0, live=True)
+    turn_gain: float = param(0.3, 'joint 1 velocity per unit certainty (left/right)',
+                             unit='rad/s', min=0.0, max=3.0, live=True)
+    default_approach_velocity: float = param(0.12, 'approach velocity with no class above the '
+                                             'threshold, and in autonomous mode', unit='rad/s',
+                                             min=0.0, max=3.0, live=True)
+    approach_center_gain: float = param(1.0, 'centring gain (x joint 1, y joint 5) while '
+                                        'approaching', min=0.0, max=10.0, live=True)
+    final_approach_pixel_fraction: float = param(0.15, 'image fraction the object fills when '
+                                                 'the final approach starts', min=0.0, max=1.0,
+                                                 live=True)
+    final_approach_distance: float = param(0.40, 'camera-object distance that starts the final '
+                                           'approach', unit='m', min=0.0, max=5.0, live=True)
+    object_lost_timeout: float = param(1.5, 'without the object of interest this long -> back '
+                                       'to search', unit='s', min=0.0, max=60.0, live=True)
     # --- state 4: final approach (grasp policy) ------------------------------------------------
-    ik_gain: float = 4.0                # 1/s, joint velocity = gain * (IK target - position)
-    joint_tolerance: float = 0.01       # rad, IK target reached
-    cartesian_speed: float = 0.12       # m/s of the tool along straight segments
-    settle_time: float = 0.3            # s still before a depth measurement
-    refine_max_correction: float = 0.15  # m; larger top-view corrections are rejected
-    max_refinements: int = 2            # top-view re-measurements before descending
-    table_height: float = 0.0           # m, z of the surface the objects stand on
-    min_reach: float = 0.12             # m, objects closer to the base axis are not grasped
-    max_reach: float = 0.85             # m
-    segment_timeout: float = 8.0        # s for one motion segment
-    min_tcp_height: float = 0.03        # m above the table (the fingertips reach 0.025 m below
-    # the grasp point and would stall on the table)
+    ik_gain: float = param(4.0, 'joint velocity = gain * (IK target - position)', unit='1/s',
+                           min=0.01, max=100.0, live=True)
+    joint_tolerance: float = param(0.01, 'IK target reached', unit='rad', min=0.0001, max=0.5,
+                                   live=True)
+    cartesian_speed: float = param(0.12, 'tool speed along straight segments', unit='m/s',
+                                   min=0.001, max=1.0, live=True)
+    settle_time: float = param(0.3, 'still before a depth measurement', unit='s', min=0.0,
+                               max=10.0, live=True)
+    refine_max_correction: float = param(0.15, 'larger top-view corrections are rejected',
+                                         unit='m', min=0.0, max=1.0, live=True)
+    max_refinements: int = param(2, 'top-view re-measurements before descending', min=0, max=20,
+                                 live=True)
+    table_height: float = param(0.0, 'z of the surface the objects stand on', unit='m',
+                                min=-2.0, max=2.0, live=True)
+    min_reach: float = param(0.12, 'objects closer to the base axis are not grasped', unit='m',
+                             min=0.0, max=5.0, live=True)
+    max_reach: float = param(0.85, 'objects farther from the base axis are not grasped',
+                             unit='m', min=0.0, max=5.0, live=True)
+    segment_timeout: float = param(8.0, 'for one motion segment', unit='s', min=0.1, max=120.0,
+                                   live=True)
+    # the fingertips reach 0.025 m below the grasp point and would stall on the table
+    min_tcp_height: float = param(0.03, 'lowest grasp point above the table', unit='m', min=0.0,
+                                  max=1.0, live=True)
     # per shape: pre-grasp height above the object top, grasp height as a fraction of the
-    # object height from the table plus an offset (m; a sphere is held with the fingertips at its
-    # equator, not squeezed upwards from below), object size (m) used for the depth-surface
-    # correction, wrist yaw offset (rad) relative to the approach direction, closing force (N)
-    cube_approach_height: float = 0.10
-    cube_grasp_height_fraction: float = 0.5
-    cube_grasp_height_offset: float = 0.0
-    cube_size: float = 0.05
-    cube_wrist_yaw: float = 0.0
-    cube_close_force: float = 40.0
-    cylinder_approach_height: float = 0.10
-    cylinder_grasp_height_fraction: float = 0.5
-    cylinder_grasp_height_offset: float = 0.0
-    cylinder_size: float = 0.05
-    cylinder_wrist_yaw: float = 0.0
-    cylinder_close_force: float = 40.0
-    sphere_approach_height: float = 0.10
-    sphere_grasp_height_fraction: float = 0.6
-    sphere_grasp_height_offset: float = 0.015
-    sphere_size: float = 0.05
-    sphere_wrist_yaw: float = 0.0
-    sphere_close_force: float = 30.0
+    # object height from the table plus an offset (a sphere is held with the fingertips at its
+    # equator, not squeezed upwards from below), object size used for the depth-surface
+    # correction, wrist yaw offset relative to the approach direction, closing force
+    cube_approach_height: float = param(0.10, 'cube: pre-grasp height above the object top',
+                                        unit='m', min=0.0, max=1.0, live=True)
+    cube_grasp_height_fraction: float = param(0.5, 'cube: grasp height as a fraction of the '
+                                              'object height', min=0.0, max=1.0, live=True)
+    cube_grasp_height_offset: float = param(0.0, 'cube: added to the grasp height', unit='m',
+                                            min=-0.5, max=0.5, live=True)
+    cube_size: float = param(0.05, 'cube: object size for the depth-surface correction',
+                             unit='m', min=0.0, max=1.0, live=True)
+    cube_wrist_yaw: float = param(0.0, 'cube: wrist yaw offset from the approach direction',
+                                  unit='rad', min=-3.15, max=3.15, live=True)
+    cube_close_force: float = param(40.0, 'cube: closing force', unit='N', min=0.0, max=500.0,
+                                    live=True)
+    cylinder_approach_height: float = param(0.10, 'cylinder: pre-grasp height above the object '
+                                            'top', unit='m', min=0.0, max=1.0, live=True)
+    cylinder_grasp_height_fraction: float = param(0.5, 'cylinder: grasp height as a fraction of '
+                                                  'the object height', min=0.0, max=1.0,
+                                                  live=True)
+    cylinder_grasp_height_offset: float = param(0.0, 'cylinder: added to the grasp height',
+                                                unit='m', min=-0.5, max=0.5, live=True)
+    cylinder_size: float = param(0.05, 'cylinder: object size for the depth-surface correction',
+                                 unit='m', min=0.0, max=1.0, live=True)
+    cylinder_wrist_yaw: float = param(0.0, 'cylinder: wrist yaw offset from the approach '
+                                      'direction', unit='rad', min=-3.15, max=3.15, live=True)
+    cylinder_close_force: float = param(40.0, 'cylinder: closing force', unit='N', min=0.0,
+                                        max=500.0, live=True)
+    sphere_approach_height: float = param(0.10, 'sphere: pre-grasp height above the object top',
+                                          unit='m', min=0.0, max=1.0, live=True)
+    sphere_grasp_height_fraction: float = param(0.6, 'sphere: grasp height as a fraction of the '
+                                                'object height', min=0.0, max=1.0, live=True)
+    sphere_grasp_height_offset: float = param(0.015, 'sphere: added to the grasp height',
+                                              unit='m', min=-0.5, max=0.5, live=True)
+    sphere_size: float = param(0.05, 'sphere: object size for the depth-surface correction',
+                               unit='m', min=0.0, max=1.0, live=True)
+    sphere_wrist_yaw: float = param(0.0, 'sphere: wrist yaw offset from the approach direction',
+                                    unit='rad', min=-3.15, max=3.15, live=True)
+    sphere_close_force: float = param(30.0, 'sphere: closing force', unit='N', min=0.0,
+                                      max=500.0, live=True)
     # --- state 5: grasp ------------------------------------------------------------------------
-    gripper_open_position: float = 0.0   # command for open (0 open .. 1 closed)
-    gripper_closed_position: float = 1.0
-    close_timeout: float = 2.0          # s to reach contact
-    stall_rate: float = 0.05            # 1/s opening change below which the fingers have stalled
-    grip_squeeze: float = 0.15          # closure (0..1) held past the contact point; 0: full close
-    contact_settle_time: float = 0.05   # s all fingers touch before the closing stops
-    contact_min_force: float = 1.0      # N finger force that counts as contact
-    min_fingers_in_contact: int = 3     # fingers that must touch for a firm grasp (contact sensing)
-    # N m effort of a finger motor that means "this finger pushes on something" (a finger closing
-    # freely needs < 0.1 N m, one squeezing an object its limit of 1.2-2.4 N m). A real hand
-    # cannot tell the object from the table by contact, so the grasp check counts loaded
-    # fingers; 0 uses the contact flags instead (a simulator's "touches an object")
-    finger_contact_effort: float = 0.4
-    closed_empty_opening: float = 0.05  # opening (0 closed .. 1 open) below which the hand is empty
-    lift_height: float = 0.12           # m lift after closing
-    lift_check_time: float = 0.3        # s held still after the lift before checking
-    grasp_retries: int = 1              # re-grasps after a slip or a missed closure
-    grasp_hold_time: float = 0.5        # s after a good check before returning (paper: several s)
+    gripper_open_position: float = param(0.0, 'gripper command for open (0 open .. 1 closed)',
+                                         min=0.0, max=1.0, live=True)
+    gripper_closed_position: float = param(1.0, 'gripper command for closed', min=0.0, max=1.0,
+                                           live=True)
+    close_timeout: float = param(2.0, 'to reach contact', unit='s', min=0.01, max=60.0,
+                                 live=True)
+    stall_rate: float = param(0.05, 'opening change below which the fingers have stalled',
+                              unit='1/s', min=0.0, max=10.0, live=True)
+    grip_squeeze: float = param(0.15, 'closure (0..1) held past the contact point; 0: full '
+                                'close', min=0.0, max=1.0, live=True)
+    contact_settle_time: float = param(0.05, 'all fingers touch this long before the closing '
+                                       'stops', unit='s', min=0.0, max=10.0, live=True)
+    contact_min_force: float = param(1.0, 'finger force that counts as contact', unit='N',
+                                     min=0.0, max=500.0, live=True)
+    min_fingers_in_contact: int = param(3, 'fingers that must touch for a firm grasp (contact '
+                                        'sensing)', min=1, max=10, live=True)
+    # a finger closing freely needs < 0.1 N m, one squeezing an object its limit of 1.2-2.4 N m.
+    # A real hand cannot tell the object from the table by contact, so the grasp check counts
+    # loaded fingers; 0 uses the contact flags instead (a simulator's "touches an object")
+    finger_contact_effort: float = param(0.4, 'finger motor effort that means "this finger '
+                                         'pushes on something"; 0 uses the contact flags',
+                                         unit='N m', min=0.0, max=100.0, live=True)
+    closed_empty_opening: float = param(0.05, 'opening (0 closed .. 1 open) below which the hand '
+                                        'is empty', min=0.0, max=1.0, live=True)
+    lift_height: float = param(0.12, 'lift after closing', unit='m', min=0.0, max=1.0,
+                               live=True)
+    lift_check_time: float = param(0.3, 'held still after the lift before checking', unit='s',
+                                   min=0.0, max=10.0, live=True)
+    grasp_retries: int = param(1, 're-grasps after a slip or a missed closure', min=0, max=10,
+                               live=True)
+    grasp_hold_time: float = param(0.5, 'after a good check before returning (paper: several '
+                                   's)', unit='s', min=0.0, max=60.0, live=True)
     # --- state 6: return to start --------------------------------------------------------------
-    return_gain: float = 1.0            # 1/s, joint velocity = gain * (home - position)
-    return_tolerance: float = 0.05      # rad per joint
-    return_timeout: float = 20.0        # s
-    return_velocity_holding: float = 0.5  # rad/s per joint at most while carrying an object
-    return_acceleration: float = 1.0    # rad/s^2 ramp at the start of the return (no jerk)
-    return_lift_height: float = 0.25    # m; carrying, the hand first rises straight to this height
+    return_gain: float = param(1.0, 'joint velocity = gain * (home - position)', unit='1/s',
+                               min=0.01, max=100.0, live=True)
+    return_tolerance: float = param(0.05, 'home reached, per joint', unit='rad', min=0.001,
+                                    max=1.0, live=True)
+    return_timeout: float = param(20.0, 'to reach home', unit='s', min=0.1, max=600.0,
+                                  live=True)
+    return_velocity_holding: float = param(0.5, 'per-joint velocity limit while carrying an '
+                                           'object', unit='rad/s', min=0.01, max=3.0, live=True)
+    return_acceleration: float = param(1.0, 'ramp at the start of the return (no jerk)',
+                                       unit='rad/s^2', min=0.01, max=100.0, live=True)
+    return_lift_height: float = param(0.25, 'carrying, the hand first rises straight to this '
+                                      'height', unit='m', min=0.0, max=2.0, live=True)
 
     def __post_init__(self) -> None:
         self.validate()

@@ -49,8 +49,8 @@ from typing import Any
 
 from mindgrasp_ros import rclpy
 
-__all__ = ['EXIT_FAILED', 'EXIT_OK', 'EXIT_REFUSED', 'NodeFailure', 'end_after', 'error_text',
-           'exit_code', 'fail', 'is_done', 'run_node']
+__all__ = ['EXIT_FAILED', 'EXIT_OK', 'EXIT_REFUSED', 'NodeFailure', 'declare_duration',
+           'end_after', 'error_text', 'exit_code', 'fail', 'is_done', 'run_node']
 
 EXIT_OK = 0       #: finished or stopped
 EXIT_FAILED = 1   #: failed while running
@@ -103,6 +103,20 @@ def end_after(node: Any, duration_sec: float) -> Any:
 
     timer = node.create_timer(float(duration_sec), callback)
     return timer
+
+
+def declare_duration(node: Any, default: float = 0.0) -> float:
+    """Declare the read-only ``duration`` parameter (s; > 0 ends the node after that long of ROS
+    time, for launch tests and demos) and arm :func:`end_after` with it; returns the value."""
+    from mindgrasp_ros.interfaces.rcl_interfaces.msg import FloatingPointRange, ParameterDescriptor
+
+    desc = ParameterDescriptor(
+        description='end the node after this long of ROS time; 0 runs until stopped [s]',
+        additional_constraints='read-only: restart the node to change it', read_only=True,
+        floating_point_range=[FloatingPointRange(from_value=0.0, to_value=float('inf'))])
+    value = float(node.declare_parameter('duration', float(default), desc).value)
+    end_after(node, value)
+    return value
 
 
 def fail(node: Any, reason: str) -> None:
