@@ -112,3 +112,22 @@ def test_virtual_session_runs_every_phase_retrains_and_resumes(tmp_path):
     report = (folder / 'report.md').read_text()
     assert 'cross-validated accuracy' in report and 'Trainer end-effector distance' in report
     assert (folder / 'report.yaml').is_file()
+
+
+def test_calibration_plan_sets_trials_per_class_and_adds_a_heldout_run():
+    from mindgrasp_trainer.session import calibration_plan
+
+    plan = calibration_plan(load_plan('quick'), trials_per_class=5, virtual_accuracy=0.9)
+    # quick prompts two classes; its test-free phases keep their order, the held-out run last
+    assert [(p.name, p.trials, p.train) for p in plan.phases] == [
+        ('graz', 10, True), ('graz_feedback', 10, True), ('trainer', 10, True),
+        ('heldout', 10, False)]
+    assert all(p.params['virtual_amp']['accuracy'] == 0.9 for p in plan.phases)
+    assert plan.phases[-1].args['seed'] != plan.phases[0].args.get('seed', '0')
+    graded = calibration_plan(load_plan('graded'), trials_per_class=3, virtual_accuracy=1.0)
+    assert [p.kind for p in graded.phases] == ['graz', 'graz', 'trainer', 'graz']   # no test
+    assert graded.phases[0].trials == 12
+    with pytest.raises(SessionError, match='--trials-per-class must be an integer of at least 2'):
+        calibration_plan(plan, trials_per_class=1, virtual_accuracy=0.9)
+    with pytest.raises(SessionError, match='--virtual-accuracy must be a probability'):
+        calibration_plan(plan, trials_per_class=5, virtual_accuracy=1.5)

@@ -65,6 +65,7 @@ COMMANDS: dict[str, str | dict[str, str]] = {
     'session': {
         'run': 'mindgrasp_trainer.session_cli',
         'resume': 'mindgrasp_trainer.session_cli',
+        'calibrate': 'mindgrasp_trainer.session_cli',
     },
 }
 

@@ -46,7 +46,8 @@ import yaml
 from mindgrasp_common.resources import resource_path
 from mindgrasp_trainer.protocol import TrainerError
 
-__all__ = ['PLAN_DIR', 'Phase', 'Plan', 'Session', 'SessionError', 'check_subject', 'load_plan']
+__all__ = ['PLAN_DIR', 'Phase', 'Plan', 'Session', 'SessionError', 'calibration_plan',
+           'check_subject', 'load_plan']
 
 PLAN_DIR = resource_path('mindgrasp_trainer', 'plans')
 KINDS = {'graz': 'graz', 'trainer': 'trainer', 'test': 'demo'}   # phase kind -> launch profile
@@ -147,6 +148,66 @@ def load_plan(plan: str) -> Plan:
                 str(k): str(v) for k, v in (raw.get('args') or {}).items()},
             params=dict(raw.get('params') or {})))
     return Plan(str(data.get('name') or path.stem), phases, training, data)
+
+
+def _phase_classes(phase: Phase) -> int:
+    """Number of classes a phase prompts (its prompter's ``classes`` parameter, else 4)."""
+    node = {'graz': 'graz_prompter', 'trainer': 'trainer'}.get(phase.kind, '')
+    classes = phase.params.get(node, {}).get('classes')
+    return len(classes) if isinstance(classes, list) and classes else 4
+
+
+def calibration_plan(plan: Plan, trials_per_class: int, virtual_accuracy: float,
+                     seed: int = 0) -> Plan:
+    """The plan for ``mindgrasp session calibrate``: its Graz and Trainer phases with
+    ``trials_per_class`` trials of each class, the virtual subject right with probability
+    ``virtual_accuracy``, and a last Graz phase of the same size (``heldout``, not trained on)
+    that scores the final model."""
+    if not isinstance(trials_per_class, int) or trials_per_class < 2:
+        msg = (f'--trials-per-class must be an integer of at least 2, not {trials_per_class!r}; '
+               'training needs a few trials of each class (5 or more is sensible).')
+        raise SessionError(msg)
+    if not 0.0 <= virtual_accuracy <= 1.0:
+        msg = (f'--virtual-accuracy must be a probability from 0 to 1, not {virtual_accuracy!r}; '
+               'e.g. 0.9 (the virtual subject imagines the prompted class 90 % of the time).')
+        raise SessionError(msg)
+    phases = []
+    for phase in plan.phases:
+        if phase.kind == 'test':
+            continue
+        params = {name: dict(values) for name, values in phase.params.items()}
+        params.setdefault('virtual_amp', {})['accuracy'] = float(virtual_accuracy)
+        phases.append(Phase(phase.name, phase.kind, trials_per_class * _phase_classes(phase),
+                            phase.feedback, phase.train, phase.duration, dict(phase.args),
+                            params))
+    if not phases:
+        msg = f'The plan {plan.name} has no Graz or Trainer phase to calibrate on.'
+        raise SessionError(msg)
+    graz = next((p for p in phases if p.kind == 'graz'), None)
+    params = {name: dict(v) for name, v in (graz.params if graz else {}).items()
+              if name in ('graz_prompter', 'virtual_amp')}
+    params.setdefault('virtual_amp', {})['accuracy'] = float(virtual_accuracy)
+    n_classes = _phase_classes(graz) if graz else 4
+    heldout = Phase('heldout', 'graz', trials_per_class * n_classes, train=False,
+                    args={'seed': str(seed + 1000)}, params=params)
+    source = {**plan.source, 'name': f'{plan.name} (calibrate)',
+              'phases': [_phase_source(p) for p in (*phases, heldout)]}
+    return Plan(f'{plan.name} (calibrate)', [*phases, heldout], plan.training, source)
+
+
+def _phase_source(p: Phase) -> dict[str, Any]:
+    out: dict[str, Any] = {'name': p.name, 'kind': p.kind, 'trials': p.trials}
+    if p.feedback:
+        out['feedback'] = True
+    if p.train != (p.kind != 'test'):
+        out['train'] = p.train
+    if p.duration:
+        out['duration'] = p.duration
+    if p.args:
+        out['args'] = p.args
+    if p.params:
+        out['params'] = p.params
+    return out
 
 
 def _unknown(keys: set, where: str, allowed: set) -> None:
@@ -370,6 +431,24 @@ class Session:
                           and r['grasped'] == r['desired'])
             return {'grasps': results, 'n_grasp_trials': n, 'n_correct_grasps': correct}
         return {}
+
+    def heldout_accuracy(self, log: dict[str, Any], phase: str = 'heldout') -> dict[str, Any]:
+        """Score the last trained model on the run of ``phase`` (not trained on)."""
+        from mindgrasp_classifier.data import load_inputs
+        from mindgrasp_classifier.errors import ClassifierError
+        from mindgrasp_classifier.model import MiModel
+        from mindgrasp_classifier.training import evaluate
+
+        entry = next(e for e in log['phases'] if e['name'] == phase)
+        model_path = next(e['model'] for e in reversed(log['phases']) if e.get('model'))
+        try:
+            model = MiModel.load(self.dir / model_path)
+            report = evaluate(model, load_inputs(bags=[str(self.dir / entry['run_dir'])]))
+        except ClassifierError as err:
+            msg = f'The held-out run {entry["run_dir"]} could not be scored: {err}'
+            raise SessionError(msg) from None
+        return {'heldout_accuracy': float(report['accuracy']), 'model_path': model_path,
+                'heldout_trials': int(report['n_trials'])}
 
     def write_report(self, log: dict[str, Any]) -> str:
         """report.yaml and report.md; returns the Markdown."""

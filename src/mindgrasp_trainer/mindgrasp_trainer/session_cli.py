@@ -1,21 +1,29 @@
 """Run a calibration session: the phases of a plan, retraining between them, one subject folder.
 
     mindgrasp session run --subject S01 --plan graded            # virtual subject, headless
-    mindgrasp session run --subject S01 --plan graded --amp lsl --eeg-stream MyAmp \
-        --display fullscreen                                     # a person, a real amplifier
+    mindgrasp session run --subject S01 --amp lsl --eeg-stream MyAmp --display fullscreen
     mindgrasp session run --subject S01 --plan my_plan.yaml
     mindgrasp session resume --subject S01                       # after an interruption
+    mindgrasp session calibrate --subject V01 --virtual-accuracy 0.9 --trials-per-class 10 --json
 """
 
 from __future__ import annotations
 
 import argparse
 import datetime as dt
+import json
 import os
 import sys
+import time
 from pathlib import Path
 
-from mindgrasp_trainer.session import Session, SessionError, check_subject, load_plan
+from mindgrasp_trainer.session import (
+    Session,
+    SessionError,
+    calibration_plan,
+    check_subject,
+    load_plan,
+)
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -27,13 +35,23 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help='session name (run: a new UTC timestamp; resume: the latest)')
     parser.add_argument('--root', default='subjects', help='folder of all subjects (subjects)')
     parser.add_argument('--plan', default='graded',
-                        help='plan name (graded, quick) or a plan YAML file (run only)')
+                        help='plan name (graded, quick, calibrate) or a plan YAML file')
     parser.add_argument('--amp', choices=['virtual', 'lsl'], default=None,
                         help='EEG source: virtual subject (default) or an LSL amplifier')
     parser.add_argument('--eeg-stream', default=None, help='LSL stream name of the amplifier')
     parser.add_argument('--display', choices=['off', 'window', 'fullscreen', 'headless'],
                         default=None, help="the participant's screen (default headless)")
     parser.add_argument('--seed', type=int, default=None, help='seed of every phase (0)')
+    if getattr(parser, 'prog', '').endswith('calibrate'):
+        parser.set_defaults(plan='calibrate')
+        parser.add_argument('--virtual-accuracy', type=float, required=True, metavar='A',
+                            help='probability that the virtual subject imagines the prompted '
+                                 'class (0..1)')
+        parser.add_argument('--trials-per-class', type=int, required=True, metavar='N',
+                            help='trials of each class in every training phase and in the '
+                                 'held-out run')
+        parser.add_argument('--json', action='store_true',
+                            help='print the result as one JSON object on the last line')
 
 
 def _launch_args(args: argparse.Namespace) -> dict[str, str]:
@@ -46,13 +64,44 @@ def _launch_args(args: argparse.Namespace) -> dict[str, str]:
     return out
 
 
+def _calibrate_result(session: Session, args: argparse.Namespace, t0: float) -> int:
+    """Print the cross-validated and held-out accuracy (and JSON with --json)."""
+    log = session.read_log()
+    try:
+        held = session.heldout_accuracy(log)
+    except SessionError as err:
+        print(f'mindgrasp session calibrate: {err}', file=sys.stderr)
+        return 1
+    cv = next(e['cv_accuracy'] for e in reversed(log['phases']) if 'cv_accuracy' in e)
+    wall = time.monotonic() - t0
+    print(f'Calibrated {session.dir}: cross-validated accuracy {100 * cv:.1f} %, held-out '
+          f"accuracy {100 * held['heldout_accuracy']:.1f} % on {held['heldout_trials']} trials "
+          f'(virtual subject {100 * args.virtual_accuracy:.0f} %), model '
+          f"{session.dir / held['model_path']}, {wall:.0f} s.")
+    if args.json:
+        print(json.dumps({'cv_accuracy': cv, 'heldout_accuracy': held['heldout_accuracy'],
+                          'virtual_accuracy': args.virtual_accuracy,
+                          'model_path': str(session.dir / held['model_path']),
+                          'heldout_trials': held['heldout_trials'],
+                          'session_dir': str(session.dir), 'wall_time_s': round(wall, 1)}))
+    return 0
+
+
 def main(args: argparse.Namespace) -> int:
     verb = args.verb
+    t0 = time.monotonic()
     try:
         check_subject(args.subject)
         root = Path(args.root)
-        if verb == 'run':
+        if verb in ('run', 'calibrate'):
             plan = load_plan(args.plan)
+            if verb == 'calibrate':
+                if args.amp == 'lsl':
+                    msg = ('calibrate runs the virtual subject; for a person use mindgrasp '
+                           'session run --amp lsl.')
+                    raise SessionError(msg)
+                plan = calibration_plan(plan, args.trials_per_class, args.virtual_accuracy,
+                                        args.seed or 0)
             name = args.session or dt.datetime.now(dt.timezone.utc).strftime('%Y%m%dT%H%M%SZ')
             # the virtual amplifier's LSL stream is host-wide: a name of its own per session
             stream = f'MIndGrasp-{args.subject}-{os.getpid()}'
@@ -83,7 +132,10 @@ def main(args: argparse.Namespace) -> int:
         return 2
     print(f'Session {session.dir} ({plan.name}: {", ".join(p.name for p in plan.phases)})')
     try:
-        return session.run(plan, log)
+        code = session.run(plan, log)
+        if code != 0 or verb != 'calibrate':
+            return code
+        return _calibrate_result(session, args, t0)
     except KeyboardInterrupt:
         print(f'Interrupted; finished phases are kept. Continue with: mindgrasp session resume '
               f'--subject {args.subject} --session {session.session}', file=sys.stderr)
