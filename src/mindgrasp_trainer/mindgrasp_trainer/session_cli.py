@@ -81,9 +81,10 @@ def _calibrate_result(session: Session, args: argparse.Namespace, t0: float) -> 
     if args.json:
         print(json.dumps({'cv_accuracy': cv, 'heldout_accuracy': held['heldout_accuracy'],
                           'virtual_accuracy': args.virtual_accuracy,
-                          'model_path': str(session.dir / held['model_path']),
+                          'model_path': str((session.dir / held['model_path']).resolve()),
                           'heldout_trials': held['heldout_trials'],
-                          'session_dir': str(session.dir), 'wall_time_s': round(wall, 1)}))
+                          'session_dir': str(session.dir.resolve()),
+                          'wall_time_s': round(wall, 1)}))
     return 0
 
 
