@@ -62,6 +62,9 @@ def _run_chunk(profile: dict | None, seed: int, n_trials: int, indices: list[int
                         'detected_shape': res.detected_shape, 'reason': res.reason,
                         'wall_s': time.perf_counter() - t0, 'radius': spec.radius,
                         'angle_deg': spec.angle_deg})
+            print(f'    [{profile["name"] if profile else "off"}] trial {i}: {spec.shape} '
+                  f'{"grasped" if res.success else "FAILED"} ({out[-1]["wall_s"]:.0f} s wall)',
+                  flush=True)
     finally:
         loop.sim.close()
     return out
@@ -110,8 +113,13 @@ def compare(args: argparse.Namespace) -> dict:
 
     profile = RealismProfile.load(args.profile)
     t0 = time.perf_counter()
-    off = run_condition(None, args.trials, args.seed, args.workers, args.timeout)
+    # realism first: the perfect world's figure is the known one
     on = run_condition(profile, args.trials, args.seed, args.workers, args.timeout)
+    s = by_shape(on)
+    print(f"Realism '{profile.name}': " + ', '.join(f'{k} {_pct(*s[k])}' for k in SHAPES),
+          flush=True)
+    off = [] if args.skip_off else run_condition(None, args.trials, args.seed, args.workers,
+                                                 args.timeout)
     wall = time.perf_counter() - t0
     s_off, s_on = by_shape(off), by_shape(on)
     print(f'Grasp success, random locations, {args.trials} trials each (seed {args.seed}), '
@@ -130,7 +138,8 @@ def compare(args: argparse.Namespace) -> dict:
     if args.plot:
         _plot_compare(args.plot, s_off, s_on, profile.name, args.trials)
     return {'mode': 'compare', 'profile': profile.name, 'trials': args.trials,
-            'seed': args.seed, 'off': s_off, 'on': s_on, 'wall_time_s': wall}
+            'seed': args.seed, 'off': s_off, 'on': s_on, 'wall_time_s': wall,
+            'records_on': on, 'records_off': off}
 
 
 def sweep_levels(profile: object) -> list[tuple[str, str, object]]:
@@ -145,6 +154,17 @@ def sweep_levels(profile: object) -> list[tuple[str, str, object]]:
     return levels
 
 
+def _records_from_lines(lines: list[str], name: str) -> list[dict]:
+    """Trial records from the per-trial lines of a run (``[name] trial i: shape grasped``)."""
+    out = []
+    for line in lines:
+        parts = line.split()
+        if len(parts) >= 5 and parts[0] == f'[{name}]' and parts[1] == 'trial':
+            out.append({'index': int(parts[2].rstrip(':')), 'shape': parts[3],
+                        'success': parts[4] == 'grasped'})
+    return out
+
+
 def sweep(args: argparse.Namespace) -> dict:
     from mindgrasp_sim.realism import RealismProfile
 
@@ -152,6 +172,20 @@ def sweep(args: argparse.Namespace) -> dict:
     rows = []
     t0 = time.perf_counter()
     done: dict[object, list[dict]] = {}
+    if args.reuse:
+        # the profile's own level from a compare run: same seed, same first trials, same code
+        with open(args.reuse, encoding='utf-8') as f:
+            text = f.read().strip().splitlines()
+        prior = json.loads(text[-1])
+        if prior.get('seed') != args.seed or prior.get('profile') != profile.name:
+            print(f'realism.py: --reuse {args.reuse} ran seed {prior.get("seed")} profile '
+                  f'{prior.get("profile")}; run it with this --seed and --profile.',
+                  file=sys.stderr)
+            raise SystemExit(2)
+        records = prior.get('records_on') or _records_from_lines(text, profile.name)
+        records = [r for r in records if r['index'] < args.trials]
+        if len(records) == args.trials:
+            done[json.dumps(_profile_dict(profile), sort_keys=True)] = records
     for factor, label, p in sweep_levels(profile):
         key = json.dumps(_profile_dict(p), sort_keys=True)
         if key not in done:     # x1 and the profile's own mount error are the same runs
@@ -185,7 +219,8 @@ def cnn(args: argparse.Namespace) -> dict:
     clf = ShapeClassifier.load(model)
     profile = RealismProfile.load(args.profile)
     out = {'mode': 'cnn', 'model': model, 'images': args.images, 'seed': args.seed + 1000}
-    for name, realism in (('none', None), (profile.name, profile)):
+    conditions = [(profile.name, profile)] + ([] if args.skip_off else [('none', None)])
+    for name, realism in conditions:
         t0 = time.perf_counter()
         data = collect_shape_dataset(args.images, seed=args.seed + 1000, realism=realism)
         pred = clf.predict_proba(data.x).argmax(1)
@@ -257,6 +292,11 @@ def main() -> int:
     parser.add_argument('--timeout', type=float, default=120.0, help='simulated s per trial')
     parser.add_argument('--plot', default='', help='write a PNG plot here')
     parser.add_argument('--images', type=int, default=150, help='cnn: test views per condition')
+    parser.add_argument('--reuse', default='',
+                        help="sweep: a compare run's output whose realism trials stand for the "
+                             "profile's own level")
+    parser.add_argument('--skip-off', action='store_true',
+                        help='compare, cnn: run the realism condition only')
     parser.add_argument('--model', default='', help='cnn: shape model (default the vision one)')
     args = parser.parse_args()
     if args.trials is None:

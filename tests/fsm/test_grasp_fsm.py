@@ -534,3 +534,34 @@ def test_contact_flags_are_used_without_efforts_or_when_asked(params: FsmParams)
     fsm = _grasp_fsm(dataclasses.replace(params, finger_contact_effort=0.0))
     _drive(fsm, _grasp_pose(), ON_TABLE, 8.0)
     assert fsm.outcome == 'holding'                        # a simulator's contact flags
+
+
+def test_a_measurement_is_the_median_of_several_frames(params: FsmParams) -> None:
+    """A noisy camera: one measurement takes ``measure_frames`` frames, an outlier frame (a
+    depth drop-out, a mis-segmented box) does not move the estimate."""
+    from mindgrasp_fsm.grasp_policy import GraspPolicy
+
+    from .conftest import CAMERA, frame
+
+    fsm = GraspFsm.from_params(params)
+    kin = fsm.kinematics
+
+    def measured(frames: list) -> np.ndarray:
+        policy = GraspPolicy(dataclasses.replace(params, measure_frames=len(frames)), kin)
+        policy.begin_approach(0.0, 'cube', 0)
+        policy.phase = 'measure'
+        t = 1.0
+        for obs in frames:
+            step = policy.approach_step(t, HOME, frame(t, obs), CAMERA, None)
+            assert policy.object_position is None or step.phase == 'to_pregrasp'
+            t += 0.1
+        assert policy.phase == 'to_pregrasp'
+        return policy.object_position
+
+    good = observation(64, 70, distance=0.6)
+    single = measured([good])
+    noisy = measured([observation(62, 71, distance=0.61), good,
+                      observation(90, 40, distance=0.3)])   # an outlier frame
+    np.testing.assert_allclose(noisy[:2], single[:2], atol=0.01)
+    repeated = measured([good, good, good])
+    np.testing.assert_allclose(repeated, single)

@@ -26,6 +26,7 @@ def test_parameter_file_holds_every_parameter_with_the_defaults() -> None:
     ({'recenter_threshold': 0.01}, r"'recenter_threshold' .* must exceed 'center_tolerance'"),
     ({'max_joint_velocity': [1.0, 1.0, 0.0, 1.0, 1.0, 1.0]}, r"'max_joint_velocity' must be > 0"),
     ({'grasp_retries': -1}, r"'grasp_retries' must be >= 0"),
+    ({'measure_frames': 0}, r"'measure_frames' must be >= 1 camera frame"),
     ({'watchdog_timout': 0.3}, r"Unknown controller parameter\(s\) \['watchdog_timout'\]"),
 ])
 def test_bad_parameters_name_the_problem(values: dict, match: str) -> None:

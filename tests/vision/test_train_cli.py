@@ -44,6 +44,20 @@ def test_collects_trains_reports_and_saves(tmp_path, capsys):
 def test_bad_arguments_are_reported(capsys):
     assert mindgrasp(['train', 'vision', '--n-images', '5']) == 2
     assert '--n-images must be >= 30' in capsys.readouterr().err
+    assert mindgrasp(['train', 'vision', '--realism', 'realistic']) == 2
+    assert "--realism realistic: Unknown realism profile 'realistic'" in capsys.readouterr().err
+
+
+def test_trains_on_noisy_images_with_a_realism_profile(tmp_path, capsys):
+    code = mindgrasp(['train', 'vision', '--realism', 'default', '--n-images', '30',
+                      '--test-images', '0', '--epochs', '1', '--seed', '6', '--quiet', '--json',
+                      '--output', str(tmp_path / 'm'), '--dataset', str(tmp_path / 'd.npz')])
+    out = capsys.readouterr().out
+    assert code in (0, 1), out
+    assert "realism 'default'" in out
+    figures = json.loads(out.strip().splitlines()[-1])
+    assert figures['realism'] == 'default' and figures['n_images'] == 30
+    assert ShapeClassifier.load(tmp_path / 'm').training_['realism'] == 'default'
 
 
 def test_split_is_stratified_and_seeded():

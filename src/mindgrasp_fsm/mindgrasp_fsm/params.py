@@ -148,6 +148,8 @@ class FsmParams:
                                    min=0.001, max=1.0, live=True)
     settle_time: float = param(0.3, 'still before a depth measurement', unit='s', min=0.0,
                                max=10.0, live=True)
+    measure_frames: int = param(3, 'camera frames whose median position is one measurement (a '
+                                'noisy depth camera scatters)', min=1, max=30, live=True)
     refine_max_correction: float = param(0.15, 'larger top-view corrections are rejected',
                                          unit='m', min=0.0, max=1.0, live=True)
     max_refinements: int = param(2, 'top-view re-measurements before descending', min=0, max=20,
@@ -295,6 +297,10 @@ class FsmParams:
             msg = (f"'recenter_threshold' ({self.recenter_threshold}) must exceed "
                    f"'center_tolerance' ({self.center_tolerance}), or the controller would "
                    'oscillate between centring and approaching.')
+            raise FsmError(msg)
+        if self.measure_frames < 1:
+            msg = (f"'measure_frames' must be >= 1 camera frame, got {self.measure_frames}; "
+                   'use 3 with a noisy depth camera.')
             raise FsmError(msg)
         if self.grasp_retries < 0:
             msg = f"'grasp_retries' must be >= 0, got {self.grasp_retries}."

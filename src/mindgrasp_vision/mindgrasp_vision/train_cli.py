@@ -50,7 +50,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--output', default=DEFAULT_SHAPE_MODEL,
                         help=f'model path without suffix (default {DEFAULT_SHAPE_MODEL})')
     parser.add_argument('--dataset', default=None,
-                        help='.npz cache of the collected images: read if it exists, else written')
+                        help='.npz cache of the collected images: read if it exists (as it is, '
+                             'whatever --realism), else written')
     parser.add_argument('--realism', default='none',
                         help="camera realism of the training and test images: none (default), "
                              'default or a profile YAML path (mindgrasp_sim.realism)')
