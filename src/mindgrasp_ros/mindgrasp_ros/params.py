@@ -32,6 +32,7 @@ Works with the real rclpy and with our runtime (rcl_interfaces messages, ``decla
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import math
 from collections.abc import Callable, Iterable, Mapping
@@ -93,10 +94,9 @@ def param(default: Any, description: str = '', *, unit: str = '', min: float | N
 
     info = ParamInfo(description, unit, min, max, tuple(choices), live)
     metadata = {_META: info}
-    if isinstance(default, (list, dict, set)):
-        value = list(default) if isinstance(default, list) else default
-        return dataclasses.field(default_factory=lambda: list(value) if isinstance(value, list)
-                                 else type(value)(value), metadata=metadata)
+    if isinstance(default, (list, dict)):
+        return dataclasses.field(default_factory=lambda: copy.deepcopy(default),
+                                 metadata=metadata)
     return dataclasses.field(default=default, metadata=metadata)
 
 
@@ -145,11 +145,10 @@ def describe(cls: type) -> dict[str, tuple[Any, Any]]:
     ptype = rclpy.parameter.Parameter.Type
     defaults = cls()
     out = {}
-    for field in dataclasses.fields(cls):
+    for field, name, default in _flat_fields(cls, defaults):
         info = _info(field)
-        default = getattr(defaults, field.name)
         kind = parameter_type(field, default)
-        desc = ParameterDescriptor(name=field.name, type=int(kind), description=info.text(),
+        desc = ParameterDescriptor(name=name, type=int(kind), description=info.text(),
                                    additional_constraints=info.constraints(),
                                    read_only=not info.live)
         if info.min is not None or info.max is not None:
@@ -161,13 +160,42 @@ def describe(cls: type) -> dict[str, tuple[Any, Any]]:
                 desc.integer_range = [IntegerRange(
                     from_value=int(-_INT_MAX if info.min is None else info.min),
                     to_value=int(_INT_MAX if info.max is None else info.max), step=0)]
-        out[field.name] = (default, desc)
+        out[name] = (default, desc)
+    return out
+
+
+def _flat_fields(cls: type, instance: Any) -> list[tuple[dataclasses.Field, str, Any]]:
+    """``(field, parameter name, value)``; a dict field is one parameter per key
+    (``colour_ranges.red``), as ROS parameter files nest them."""
+    out = []
+    for field in dataclasses.fields(cls):
+        value = getattr(instance, field.name)
+        if isinstance(value, dict):
+            out += [(field, f'{field.name}.{key}', item) for key, item in value.items()]
+        else:
+            out.append((field, field.name, value))
+    return out
+
+
+def _nest(cls: type, values: Mapping[str, Any], base: Any = None) -> dict[str, Any]:
+    """Flat parameter names back to field values: ``colour_ranges.red`` into its dict (the
+    other keys from ``base``)."""
+    fields = {f.name for f in dataclasses.fields(cls)}
+    out: dict[str, Any] = {}
+    for name, value in values.items():
+        head, _, key = name.partition('.')
+        if key and head in fields:
+            if head not in out:
+                out[head] = dict(getattr(base, head)) if base is not None else {}
+            out[head][key] = value
+        else:
+            out[name] = value
     return out
 
 
 def check_value(cls: type, name: str, value: Any) -> None:
     """Raise :class:`ParameterError` when ``value`` is outside the range or choices of ``name``."""
-    field = {f.name: f for f in dataclasses.fields(cls)}[name]
+    field = {f.name: f for f in dataclasses.fields(cls)}[name.partition('.')[0]]
     info = _info(field)
     unit = f' {info.unit}' if info.unit else ''
     if info.choices and value not in info.choices:
@@ -192,7 +220,9 @@ def from_mapping(cls: type[T], values: Mapping[str, Any]) -> T:
         msg = f'Unknown parameter(s) {unknown}; the parameters are: {", ".join(sorted(names))}.'
         raise ParameterError(msg)
     for name, value in values.items():
-        check_value(cls, name, value)
+        items = value.values() if isinstance(value, dict) else [value]
+        for item in items:
+            check_value(cls, name, item)
     try:
         return cls(**values)
     except ParameterError:
@@ -208,9 +238,10 @@ def declare_params(node: Any, cls: type[T], *,
     The values come from the node's overrides (parameter files, ``-p``); an invalid value raises
     :class:`ParameterError` (``run_node`` ends the node with exit code 2 and the message). Later
     ``set_parameters`` calls go through an on-set callback: read-only fields are refused by their
-    descriptor; live ones are checked on a copy (ranges, choices, ``__post_init__``) and, when
-    valid, written into the returned instance in place, then ``on_change(instance, names)`` runs
-    (to update what was derived from them). Invalid changes are refused with the reason.
+    descriptor; live ones are checked on a copy (ranges, choices, ``__post_init__``), then
+    ``on_change(candidate, names)`` may rebuild what depends on them (raise a ``ValueError`` to
+    refuse the change with its message); on success the new values are written into the returned
+    instance in place, so every object holding it sees them at once.
     """
     from mindgrasp_ros import rclpy
 
@@ -224,7 +255,7 @@ def declare_params(node: Any, cls: type[T], *,
             value = default
         node.declare_parameter(name, value, desc)
     values = {name: _python(node.get_parameter(name).value, specs[name][0]) for name in specs}
-    instance = from_mapping(cls, values)
+    instance = from_mapping(cls, _nest(cls, values))
 
     def callback(params: list) -> Any:
         from mindgrasp_ros.interfaces.rcl_interfaces.msg import SetParametersResult
@@ -237,15 +268,16 @@ def declare_params(node: Any, cls: type[T], *,
             return SetParametersResult(
                 successful=False,
                 reason=f"'{fixed[0]}' is read-only: restart the node to change it.")
+        nested = _nest(cls, changes, instance)
         current = {f.name: getattr(instance, f.name) for f in dataclasses.fields(cls)}
         try:
-            from_mapping(cls, {**current, **changes})
-        except ParameterError as exc:
+            candidate = from_mapping(cls, {**current, **nested})
+            if on_change is not None:
+                on_change(candidate, set(nested))
+        except ValueError as exc:   # ParameterError and the packages' errors
             return SetParametersResult(successful=False, reason=str(exc))
-        for name, value in changes.items():
-            setattr(instance, name, value)
-        if on_change is not None:
-            on_change(instance, set(changes))
+        for name in nested:
+            setattr(instance, name, getattr(candidate, name))
         node.get_logger().info(
             'Parameter change applied: ' + ', '.join(f'{k}={v!r}' for k, v in changes.items()))
         return SetParametersResult(successful=True)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 
-class VisionError(Exception):
+class VisionError(ValueError):
     """Bad input or state in :mod:`mindgrasp_vision` (wrong image encoding/size, bad parameter)."""
 
 

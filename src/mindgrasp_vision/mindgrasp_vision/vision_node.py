@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import sys
 import threading
-import time
 
 from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import (
     Detection,
@@ -24,11 +23,21 @@ from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import (
     FsmState,
     MIPrediction,
 )
-from mindgrasp_ros.interfaces.rcl_interfaces.msg import SetParametersResult
 from mindgrasp_ros.interfaces.sensor_msgs.msg import CameraInfo, Image, RegionOfInterest
 from mindgrasp_ros.interfaces.std_srvs.srv import Trigger
 
 from mindgrasp_ros import rclpy
+from mindgrasp_ros.node_main import declare_duration, run_node
+from mindgrasp_ros.params import declare_params
+from mindgrasp_ros.topics import (
+    BCI_PREDICTION,
+    COLOR_IMAGE,
+    COLOR_INFO,
+    DEPTH_IMAGE,
+    FSM_STATE,
+    VISION_DETECTIONS,
+    VISION_OVERLAY,
+)
 from mindgrasp_vision._checks import VisionError
 from mindgrasp_vision.config import VisionConfig
 from mindgrasp_vision.detector import CameraIntrinsics
@@ -39,11 +48,9 @@ from mindgrasp_vision.ros_conversions import (
     rgb_from_image,
 )
 
-_RELIABLE = 10
-
 
 def _stamp_ns(header: object) -> int:
-    return int(header.stamp.sec) * 1_000_000_000 + int(header.stamp.nanosec)
+    return rclpy.time.Time.from_msg(header.stamp).nanoseconds
 
 
 class VisionNode(rclpy.node.Node):
@@ -51,45 +58,36 @@ class VisionNode(rclpy.node.Node):
 
     def __init__(self, **kwargs: object) -> None:
         super().__init__('vision', **kwargs)
-        defaults = VisionConfig().flat()
-        self.declare_parameters('', list(defaults.items()))
-        self.cfg = VisionConfig.from_mapping(
-            {name: self.get_parameter(name).value for name in defaults})
+        # callbacks may run on several threads (composition uses a MultiThreadedExecutor)
+        self._lock = threading.RLock()
+        self.cfg = declare_params(self, VisionConfig, on_change=self.apply_parameters)
         classifier = None
         try:
             classifier = self.cfg.load_classifier()
         except VisionError as exc:
             self.get_logger().error(f'{exc} Running without shape classification.')
         self.pipeline = self.cfg.build_pipeline(classifier)
-        sensor = rclpy.qos.qos_profile_sensor_data
-        self.detections_pub = self.create_publisher(DetectionArray, '/vision/detections', _RELIABLE)
-        self.overlay_pub = self.create_publisher(Image, '/vision/overlay', sensor)
-        self.create_subscription(Image, '/camera/color/image_raw', self.color_callback, sensor)
-        self.create_subscription(Image, '/camera/depth/image_raw', self.depth_callback, sensor)
-        self.create_subscription(CameraInfo, '/camera/color/camera_info', self.info_callback,
-                                 sensor)
-        self.create_subscription(MIPrediction, '/bci/prediction', self.prediction_callback,
-                                 _RELIABLE)
-        state_qos = rclpy.qos.QoSProfile(
-            depth=1, reliability=rclpy.qos.ReliabilityPolicy.RELIABLE,
-            durability=rclpy.qos.DurabilityPolicy.TRANSIENT_LOCAL)
-        self.create_subscription(FsmState, '/fsm/state', self.state_callback, state_qos)
+        self.detections_pub = self.create_publisher(DetectionArray, VISION_DETECTIONS.name,
+                                                    VISION_DETECTIONS.qos)
+        self.overlay_pub = self.create_publisher(Image, VISION_OVERLAY.name, VISION_OVERLAY.qos)
+        self.create_subscription(Image, COLOR_IMAGE.name, self.color_callback, COLOR_IMAGE.qos)
+        self.create_subscription(Image, DEPTH_IMAGE.name, self.depth_callback, DEPTH_IMAGE.qos)
+        self.create_subscription(CameraInfo, COLOR_INFO.name, self.info_callback, COLOR_INFO.qos)
+        self.create_subscription(MIPrediction, BCI_PREDICTION.name, self.prediction_callback,
+                                 BCI_PREDICTION.qos)
+        self.create_subscription(FsmState, FSM_STATE.name, self.state_callback, FSM_STATE.qos)
         self.create_service(Trigger, '~/classify_shape', self.classify_callback)
-        self.add_on_set_parameters_callback(self.parameters_callback)
         self._pending = None      # (stamp ns, rgb, header) waiting for its depth image
         self._depth = None        # (stamp ns, depth)
         self._seen_depth = False
         self._mi = None           # (class index, receipt ROS time s)
         self._fsm_state = 0
         self._last = None         # (rgb, header, depth) of the last processed frame
-        self._errors: dict[str, float] = {}
         self.frames = 0
-        self._start = time.monotonic()
-        self.done = False
+        self.done = rclpy.task.Future()
         self._last_image: float | None = None   # ROS time (s); set on the first watch tick
-        # callbacks may run on several threads (composition uses a MultiThreadedExecutor)
-        self._lock = threading.RLock()
         self.create_timer(0.5, self.watch_callback)
+        declare_duration(self)
         self.get_logger().info(
             f'Vision ready: colours {self.cfg.colour_names}, shape model '
             f'{"none" if classifier is None else self.cfg.shape_model}.')
@@ -101,7 +99,7 @@ class VisionNode(rclpy.node.Node):
             rgb = rgb_from_image(msg)
             self._check_size(rgb.shape[1], rgb.shape[0], '/camera/color/image_raw')
         except VisionError as exc:
-            self._error('color', str(exc))
+            self.get_logger().error(str(exc), throttle_duration_sec=5.0)
             return
         with self._lock:
             if self._pending is not None:
@@ -115,7 +113,7 @@ class VisionNode(rclpy.node.Node):
             depth = depth_from_image(msg)
             self._check_size(depth.shape[1], depth.shape[0], '/camera/depth/image_raw')
         except VisionError as exc:
-            self._error('depth', str(exc))
+            self.get_logger().error(str(exc), throttle_duration_sec=5.0)
             return
         with self._lock:
             self._seen_depth = True
@@ -126,7 +124,7 @@ class VisionNode(rclpy.node.Node):
         try:
             self.pipeline.detector.intrinsics = CameraIntrinsics.from_k(msg.k)
         except VisionError as exc:
-            self._error('camera_info', str(exc))
+            self.get_logger().error(str(exc), throttle_duration_sec=5.0)
 
     def prediction_callback(self, msg: MIPrediction) -> None:
         self._mi = (int(msg.class_index), self._now())
@@ -155,23 +153,14 @@ class VisionNode(rclpy.node.Node):
             response.message = f'{target.label} {target.shape_confidence:.3f}'
         return response
 
-    def parameters_callback(self, params: list) -> SetParametersResult:
-        values = {p.name: p.value for p in params}
-        if 'shape_model' in values:
-            return SetParametersResult(successful=False,
-                                       reason='shape_model is read at start; restart the node.')
-        try:
-            cfg = VisionConfig.from_mapping({**self.cfg.flat(), **values})
-            detector, ranker = cfg.build_detector(), cfg.build_ranker()
-        except (VisionError, TypeError, ValueError) as exc:
-            return SetParametersResult(successful=False, reason=str(exc))
+    def apply_parameters(self, cfg: VisionConfig, names: set[str]) -> None:
+        """A live change: rebuild the detector and ranker (a VisionError refuses the change)."""
+        detector, ranker = cfg.build_detector(), cfg.build_ranker()
         with self._lock:
             detector.intrinsics = self.pipeline.detector.intrinsics
-            self.cfg = cfg
             self.pipeline.detector, self.pipeline.ranker = detector, ranker
             self.pipeline.shape_min_fraction = float(cfg.shape_min_fraction)
             self.pipeline.shape_max_fraction = float(cfg.shape_max_fraction)
-        return SetParametersResult(successful=True)
 
     def watch_callback(self) -> None:
         now = self._now()
@@ -179,11 +168,9 @@ class VisionNode(rclpy.node.Node):
             self._last_image = now
         silent = now - self._last_image
         if 0 < self.cfg.image_timeout < silent:
-            self._error('no_image', f'No camera image on /camera/color/image_raw for '
-                        f'{silent:.1f} s; check that the camera driver or the simulator is '
-                        'running and publishing rgb8 images.')
-        if self.cfg.duration > 0 and time.monotonic() - self._start >= self.cfg.duration:
-            self.done = True
+            self.get_logger().error(f'No camera image on {COLOR_IMAGE.name} for {silent:.1f} s; '
+                                    'check that the camera driver or the simulator is running '
+                                    'and publishing rgb8 images.', throttle_duration_sec=5.0)
 
     # ------------------------------------------------------------------ work
     def _now(self) -> float:
@@ -214,9 +201,10 @@ class VisionNode(rclpy.node.Node):
 
     def _process(self, rgb: object, header: object, depth: object, classify: bool = False):
         if depth is not None and depth.shape != rgb.shape[:2]:
-            self._error('size', f'The depth image is {depth.shape[1]}x{depth.shape[0]} px but '
-                        f'the colour image is {rgb.shape[1]}x{rgb.shape[0]} px; publish the '
-                        'depth registered to the colour camera.')
+            self.get_logger().error(f'The depth image is {depth.shape[1]}x{depth.shape[0]} px '
+                                    f'but the colour image is {rgb.shape[1]}x{rgb.shape[0]} px; '
+                                    'publish the depth registered to the colour camera.',
+                                    throttle_duration_sec=5.0)
             depth = None
         mi = None
         if self._mi is not None and self._now() - self._mi[1] <= self.cfg.prediction_timeout:
@@ -225,7 +213,7 @@ class VisionNode(rclpy.node.Node):
         try:
             result = self.pipeline.process(rgb, depth, mi, classify=classify)
         except VisionError as exc:
-            self._error('process', str(exc))
+            self.get_logger().error(str(exc), throttle_duration_sec=5.0)
             return None
         self._last = (rgb, header, depth)
         self.frames += 1
@@ -241,28 +229,14 @@ class VisionNode(rclpy.node.Node):
                                                     header))
         return result
 
-    def _error(self, key: str, text: str) -> None:
-        now = time.monotonic()
-        if now - self._errors.get(key, -1e9) >= 5.0:  # the same problem at most every 5 s
-            self._errors[key] = now
-            self.get_logger().error(text)
+    def destroy_node(self) -> None:
+        self.get_logger().info(f'Vision processed {self.frames} frames.')
+        super().destroy_node()
 
 
 def main(args: list[str] | None = None) -> int:
     """Run the vision node until Ctrl-C or the ``duration`` parameter."""
-    rclpy.init(args=args if args is not None else sys.argv)
-    node = VisionNode()
-    try:
-        while rclpy.ok() and not node.done:
-            rclpy.spin_once(node, timeout_sec=0.1)
-    except KeyboardInterrupt:
-        pass
-    finally:
-        node.get_logger().info(f'Vision processed {node.frames} frames.')
-        node.destroy_node()
-        if rclpy.ok():
-            rclpy.shutdown()
-    return 0
+    return run_node(VisionNode, args, errors=(VisionError,))
 
 
 if __name__ == '__main__':

@@ -1,0 +1,78 @@
+"""Every node's parameters: declared once from a dataclass (descriptors with descriptions, units,
+ranges), one ROS parameter file per node that agrees with the defaults, live changes applied or
+refused with the reason. Parametrised over the nodes, as tests/fsm/test_params.py does for the
+controller's own checks."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import pytest
+import yaml
+
+from mindgrasp_common.resources import resource_path
+from mindgrasp_ros.params import _flat_fields, _info, describe
+
+#: node name, parameter dataclass (module, class), parameter file (package, file)
+NODES = [
+    ('fsm', 'mindgrasp_fsm.params', 'FsmParams', 'mindgrasp_fsm', 'fsm.yaml'),
+    ('vision', 'mindgrasp_vision.config', 'VisionConfig', 'mindgrasp_vision', 'vision.yaml'),
+]
+IDS = [n[0] for n in NODES]
+
+
+def _cls(module: str, name: str) -> type:
+    import importlib
+
+    return getattr(importlib.import_module(module), name)
+
+
+@pytest.mark.parametrize(('node', 'module', 'cls_name', 'package', 'file'), NODES, ids=IDS)
+def test_parameter_file_agrees_with_the_defaults(node, module, cls_name, package, file):
+    cls = _cls(module, cls_name)
+    data = yaml.safe_load(resource_path(package, 'param', file).read_text())
+    section = data[node]['ros__parameters']
+    flat: dict[str, object] = {}
+    for key, value in section.items():   # nested dicts are dotted names, as ROS reads them
+        if isinstance(value, dict):
+            flat.update({f'{key}.{k}': v for k, v in value.items()})
+        else:
+            flat[key] = value
+    defaults = {name: value for _, name, value in _flat_fields(cls, cls())}
+    assert set(flat) == set(defaults), (sorted(set(flat) ^ set(defaults)))
+    for name, value in flat.items():
+        assert value == pytest.approx(defaults[name]), (name, value, defaults[name])
+
+
+@pytest.mark.parametrize(('node', 'module', 'cls_name', 'package', 'file'), NODES, ids=IDS)
+def test_every_parameter_has_a_description_and_numbers_a_range(node, module, cls_name, package,
+                                                               file):
+    cls = _cls(module, cls_name)
+    for field in dataclasses.fields(cls):
+        info = _info(field)
+        assert info.description, f'{node}: {field.name} has no description'
+        default = getattr(cls(), field.name)
+        if isinstance(default, (int, float)) and not isinstance(default, bool):
+            assert info.min is not None or info.max is not None, f'{node}: {field.name} range'
+    for name, (_default, desc) in describe(cls).items():
+        assert desc.name == name and desc.type != 0
+
+
+def test_vision_live_change_rebuilds_the_pipeline_or_is_refused(rclpy_ctx):
+    from mindgrasp_vision.vision_node import VisionNode
+
+    param = rclpy_ctx.parameter.Parameter
+    node = VisionNode()
+    try:
+        ok = node.set_parameters([param('hysteresis', value=0.3)])[0]
+        assert ok.successful and node.pipeline.ranker.hysteresis == pytest.approx(0.3)
+        assert node.cfg.hysteresis == pytest.approx(0.3)
+        bad = node.set_parameters([param('colour_ranges.red', value=[170, 8, 120])])[0]
+        assert not bad.successful and 'needs 4 numbers' in bad.reason, bad.reason
+        assert node.cfg.colour_ranges['red'] == [170, 8, 120, 40]
+        fixed = node.set_parameters([param('shape_model', value='none')])[0]
+        assert not fixed.successful and 'read-only' in fixed.reason
+        out = node.set_parameters([param('min_pixels', value=0)])[0]
+        assert not out.successful and 'within [1, 100000]' in out.reason, out.reason
+    finally:
+        node.destroy_node()
