@@ -45,7 +45,7 @@ class BridgeParams:
                       min=0, max=65535)
     address: str = param('127.0.0.1', 'address to listen on (loopback: this machine only)')
     # param() returns a dataclasses.field with a default_factory for lists
-    topic_whitelist: list[str] = param(['.*'], 'regexes of the topics to serve')  # noqa: RUF009
+    topic_whitelist: list[str] = param(['.*'], 'regexes of the topics to serve')
     message_backlog_size: int = param(
         1024, 'messages queued per client before its oldest are dropped', min=1)
     discovery_period: float = param(1.0, 'how often new topics are looked for', unit='s',
