@@ -4,9 +4,10 @@ import math
 
 import pytest
 
-from mindgrasp_bringup.trials import SceneObjectRef, TrialOutcome, TrialPlanner
+from mindgrasp_bringup.trials import TrialOutcome, TrialPlanner
+from mindgrasp_common.types import SceneObject
 
-SCENE = [SceneObjectRef(i, c, s) for i, (c, s) in enumerate(
+SCENE = [SceneObject(i, c, s) for i, (c, s) in enumerate(
     [('red', 'cube'), ('blue', 'cylinder'), ('yellow', 'sphere')])]
 
 

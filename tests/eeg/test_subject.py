@@ -7,8 +7,9 @@ import math
 import numpy as np
 import pytest
 
+from mindgrasp_common.types import SceneObject
 from mindgrasp_eeg import EEGError
-from mindgrasp_eeg.subject import SceneObject, VirtualSubject, pursue_class
+from mindgrasp_eeg.subject import VirtualSubject, pursue_class
 from mindgrasp_eeg.synthetic import SyntheticEEG
 
 FS = 250.0
@@ -93,8 +94,8 @@ def test_noise_mode_carries_no_class_information_follow_does() -> None:
 
 
 def test_pursue_class_like_a_competent_user() -> None:
-    left = SceneObject(1, 'blue', 'cylinder', 0.5 * math.cos(0.7), 0.5 * math.sin(0.7))
-    ahead = SceneObject(2, 'red', 'cube', 0.5, 0.0)
+    left = SceneObject(1, 'blue', 'cylinder', (0.5 * math.cos(0.7), 0.5 * math.sin(0.7), 0.0))
+    ahead = SceneObject(2, 'red', 'cube', (0.5, 0.0, 0.0))
     assert pursue_class(left, 0.0, 1) == 0                     # turn left towards it
     assert pursue_class(left, 1.4, 1) == 1                     # overshot: turn right
     assert pursue_class(left, 0.68, 1) == 2                    # centred: stop and approach
@@ -105,13 +106,14 @@ def test_pursue_class_like_a_competent_user() -> None:
     assert pursue_class(ahead, 0.0, 4) is None
     assert pursue_class(None, 0.0, 1) is None
     # angles wrap: target at +170 deg seen from -170 deg is 20 deg to the right
-    back = SceneObject(3, 'red', 'sphere', math.cos(math.radians(170)), math.sin(math.radians(170)))
+    back = SceneObject(3, 'red', 'sphere',
+                       (math.cos(math.radians(170)), math.sin(math.radians(170)), 0.0))
     assert pursue_class(back, math.radians(-170), 1) == 1
 
 
 def test_pursue_mode_uses_its_inputs_and_accuracy() -> None:
     s = VirtualSubject('pursue', reaction_delay=0.2, decision_period=0.5, seed=0)
-    s.set_objects([SceneObject(7, 'yellow', 'sphere', 0.0, 0.5)])
+    s.set_objects([SceneObject(7, 'yellow', 'sphere', (0.0, 0.5, 0.0))])
     s.set_target(7, 'yellow', 'sphere')
     s.set_fsm(1)
     s.intent(0.0)
@@ -120,7 +122,7 @@ def test_pursue_mode_uses_its_inputs_and_accuracy() -> None:
     s.intent(0.5)
     assert s.intent(0.75) == 2
     noisy = VirtualSubject('pursue', accuracy=0.5, decision_period=0.1, seed=1)
-    noisy.set_objects([SceneObject(7, 'yellow', 'sphere', 0.0, 0.5)])
+    noisy.set_objects([SceneObject(7, 'yellow', 'sphere', (0.0, 0.5, 0.0))])
     noisy.set_target(7, '', '')
     for k in range(1000):
         noisy.intent(k * 0.1)

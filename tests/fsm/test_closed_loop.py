@@ -44,7 +44,7 @@ def test_oracle_bci_grasps_the_desired_object(set_locations_loop: LockstepLoop, 
                                               ) -> None:
     loop = set_locations_loop
     loop.sim.reset()
-    target = next(o.id for o in loop.sim.objects() if o.label == label)
+    target = next(o.object_id for o in loop.sim.objects() if o.label == label)
     out = loop.run(target, timeout=90.0, oracle=OracleBci(target))
     assert out.success, (out.reason, out.states)
     assert out.grasped_object == label

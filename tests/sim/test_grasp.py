@@ -29,7 +29,7 @@ def test_scripted_grasp_lifts_each_shape(shape, size):
         assert out.success, out.reason
         assert out.lift_height > SUCCESS_HEIGHT
         held = sim.held_object()
-        assert held is not None and held.id == obj.id
+        assert held is not None and held.object_id == obj.object_id
         # held by friction: at least two fingers touch it, and it moves with the hand
         assert sim.gripper_state()['contacts'].sum() >= 2
         tcp_before, obj_before = sim.ee_pose()[0], sim.objects()[0].position

@@ -66,11 +66,13 @@ def test_object_markers(sim):
     assert [m.type for m in markers[:3]] == [1, 3, 2]          # CUBE, CYLINDER, SPHERE
     assert markers[0].scale.x == pytest.approx(0.05) and markers[0].color.r > 0.8
     assert markers[1].pose.position.y == pytest.approx(0.5 * np.sin(np.radians(40)))
-    from mindgrasp_eeg import ros_conversions as conv
+    from mindgrasp_common.markers import objects_from_markers
 
-    seen = conv.markers_to_objects(markers)
+    seen = objects_from_markers(markers)       # what every subscriber of /sim/objects reads
     assert [(o.colour, o.shape) for o in seen[:3]] == [
         ('red', 'cube'), ('blue', 'cylinder'), ('yellow', 'sphere')]
+    assert [o.object_id for o in seen] == [o.object_id for o in sim.objects()]
+    np.testing.assert_allclose(seen[1].position, sim.objects()[1].position)
 
 
 def test_grasp_result():

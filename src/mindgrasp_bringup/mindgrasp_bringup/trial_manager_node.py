@@ -17,7 +17,9 @@ from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import FsmState, GraspResult, T
 from mindgrasp_ros.interfaces.mindgrasp_msgs.srv import ResetSim
 from mindgrasp_ros.interfaces.visualization_msgs.msg import MarkerArray
 
-from mindgrasp_bringup.trials import SceneObjectRef, TrialOutcome, TrialPlanner
+from mindgrasp_bringup.trials import TrialOutcome, TrialPlanner
+from mindgrasp_common.markers import objects_from_markers
+from mindgrasp_common.types import SceneObject
 from mindgrasp_ros import rclpy
 
 
@@ -41,10 +43,10 @@ class TrialManagerNode(rclpy.node.Node):
         self.create_subscription(GraspResult, '/task/result', self.result_callback, 10)
         self.create_subscription(FsmState, '/fsm/state', self.fsm_callback, latched)
         self.reset_client = self.create_client(ResetSim, '/sim/reset')
-        self.scene: list[SceneObjectRef] = []
+        self.scene: list[SceneObject] = []
         self.fsm_state = 0
         self.trial = 0
-        self.target: SceneObjectRef | None = None
+        self.target: SceneObject | None = None
         self.trial_start = 0.0
         self.result: GraspResult | None = None
         self.phase = 'waiting for the scene'
@@ -55,12 +57,7 @@ class TrialManagerNode(rclpy.node.Node):
 
     # ------------------------------------------------------------------ inputs
     def objects_callback(self, msg: MarkerArray) -> None:
-        scene = []
-        for marker in msg.markers:
-            colour, _, shape = marker.text.partition(' ')
-            if colour and shape:
-                scene.append(SceneObjectRef(int(marker.id), colour, shape))
-        self.scene = sorted(scene, key=lambda o: o.object_id)
+        self.scene = objects_from_markers(msg.markers)
 
     def result_callback(self, msg: GraspResult) -> None:
         if self.phase == 'trial' and self.result is None:

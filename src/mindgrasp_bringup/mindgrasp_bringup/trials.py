@@ -11,20 +11,9 @@ import random
 import statistics
 from dataclasses import dataclass, field
 
-__all__ = ['SceneObjectRef', 'TrialOutcome', 'TrialPlanner']
+from mindgrasp_common.types import SceneObject
 
-
-@dataclass(frozen=True)
-class SceneObjectRef:
-    """An object of the scene as /sim/objects names it."""
-
-    object_id: int
-    colour: str
-    shape: str
-
-    @property
-    def label(self) -> str:
-        return f'{self.colour} {self.shape}'
+__all__ = ['TrialOutcome', 'TrialPlanner']
 
 
 @dataclass(frozen=True)
@@ -58,7 +47,7 @@ class TrialPlanner:
     def __post_init__(self) -> None:
         self._rng = random.Random(self.seed)
 
-    def next_target(self, trial: int, scene: list[SceneObjectRef]) -> SceneObjectRef:
+    def next_target(self, trial: int, scene: list[SceneObject]) -> SceneObject:
         """The desired object of ``trial`` (1-based) among ``scene``."""
         if not scene:
             msg = 'The scene has no objects (is /sim/objects published?); cannot choose a target.'

@@ -5,16 +5,9 @@ Only duck-typed attribute access on messages; no ROS import, so tests can use an
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Sequence
-
-import numpy as np
+from collections.abc import Sequence
 
 from .acquisition import ERROR, OK, WARN, Status
-from .subject import SceneObject
-
-_COLOURS = {'red': (1.0, 0.0, 0.0), 'yellow': (1.0, 1.0, 0.0), 'blue': (0.0, 0.0, 1.0)}
-_SHAPES_BY_MARKER_TYPE = {1: 'cube', 2: 'sphere', 3: 'cylinder'}   # visualization_msgs/Marker
-_MARKER_DELETE, _MARKER_DELETEALL, _MARKER_TEXT = 2, 3, 9
 
 
 def time_to_s(stamp: object) -> float:
@@ -25,32 +18,6 @@ def time_to_s(stamp: object) -> float:
 def ns_to_time_fields(ns: int) -> tuple[int, int]:
     """Nanoseconds -> (sec, nanosec) of ``builtin_interfaces/Time``."""
     return int(ns // 1_000_000_000), int(ns % 1_000_000_000)
-
-
-def markers_to_objects(markers: Iterable[object], base_xy: Sequence[float] = (0.0, 0.0)
-                       ) -> list[SceneObject]:
-    """``visualization_msgs/MarkerArray.markers`` -> scene objects in the arm base frame.
-
-    Colour from the marker text or namespace (``red``/``yellow``/``blue``), else the nearest of
-    those to the marker colour; shape from the text or namespace (``cube``/``cylinder``/
-    ``sphere``), else from the marker type. Text-only and delete markers are skipped. Positions are
-    taken in the world frame with the arm base at ``base_xy`` (m).
-    """
-    out = []
-    for m in markers:
-        if m.action in (_MARKER_DELETE, _MARKER_DELETEALL) or m.type == _MARKER_TEXT:
-            continue
-        words = f'{m.text} {m.ns}'.lower().replace('_', ' ').replace('/', ' ').split()
-        colour = next((w for w in words if w in _COLOURS), '')
-        if not colour:
-            rgb = np.array([m.color.r, m.color.g, m.color.b])
-            colour = min(_COLOURS, key=lambda c: float(np.sum((rgb - _COLOURS[c]) ** 2)))
-        shape = next((w for w in words if w in ('cube', 'cylinder', 'sphere')),
-                     _SHAPES_BY_MARKER_TYPE.get(int(m.type), 'unknown'))
-        p = m.pose.position
-        out.append(SceneObject(int(m.id), colour, shape, float(p.x) - base_xy[0],
-                               float(p.y) - base_xy[1], float(p.z)))
-    return out
 
 
 def base_yaw_from_joint_state(names: Sequence[str], positions: Sequence[float],

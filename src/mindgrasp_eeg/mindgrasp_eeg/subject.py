@@ -22,35 +22,18 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 
 import numpy as np
 
 from mindgrasp_common.geometry import wrap_angle
 from mindgrasp_common.states import State
+from mindgrasp_common.types import SceneObject
 
 from . import EEGError
 from .montage import BOTH_FEET, BOTH_HANDS, LEFT_HAND, NO_CLASS, RIGHT_HAND
 
 MODES = ('noise', 'follow', 'pursue')
 
-
-
-@dataclass(frozen=True)
-class SceneObject:
-    """One object of the scene, in the robot base frame (x forward at joint 1 = 0, y left; m)."""
-
-    object_id: int
-    colour: str
-    shape: str
-    x: float
-    y: float
-    z: float = 0.0
-
-    @property
-    def label(self) -> str:
-        """``"<colour> <shape>"`` as in ``FsmState.object_of_interest``."""
-        return f'{self.colour} {self.shape}'
 
 
 def find_target(objects: Sequence[SceneObject], object_id: int = -1, colour: str = '',

@@ -20,10 +20,11 @@ from mindgrasp_ros.interfaces.sensor_msgs.msg import JointState
 from mindgrasp_ros.interfaces.std_msgs.msg import String
 from mindgrasp_ros.interfaces.visualization_msgs.msg import MarkerArray
 
+from mindgrasp_common.markers import objects_from_markers
 from mindgrasp_eeg.lsl import EEGOutlet, MarkerOutlet
 from mindgrasp_eeg.montage import NAUTILUS_32, class_name
 from mindgrasp_eeg.node_main import run_node
-from mindgrasp_eeg.ros_conversions import base_yaw_from_joint_state, markers_to_objects, time_to_s
+from mindgrasp_eeg.ros_conversions import base_yaw_from_joint_state, time_to_s
 from mindgrasp_eeg.subject import VirtualSubject
 from mindgrasp_eeg.synthetic import SyntheticEEG
 from mindgrasp_eeg.virtual_amp import VirtualAmplifier
@@ -110,7 +111,7 @@ class VirtualAmpNode(rclpy.node.Node):
 
     def objects_callback(self, msg: MarkerArray) -> None:
         """Scene objects (world frame, base at ``base_position``)."""
-        self.subject.set_objects(markers_to_objects(msg.markers, self.p['base_position']))
+        self.subject.set_objects(objects_from_markers(msg.markers, self.p['base_position']))
 
     def joints_callback(self, msg: JointState) -> None:
         """Arm heading from the base joint."""

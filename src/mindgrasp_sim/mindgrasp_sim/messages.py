@@ -16,7 +16,7 @@ from mindgrasp_ros.interfaces.std_msgs.msg import Header
 from mindgrasp_ros.interfaces.tf2_msgs.msg import TFMessage
 from mindgrasp_ros.interfaces.visualization_msgs.msg import Marker, MarkerArray
 
-from mindgrasp_sim.simulation import SceneObject
+from mindgrasp_common.types import SceneObject
 from mindgrasp_sim.task import TaskEvent
 from mindgrasp_sim.tf_tree import Transform
 
@@ -91,8 +91,8 @@ def object_markers(hdr: Header, objects: list[SceneObject]) -> MarkerArray:
     ``"<colour> <shape>"`` as text, in namespace ``objects``."""
     markers = []
     for obj in objects:
-        m = Marker(header=hdr, ns='objects', id=obj.id, type=MARKER_TYPE[obj.shape], action=0,
-                   text=obj.label, frame_locked=False)
+        m = Marker(header=hdr, ns='objects', id=obj.object_id, type=MARKER_TYPE[obj.shape],
+                   action=0, text=obj.label, frame_locked=False)
         p, o = m.pose.position, m.pose.orientation
         p.x, p.y, p.z = (float(v) for v in obj.position)
         o.x, o.y, o.z, o.w = (float(v) for v in obj.orientation)

@@ -12,7 +12,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mindgrasp_sim.simulation import SceneObject, Simulation, top_down_quat
+from mindgrasp_common.geometry import top_down_quat
+from mindgrasp_common.types import SceneObject
+from mindgrasp_sim.simulation import Simulation
 
 #: object centre height above which a held object counts as lifted (m), as in the original code
 SUCCESS_HEIGHT = 0.22
@@ -114,9 +116,9 @@ def grasp_object_at(sim: Simulation, obj: SceneObject | int, robot: str = 'user'
     move_tcp_line(sim, np.array([centre[0], centre[1], lift_to]), quat, robot=robot, speed=0.1)
     sim.step(int(0.5 * sim.physics_hz))
     held = sim.held_object(robot)
-    now = sim.objects()[obj.id]
+    now = sim.objects()[obj.object_id]
     height = float(now.position[2])
-    ok = held is not None and held.id == obj.id and height > SUCCESS_HEIGHT
+    ok = held is not None and held.object_id == obj.object_id and height > SUCCESS_HEIGHT
     reason = 'lifted' if ok else ('not held' if held is None else f'held {held.label}')
     return GraspOutcome(ok, height, held, sim.time - t0, reason)
 

@@ -49,6 +49,7 @@ from mindgrasp_common.robot import (
     HOME_POSE,
     URDF_URI,
 )
+from mindgrasp_common.types import SceneObject
 from mindgrasp_sim.control import validate_velocities
 from mindgrasp_sim.errors import SimError
 from mindgrasp_sim.realism import Realism, RealismProfile
@@ -108,26 +109,6 @@ class CameraConfig:
             msg = f'Camera clipping planes must satisfy 0 < near < far, got near={self.near!r}, ' \
                   f'far={self.far!r}.'
             raise SimError(msg)
-
-
-@dataclass
-class SceneObject:
-    """State of one scene object. position (3,) m and orientation (4,) quaternion xyzw, world."""
-
-    id: int
-    shape: str
-    colour: str
-    size: float
-    mass: float
-    position: np.ndarray
-    orientation: np.ndarray
-    body: int = field(default=-1, repr=False)
-    rgba: tuple[float, float, float, float] = field(default=(1.0, 1.0, 1.0, 1.0), repr=False)
-
-    @property
-    def label(self) -> str:
-        """``"<colour> <shape>"`` as used in GraspResult and TaskTarget."""
-        return f'{self.colour} {self.shape}'
 
 
 @dataclass
@@ -612,14 +593,14 @@ class Simulation:
         out = []
         for i, (spec, body) in enumerate(self._objects):
             pos, orn = self._p.getBasePositionAndOrientation(body)
-            out.append(SceneObject(id=i, shape=spec.shape, colour=spec.colour, size=spec.size,
-                                   mass=spec.mass, position=np.array(pos),
-                                   orientation=np.array(orn), body=body, rgba=spec.rgba))
+            out.append(SceneObject(object_id=i, colour=spec.colour, shape=spec.shape,
+                                   position=np.array(pos), orientation=np.array(orn),
+                                   size=spec.size, mass=spec.mass, rgba=spec.rgba))
         return out
 
     def object_velocity(self, obj: SceneObject | int) -> np.ndarray:
         """Linear velocity (3,) m/s of an object."""
-        body = self._objects[obj if isinstance(obj, int) else obj.id][1]
+        body = self._objects[obj if isinstance(obj, int) else obj.object_id][1]
         return np.array(self._p.getBaseVelocity(body)[0])
 
     def _finger_contacts(self, robot_body: int) -> dict[int, set[int]]:

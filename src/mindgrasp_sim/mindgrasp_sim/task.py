@@ -63,8 +63,8 @@ class TaskMonitor:
     def update(self, sim: Simulation, robot: str = 'user') -> TaskEvent | None:
         """Check the gripper once; return an event when a success or a drop happened now."""
         held = sim.held_object(robot)
-        if held is not None and self._tracked != held.id:
-            self._tracked, self._label = held.id, held.label
+        if held is not None and self._tracked != held.object_id:
+            self._tracked, self._label = held.object_id, held.label
             self._rest_z = held.size / 2
             self._max_z = float(held.position[2])
             self._reported = False
