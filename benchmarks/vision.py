@@ -20,7 +20,7 @@ import time
 import numpy as np
 
 from mindgrasp_common.resources import resource_path
-from mindgrasp_vision.detector import CameraIntrinsics, ColourDetector
+from mindgrasp_vision.detector import CameraModel, ColourDetector
 from mindgrasp_vision.overlay import render_overlay
 from mindgrasp_vision.ranking import ObjectOfInterestRanker
 from mindgrasp_vision.shape_cnn import ShapeClassifier, preprocess_depth
@@ -53,7 +53,7 @@ def _stats(samples: list[float]) -> dict[str, float]:
 def bench_resolution(width: int, height: int, n: int) -> dict[str, dict[str, float]]:
     """Time detect+rank, and the overlay, over ``n`` frames of one resolution."""
     frames, k = _frames(width, height)
-    detector = ColourDetector(intrinsics=CameraIntrinsics.from_k(k.ravel()))
+    detector = ColourDetector(intrinsics=CameraModel.from_k(width, height, k))
     ranker = ObjectOfInterestRanker()
     vision, overlay = [], []
     for i in range(n + 10):

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from mindgrasp_vision.detector import CameraIntrinsics, ColourDetector
+from mindgrasp_vision.detector import CameraModel, ColourDetector
 
 
 @pytest.fixture(scope='session')
@@ -29,8 +29,8 @@ def placer(sim):
 
 @pytest.fixture(scope='session')
 def detector(sim) -> ColourDetector:
-    k, _, _ = sim.camera_intrinsics()
-    return ColourDetector(intrinsics=CameraIntrinsics.from_k(k.ravel()))
+    k, width, height = sim.camera_intrinsics()
+    return ColourDetector(intrinsics=CameraModel.from_k(width, height, k))
 
 
 @pytest.fixture

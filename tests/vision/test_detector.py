@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from mindgrasp_vision import CameraIntrinsics, ColourDetector, ColourRange, VisionError
+from mindgrasp_vision import CameraModel, ColourDetector, ColourRange, VisionError
 
 COLOURS = ('red', 'yellow', 'blue')
 SHAPES = ('cube', 'cylinder', 'sphere')
@@ -139,8 +139,8 @@ def test_bad_parameters():
         ColourDetector.from_parameters(['purple'], {})
     with pytest.raises(VisionError, match=r'needs 4 numbers'):
         ColourRange.from_sequence([1, 2])
-    with pytest.raises(VisionError, match=r'not a valid pinhole matrix'):
-        CameraIntrinsics.from_k([0.0] * 9)
+    with pytest.raises(ValueError, match=r'not a valid pinhole matrix'):
+        CameraModel.from_k(128, 128, [0.0] * 9)
 
 
 def test_640x480_frame_gives_the_same_objects():
@@ -149,7 +149,7 @@ def test_640x480_frame_gives_the_same_objects():
     with Simulation(scene='set_locations', seed=0,
                     camera=CameraConfig(width=640, height=480)) as big:
         rgb, depth = big.render_camera()
-        k, _, _ = big.camera_intrinsics()
-    dets = ColourDetector(intrinsics=CameraIntrinsics.from_k(k.ravel())).detect(rgb, depth)
+        k, width, height = big.camera_intrinsics()
+    dets = ColourDetector(intrinsics=CameraModel.from_k(width, height, k)).detect(rgb, depth)
     assert [d.colour for d in sorted(dets, key=lambda d: d.centre[0])] == ['blue', 'red', 'yellow']
     assert all(d.pixel_count > 500 and 0.4 < d.distance < 0.8 for d in dets)

@@ -27,33 +27,10 @@ from mindgrasp_classifier.preprocessing import (
     step_samples,
     window_samples,
 )
+from mindgrasp_common.types import Prediction
 
 ADAPT_MODES = ('none', 'supervised', 'unsupervised', 'both')
 RECENTER_MODES = ('fixed', 'adaptive')
-
-
-@dataclass
-class Prediction:
-    """One decoded window.
-
-    Attributes
-    ----------
-    sample_index : int
-        Stream index of the window's last sample.
-    class_index : int
-        MIndGrasp class (0 left hand ... 3 both feet).
-    class_name : str
-    certainty : float
-        ``mean(distances) - min(distances)``.
-    distances : ndarray, shape (n_classes,)
-        Per-class distances in the order of the model's classes.
-    """
-
-    sample_index: int
-    class_index: int
-    class_name: str
-    certainty: float
-    distances: np.ndarray
 
 
 @dataclass
@@ -332,7 +309,8 @@ class MiDecoder:
         d = self.model.classifier.distances(rec)[0]
         pos = int(np.argmin(d))
         cls = int(self.model.classes[pos])
-        pred = Prediction(end, cls, CLASS_NAMES[cls], float(certainty_of(d)), d)
+        pred = Prediction(class_index=cls, certainty=float(certainty_of(d)), sample_index=end,
+                          distances=d)
         self._adapt(cov[0], rec[0], pred, pos)
         return pred
 

@@ -13,7 +13,7 @@ Heavy modules (torch, the simulator) are imported only when used.
 from mindgrasp_vision._checks import VisionError
 from mindgrasp_vision.detector import (
     DEFAULT_COLOURS,
-    CameraIntrinsics,
+    CameraModel,
     ColourDetector,
     ColourRange,
     Detection,
@@ -25,7 +25,7 @@ __all__ = [
     'DEFAULT_COLOURS',
     'LEFT_HAND',
     'RIGHT_HAND',
-    'CameraIntrinsics',
+    'CameraModel',
     'ColourDetector',
     'ColourRange',
     'Detection',

@@ -24,7 +24,7 @@ import numpy as np
 
 from mindgrasp_vision._checks import VisionError
 from mindgrasp_vision.depth import DepthFilter
-from mindgrasp_vision.detector import CameraIntrinsics, ColourDetector, Detection
+from mindgrasp_vision.detector import CameraModel, ColourDetector, Detection
 from mindgrasp_vision.shape_cnn import SHAPES, Preprocessing, preprocess_depth
 
 __all__ = ['CameraPlacer', 'DatasetConfig', 'ShapeDataset', 'collect_shape_dataset',
@@ -219,8 +219,8 @@ def collect_shape_dataset(n_images: int, seed: int = 0, config: DatasetConfig = 
                      realism=realism, realism_seed=seed)
     depth_filter = depth_filter or DepthFilter()
     try:
-        k, _, _ = sim.camera_intrinsics()
-        detector = ColourDetector(intrinsics=CameraIntrinsics.from_k(k.ravel()))
+        k, width, height = sim.camera_intrinsics()
+        detector = ColourDetector(intrinsics=CameraModel.from_k(width, height, k))
         placer = CameraPlacer(sim)
         xs, ys, info = [], [], []
         attempts = 0

@@ -17,11 +17,12 @@ from dataclasses import dataclass, field, replace
 import cv2
 import numpy as np
 
+from mindgrasp_common.types import CameraModel
 from mindgrasp_vision._checks import VisionError, check_depth, check_rgb
 
 __all__ = [
     'DEFAULT_COLOURS',
-    'CameraIntrinsics',
+    'CameraModel',
     'ColourDetector',
     'ColourRange',
     'Detection',
@@ -78,32 +79,6 @@ DEFAULT_COLOURS: dict[str, ColourRange] = {
     'yellow': ColourRange(20, 35, 120, 60),
     'blue': ColourRange(105, 130, 120, 40),
 }
-
-
-@dataclass(frozen=True)
-class CameraIntrinsics:
-    """Pinhole intrinsics (px), as in ``sensor_msgs/CameraInfo.k``."""
-
-    fx: float
-    fy: float
-    cx: float
-    cy: float
-
-    @classmethod
-    def from_fov(cls, width: int, height: int, vertical_fov_deg: float) -> CameraIntrinsics:
-        """Square-pixel intrinsics of a ``width`` x ``height`` px image, vertical FOV in degrees."""
-        f = 0.5 * height / math.tan(math.radians(vertical_fov_deg) / 2.0)
-        return cls(f, f, (width - 1) / 2.0, (height - 1) / 2.0)
-
-    @classmethod
-    def from_k(cls, k: Sequence[float]) -> CameraIntrinsics:
-        """From the row-major 3x3 camera matrix ``K`` of a CameraInfo message."""
-        k = [float(v) for v in k]
-        if len(k) != 9 or k[0] <= 0 or k[4] <= 0:
-            msg = (f'The camera matrix K {k} is not a valid pinhole matrix (9 values, fx, fy > 0); '
-                   'check the camera_info publisher.')
-            raise VisionError(msg)
-        return cls(k[0], k[4], k[2], k[5])
 
 
 @dataclass
@@ -202,7 +177,7 @@ class ColourDetector:
         colour; 0 disables the split.
     object_size : float | None
         Known object size (m) for the pixel-size distance estimate used when no depth is given.
-    intrinsics : CameraIntrinsics | None
+    intrinsics : CameraModel | None
         Camera model, used for ``position`` and the pixel-size distance.
     max_depth : float
         Depth readings beyond this (m) count as no reading.
@@ -213,7 +188,7 @@ class ColourDetector:
 
     def __init__(self, colours: Mapping[str, ColourRange] | None = None, *, min_pixels: int = 6,
                  morph_kernel: int = 3, depth_edge: float = 0.03,
-                 object_size: float | None = None, intrinsics: CameraIntrinsics | None = None,
+                 object_size: float | None = None, intrinsics: CameraModel | None = None,
                  max_depth: float = 10.0, min_split_fraction: float = 0.15) -> None:
         self.colours = dict(DEFAULT_COLOURS if colours is None else colours)
         if not self.colours:

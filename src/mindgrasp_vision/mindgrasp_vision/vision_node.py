@@ -26,6 +26,7 @@ from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import (
 from mindgrasp_ros.interfaces.sensor_msgs.msg import CameraInfo, Image, RegionOfInterest
 from mindgrasp_ros.interfaces.std_srvs.srv import Trigger
 
+from mindgrasp_common.errors import CommonError
 from mindgrasp_ros import rclpy
 from mindgrasp_ros.node_main import declare_duration, run_node
 from mindgrasp_ros.params import declare_params
@@ -40,7 +41,7 @@ from mindgrasp_ros.topics import (
 )
 from mindgrasp_vision._checks import VisionError
 from mindgrasp_vision.config import VisionConfig
-from mindgrasp_vision.detector import CameraIntrinsics
+from mindgrasp_vision.detector import CameraModel
 from mindgrasp_vision.ros_conversions import (
     depth_from_image,
     detection_to_msg,
@@ -122,8 +123,8 @@ class VisionNode(rclpy.node.Node):
 
     def info_callback(self, msg: CameraInfo) -> None:
         try:
-            self.pipeline.detector.intrinsics = CameraIntrinsics.from_k(msg.k)
-        except VisionError as exc:
+            self.pipeline.detector.intrinsics = CameraModel.from_k(msg.width, msg.height, msg.k)
+        except CommonError as exc:
             self.get_logger().error(str(exc), throttle_duration_sec=5.0)
 
     def prediction_callback(self, msg: MIPrediction) -> None:
