@@ -140,3 +140,49 @@ def test_committed_layout_is_the_generated_one_and_shows_demo_topics() -> None:
     assert used <= set(TOPICS), used - set(TOPICS)
     assert {'/vision/overlay', '/robot_description', '/eeg/raw', '/bci/prediction',
             '/fsm/state'} <= used
+
+
+def _subscribe_and_receive(ws, topic: str, node, rclpy, timeout: float = 60.0):
+    """On an open connection: subscribe to ``topic`` once advertised, return its first message
+    (decoded with the advertised schema)."""
+    channel = None
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        rclpy.spin_once(node, timeout_sec=0.01)
+        try:
+            frame = ws.recv(timeout=0.1)
+        except TimeoutError:
+            continue
+        if isinstance(frame, str):
+            op = json.loads(frame)
+            for ch in op.get('channels', []) if op['op'] == 'advertise' else []:
+                if ch['topic'] == topic:
+                    channel = ch
+                    ws.send(json.dumps({'op': 'subscribe',
+                                        'subscriptions': [{'id': 1, 'channelId': ch['id']}]}))
+            continue
+        decode = generate_dynamic(channel['schemaName'], channel['schema'])
+        return decode[channel['schemaName']](bytes(frame[13:]))
+    return None
+
+
+def test_latched_topic_reaches_every_client_that_joins_later(rclpy_ctx, spawn_node) -> None:
+    """/robot_description is published once; a first client gets it, then a second one that
+    subscribes while the first still watches (the bridge's subscription exists already)."""
+    from mindgrasp_ros.interfaces.std_msgs.msg import String
+
+    rclpy = rclpy_ctx
+    proc, port = _start_bridge(spawn_node)
+    node = rclpy.create_node('live_view_latched_probe')
+    latched = rclpy.qos.QoSProfile(depth=1, reliability=rclpy.qos.ReliabilityPolicy.RELIABLE,
+                                   durability=rclpy.qos.DurabilityPolicy.TRANSIENT_LOCAL)
+    pub = node.create_publisher(String, '/robot_description', latched)
+    pub.publish(String(data='<robot name="once"/>'))
+    url = f'ws://127.0.0.1:{port}'
+    with connect(url, subprotocols=SUBPROTOCOLS, proxy=None, open_timeout=30) as first_ws:
+        first = _subscribe_and_receive(first_ws, '/robot_description', node, rclpy)
+        assert first is not None and first.data == '<robot name="once"/>', proc.output()
+        with connect(url, subprotocols=SUBPROTOCOLS, proxy=None, open_timeout=30) as second_ws:
+            second = _subscribe_and_receive(second_ws, '/robot_description', node, rclpy)
+    assert second is not None and second.data == '<robot name="once"/>', proc.output()
+    assert proc.stop() == 0
