@@ -379,6 +379,9 @@ def test_tf_tree_and_robot_description_as_robot_state_publisher(rclpy_ctx, spawn
     want = Rotation.from_quat([ee.orientation.x, ee.orientation.y, ee.orientation.z,
                                ee.orientation.w])
     assert (want.inv() * rot).magnitude() < 1e-3
+    # at most 20 Hz, as robot_state_publisher's publish_frequency (joint states at 100 Hz)
+    stamps = sorted(key(m.transforms[0].header.stamp) for m in dynamic)
+    assert np.median(np.diff(stamps)) == pytest.approx(50_000_000, abs=5_000_000)
     # the fingers are in the tree too, and the camera images name a frame of it
     assert {'finger_thumb', 'finger_left', 'finger_right'} <= set(edges)
     assert probe.images[-1].header.frame_id in edges

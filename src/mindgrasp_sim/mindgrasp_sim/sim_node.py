@@ -23,8 +23,10 @@ under ``/trainer_robot/``.
 As robot_state_publisher would for a real arm: ``/robot_description`` (std_msgs/String, the URDF,
 transient local), ``/tf_static`` (``world`` -> ``base_link`` and the URDF's fixed joints: camera
 optical frame, TCP) and ``/tf`` (the URDF's moving joints, arm and fingers, from the published
-joint states at the joint-state rate); camera topics carry the frame ``camera_color_optical_frame``
-of that tree, and the objects are the markers on ``/sim/objects`` (in ``world``).
+joint states, at most ``tf_publish_frequency`` Hz as robot_state_publisher's
+``publish_frequency``, 20 Hz by default); camera topics carry the frame
+``camera_color_optical_frame`` of that tree, and the objects are the markers on ``/sim/objects``
+(in ``world``).
 Services ``/sim/reset`` (ResetSim), ``/sim/load_scene`` (LoadScene) and, in lock-step mode,
 ``/sim/step`` (Step).
 
@@ -81,6 +83,7 @@ _PARAMS = (
     ('time_mode', 'realtime'), ('command_timeout', 0.25), ('trainer_robot', False),
     ('training_robot', False), ('gui', False), ('duration', 0.0), ('sim_duration', 0.0),
     ('success_height', 0.22), ('frame_id', 'world'), ('max_catch_up', 0.25),
+    ('tf_publish_frequency', 20.0),
     ('scene_camera_rate', 0.0), ('scene_camera_width', 320), ('scene_camera_height', 240),
     ('realism', 'none'), ('realism_seed', 0),
 )  # fmt: skip
@@ -106,7 +109,8 @@ def _check_params(p: dict) -> None:
         msg = (f"Parameter 'scene_camera_rate' must be 0 (off) or a rate up to 'physics_hz' "
                f'({p["physics_hz"]} Hz), got {rate!r}; the participant display uses 5-10 Hz.')
         raise SimError(msg)
-    for name in ('joint_state_rate', 'objects_rate', 'command_timeout', 'physics_hz'):
+    for name in ('joint_state_rate', 'objects_rate', 'command_timeout', 'physics_hz',
+                 'tf_publish_frequency'):
         if not (isinstance(p[name], (int, float)) and p[name] > 0):
             msg = f"Parameter '{name}' must be a positive number, got {p[name]!r}."
             raise SimError(msg)
@@ -150,6 +154,10 @@ class SimNode(rclpy.node.Node):
         self.desired = ''
         self.total_steps = 0
         self.js_every = self.sim.physics_hz / float(p['joint_state_rate'])
+        # /tf at most at tf_publish_frequency, as robot_state_publisher's publish_frequency
+        self.tf_every = self.sim.physics_hz / min(float(p['tf_publish_frequency']),
+                                                  float(p['joint_state_rate']))
+        self._next_tf_step = 0.0
         self.cam_every = self.sim.physics_hz / self.sim.camera.rate_hz
         self.obj_every = self.sim.physics_hz / float(p['objects_rate'])
         self.task_every = max(1, round(self.sim.physics_hz / 20.0))
@@ -443,7 +451,9 @@ class SimNode(rclpy.node.Node):
             io.pubs['contacts'].publish(UInt8MultiArray(
                 data=state['contacts'].astype(np.uint8)))
             io.pubs['ee'].publish(msgs.pose_stamped(world, *sim.ee_pose(io.name)))
-            if io.name == 'user':  # the tree robot_state_publisher makes of these joint states
+            if io.name == 'user' and self.total_steps >= self._next_tf_step:
+                # the tree robot_state_publisher makes of these joint states
+                self._next_tf_step = self.total_steps + self.tf_every - 1e-6
                 positions = dict(zip(sim.joint_names, q, strict=True))
                 positions.update(zip(sim.finger_names, state['positions'], strict=True))
                 self.tf_pub.publish(msgs.tf_message(hdr.stamp, self.tf_tree.transforms(positions)))
