@@ -27,15 +27,33 @@ def add_data_arguments(parser: argparse.ArgumentParser) -> None:
     g.add_argument('--eeg-topic', default='/eeg/raw', help='EEG topic in bags (default /eeg/raw)')
     g.add_argument('--prompt-topic', default='/trainer/prompt',
                    help='prompt topic in bags (default /trainer/prompt)')
+    g.add_argument('--labels', choices=('prompt', 'intent'), default='prompt',
+                   help='labels of bag runs: the trainer/Graz prompts (prompt, default), or the '
+                        "virtual subject's intent for demo and experiment runs (intent, from "
+                        '--intent-topic; epochs [tmin, tmax] tile each intent)')
+    g.add_argument('--intent-topic', default='/virtual_subject/intent',
+                   help='intent topic in bags for --labels intent (default '
+                        '/virtual_subject/intent)')
+    g.add_argument('--keep-aborted', action='store_true',
+                   help='keep trainer trials cut short by a robot reset (left out by default: '
+                        'their epochs hold rest and the next trial)')
     g.add_argument('--tmin', type=float, default=0.5, help='epoch start after the cue (s, 0.5)')
     g.add_argument('--tmax', type=float, default=2.5, help='epoch end after the cue (s, 2.5)')
 
 
 def load_from_args(args: argparse.Namespace) -> list[Recording]:
     """Recordings named by :func:`add_data_arguments` options."""
-    return load_inputs(edf=args.edf, bags=args.bag, event_map=args.event_map,
-                       eegbci_subject=args.eegbci, eegbci_runs=args.runs,
-                       eeg_topic=args.eeg_topic, prompt_topic=args.prompt_topic)
+    recordings = load_inputs(edf=args.edf, bags=args.bag, event_map=args.event_map,
+                             eegbci_subject=args.eegbci, eegbci_runs=args.runs,
+                             eeg_topic=args.eeg_topic, prompt_topic=args.prompt_topic,
+                             labels=args.labels, keep_aborted=args.keep_aborted,
+                             intent_topic=args.intent_topic, tmin=args.tmin, tmax=args.tmax)
+    aborted = sum(r.n_aborted for r in recordings)
+    if aborted:
+        print(f"{'Kept' if args.keep_aborted else 'Left out'} {aborted} aborted trial(s) "
+              '(cut short by a robot reset)' + ('' if args.keep_aborted else
+                                                 '; --keep-aborted keeps them') + '.')
+    return recordings
 
 
 def format_report(report: dict[str, Any], title: str) -> str:

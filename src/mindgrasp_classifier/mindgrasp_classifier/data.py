@@ -7,6 +7,7 @@ decoder does.
 
 from __future__ import annotations
 
+import itertools
 import os
 import re
 from collections.abc import Iterable, Sequence
@@ -54,6 +55,7 @@ class Recording:
     events: np.ndarray
     source: str
     first_sample_index: int = 0
+    n_aborted: int = 0          # trials left out because they were cut short (see load_bag)
 
 
 def parse_event_map(text: str) -> dict[str, int]:
@@ -135,14 +137,76 @@ def eegbci_files(subject: int, runs: Sequence[int], path: str | None = None) -> 
 
 
 # --------------------------------------------------------------------------- bags
-def load_bag(path: str | Path, eeg_topic: str = '/eeg/raw',
-             prompt_topic: str = '/trainer/prompt') -> Recording:
-    """Load a recorded run (rosbag2 folder) with EEG chunks and trainer prompts.
+LABELS = ('prompt', 'intent')
+#: a phase that ends this much before its planned end was cut short (s)
+_CUT_TOLERANCE = 0.25   # prompts are stamped when published (timer ticks, load)
 
-    The label of a trial is the prompt class; its onset is the first prompt of the trial that
-    carries a class (the Graz ``cue`` or the trainer's ``move`` phase). Lost samples (gaps in
-    ``first_sample_index``) are NaN, and windows over them are skipped.
+
+def aborted_trials(prompts: Sequence[object]) -> set[int]:
+    """Trials cut short (a robot reset or the session's end during the trial), from the prompts.
+
+    A trial's classed phases (``cue``/``move``/``wait``) each announce their planned duration;
+    when the next prompt arrives before the current classed phase has run its planned time, the
+    trainer cut the trial short (it logs such trials as aborted). ``prompts`` sorted by stamp.
     """
+    def stamp(p: object) -> float:
+        return p.header.stamp.sec + 1e-9 * p.header.stamp.nanosec  # type: ignore[attr-defined]
+
+    out: set[int] = set()
+    for cur, nxt in itertools.pairwise(prompts):
+        if int(cur.class_index) == NO_CLASS or cur.phase not in ('cue', 'move', 'wait'):
+            continue
+        if stamp(nxt) < stamp(cur) + float(cur.duration) - _CUT_TOLERANCE:
+            out.add(int(cur.trial))
+    return out
+
+
+def intent_events(changes: Sequence[tuple[float, str]], end: float, tmin: float,
+                  tmax: float) -> list[tuple[float, int]]:
+    """Epoch onsets labelled by the subject's intent, epochs ``[onset + tmin, onset + tmax]``
+    tiling each intent without overlap (onsets ``tmax - tmin`` apart, the first at the change).
+
+    Parameters
+    ----------
+    changes : sequence of (time s, class name)
+        ``/virtual_subject/intent`` messages (published on change) with their receive times.
+    end : float
+        End of the recording (s).
+    tmin, tmax : float
+        Epoch limits after an onset (s), as for cue-labelled trials; an intent shorter than
+        ``tmax`` gives no epoch (``--tmax 1.5`` takes shorter ones).
+    """
+    period = tmax - tmin
+    events: list[tuple[float, int]] = []
+    for (t0, name), t1 in zip(changes, [t for t, _ in changes[1:]] + [end], strict=True):
+        try:
+            k = class_index(name)
+        except ClassifierError:
+            continue                      # 'rest' and other non-MI states
+        t = t0
+        while t + tmax <= t1:
+            events.append((t, k))
+            t += period
+    return events
+
+
+def load_bag(path: str | Path, eeg_topic: str = '/eeg/raw',
+             prompt_topic: str = '/trainer/prompt', *, labels: str = 'prompt',
+             keep_aborted: bool = False, intent_topic: str = '/virtual_subject/intent',
+             tmin: float = 0.5, tmax: float = 2.5) -> Recording:
+    """Load a recorded run (rosbag2 folder) with EEG chunks and its labels.
+
+    ``labels='prompt'``: the label of a trial is the prompt class; its onset is the first prompt
+    of the trial that carries a class (the Graz ``cue`` or the trainer's ``move`` phase). Trials
+    cut short (:func:`aborted_trials`) are left out unless ``keep_aborted``; their number is in
+    ``n_aborted``. ``labels='intent'``: demo and experiment runs, labelled by the virtual
+    subject's intent (``intent_topic``), epochs ``[tmin, tmax]`` tiling each intent
+    (:func:`intent_events`). Lost samples (gaps in ``first_sample_index``) are NaN, and windows
+    over them are skipped.
+    """
+    if labels not in LABELS:
+        msg = f"--labels must be 'prompt' or 'intent'; {labels!r} is invalid."
+        raise ClassifierError(msg)
     from rosbags.rosbag2 import Reader
 
     from mindgrasp_ros.typesupport import typestore
@@ -153,7 +217,8 @@ def load_bag(path: str | Path, eeg_topic: str = '/eeg/raw',
         raise ClassifierError(msg)
     bag_dir = _find_bag_dir(path)
     store = typestore()
-    chunks, prompts = [], []
+    chunks, prompts, intents = [], [], []
+    label_topic = prompt_topic if labels == 'prompt' else intent_topic
     try:
         with Reader(bag_dir) as reader:
             topics = {c.topic for c in reader.connections}
@@ -161,10 +226,20 @@ def load_bag(path: str | Path, eeg_topic: str = '/eeg/raw',
                 msg = (f'The bag {bag_dir} has no {eeg_topic} topic (it has {sorted(topics)}); '
                        'record the EEG stream or name the EEG topic.')
                 raise ClassifierError(msg)
-            conns = [c for c in reader.connections if c.topic in (eeg_topic, prompt_topic)]
-            for conn, _t, raw in reader.messages(connections=conns):
+            if labels == 'intent' and intent_topic not in topics:
+                msg = (f'The bag {bag_dir} has no {intent_topic} topic, so --labels intent has '
+                       'nothing to label with; it needs a run with the virtual subject (demo, '
+                       'experiment), or use --labels prompt for trainer/graz runs.')
+                raise ClassifierError(msg)
+            conns = [c for c in reader.connections if c.topic in (eeg_topic, label_topic)]
+            for conn, t_ns, raw in reader.messages(connections=conns):
                 msg_obj = store.deserialize_cdr(raw, conn.msgtype)
-                (chunks if conn.topic == eeg_topic else prompts).append(msg_obj)
+                if conn.topic == eeg_topic:
+                    chunks.append(msg_obj)
+                elif labels == 'prompt':
+                    prompts.append(msg_obj)
+                else:
+                    intents.append((t_ns * 1e-9, str(msg_obj.data)))
     except ClassifierError:
         raise
     except Exception as exc:  # rosbags raises its own error types for damaged bags
@@ -199,23 +274,37 @@ def load_bag(path: str | Path, eeg_topic: str = '/eeg/raw',
     # Stream time of stream index i: offset + i / rate (median over chunks: robust to jitter).
     offset = float(np.median(offsets))
     events, seen = [], set()
-    for p in sorted(prompts, key=lambda m: (m.header.stamp.sec, m.header.stamp.nanosec)):
+    timed: list[tuple[float, int]] = []
+    prompts.sort(key=lambda m: (m.header.stamp.sec, m.header.stamp.nanosec))
+    aborted = aborted_trials(prompts)
+    n_aborted = 0
+    for p in prompts:
         if int(p.class_index) == NO_CLASS or p.phase not in ('cue', 'move') or p.trial in seen:
             continue
         seen.add(p.trial)
-        t = p.header.stamp.sec + 1e-9 * p.header.stamp.nanosec
+        if int(p.trial) in aborted:
+            n_aborted += 1
+            if not keep_aborted:
+                continue
+        timed.append((p.header.stamp.sec + 1e-9 * p.header.stamp.nanosec, int(p.class_index)))
+    if labels == 'intent':
+        end = offset + (base + data.shape[0]) / rate
+        timed = intent_events(sorted(intents), end, tmin, tmax)
+    for t, k in timed:
         onset = round((t - offset) * rate) - base
-        if 0 <= onset < data.shape[0] and int(p.class_index) < len(CLASS_NAMES):
-            events.append((onset, int(p.class_index)))
+        if 0 <= onset < data.shape[0] and k < len(CLASS_NAMES):
+            events.append((onset, k))
     return Recording(data=data, rate=rate, channels=channels,
                      events=np.array(events, dtype=int).reshape(-1, 2), source=str(bag_dir),
-                     first_sample_index=base)
+                     first_sample_index=base, n_aborted=n_aborted)
 
 
 def _find_bag_dir(path: Path) -> Path:
     """The rosbag2 folder (with metadata.yaml) at or below ``path``."""
     if (path / 'metadata.yaml').is_file():
         return path
+    if (path / 'bag' / 'metadata.yaml').is_file():   # a run directory (it may hold replays too)
+        return path / 'bag'
     found = sorted(p.parent for p in path.rglob('metadata.yaml'))
     if len(found) == 1:
         return found[0]
@@ -229,13 +318,16 @@ def _find_bag_dir(path: Path) -> Path:
 def load_inputs(edf: Iterable[str] = (), bags: Iterable[str] = (), event_map: str | None = None,
                 eegbci_subject: int | None = None, eegbci_runs: Sequence[int] = (),
                 eeg_topic: str = '/eeg/raw',
-                prompt_topic: str = '/trainer/prompt') -> list[Recording]:
+                prompt_topic: str = '/trainer/prompt', *, labels: str = 'prompt',
+                keep_aborted: bool = False, intent_topic: str = '/virtual_subject/intent',
+                tmin: float = 0.5, tmax: float = 2.5) -> list[Recording]:
     """Load every input named on a command line; raises if none is given."""
     emap = parse_event_map(event_map) if event_map else None
     recs = [load_edf(p, emap) for p in edf]
     if eegbci_subject is not None:
         recs += [load_edf(p) for p in eegbci_files(eegbci_subject, eegbci_runs or (4, 6, 8, 10))]
-    recs += [load_bag(p, eeg_topic, prompt_topic) for p in bags]
+    recs += [load_bag(p, eeg_topic, prompt_topic, labels=labels, keep_aborted=keep_aborted,
+                      intent_topic=intent_topic, tmin=tmin, tmax=tmax) for p in bags]
     if not recs:
         msg = 'No input data; give --edf FILES, --bag RUNS or --eegbci SUBJECT.'
         raise ClassifierError(msg)
