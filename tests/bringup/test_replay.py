@@ -4,6 +4,7 @@ replayed open loop, and the report has every file."""
 
 from __future__ import annotations
 
+import itertools
 import json
 import signal
 import subprocess
@@ -110,3 +111,18 @@ def test_replay_bad_input_is_one_clear_line(tmp_path):
     done = _mindgrasp('replay', str(tmp_path / 'bag'), '--no-progress')
     assert done.returncode == 2 and 'has no /eeg/raw messages' in done.stderr
     assert 'Traceback' not in done.stderr
+
+
+def test_export_of_the_demo_run_carries_targets_states_and_the_montage(demo_run, tmp_path):
+    import mne
+
+    out = tmp_path / 'demo_raw.fif'
+    done = _mindgrasp('export', 'eeg', str(demo_run), '--format', 'fif', '-o', str(out))
+    assert done.returncode == 0, done.stdout + done.stderr
+    raw = mne.io.read_raw_fif(out, verbose='error')
+    tags = {d.split('/')[0] for d in raw.annotations.description}
+    assert {'target', 'state', 'intent'} <= tags, tags
+    states = [d for d in raw.annotations.description if d.startswith('state/')]
+    assert all(a != b for a, b in itertools.pairwise(states))   # changes only
+    positions = raw.get_montage().get_positions()['ch_pos']
+    assert 'C3' in positions and positions['C3'][0] < 0

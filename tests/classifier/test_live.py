@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import subprocess
 import sys
 
@@ -37,3 +38,8 @@ def test_live_agrees_with_offline(tmp_path):
     assert 0.1 < report['window_accuracy'] < 0.99
     assert abs(live['window_accuracy'] - report['window_accuracy']) <= 0.02
     assert 'live - offline window accuracy' in out.stdout
+    assert re.search(r'live 1/1: .*\| 2\d\.\d/24\.0 s', out.stderr), out.stderr[-2000:]  # tqdm
+    summary = out.stdout.strip().splitlines()[-2]
+    assert summary.startswith('Evaluated 4 trial(s) of 1 recording(s): accuracy ')
+    assert f"{100 * live['accuracy']:.1f} % live ({live['n_predictions']} predictions)." \
+        in summary

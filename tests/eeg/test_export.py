@@ -31,10 +31,25 @@ def write_bag(run_dir: Path, data: np.ndarray, gap: tuple[int, int]) -> None:
 
     prompt_cls = store.types['mindgrasp_msgs/msg/Prompt']
     target_cls = store.types['mindgrasp_msgs/msg/TaskTarget']
+    result_cls = store.types['mindgrasp_msgs/msg/GraspResult']
+    state_cls = store.types['mindgrasp_msgs/msg/FsmState']
     with Writer(run_dir / 'bag', version=9, storage_plugin=StoragePlugin.MCAP) as w:
         c_eeg = w.add_connection('/eeg/raw', 'mindgrasp_msgs/msg/EEGChunk', typestore=store)
         c_pr = w.add_connection('/trainer/prompt', 'mindgrasp_msgs/msg/Prompt', typestore=store)
         c_tg = w.add_connection('/task/target', 'mindgrasp_msgs/msg/TaskTarget', typestore=store)
+        c_rs = w.add_connection('/task/result', 'mindgrasp_msgs/msg/GraspResult',
+                                typestore=store)
+        c_st = w.add_connection('/fsm/state', 'mindgrasp_msgs/msg/FsmState', typestore=store)
+        # controller states published periodically: annotations only at changes
+        for at, state, name in ((0.2, 1, 'OBJECT_SEARCH'), (0.4, 1, 'OBJECT_SEARCH'),
+                                (1.2, 2, 'CENTER_OBJECT'), (1.4, 2, 'CENTER_OBJECT')):
+            ns = T0_NS + int(at * 1e9)
+            msg = state_cls(header=header(ns), state=state, state_name=name)
+            w.write(c_st, ns, store.serialize_cdr(msg, c_st.msgtype))
+        ns = T0_NS + int(3.5 * 1e9)
+        msg = result_cls(header=header(ns), trial=1, desired_object='red cube',
+                         grasped_object='red cube', success=True, duration=3.0)
+        w.write(c_rs, ns, store.serialize_cdr(msg, c_rs.msgtype))
         for first in range(0, len(data), 10):
             if gap[0] <= first < gap[1]:
                 continue
@@ -92,8 +107,17 @@ def test_export_round_trip_through_mne(run_dir, fmt: str) -> None:
     assert ann['target/red cube'][0] == pytest.approx(0.5, abs=1 / FS)
     assert ann['BAD_gap'][0] == pytest.approx(1.6, abs=1 / FS)
     assert ann['BAD_gap'][1] == pytest.approx(0.2, abs=1 / FS)
+    assert ann['result/success/red cube'] == pytest.approx((0.5, 3.0), abs=1 / FS)
+    assert ann['state/1 OBJECT_SEARCH'] == pytest.approx((0.2, 1.0), abs=1 / FS)
+    assert ann['state/2 CENTER_OBJECT'][0] == pytest.approx(1.2, abs=1 / FS)
+    assert list(raw.annotations.description).count('state/1 OBJECT_SEARCH') == 1
     _events, ids = mne.events_from_annotations(raw, verbose='error')
-    assert 'prompt/cue/left_hand' in ids
+    assert 'prompt/cue/left_hand' in ids and 'result/success/red cube' in ids
+    if fmt == 'edf':      # EDF stores no electrode positions: the reader sets the montage
+        raw.set_montage('standard_1020')
+    positions = raw.get_montage().get_positions()['ch_pos']
+    assert set(positions) == set(NAMES)                     # standard_1020 positions
+    assert positions['C3'][0] < 0 < positions['C4'][0]      # left and right of the head
 
 
 def test_export_errors(tmp_path, run_dir) -> None:

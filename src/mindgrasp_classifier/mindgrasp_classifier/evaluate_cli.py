@@ -25,6 +25,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              'keep the training reference (fixed, default)')
     parser.add_argument('--json', action='store_true',
                         help='print the results as one JSON object on the last line')
+    parser.add_argument('--no-progress', action='store_true',
+                        help='no progress bar for --live (the summary line is printed at the end)')
     parser.add_argument('--live', action='store_true',
                         help='also stream the data in real time through LSL, the acquisition '
                              'node and the classifier node, and score the published predictions')
@@ -47,7 +49,8 @@ def main(args: argparse.Namespace) -> int:
         from mindgrasp_classifier.live import evaluate_live
 
         try:
-            live = evaluate_live(args.model, recordings, args.tmin, args.tmax)
+            live = evaluate_live(args.model, recordings, args.tmin, args.tmax,
+                                 progress=not args.no_progress)
         except ClassifierError as exc:
             print(f'mindgrasp evaluate classifier --live: {exc}', file=sys.stderr)
             return 1
@@ -56,6 +59,10 @@ def main(args: argparse.Namespace) -> int:
         print(f'  live - offline window accuracy: {diff:+.1f} points '
               f"(trial accuracy {100 * (live['accuracy'] - report['accuracy']):+.1f})")
         result['live'] = live
+    print(f"Evaluated {report['n_trials']} trial(s) of {len(recordings)} recording(s): accuracy "
+          f"{100 * report['accuracy']:.1f} % offline"
+          + (f", {100 * result['live']['accuracy']:.1f} % live "
+             f"({result['live']['n_predictions']} predictions)" if args.live else '') + '.')
     if args.json:
         print_json(result)
     return 0

@@ -72,7 +72,8 @@ def _stamp(msg: Any) -> float:
 
 
 def stream_live(model_path: str, rec: Recording, workdir: Path,
-                timeout_margin: float = 20.0) -> tuple[np.ndarray, np.ndarray]:
+                timeout_margin: float = 20.0, progress: bool = False,
+                desc: str = 'live') -> tuple[np.ndarray, np.ndarray]:
     """Play one recording through LSL -> acquisition node -> classifier node in real time.
 
     Returns
@@ -134,8 +135,16 @@ def stream_live(model_path: str, rec: Recording, workdir: Path,
         thread.start()
         end = time.monotonic() + rec.data.shape[0] / rec.rate + timeout_margin
         n_expected = rec.data.shape[0]
+        from tqdm import tqdm
+
+        bar = tqdm(total=round(n_expected / rec.rate, 1), unit='s', desc=desc, file=sys.stderr,
+                   disable=not progress, bar_format='{l_bar}{bar}| {n:.1f}/{total:.1f} s '
+                                                    '[{elapsed}<{remaining}]')
         while time.monotonic() < end:
             executor.spin_once(timeout_sec=0.02)
+            streamed = round(min(sum(c[2] for c in chunks), n_expected) / rec.rate, 1)
+            if streamed > bar.n:
+                bar.update(streamed - bar.n)   # seconds of EEG through the node chain
             if not thread.is_alive() and chunks and \
                     chunks[-1][1] + chunks[-1][2] >= n_expected and \
                     preds and preds[-1][0] >= chunks[-1][0]:
@@ -143,6 +152,7 @@ def stream_live(model_path: str, rec: Recording, workdir: Path,
             if clf.proc.poll() is not None:
                 msg = f'The classifier node stopped:\n{clf.output()[-2000:]}'
                 raise ClassifierError(msg)
+        bar.close()
         for _ in range(20):
             executor.spin_once(timeout_sec=0.02)
         node.destroy_node()
@@ -175,7 +185,7 @@ def _map_predictions(chunks: list[tuple[float, int, int]], preds: list[tuple[flo
 
 
 def evaluate_live(model_path: str, recordings: Sequence[Recording], tmin: float = 0.5,
-                  tmax: float = 2.5, speed: float = 1.0) -> dict[str, Any]:
+                  tmax: float = 2.5, speed: float = 1.0, progress: bool = False) -> dict[str, Any]:
     """Stream each recording through the live node chain and score the predictions."""
     if speed != 1.0:
         msg = (f'--live plays in real time only (speed 1.0, got {speed}): prediction stamps are '
@@ -187,7 +197,9 @@ def evaluate_live(model_path: str, recordings: Sequence[Recording], tmin: float 
         for i, rec in enumerate(recordings):
             work = Path(tmp) / f'rec{i}'
             work.mkdir()
-            results.append(stream_live(str(Path(model_path).resolve()), rec, work))
+            results.append(stream_live(str(Path(model_path).resolve()), rec, work,
+                                       progress=progress,
+                                       desc=f'live {i + 1}/{len(recordings)}'))
     report = score_predictions(model, recordings, results, tmin, tmax)
     report['n_predictions'] = int(sum(len(e) for e, _ in results))
     return report

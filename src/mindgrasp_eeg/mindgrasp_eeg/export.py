@@ -11,7 +11,16 @@ Annotations (onset in seconds from the first sample, from the message header sta
 - ``/trainer/prompt`` -> ``prompt/<phase>/<class>`` with the phase's planned duration
   (e.g. ``prompt/cue/left_hand``, ``prompt/fixation/rest``),
 - ``/task/target`` -> ``target/<colour> <shape>``,
-- ``/virtual_subject/intent`` (virtual amplifier ground truth) -> ``intent/<class>``.
+- ``/virtual_subject/intent`` (virtual amplifier ground truth) -> ``intent/<class>``,
+- ``/task/result`` -> ``result/success/<desired object>`` or ``result/failure/<desired object>``
+  spanning the trial (onset = result stamp - trial duration),
+- ``/fsm/state`` -> ``state/<n> <name>`` at each change of the controller state, lasting until the
+  next change.
+
+MNE selects annotations by their ``/``-separated tags, so ``epochs['success']`` or
+``epochs['target']`` epoch by trial outcome or target. The raw data get the ``standard_1020``
+montage (positions of the channels it knows; others stay without position); FIF keeps it, EDF has
+no field for positions (``raw.set_montage('standard_1020')`` after reading).
 
 Units: EEGChunk data are volts; MNE keeps volts (FIF float32; EDF scales to 16-bit per channel).
 """
@@ -90,10 +99,12 @@ def read_session(path: str | Path, eeg_topic: str = '/eeg/raw') -> Session:
     chunks: list[tuple[int, int, np.ndarray]] = []          # (first index, stamp ns, data)
     events: list[tuple[int, float, str]] = []              # (stamp ns, duration s, description)
     layout: tuple[float, tuple[str, ...]] | None = None
+    states: list[tuple[int, str]] = []                    # (stamp ns, description)
     skipped = 0
     try:
         with Reader(bag) as reader:
-            wanted = {eeg_topic, '/trainer/prompt', '/task/target', '/virtual_subject/intent'}
+            wanted = {eeg_topic, '/trainer/prompt', '/task/target', '/virtual_subject/intent',
+                      '/task/result', '/fsm/state'}
             conns = [c for c in reader.connections if c.topic in wanted]
             for conn, t_log, raw in reader.messages(connections=conns):
                 msg = store.deserialize_cdr(raw, conn.msgtype)
@@ -112,6 +123,14 @@ def read_session(path: str | Path, eeg_topic: str = '/eeg/raw') -> Session:
                 elif conn.topic == '/task/target':
                     events.append((_stamp_ns(msg.header) or t_log, 0.0,
                                    f'target/{msg.colour} {msg.shape}'))
+                elif conn.topic == '/task/result':
+                    end = _stamp_ns(msg.header) or t_log
+                    outcome = 'success' if msg.success else 'failure'
+                    events.append((end - round(float(msg.duration) * 1e9), float(msg.duration),
+                                   f'result/{outcome}/{msg.desired_object}'))
+                elif conn.topic == '/fsm/state':
+                    states.append((_stamp_ns(msg.header) or t_log,
+                                   f'state/{int(msg.state)} {msg.state_name}'))
                 else:
                     events.append((t_log, 0.0, f'intent/{msg.data}'))
     except EEGError:
@@ -125,6 +144,11 @@ def read_session(path: str | Path, eeg_topic: str = '/eeg/raw') -> Session:
                f'node (or pass the topic the EEG was recorded on).')
         raise EEGError(msg)
     fs, names = layout
+    # controller states: one annotation per change, lasting until the next change (s)
+    states.sort()
+    changes = [st for k, st in enumerate(states) if k == 0 or st[1] != states[k - 1][1]]
+    for (t, desc), nxt in zip(changes, [c[0] for c in changes[1:]] + [None], strict=True):
+        events.append((t, 1e9 if nxt is None else (nxt - t) * 1e-9, desc))  # last: to the end
     chunks.sort(key=lambda c: c[0])
     i0 = chunks[0][0]
     n_total = chunks[-1][0] + len(chunks[-1][2]) - i0
@@ -153,6 +177,9 @@ def to_raw(session: Session):
     info = mne.create_info(session.channel_names, session.sample_rate, 'eeg')
     raw = mne.io.RawArray(session.data.T, info, verbose='error')
     raw.set_meas_date(dt.datetime.fromtimestamp(session.start_ns * 1e-9, tz=dt.timezone.utc))
+    # electrode positions for topographies and source analysis; channels outside 10-20 keep none
+    raw.set_montage(mne.channels.make_standard_montage('standard_1020'), on_missing='ignore',
+                    match_case=False, verbose='error')
     if session.annotations:
         onset, duration, desc = zip(*session.annotations, strict=True)
         raw.set_annotations(mne.Annotations(onset, duration, desc,
