@@ -41,7 +41,8 @@ def write_bag(run_dir: Path, data: np.ndarray, gap: tuple[int, int]) -> None:
                                 typestore=store)
         c_st = w.add_connection('/fsm/state', 'mindgrasp_msgs/msg/FsmState', typestore=store)
         # controller states published periodically: annotations only at changes
-        for at, state, name in ((0.2, 1, 'OBJECT_SEARCH'), (0.4, 1, 'OBJECT_SEARCH'),
+        # the first state message comes before the EEG: the state holds from sample 0 on
+        for at, state, name in ((-0.3, 1, 'OBJECT_SEARCH'), (0.4, 1, 'OBJECT_SEARCH'),
                                 (1.2, 2, 'CENTER_OBJECT'), (1.4, 2, 'CENTER_OBJECT')):
             ns = T0_NS + int(at * 1e9)
             msg = state_cls(header=header(ns), state=state, state_name=name)
@@ -104,11 +105,11 @@ def test_export_round_trip_through_mne(run_dir, fmt: str) -> None:
     assert ann['prompt/cue/left_hand'][0] == pytest.approx(1.0, abs=1 / FS)
     assert ann['prompt/cue/left_hand'][1] == pytest.approx(1.5, abs=1 / FS)
     assert ann['prompt/rest/rest'][0] == pytest.approx(3.0, abs=1 / FS)
-    assert ann['target/red cube'][0] == pytest.approx(0.5, abs=1 / FS)
+    assert ann['target/red cube'] == pytest.approx((0.5, 3.5), abs=1 / FS)   # to the end
     assert ann['BAD_gap'][0] == pytest.approx(1.6, abs=1 / FS)
     assert ann['BAD_gap'][1] == pytest.approx(0.2, abs=1 / FS)
     assert ann['result/success/red cube'] == pytest.approx((0.5, 3.0), abs=1 / FS)
-    assert ann['state/1 OBJECT_SEARCH'] == pytest.approx((0.2, 1.0), abs=1 / FS)
+    assert ann['state/1 OBJECT_SEARCH'] == pytest.approx((0.0, 1.2), abs=1 / FS)
     assert ann['state/2 CENTER_OBJECT'][0] == pytest.approx(1.2, abs=1 / FS)
     assert list(raw.annotations.description).count('state/1 OBJECT_SEARCH') == 1
     _events, ids = mne.events_from_annotations(raw, verbose='error')

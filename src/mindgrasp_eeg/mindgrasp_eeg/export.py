@@ -10,7 +10,7 @@ Annotations (onset in seconds from the first sample, from the message header sta
 
 - ``/trainer/prompt`` -> ``prompt/<phase>/<class>`` with the phase's planned duration
   (e.g. ``prompt/cue/left_hand``, ``prompt/fixation/rest``),
-- ``/task/target`` -> ``target/<colour> <shape>``,
+- ``/task/target`` -> ``target/<colour> <shape>``, lasting until the next target,
 - ``/virtual_subject/intent`` (virtual amplifier ground truth) -> ``intent/<class>``,
 - ``/task/result`` -> ``result/success/<desired object>`` or ``result/failure/<desired object>``
   spanning the trial (onset = result stamp - trial duration),
@@ -100,6 +100,7 @@ def read_session(path: str | Path, eeg_topic: str = '/eeg/raw') -> Session:
     events: list[tuple[int, float, str]] = []              # (stamp ns, duration s, description)
     layout: tuple[float, tuple[str, ...]] | None = None
     states: list[tuple[int, str]] = []                    # (stamp ns, description)
+    targets: list[tuple[int, str]] = []                   # (stamp ns, description)
     skipped = 0
     try:
         with Reader(bag) as reader:
@@ -121,8 +122,8 @@ def read_session(path: str | Path, eeg_topic: str = '/eeg/raw') -> Session:
                     events.append((_stamp_ns(msg.header), float(msg.duration),
                                    f'prompt/{msg.phase}/{class_name(int(msg.class_index))}'))
                 elif conn.topic == '/task/target':
-                    events.append((_stamp_ns(msg.header) or t_log, 0.0,
-                                   f'target/{msg.colour} {msg.shape}'))
+                    targets.append((_stamp_ns(msg.header) or t_log,
+                                    f'target/{msg.colour} {msg.shape}'))
                 elif conn.topic == '/task/result':
                     end = _stamp_ns(msg.header) or t_log
                     outcome = 'success' if msg.success else 'failure'
@@ -149,6 +150,10 @@ def read_session(path: str | Path, eeg_topic: str = '/eeg/raw') -> Session:
     changes = [st for k, st in enumerate(states) if k == 0 or st[1] != states[k - 1][1]]
     for (t, desc), nxt in zip(changes, [c[0] for c in changes[1:]] + [None], strict=True):
         events.append((t, 1e9 if nxt is None else (nxt - t) * 1e-9, desc))  # last: to the end
+    # a target is in force until the next one
+    targets.sort()
+    for (t, desc), nxt in zip(targets, [c[0] for c in targets[1:]] + [None], strict=True):
+        events.append((t, 1e9 if nxt is None else (nxt - t) * 1e-9, desc))
     chunks.sort(key=lambda c: c[0])
     i0 = chunks[0][0]
     n_total = chunks[-1][0] + len(chunks[-1][2]) - i0
@@ -159,8 +164,15 @@ def read_session(path: str | Path, eeg_topic: str = '/eeg/raw') -> Session:
         have[first - i0:first - i0 + len(block)] = True
     start_ns = chunks[0][1]
     end = n_total / fs
-    ann = [(on, min(d, end - on), desc) for on, d, desc in
-           (((t - start_ns) * 1e-9, d, desc) for t, d, desc in sorted(events)) if 0 <= on < end]
+    # an interval that began before the first sample (a target named, or a state entered, while
+    # the EEG was starting) is kept from sample 0 on: it is in force when the EEG begins
+    ann = []
+    for t, d, desc in sorted(events):
+        on = (t - start_ns) * 1e-9
+        if on < 0 and on + d > 0:
+            on, d = 0.0, on + d
+        if 0 <= on < end:
+            ann.append((on, min(d, end - on), desc))
     # gaps as BAD_ annotations so MNE excludes them from epochs
     edges = np.flatnonzero(np.diff(np.concatenate([[1], have.astype(np.int8), [1]])))
     for a, b in zip(edges[::2], edges[1::2], strict=True):
