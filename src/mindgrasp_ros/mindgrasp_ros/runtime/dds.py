@@ -17,6 +17,7 @@ from __future__ import annotations
 import functools
 import os
 import threading
+from collections.abc import Callable
 from typing import Any
 
 from cyclonedds import idl
@@ -255,7 +256,7 @@ class DdsReader:
         return self.reader.guid.bytes
 
     def matched_count(self) -> int:
-        return len(self.reader.get_matched_publications())
+        return _matched(self.reader.get_matched_publications)
 
 
 class DdsWriter:
@@ -280,7 +281,20 @@ class DdsWriter:
         return self.writer.guid.bytes
 
     def matched_count(self) -> int:
-        return len(self.writer.get_matched_subscriptions())
+        return _matched(self.writer.get_matched_subscriptions)
+
+
+def _matched(handles: Callable[[], list[int]]) -> int:
+    """How many endpoints are matched. cyclonedds-python sizes the handle list from a first count
+    and then fills it; an endpoint that matches between the two calls makes it index past the list
+    (IndexError), e.g. a recorder or live view subscribing while a node publishes. Ask again; while
+    endpoints keep matching, say 'at least one' (the caller then writes, which is always safe)."""
+    for _ in range(3):
+        try:
+            return len(handles())
+        except IndexError:
+            continue
+    return 1
 
 
 class DdsParticipant:
