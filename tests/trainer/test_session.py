@@ -34,6 +34,8 @@ def test_the_graded_plan_is_the_papers_protocol():
     ('phases:\n  - {kind: graz, trials: 0}\n', 'trials must be a positive integer'),
     ('phases: []\n', "needs a non-empty list 'phases'"),
     ('training: {folds: 3}\nphases:\n  - {kind: graz}\n', 'training has unknown key.s. folds'),
+    ('training: {labels: screen}\nphases:\n  - {kind: graz}\n',
+     "training labels 'screen' are unknown; use prompt"),
 ])
 def test_bad_plans_are_refused_with_the_fix(tmp_path, text, message):
     path = tmp_path / 'plan.yaml'

@@ -5,6 +5,7 @@ A plan is a YAML file (``plans/graded.yaml`` is the paper's graded protocol)::
 
     name: graded
     training: {min_trials: 5, cv: 5}      # mindgrasp train classifier settings
+                                          # (labels: display labels epochs by the flip times)
     phases:
       - {name: graz, kind: graz, trials: 40}
       - {name: graz_feedback, kind: graz, trials: 40, feedback: true}
@@ -55,7 +56,9 @@ KINDS = {'graz': 'graz', 'trainer': 'trainer', 'test': 'demo'}   # phase kind ->
 PROMPTERS = {'graz': 'graz_prompter', 'trainer': 'trainer', 'test': 'trial_manager'}
 PHASE_KEYS = {'name', 'kind', 'trials', 'feedback', 'train', 'duration', 'args', 'params'}
 PLAN_KEYS = {'name', 'description', 'training', 'phases'}
-TRAINING_KEYS = {'min_trials', 'cv', 'pipeline', 'tmin', 'tmax', 'seed'}
+TRAINING_KEYS = {'min_trials', 'cv', 'pipeline', 'tmin', 'tmax', 'seed', 'labels'}
+#: where training labels come from: the prompters' stamps, or when the display drew them
+LABEL_TOPICS = {'prompt': '/trainer/prompt', 'display': '/display/flip'}
 
 
 class SessionError(TrainerError):
@@ -119,6 +122,10 @@ def load_plan(plan: str) -> Plan:
     _unknown(set(data) - PLAN_KEYS, where, PLAN_KEYS)
     training = dict(data.get('training') or {})
     _unknown(set(training) - TRAINING_KEYS, f'{where} training', TRAINING_KEYS)
+    if training.get('labels', 'prompt') not in LABEL_TOPICS:
+        msg = (f"The {where} training labels {training['labels']!r} are unknown; use prompt "
+               '(the prompter\'s stamps) or display (when the display drew each cue).')
+        raise SessionError(msg)
     phases, names = [], set()
     for i, raw in enumerate(data['phases'], start=1):
         if not isinstance(raw, dict):
@@ -396,7 +403,8 @@ class Session:
                              tmax=float(t.get('tmax', 2.5)), cv_folds=max(int(t.get('cv', 5)), 2),
                              min_trials=int(t.get('min_trials', 5)), seed=int(t.get('seed', 0)))
         try:
-            recordings = load_inputs(bags=[str(r) for r in runs])
+            recordings = load_inputs(bags=[str(r) for r in runs],
+                                     prompt_topic=LABEL_TOPICS[t.get('labels', 'prompt')])
             model, report = train(recordings, cfg, cross_validate=True)
             path = model.save(self.dir / 'models' / f'after_{upto:02d}_{name}')
         except ClassifierError as err:
