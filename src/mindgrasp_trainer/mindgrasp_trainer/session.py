@@ -358,6 +358,7 @@ class Session:
         if phase.kind == 'test':
             args.setdefault('targets', '')
             args.setdefault('subject', 'pursue')
+            args.setdefault('live_view', 'false')   # the experimenter opts in (a port each)
         if phase.kind != 'test':
             args.pop('targets', None)
             if args.get('subject') == 'pursue':
