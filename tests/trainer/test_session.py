@@ -133,3 +133,38 @@ def test_calibration_plan_sets_trials_per_class_and_adds_a_heldout_run():
         calibration_plan(plan, trials_per_class=1, virtual_accuracy=0.9)
     with pytest.raises(SessionError, match='--virtual-accuracy must be a probability'):
         calibration_plan(plan, trials_per_class=5, virtual_accuracy=1.5)
+
+
+def test_grasp_figures_come_from_the_test_runs_bag(tmp_path):
+    """Targets and results written to a real rosbag2 (MCAP) are read back per trial: a lift of
+    the desired object, a lift of another one, and a trial that ended without a grasp."""
+    from mindgrasp_bringup.bag.writer import BagWriter
+    from mindgrasp_ros.typesupport import typestore
+    from mindgrasp_trainer.session import _grasp_results
+
+    store = typestore()
+    target = store.types['mindgrasp_msgs/msg/TaskTarget']
+    result = store.types['mindgrasp_msgs/msg/GraspResult']
+    header = store.types['std_msgs/msg/Header']
+    stamp = store.types['builtin_interfaces/msg/Time']
+    hdr = header(stamp=stamp(sec=1, nanosec=0), frame_id='')
+    with BagWriter(tmp_path / 'bag') as bag:
+        bag.add_topic('/task/target', 'mindgrasp_msgs/msg/TaskTarget')
+        bag.add_topic('/task/result', 'mindgrasp_msgs/msg/GraspResult')
+        t = 1_000_000_000
+        for trial, (colour, shape), grasped in ((1, ('red', 'cube'), 'red cube'),
+                                                 (2, ('blue', 'cylinder'), 'yellow sphere'),
+                                                 (3, ('yellow', 'sphere'), None)):
+            t += 1_000_000_000
+            bag.write('/task/target', t, store.serialize_cdr(
+                target(header=hdr, trial=trial, object_id=0, colour=colour, shape=shape,
+                       scene='set_locations'), 'mindgrasp_msgs/msg/TaskTarget'))
+            if grasped:
+                bag.write('/task/result', t + 1, store.serialize_cdr(
+                    result(header=hdr, trial=trial, desired_object=f'{colour} {shape}',
+                           grasped_object=grasped, success=True, duration=12.5,
+                           lift_height=0.1, reason='lifted'), 'mindgrasp_msgs/msg/GraspResult'))
+    got = _grasp_results(tmp_path / 'bag')
+    assert [(r['trial'], r['desired'], r['grasped'], r['success']) for r in got] == [
+        (1, 'red cube', 'red cube', True), (2, 'blue cylinder', 'yellow sphere', True),
+        (3, 'yellow sphere', '', False)]

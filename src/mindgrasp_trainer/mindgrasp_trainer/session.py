@@ -436,9 +436,10 @@ class Session:
         if phase.kind == 'test':
             results = _grasp_results(run_dir / 'bag')
             n = len(results)
-            correct = sum(1 for r in results if r['success']
-                          and r['grasped'] == r['desired'])
-            return {'grasps': results, 'n_grasp_trials': n, 'n_correct_grasps': correct}
+            lifted = sum(1 for r in results if r['success'])
+            correct = sum(1 for r in results if r['success'] and r['grasped'] == r['desired'])
+            return {'grasps': results, 'n_grasp_trials': n, 'n_lifted': lifted,
+                    'n_correct_grasps': correct}
         return {}
 
     def heldout_accuracy(self, log: dict[str, Any], phase: str = 'heldout') -> dict[str, Any]:
@@ -471,7 +472,8 @@ class Session:
             if 'mean_ee_distance_m' in e:
                 fig = f"Trainer distance {100 * e['mean_ee_distance_m']:.1f} cm (mean)"
             if 'n_grasp_trials' in e:
-                fig = f"{e['n_correct_grasps']}/{e['n_grasp_trials']} correct grasps"
+                fig = (f"{e['n_correct_grasps']}/{e['n_grasp_trials']} correct grasps "
+                       f"({e.get('n_lifted', 0)} lifted)")
             lines.append(f"| {e['name']} | {e['kind']} | {e['status']} | "
                          f"{e.get('model', '-')} | {acc} | {fig} |")
         for e in log['phases']:
@@ -507,18 +509,26 @@ def _phase_outcome(phase: Phase, run_dir: Path, code: int) -> tuple[int, str]:
 
 
 def _grasp_results(bag: Path) -> list[dict[str, Any]]:
-    """Every /task/result of a run's bag: trial, desired and grasped object, success."""
+    """One entry per trial of a test run's bag: the desired object (/task/target), what was
+    grasped and whether it was lifted (/task/result; none: no grasp before the trial ended)."""
     if not bag.is_dir():
         return []
     from mindgrasp_bringup.bag.reader import BagReader
     from mindgrasp_ros.typesupport import typestore
 
     store = typestore()
-    out = []
+    trials: dict[int, dict[str, Any]] = {}
     with BagReader(bag) as reader:
-        for _, _, data in reader.messages(['/task/result']):
-            m = store.deserialize_cdr(data, 'mindgrasp_msgs/msg/GraspResult')
-            out.append({'trial': int(m.trial), 'desired': m.desired_object,
-                        'grasped': m.grasped_object, 'success': bool(m.success),
-                        'duration_s': round(float(m.duration), 2)})
-    return out
+        for topic, _, data in reader.messages(['/task/target', '/task/result']):
+            if topic == '/task/target':
+                m = store.deserialize_cdr(data, 'mindgrasp_msgs/msg/TaskTarget')
+                trials.setdefault(int(m.trial), {
+                    'trial': int(m.trial), 'desired': f'{m.colour} {m.shape}'.strip(),
+                    'grasped': '', 'success': False, 'duration_s': None})
+            else:
+                m = store.deserialize_cdr(data, 'mindgrasp_msgs/msg/GraspResult')
+                entry = trials.setdefault(int(m.trial), {'trial': int(m.trial),
+                                                         'desired': m.desired_object})
+                entry.update(grasped=m.grasped_object, success=bool(m.success),
+                             duration_s=round(float(m.duration), 2))
+    return [trials[k] for k in sorted(trials) if k > 0]
