@@ -7,8 +7,10 @@ Runs ``mindgrasp launch demo trials:=0`` (every node its own process, no recordi
 view on a free port, then measures the CPU time of every process of the launch with psutil:
 
 1. idle: no Foxglove client connected (the bridge only discovers topics);
-2. viewing: one WebSocket client (Foxglove protocol) subscribed to every advertised channel,
-   reading as fast as it can (what the Foxglove app does with the layout open).
+2. layout: one WebSocket client (Foxglove protocol) subscribed to the topics of the shipped layout
+   (mindgrasp_bringup/foxglove/mindgrasp_live.json), reading as fast as it can (what the Foxglove
+   app does with that layout open);
+3. all topics: the same client subscribed to every advertised channel (the worst case).
 
 Prints, per phase, the bridge's CPU (% of one core), the rest of the demo's CPU (% of one core)
 and the bridge's share ``bridge / rest`` (target: < 5 %), plus the messages and MB the client
@@ -30,7 +32,10 @@ import uuid
 from pathlib import Path
 
 import psutil
+from websockets.exceptions import ConnectionClosed
 from websockets.sync.client import connect
+
+from mindgrasp_bringup.live_layout import TOPICS
 
 
 def _free_port() -> int:
@@ -70,9 +75,10 @@ def _measure(root: psutil.Process, seconds: float) -> dict[str, float]:
 class Client(threading.Thread):
     """A Foxglove WebSocket client subscribed to every channel; counts what it receives."""
 
-    def __init__(self, port: int) -> None:
+    def __init__(self, port: int, topics: tuple[str, ...] | None = None) -> None:
         super().__init__(daemon=True)
         self.port = port
+        self.wanted = topics  # None: every channel
         self.messages = 0
         self.bytes = 0
         self.topics: set[str] = set()
@@ -87,15 +93,20 @@ class Client(threading.Thread):
                     frame = ws.recv(timeout=0.2)
                 except TimeoutError:
                     continue
+                except ConnectionClosed:  # the launch ended
+                    return
                 if isinstance(frame, str):
                     op = json.loads(frame)
                     if op.get('op') == 'advertise':
                         subs = []
                         for ch in op['channels']:
+                            if self.wanted is not None and ch['topic'] not in self.wanted:
+                                continue
                             subs.append({'id': next_id, 'channelId': ch['id']})
                             self.topics.add(ch['topic'])
                             next_id += 1
-                        ws.send(json.dumps({'op': 'subscribe', 'subscriptions': subs}))
+                        if subs:
+                            ws.send(json.dumps({'op': 'subscribe', 'subscriptions': subs}))
                     continue
                 self.messages += 1
                 self.bytes += len(frame)
@@ -111,22 +122,27 @@ def main() -> int:
     stream = f'mg-live-view-bench-{uuid.uuid4().hex[:8]}'  # LSL names are host-wide
     cmd = [sys.executable, '-m', 'mindgrasp_bringup', 'launch', 'demo', 'trials:=0',
            'record:=false', f'live_view_port:={port}', f'eeg_stream:={stream}',
-           f'duration:={args.warmup + 2 * args.seconds + 30}', '--run-dir', str(run_dir)]
+           f'duration:={args.warmup + 3 * args.seconds + 40}', '--run-dir', str(run_dir)]
     launcher = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
                                 start_new_session=True, env=dict(os.environ))
     try:
         time.sleep(args.warmup)
         root = psutil.Process(launcher.pid)
         idle = _measure(root, args.seconds)
-        client = Client(port)
-        client.start()
-        time.sleep(3.0)  # subscribed to what is advertised
-        count0, bytes0 = client.messages, client.bytes
-        viewing = _measure(root, args.seconds)
-        viewing['client_msgs_per_s'] = (client.messages - count0) / args.seconds
-        viewing['client_mb_per_s'] = (client.bytes - bytes0) / args.seconds / 1e6
-        viewing['topics'] = len(client.topics)
-        client.stop.set()
+        phases = {'idle (no client)': idle}
+        for name, topics in (('layout (1 client, its topics)', TOPICS),
+                             ('all topics (1 client)', None)):
+            client = Client(port, topics)
+            client.start()
+            time.sleep(3.0)  # subscribed to what is advertised
+            count0, bytes0 = client.messages, client.bytes
+            result = _measure(root, args.seconds)
+            result['client_msgs_per_s'] = (client.messages - count0) / args.seconds
+            result['client_mb_per_s'] = (client.bytes - bytes0) / args.seconds / 1e6
+            result['topics'] = len(client.topics)
+            client.stop.set()
+            client.join(10)
+            phases[name] = result
     finally:
         launcher.send_signal(2)
         try:
@@ -134,14 +150,14 @@ def main() -> int:
         except subprocess.TimeoutExpired:
             launcher.kill()
     print(f'machine: {os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f}')
-    for name, r in (('idle (no client)', idle), ('viewing (1 client, all topics)', viewing)):
-        line = (f'{name:32s} bridge {r["bridge_cpu_pct"]:5.1f} % of a core, rest of the demo '
+    for name, r in phases.items():
+        line = (f'{name:30s} bridge {r["bridge_cpu_pct"]:5.1f} % of a core, rest of the demo '
                 f'{r["demo_cpu_pct"]:6.1f} %, bridge/demo {r["bridge_share_pct"]:4.1f} %')
         if 'client_msgs_per_s' in r:
             line += (f'; client got {r["client_msgs_per_s"]:.0f} msg/s, '
                      f'{r["client_mb_per_s"]:.2f} MB/s on {r["topics"]} topics')
         print(line)
-    print(json.dumps({'idle': idle, 'viewing': viewing}))
+    print(json.dumps(phases))
     return 0
 
 
