@@ -18,6 +18,7 @@ from collections.abc import Sequence
 #: command -> module, or command -> {verb: module}
 COMMANDS: dict[str, str | dict[str, str]] = {
     'launch': 'mindgrasp_bringup.commands.launch',
+    'run': 'mindgrasp_bringup.commands.run',
     'replay': 'mindgrasp_bringup.commands.replay',
     'bag': {
         'record': 'mindgrasp_bringup.commands.bag_record',
