@@ -139,10 +139,10 @@ def sourced(ws: Path, *command: str) -> list[str]:
 
 def workspace_env() -> dict[str, str]:
     """The test's environment without the source tree on PYTHONPATH: the workspace's setup.sh
-    provides the installed packages. mindgrasp_msgs is not built (no rosidl), so its interface
-    files come from the source folder, as MINDGRASP_MSGS_DIR allows."""
-    env = {k: v for k, v in os.environ.items() if k not in ('PYTHONPATH', 'AMENT_PREFIX_PATH')}
-    env['MINDGRASP_MSGS_DIR'] = str(SRC / 'mindgrasp_msgs')
+    provides the installed packages (mindgrasp_ros carries a copy of the mindgrasp_msgs interface
+    files, so the runtime needs no built mindgrasp_msgs)."""
+    env = {k: v for k, v in os.environ.items()
+           if k not in ('PYTHONPATH', 'AMENT_PREFIX_PATH', 'MINDGRASP_MSGS_DIR')}
     env['PATH'] = os.pathsep.join([str(Path(sys.executable).parent), env.get('PATH', '')])
     return env
 
