@@ -86,9 +86,13 @@ def display_nodes(files: list[Path], n_trials: object = 0) -> list[Any]:
     ]
 
 
-def sim_scene_camera(display_rate: float = 5.0) -> list[tuple[object, dict]]:
+def sim_scene_camera(display_rate: float = 3.0) -> list[tuple[object, dict]]:
     """(condition, parameters) pairs for the simulator: its scene camera
-    (``/scene/image_raw``) runs at ``display_rate`` Hz when a display is shown, else it is off."""
+    (``/scene/image_raw``) runs at ``display_rate`` Hz when a display is shown, else it is off.
+
+    3 Hz: a 320x240 view with the training robot takes two TinyRenderer passes (about 30 ms on
+    an idle core, several times that on a loaded machine; benchmarks/display.py), which the
+    simulator pays inside its real-time loop; the training robot moves slowly enough for 3 Hz."""
     return [(la.LaunchConfigurationEquals('display', 'off'), {'scene_camera_rate': 0.0}),
             (la.LaunchConfigurationNotEquals('display', 'off'),
              {'scene_camera_rate': display_rate})]
