@@ -56,6 +56,8 @@ def test_cli_bad_input_is_one_line_and_exit_code_2(tmp_path):
     assert 'Traceback' not in res.stderr
     res = mindgrasp('session', 'run', '--subject', 'S1', '--plan', 'nope', cwd=tmp_path)
     assert res.returncode == 2 and "No plan 'nope'" in res.stderr
+    res = mindgrasp('session', 'run', '--subject', 'S1', '--amp', 'lsl', cwd=tmp_path)
+    assert res.returncode == 2 and '--amp lsl needs --eeg-stream NAME' in res.stderr
     res = mindgrasp('session', 'resume', '--subject', 'S1', cwd=tmp_path)
     assert res.returncode == 2 and 'No session of subject S1' in res.stderr
 

@@ -40,7 +40,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help='EEG source: virtual subject (default) or an LSL amplifier')
     parser.add_argument('--eeg-stream', default=None, help='LSL stream name of the amplifier')
     parser.add_argument('--display', choices=['off', 'window', 'fullscreen', 'headless'],
-                        default=None, help="the participant's screen (default headless)")
+                        default=None, help="the participant's screen (default: window with "
+                                           '--amp lsl, else headless)')
     parser.add_argument('--seed', type=int, default=None, help='seed of every phase (0)')
     if getattr(parser, 'prog', '').endswith('calibrate'):
         parser.set_defaults(plan='calibrate')
@@ -104,10 +105,16 @@ def main(args: argparse.Namespace) -> int:
                 plan = calibration_plan(plan, args.trials_per_class, args.virtual_accuracy,
                                         args.seed or 0)
             name = args.session or dt.datetime.now(dt.timezone.utc).strftime('%Y%m%dT%H%M%SZ')
-            # the virtual amplifier's LSL stream is host-wide: a name of its own per session
+            if args.amp == 'lsl' and not args.eeg_stream:
+                msg = ("--amp lsl needs --eeg-stream NAME, the LSL stream name of the amplifier "
+                       "(check it with: mindgrasp launch eeg eeg_stream:=NAME).")
+                raise SessionError(msg)
+            # the virtual amplifier's LSL stream is host-wide: a name of its own per session;
+            # a person (a real amplifier) looks at a window, the virtual subject needs none
             stream = f'MIndGrasp-{args.subject}-{os.getpid()}'
+            display = 'window' if args.amp == 'lsl' else 'headless'
             session = Session(root, args.subject, name,
-                              {'display': 'headless', 'seed': '0', 'eeg_stream': stream,
+                              {'display': display, 'seed': '0', 'eeg_stream': stream,
                                **_launch_args(args)})
             log = session.start(plan)
         else:
