@@ -24,6 +24,7 @@ from mindgrasp_trainer.display import render_display
 from mindgrasp_trainer.graz import GrazProtocol, PromptSequencer
 from mindgrasp_trainer.protocol import TrainerError
 from mindgrasp_trainer.ros_common import (
+    EegGate,
     check_rate,
     fixed_parameters_callback,
     prompt_qos,
@@ -44,6 +45,7 @@ class GrazNode(rclpy.node.Node):
             ('start_delay', 5.0), ('duration', 0.0), ('rate', 200.0),
             ('display_rate', 10.0), ('display_width', 480), ('display_height', 360),
             ('feedback', 'move'), ('max_certainty', 1.0), ('prediction_timeout', 1.0),
+            ('wait_for_eeg', False),
         ])  # fmt: skip
         p = {name: self.get_parameter(name).value for name in (
             'n_trials', 'classes', 'seed', 'fixation', 'cue', 'imagery', 'rest_min', 'rest_max',
@@ -73,6 +75,9 @@ class GrazNode(rclpy.node.Node):
         self.prediction_timeout_ns = int(timeout * 1e9)
         self.t0_ns: int | None = None
         self.done = rclpy.task.Future()  # result set when the session has ended
+        # wait_for_eeg: the schedule starts once EEG flows (an amplifier that starts late on a
+        # busy machine would otherwise miss the first trials)
+        self.eeg_gate = EegGate(self) if self.get_parameter('wait_for_eeg').value else None
 
         self.prompt_pub = self.create_publisher(Prompt, '/trainer/prompt', prompt_qos())
         self.create_subscription(MIPrediction, '/bci/prediction', self.prediction_callback, 10)
@@ -110,6 +115,8 @@ class GrazNode(rclpy.node.Node):
         if now.nanoseconds == 0:  # use_sim_time and no /clock yet
             return
         if self.t0_ns is None:
+            if self.eeg_gate is not None and not self.eeg_gate.ready():
+                return
             self.t0_ns = now.nanoseconds
         elapsed = (now.nanoseconds - self.t0_ns) * 1e-9
         events = self.sequencer.due(elapsed)

@@ -378,6 +378,10 @@ class Session:
                                                                     round(certainty_scale, 4))
         if display == 'headless':  # frames for the record, not for a person: 10 Hz is plenty
             params.setdefault('participant_display', {}).setdefault('rate', 10.0)
+        # the first trial starts once EEG flows (the amplifier may start late on a busy machine)
+        prompter = {'graz': 'graz_prompter', 'trainer': 'trainer'}.get(phase.kind)
+        if prompter:
+            params.setdefault(prompter, {}).setdefault('wait_for_eeg', True)
         if phase.kind == 'trainer':
             params.setdefault('trainer', {})['log_file'] = str(run_dir / 'trainer_trials.csv')
         if params:

@@ -30,6 +30,7 @@ from mindgrasp_ros.interfaces.std_msgs.msg import Float64, Float64MultiArray
 from mindgrasp_ros import rclpy
 from mindgrasp_trainer.protocol import CLASS_NAMES, TrainerError
 from mindgrasp_trainer.ros_common import (
+    EegGate,
     check_rate,
     fixed_parameters_callback,
     prompt_qos,
@@ -58,7 +59,7 @@ class TrainerNode(rclpy.node.Node):
         super().__init__('trainer', **kwargs)
         self.declare_parameters('', [
             *_PROTOCOL_PARAMS, ('rate', 50.0), ('robot_timeout', 30.0), ('reset_timeout', 5.0),
-            ('reset_new_random_draw', False), ('log_file', ''),
+            ('reset_new_random_draw', False), ('log_file', ''), ('wait_for_eeg', False),
         ])  # fmt: skip
         params = {name: self.get_parameter(name).value for name, _ in _PROTOCOL_PARAMS}
         try:
@@ -87,6 +88,7 @@ class TrainerNode(rclpy.node.Node):
         self.trainer_pose_time = math.inf  # wall time of the last training robot pose
         self.stale_warned = 0.0
         self.done = rclpy.task.Future()  # result: exit code, set when the session has ended
+        self.eeg_gate = EegGate(self) if self.get_parameter('wait_for_eeg').value else None
 
         self.prompt_pub = self.create_publisher(Prompt, '/trainer/prompt', prompt_qos())
         self.command_pub = self.create_publisher(
@@ -164,6 +166,8 @@ class TrainerNode(rclpy.node.Node):
     def _ready(self) -> bool:
         """True once the training robot is heard from; ends the node if it never is."""
         if self.joint_count is not None and self.trainer_pos is not None:
+            if self.eeg_gate is not None and not self.eeg_gate.ready():
+                return False
             if self.joint_count != self.protocol.n_joints:
                 self.get_logger().error(
                     f'/trainer_robot/joint_states has {self.joint_count} joints but the trainer '
