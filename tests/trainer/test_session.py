@@ -67,6 +67,7 @@ def _log(folder: Path) -> dict:
 
 
 @pytest.mark.slow
+@pytest.mark.timeout(1200)   # three recorded launches and a resume: ~4 min, more on a busy machine
 def test_virtual_session_runs_every_phase_retrains_and_resumes(tmp_path):
     """The quick plan (Graz, Graz with feedback, Trainer) with the virtual subject; interrupted in
     phase 2, resumed: every run, a model per phase, the report."""
