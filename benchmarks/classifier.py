@@ -64,7 +64,8 @@ def synthetic(n_channels: int, rate: float, trials_per_class: int = 6, seed: int
     if drift is not None:
         data = data @ drift.T
     names = [f'E{i + 1}' for i in range(n_channels)]
-    return Recording(data, rate, names, np.array(events), f'synthetic seed {seed}')
+    return Recording(data=data, rate=rate, channels=names, events=np.array(events),
+                     source=f'synthetic seed {seed}')
 
 
 def accuracy_table(all_channels: bool) -> list[dict]:

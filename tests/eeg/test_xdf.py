@@ -57,7 +57,7 @@ def test_xdf_recording_in_volts_with_markers(tmp_path: Path) -> None:
     write_xdf(path, eeg, 100.0, 5000.0, [(5000.5, 'cue/left_hand'), (5002.0, 'rest')],
               ['C3', 'Cz', 'C4'])
     rec = load_recording(path)
-    assert rec.sample_rate == 100.0 and rec.channel_names == ['C3', 'Cz', 'C4']
+    assert rec.rate == 100.0 and rec.channels == ['C3', 'Cz', 'C4']
     np.testing.assert_allclose(rec.data, eeg * 1e-6, rtol=1e-6)
     assert [d for _o, _dur, d in rec.annotations] == ['cue/left_hand', 'rest']
     assert rec.annotations[0][0] == pytest.approx(0.5, abs=1e-3)

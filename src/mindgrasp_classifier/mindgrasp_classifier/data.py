@@ -11,7 +11,6 @@ import itertools
 import os
 import re
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -19,6 +18,7 @@ import numpy as np
 from mindgrasp_classifier.errors import ClassifierError
 from mindgrasp_classifier.model import CLASS_NAMES, class_index
 from mindgrasp_common.mi import NO_CLASS
+from mindgrasp_common.types import Recording
 
 #: EEGMMIDB run -> {annotation: MIndGrasp class} (../shared/data/EEGMMIDB-README.md).
 EEGMMIDB_RUNS: dict[int, dict[str, int]] = {
@@ -27,35 +27,6 @@ EEGMMIDB_RUNS: dict[int, dict[str, int]] = {
 }
 EEGMMIDB_IMAGERY_RUNS = (4, 6, 8, 10, 12, 14)
 _EEGMMIDB_NAME = re.compile(r'^S(\d{3})R(\d{2})\.edf$', re.IGNORECASE)
-
-
-
-@dataclass
-class Recording:
-    """Continuous labelled EEG.
-
-    Attributes
-    ----------
-    data : ndarray, shape (n_samples, n_channels)
-        EEG in volts; NaN where samples were lost.
-    rate : float
-        Sampling rate (Hz).
-    channels : list of str
-    events : ndarray of int, shape (n_events, 2)
-        ``[onset_sample, class_index]`` of each cue, onset relative to ``data[0]``.
-    source : str
-        File or bag the data came from.
-    first_sample_index : int
-        Stream index of ``data[0]`` (0 for files).
-    """
-
-    data: np.ndarray
-    rate: float
-    channels: list[str]
-    events: np.ndarray
-    source: str
-    first_sample_index: int = 0
-    n_aborted: int = 0          # trials left out because they were cut short (see load_bag)
 
 
 def parse_event_map(text: str) -> dict[str, int]:

@@ -10,6 +10,7 @@ evaluation. Use a ``ROS_DOMAIN_ID`` of your own: the nodes run on the current on
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import subprocess
 import sys
@@ -85,12 +86,11 @@ def stream_live(model_path: str, rec: Recording, workdir: Path,
     from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import EEGChunk, MIPrediction
 
     from mindgrasp_eeg.player import DatasetPlayer
-    from mindgrasp_eeg.player import Recording as PlayerRecording
     from mindgrasp_ros import rclpy
 
     name = f'mindgrasp-eval-{uuid.uuid4().hex[:8]}'
     data = np.where(np.isfinite(rec.data), rec.data, 0.0)   # the player streams numbers only
-    player = DatasetPlayer(PlayerRecording(data, rec.rate, list(rec.channels), [], rec.source),
+    player = DatasetPlayer(dataclasses.replace(rec, data=data, annotations=[]),
                            name, block=max(1, round(rec.rate / 64)))
     procs: list[_Proc] = []
     rclpy.init(args=[])

@@ -190,6 +190,8 @@ class Recording:
         File or bag the data came from.
     first_sample_index : int
         Stream index of ``data[0]`` (0 for files).
+    n_aborted : int
+        Cued trials left out of ``events`` because they were cut short (recorded runs).
     """
 
     data: np.ndarray
@@ -199,6 +201,7 @@ class Recording:
     annotations: list[tuple[float, float, str]] = field(default_factory=list)
     source: str = ''
     first_sample_index: int = 0
+    n_aborted: int = 0
 
     @property
     def duration(self) -> float:

@@ -17,38 +17,19 @@ from __future__ import annotations
 import os
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 import pylsl
 
+from mindgrasp_common.types import Recording
+
 from . import EEGError
 from .lsl import EEGOutlet, MarkerOutlet, unit_scale
 
+__all__ = ['DatasetPlayer', 'Recording', 'concatenate', 'expand_sources', 'load_recording']
+
 MNE_SUFFIXES = {'.edf': 'edf', '.bdf': 'bdf', '.gdf': 'gdf', '.fif': 'fif', '.fif.gz': 'fif'}
-
-
-@dataclass
-class Recording:
-    """EEG loaded from a file.
-
-    data : ndarray, shape (n_samples, n_channels), float64, volts
-    sample_rate : Hz
-    channel_names : n_channels labels
-    annotations : list of (onset s from the first sample, duration s, description)
-    """
-
-    data: np.ndarray
-    sample_rate: float
-    channel_names: list[str]
-    annotations: list[tuple[float, float, str]] = field(default_factory=list)
-    source: str = ''
-
-    @property
-    def duration(self) -> float:
-        """Length (s)."""
-        return len(self.data) / self.sample_rate
 
 
 def expand_sources(sources: Sequence[str]) -> list[str]:
@@ -122,7 +103,8 @@ def _load_mne(path: Path, kind: str) -> Recording:
         raise EEGError(msg)
     ann = [(float(a['onset'] - raw.first_time), float(a['duration']), str(a['description']))
            for a in raw.annotations]
-    return Recording(data, float(raw.info['sfreq']), list(raw.ch_names), ann, str(path))
+    return Recording(data=data, rate=float(raw.info['sfreq']), channels=list(raw.ch_names),
+                     annotations=ann, source=str(path))
 
 
 def _load_xdf(path: Path) -> Recording:
@@ -156,26 +138,26 @@ def _load_xdf(path: Path) -> Recording:
             for ts, values in zip(s['time_stamps'], s['time_series'], strict=True):
                 ann.append((float(ts) - t0, 0.0, str(values[0])))
     ann.sort()
-    return Recording(data, srate(eeg), names, ann, str(path))
+    return Recording(data=data, rate=srate(eeg), channels=names, annotations=ann,
+                     source=str(path))
 
 
 def concatenate(recordings: Sequence[Recording]) -> Recording:
     """Play several files back to back (same channels and rate required)."""
     first = recordings[0]
     for rec in recordings[1:]:
-        if rec.channel_names != first.channel_names or rec.sample_rate != first.sample_rate:
+        if rec.channels != first.channels or rec.rate != first.rate:
             msg = (f'Cannot play {rec.source!r} after {first.source!r}: channels or rate differ '
-                   f'({len(rec.channel_names)} ch @ {rec.sample_rate:g} Hz vs '
-                   f'{len(first.channel_names)} ch @ {first.sample_rate:g} Hz); play them '
-                   f'separately.')
+                   f'({len(rec.channels)} ch @ {rec.rate:g} Hz vs '
+                   f'{len(first.channels)} ch @ {first.rate:g} Hz); play them separately.')
             raise EEGError(msg)
     data, ann, offset = [], [], 0.0
     for rec in recordings:
         data.append(rec.data)
         ann += [(o + offset, d, desc) for o, d, desc in rec.annotations]
         offset += rec.duration
-    return Recording(np.vstack(data), first.sample_rate, list(first.channel_names), ann,
-                     ' + '.join(r.source for r in recordings))
+    return Recording(data=np.vstack(data), rate=first.rate, channels=list(first.channels),
+                     annotations=ann, source=' + '.join(r.source for r in recordings))
 
 
 class DatasetPlayer:
@@ -200,7 +182,7 @@ class DatasetPlayer:
             msg = f'The playback rate must be positive (1 = real time); {rate} is invalid.'
             raise EEGError(msg)
         self.rec, self.rate, self.loop, self.block = recording, rate, loop, max(1, block)
-        self.outlet = EEGOutlet(name, recording.channel_names, recording.sample_rate,
+        self.outlet = EEGOutlet(name, recording.channels, recording.rate,
                                 stream_type=stream_type, source_id=source_id or name,
                                 model=f'dataset player: {Path(recording.source).name}')
         self.markers = MarkerOutlet(f'{name}-markers', f'{source_id or name}-markers')
@@ -219,7 +201,7 @@ class DatasetPlayer:
         now = pylsl.local_clock()
         if self._t0 is None:
             self._t0 = now
-        fs, n_total = self.rec.sample_rate, len(self.rec.data)
+        fs, n_total = self.rec.rate, len(self.rec.data)
         due = int((now - self._t0) * self.rate * fs) + 1
         if not self.loop:
             due = min(due, n_total)
@@ -237,7 +219,7 @@ class DatasetPlayer:
 
     def _push_markers(self, k0: int, k1: int) -> None:
         """Markers whose onset lies in samples [k0, k1) of the (looped) playback."""
-        fs, n_total = self.rec.sample_rate, len(self.rec.data)
+        fs, n_total = self.rec.rate, len(self.rec.data)
         ann = self.rec.annotations
         if not ann:
             return

@@ -42,7 +42,7 @@ def main(args: argparse.Namespace) -> int:
         print(f'mindgrasp eeg play: {exc}', file=sys.stderr)
         return 1
     print(f"Playing {recording.source} as LSL stream '{args.name}' "
-          f'({len(recording.channel_names)} ch @ {recording.sample_rate:g} Hz, '
+          f'({len(recording.channels)} ch @ {recording.rate:g} Hz, '
           f'{recording.duration:.1f} s, {len(recording.annotations)} annotations on '
           f"'{args.name}-markers') at {args.rate:g}x{' in a loop' if args.loop else ''}.",
           flush=True)
