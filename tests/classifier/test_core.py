@@ -115,9 +115,10 @@ def test_mdm_and_fgmdm_match_pyriemann():
     ours = MdmClassifier().fit(covs, y)
     ref = MDM(metric='riemann').fit(covs, y)
     np.testing.assert_allclose(ours.distances(covs), ref.transform(covs), rtol=1e-6)
-    fg = make_classifier('fgmdm').fit(covs, y)
-    np.testing.assert_array_equal(fg.predict(covs), FgMDM(metric='riemann').fit(covs, y)
-                                  .predict(covs))
+    fg = make_classifier('fgmdm').fit(covs, y)     # built from pyRiemann's public parts
+    fg_ref = FgMDM(metric='riemann').fit(covs, y)
+    np.testing.assert_array_equal(fg.predict(covs), fg_ref.predict(covs))
+    np.testing.assert_allclose(fg.distances(covs), fg_ref.transform(covs), rtol=1e-6)
 
 
 def test_certainty_formula():

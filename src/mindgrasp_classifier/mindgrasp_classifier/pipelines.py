@@ -15,12 +15,14 @@ numpy arrays (no pickle).
 from __future__ import annotations
 
 import numpy as np
-from pyriemann.classification import MDM, FgMDM
+from pyriemann.classification import MDM
 from pyriemann.geometry.base import invsqrtm
 from pyriemann.geometry.geodesic import geodesic_riemann
 from pyriemann.geometry.mean import mean_riemann
 from pyriemann.geometry.tangentspace import tangent_space, untangent_space
+from pyriemann.tangentspace import TangentSpace
 from sklearn.base import BaseEstimator, ClassifierMixin
+from sklearn.discriminant_analysis import LinearDiscriminantAnalysis
 from sklearn.linear_model import LogisticRegression
 
 from mindgrasp_classifier.errors import ClassifierError
@@ -150,7 +152,7 @@ class MdmClassifier(_DistanceClassifier):
 
 
 class FgMdmClassifier(MdmClassifier):
-    """MDM after geodesic filtering (FGDA, pyRiemann ``FgMDM``).
+    """MDM after geodesic filtering (FGDA): the same fit as pyRiemann ``FgMDM``.
 
     Attributes
     ----------
@@ -166,12 +168,21 @@ class FgMdmClassifier(MdmClassifier):
 
     def fit(self, X: np.ndarray, y: np.ndarray) -> FgMdmClassifier:
         """Fit the geodesic filter and the class means."""
-        X = _check_covs(X)
-        fg = FgMDM(metric='riemann').fit(X, np.asarray(y))
-        self.classes_ = fg.classes_
-        self.reference_ = np.asarray(fg._fgda._ts.reference_, dtype=float)
-        self.filter_ = np.asarray(fg._fgda._W, dtype=float)
-        self.covmeans_ = np.asarray(fg._mdm.covmeans_, dtype=float)
+        X, y = _check_covs(X), np.asarray(y)
+        # pyRiemann's FgMDM (FGDA then MDM), from public parts so the state is ours to store:
+        # tangent space at the Riemannian mean, shrinkage LDA there, the filter projecting onto
+        # the discriminant directions, class means of the filtered matrices
+        ts = TangentSpace(metric='riemann').fit(X)
+        features = ts.transform(X)
+        lda = LinearDiscriminantAnalysis(n_components=len(np.unique(y)) - 1, solver='lsqr',
+                                         shrinkage='auto').fit(features, y)
+        w = lda.coef_
+        self.reference_ = np.asarray(ts.reference_, dtype=float)
+        self.filter_ = w.T @ np.linalg.pinv(w @ w.T) @ w
+        filtered = untangent_space(features @ self.filter_, self.reference_, metric='riemann')
+        mdm = MDM(metric='riemann').fit(filtered, y)
+        self.classes_ = mdm.classes_
+        self.covmeans_ = np.asarray(mdm.covmeans_, dtype=float)
         self._refresh()
         return self
 
