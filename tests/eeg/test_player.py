@@ -36,7 +36,7 @@ def start_player(name: str, *args: str) -> subprocess.Popen:
 
 
 def open_inlet(name: str) -> pylsl.StreamInlet:
-    found = pylsl.resolve_byprop('name', name, timeout=10)
+    found = pylsl.resolve_byprop('name', name, timeout=60)   # a busy host starts it slowly
     assert found, f'stream {name} not found'
     inlet = pylsl.StreamInlet(found[0], processing_flags=pylsl.proc_clocksync)
     inlet.open_stream(timeout=5)
