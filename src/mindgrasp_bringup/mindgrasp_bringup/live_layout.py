@@ -14,10 +14,12 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
+from mindgrasp_common.resources import resource_path
+
 __all__ = ['LAYOUT_FILE', 'TOPICS', 'build_layout']
 
 #: the committed layout file (package data of mindgrasp_bringup)
-LAYOUT_FILE = Path(__file__).resolve().parent / 'foxglove' / 'mindgrasp_live.json'
+LAYOUT_FILE = resource_path('mindgrasp_bringup', 'foxglove') / 'mindgrasp_live.json'
 
 #: topics the layout shows (each published by the demo)
 TOPICS = ('/vision/overlay', '/camera/color/image_raw', '/robot_description', '/tf',
