@@ -233,3 +233,21 @@ def test_virtual_amp_paced_by_sim_clock(spawn_node, listener, stream_name) -> No
         arrived()
         listener.spin(0.02)
     assert 480 <= got <= 510, got         # 250 Hz of simulated time, nothing more
+
+
+def test_acquisition_searches_without_blocking_and_reports_it(spawn_node, listener,
+                                                              stream_name) -> None:
+    """No stream yet: /eeg/status says what the node is looking for (WARN) and the node keeps
+    running; once an amplifier appears, its samples flow."""
+    acq = spawn_node('mindgrasp_eeg.acquisition_node', stream_name=stream_name,
+                     resolve_timeout=300.0)
+
+    def searching() -> bool:
+        return any(level_of(s) == 1 and 'Searching for the LSL stream' in s.status[0].message
+                   and stream_name in s.status[0].message for s in listener.status)
+
+    assert listener.spin(60, searching), acq.output()
+    assert 'is not pinned' in acq.output()              # any sender with this name is taken
+    spawn_node('mindgrasp_eeg.virtual_amp_node', stream_name=stream_name)
+    assert listener.spin(60, lambda: len(listener.chunks) > 10), acq.output()
+    assert listener.spin(60, lambda: level_of(listener.status[-1]) == 0)

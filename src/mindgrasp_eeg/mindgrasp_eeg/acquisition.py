@@ -39,6 +39,7 @@ import contextlib
 import math
 import socket
 import threading
+import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
@@ -47,7 +48,15 @@ import pylsl
 from pylsl.util import LostError
 
 from . import EEGError
-from .lsl import StreamDescription, check_stream, open_inlet, resolve_stream, unit_scale
+from .lsl import (
+    StreamDescription,
+    check_stream,
+    not_found_error,
+    open_inlet,
+    resolve_stream,
+    stream_predicate,
+    unit_scale,
+)
 from .quality import QualityMonitor
 
 NAN_POLICIES = ('replace', 'drop', 'keep')
@@ -121,7 +130,7 @@ class EEGAcquisition:
                  resolve_timeout: float = 10.0, lost_timeout: float = 0.5,
                  nan_policy: str = 'replace', dejitter: bool = True, clocksync: bool = True,
                  quality_window: float = 1.0, flat_threshold: float = 1e-7,
-                 rail_threshold: float = 0.1) -> None:
+                 rail_threshold: float = 0.1, hostname: str = '') -> None:
         if nan_policy not in NAN_POLICIES:
             msg = f'nan_policy must be one of {NAN_POLICIES}; {nan_policy!r} is unknown.'
             raise EEGError(msg)
@@ -132,6 +141,7 @@ class EEGAcquisition:
         if stream_unit != 'auto':
             unit_scale(stream_unit)
         self.selector = (name, stream_type, source_id)
+        self.hostname = hostname
         self.expected = (int(n_channels), float(sample_rate), tuple(channel_names))
         self.adapt, self.stream_unit, self.max_buflen = adapt, stream_unit, max_buflen
         self.resolve_timeout, self.lost_timeout, self.nan_policy = (
@@ -149,6 +159,7 @@ class EEGAcquisition:
         self._reconnect_error = ''
         self._reconnect_thread: threading.Thread | None = None
         self._stop = threading.Event()
+        self._search: tuple[threading.Thread, dict[str, object]] | None = None
         self._last_ts: float | None = None       # timestamp of the last accepted sample
         self._next_index = 0                     # index the next sample would get without gaps
         self._last_data_at = 0.0                 # local_clock() when samples last arrived
@@ -175,9 +186,85 @@ class EEGAcquisition:
             layout mismatch with ``adapt`` false.
         """
         timeout = self.resolve_timeout if timeout is None else timeout
-        info = resolve_stream(*self.selector, timeout=timeout)
+        info = resolve_stream(*self.selector, timeout=timeout, hostname=self.hostname)
         inlet, desc = open_inlet(info, max_buflen=self.max_buflen, dejitter=self.dejitter,
                                  clocksync=self._clocksync_for(info))
+        try:
+            self._adopt(desc)
+        except EEGError:
+            inlet.close_stream()
+            raise
+        self._inlet = inlet
+        self._last_data_at = pylsl.local_clock()
+        self._got_data = False
+        return desc
+
+    @property
+    def pinned(self) -> bool:
+        """True when the selector names both the stream's source_id and its host: no other
+        sender on the network can stand in for the amplifier."""
+        return bool(self.selector[2] and self.hostname)
+
+    @property
+    def searching(self) -> bool:
+        """True between :meth:`start_search` and the stream being found (or not)."""
+        return self._search is not None
+
+    def start_search(self, timeout: float | None = None) -> None:
+        """Look for the stream in a background thread, in slices of 0.5 s, so the caller never
+        blocks (an executor keeps serving signals, timers and status). :meth:`finish_search`
+        collects the outcome."""
+        timeout = self.resolve_timeout if timeout is None else timeout
+        stream_predicate(*self.selector, self.hostname)          # bad selectors fail here, at once
+        if not any(self.selector):
+            resolve_stream(*self.selector, timeout=0.0)     # raises: no selector given
+        outcome: dict[str, object] = {}
+
+        def run() -> None:
+            deadline = time.monotonic() + timeout
+            while not self._stop.is_set():
+                remaining = deadline - time.monotonic()
+                try:
+                    info = resolve_stream(*self.selector, timeout=max(0.05, min(0.5, remaining)),
+                                          list_visible=False, hostname=self.hostname)
+                    outcome['found'] = open_inlet(info, max_buflen=self.max_buflen,
+                                                  dejitter=self.dejitter,
+                                                  clocksync=self._clocksync_for(info))
+                    return
+                except EEGError as exc:
+                    if time.monotonic() < deadline:
+                        continue
+                    outcome['error'] = not_found_error(
+                        stream_predicate(*self.selector, self.hostname), timeout) \
+                        if str(exc).startswith('No LSL stream with') else exc
+                    return
+                except Exception as exc:  # reported by finish_search
+                    outcome['error'] = EEGError(f'Opening the LSL stream failed: '
+                                                f'{type(exc).__name__}: {exc}')
+                    return
+
+        thread = threading.Thread(target=run, name='eeg-search', daemon=True)
+        self._search = (thread, outcome)
+        thread.start()
+
+    def finish_search(self) -> StreamDescription | None:
+        """The stream's description once the search of :meth:`start_search` found it (and its
+        layout was checked), None while it goes on.
+
+        Raises
+        ------
+        EEGError
+            Nothing found within the timeout (visible streams listed), or a layout mismatch.
+        """
+        if self._search is None:
+            return self.desc
+        thread, outcome = self._search
+        if thread.is_alive():
+            return None
+        self._search = None
+        if 'error' in outcome:
+            raise outcome['error']
+        inlet, desc = outcome['found']
         try:
             self._adopt(desc)
         except EEGError:
@@ -214,10 +301,13 @@ class EEGAcquisition:
         self.desc = desc
 
     def close(self) -> None:
-        """Stop reconnecting and close the inlet."""
+        """Stop searching and reconnecting and close the inlet. The threads end by themselves
+        within 0.5 s (their resolve slice); waiting for them here would only delay a node's
+        stop, so they get 0.1 s (they are daemon threads)."""
         self._stop.set()
-        if self._reconnect_thread is not None:
-            self._reconnect_thread.join(timeout=1.0)
+        for thread in (self._reconnect_thread, self._search and self._search[0]):
+            if thread is not None:
+                thread.join(timeout=0.1)
         if self._inlet is not None:
             self._inlet.close_stream()
             self._inlet = None
@@ -229,7 +319,8 @@ class EEGAcquisition:
         def run() -> None:
             while not self._stop.is_set():
                 try:
-                    info = resolve_stream(*self.selector, timeout=0.5, list_visible=False)
+                    info = resolve_stream(*self.selector, timeout=0.5, list_visible=False,
+                                          hostname=self.hostname)
                     if info.uid() == lost_uid and pylsl.local_clock() - self._last_data_at < 2.0:
                         # the lost outlet may still be listed for a moment; give it time
                         self._stop.wait(0.1)

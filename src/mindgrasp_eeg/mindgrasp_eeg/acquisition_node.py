@@ -9,10 +9,19 @@ samples that arrived, in volts, stamped with the ROS time of the first sample (s
 :mod:`mindgrasp_eeg.acquisition` for the LSL-to-ROS time mapping), and ``/eeg/status``
 (diagnostic_msgs/DiagnosticArray, reliable) every ``status_period`` seconds and on every change
 of level. All the work is done by :class:`~mindgrasp_eeg.acquisition.EEGAcquisition`.
+
+The stream is looked for in a background thread (up to ``resolve_timeout`` s): meanwhile the node
+answers signals at once and says "Searching for the LSL stream ..." on /eeg/status (WARN). Not
+found in time, or a layout that does not match: exit 1 with the reason.
+
+Which sender is trusted: by default any stream with the right name (a warning says so). Pin the
+amplifier with ``source_id`` and ``hostname`` (``hostname:=local`` means this host), so no other
+sender on the network can stand in for it.
 """
 
 from __future__ import annotations
 
+import socket
 import sys
 
 import numpy as np
@@ -27,6 +36,7 @@ from mindgrasp_ros import rclpy
 
 PARAMETERS = [
     ('stream_name', 'MIndGrasp-VirtualAmp'), ('stream_type', ''), ('source_id', ''),
+    ('hostname', ''),
     ('n_channels', 32), ('sample_rate', 250.0), ('channel_names', list(NAUTILUS_32)),
     ('check_channel_names', True), ('adapt_to_stream', False), ('stream_unit', 'auto'),
     ('chunk_period', 1.0 / 32.0), ('max_buflen', 1.0), ('resolve_timeout', 30.0),
@@ -53,22 +63,24 @@ class AcquisitionNode(rclpy.node.Node):
             resolve_timeout=p['resolve_timeout'], lost_timeout=p['lost_timeout'],
             nan_policy=p['nan_policy'], dejitter=p['dejitter'], clocksync=p['clocksync'],
             quality_window=p['quality_window'], flat_threshold=p['flat_threshold'],
-            rail_threshold=p['rail_threshold'])
+            rail_threshold=p['rail_threshold'],
+            hostname=socket.gethostname() if p['hostname'] == 'local' else p['hostname'])
         qos_raw = rclpy.qos.QoSProfile(depth=100,
                                        reliability=rclpy.qos.ReliabilityPolicy.BEST_EFFORT,
                                        durability=rclpy.qos.DurabilityPolicy.VOLATILE)
         self.pub_raw = self.create_publisher(EEGChunk, '/eeg/raw', qos_raw)
         self.pub_status = self.create_publisher(DiagnosticArray, '/eeg/status', 10)
-        self.get_logger().info(f'Looking for the LSL stream (name {p["stream_name"]!r}, type '
-                               f'{p["stream_type"]!r}, source_id {p["source_id"]!r}) for up to '
+        self._wanted = (f'name {p["stream_name"]!r}, type {p["stream_type"]!r}, source_id '
+                        f'{p["source_id"]!r}, host {self.acq.hostname!r}')
+        if not self.acq.pinned:
+            self.get_logger().warning(
+                'The EEG stream is not pinned: any LSL sender with this name is accepted. Set '
+                'source_id and hostname (hostname:=local for this host) to accept only your '
+                'amplifier.')
+        self.get_logger().info(f'Searching for the LSL stream ({self._wanted}) for up to '
                                f'{p["resolve_timeout"]:g} s.')
-        desc = self.acq.connect()
-        for warning in self.acq.warnings:
-            self.get_logger().warning(warning)
-        self.get_logger().info(f'Connected to {desc.summary()}, unit {desc.unit or "?"} '
-                               f'(x{self.acq.scale:g} to volts); publishing /eeg/raw every '
-                               f'{p["chunk_period"] * 1e3:.1f} ms.')
-        self._n_warnings = len(self.acq.warnings)
+        self.acq.start_search()
+        self._n_warnings = 0
         self._last_level = -1
         self._last_stamp_ns = -1
         self.create_timer(p['chunk_period'], self.poll_callback)
@@ -76,8 +88,27 @@ class AcquisitionNode(rclpy.node.Node):
         self._start_ns = self.get_clock().now().nanoseconds
         self.done = False
 
+    def _connected(self) -> bool:
+        """False while the search goes on; raises EEGError when it failed (ends the node)."""
+        if not self.acq.searching:
+            return True
+        desc = self.acq.finish_search()
+        if desc is None:
+            return False
+        for warning in self.acq.warnings:
+            self.get_logger().warning(warning)
+        self._n_warnings = len(self.acq.warnings)
+        self.get_logger().info(f'Connected to {desc.summary()}, unit {desc.unit or "?"} '
+                               f'(x{self.acq.scale:g} to volts); publishing /eeg/raw every '
+                               f'{self.p["chunk_period"] * 1e3:.1f} ms.')
+        self.status_callback()
+        return True
+
     def poll_callback(self) -> None:
-        """Pull what LSL has and publish it."""
+        """Pull what LSL has and publish it (once the stream is found)."""
+        self._check_duration()
+        if not self._connected():
+            return
         chunks = self.acq.poll()
         if chunks:
             ros_now = self.get_clock().now().nanoseconds
@@ -98,12 +129,22 @@ class AcquisitionNode(rclpy.node.Node):
             self._n_warnings = len(self.acq.warnings)
         if self.acq.status().level != self._last_level:
             self.status_callback()
+
+    def _check_duration(self) -> None:
         duration = self.p['duration']
         if duration > 0 and self.get_clock().now().nanoseconds - self._start_ns > duration * 1e9:
             self.done = True
 
     def status_callback(self) -> None:
         """Publish /eeg/status; log level changes."""
+        if self.acq.searching:
+            item = DiagnosticStatus(level=DiagnosticStatus.WARN, name='eeg_acquisition',
+                                    message=f'Searching for the LSL stream ({self._wanted}).',
+                                    values=[KeyValue(key='state', value='searching')])
+            msg = DiagnosticArray(status=[item])
+            msg.header.stamp = self.get_clock().now().to_msg()
+            self.pub_status.publish(msg)
+            return
         status = self.acq.status()
         if status.level != self._last_level:
             log = {OK: self.get_logger().info, WARN: self.get_logger().warning,

@@ -90,10 +90,25 @@ class StreamDescription:
                 f"{self.sample_rate:g} Hz, source_id {self.source_id!r}, host {self.hostname!r})")
 
 
-def _predicate(name: str, stream_type: str, source_id: str) -> str:
-    parts = [f"{key}='{value}'" for key, value in
-             (('name', name), ('type', stream_type), ('source_id', source_id)) if value]
-    return ' and '.join(parts)
+def stream_predicate(name: str, stream_type: str, source_id: str, hostname: str = '') -> str:
+    """An LSL (XPath 1.0) predicate over the stream's fields; quotes in values are refused."""
+    fields = (('name', name), ('type', stream_type), ('source_id', source_id),
+              ('hostname', hostname))
+    for key, value in fields:
+        if "'" in value or '"' in value:
+            msg = f'The LSL stream {key} {value!r} contains a quote; LSL selectors cannot match it.'
+            raise EEGError(msg)
+    return ' and '.join(f"{key}='{value}'" for key, value in fields if value)
+
+
+def not_found_error(pred: str, timeout: float, list_visible: bool = True) -> EEGError:
+    """The error for "no stream matched ``pred`` within ``timeout`` s", listing what is visible
+    (looked up for one more second) unless ``list_visible`` is false."""
+    seen = visible_streams(1.0) if list_visible else []
+    listing = '; '.join(s.summary() for s in seen) or 'none'
+    return EEGError(f'No LSL stream with {pred} was found within {timeout:g} s. Visible streams: '
+                    f'{listing}. Start the amplifier (or `mindgrasp eeg virtual-amp`) or select '
+                    f'one of the visible streams by name, type or source_id.')
 
 
 def visible_streams(wait_time: float = 1.0) -> list[StreamDescription]:
@@ -103,8 +118,9 @@ def visible_streams(wait_time: float = 1.0) -> list[StreamDescription]:
 
 def resolve_stream(name: str = '', stream_type: str = '', source_id: str = '',
                    timeout: float = 10.0, exclude_uids: Sequence[str] = (),
-                   list_visible: bool = True) -> pylsl.StreamInfo:
-    """Find one LSL stream by name, type and/or source_id (the newest if several match).
+                   list_visible: bool = True, hostname: str = '') -> pylsl.StreamInfo:
+    """Find one LSL stream by name, type, source_id and/or hostname (the newest if several
+    match).
 
     Raises
     ------
@@ -112,7 +128,7 @@ def resolve_stream(name: str = '', stream_type: str = '', source_id: str = '',
         Nothing matched within ``timeout`` seconds; the message lists the visible streams
         (looked up for one more second) unless ``list_visible`` is false.
     """
-    pred = _predicate(name, stream_type, source_id)
+    pred = stream_predicate(name, stream_type, source_id, hostname)
     if not pred:
         msg = ('No LSL stream selector given: set at least one of eeg_stream (name), '
                'stream_type or source_id.')
@@ -120,12 +136,7 @@ def resolve_stream(name: str = '', stream_type: str = '', source_id: str = '',
     found = [i for i in pylsl.resolve_bypred(pred, minimum=1, timeout=timeout)
              if i.uid() not in exclude_uids]
     if not found:
-        seen = visible_streams(1.0) if list_visible else []
-        listing = '; '.join(s.summary() for s in seen) or 'none'
-        msg = (f'No LSL stream with {pred} was found within {timeout:g} s. Visible streams: '
-               f'{listing}. Start the amplifier (or `mindgrasp eeg virtual-amp`) or select one of '
-               f'the visible streams by name, type or source_id.')
-        raise EEGError(msg)
+        raise not_found_error(pred, timeout, list_visible)
     return max(found, key=lambda i: i.created_at())
 
 

@@ -7,12 +7,22 @@ from collections.abc import Callable
 
 from mindgrasp_eeg import EEGError
 from mindgrasp_ros import rclpy
+from mindgrasp_ros.process import exit_if_main_program
 
 
 def run_node(factory: Callable[[], rclpy.node.Node], label: str,
              args: list[str] | None = None) -> int:
     """Run the node ``factory()`` makes until Ctrl-C or its ``done`` flag (the ``duration``
-    parameter); exit 1 with the message of an :class:`EEGError` (bad input, lost stream)."""
+    parameter); exit 1 with the message of an :class:`EEGError` (bad input, lost stream).
+
+    Run as a program, the process ends right after the node's cleanup (see
+    :mod:`mindgrasp_ros.process`): within 1 s of SIGINT/SIGTERM in every state."""
+    code = _run(factory, label, args)
+    exit_if_main_program(code, getattr(factory, '__module__', ''))
+    return code
+
+
+def _run(factory: Callable[[], rclpy.node.Node], label: str, args: list[str] | None) -> int:
     rclpy.init(args=args)
     node = None
     try:
