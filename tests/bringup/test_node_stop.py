@@ -2,11 +2,15 @@
 
 Each case starts the node as its own process, waits for the state (a line of its log), sends the
 signal and measures the time until the process has exited. The figures are printed (``-s``) for
-the reliability note; the bound is the one an operator relies on: 1 s.
+the reliability note. The bound is the one an operator relies on, 1 s, on a machine with a free
+core; on an oversubscribed machine (load average above the core count) every process waits for a
+core in proportion, so the bound scales with load / cores. A node that blocks (a resolve in
+``__init__``, a slow interpreter teardown: 2-30 s) fails either way.
 """
 
 from __future__ import annotations
 
+import os
 import signal
 import subprocess
 import time
@@ -16,7 +20,12 @@ import pytest
 
 pytestmark = pytest.mark.slow
 
-STOP_WITHIN = 1.0   # s, from the signal to the process' exit
+STOP_WITHIN = 1.0   # s, from the signal to the process' exit, with a free core
+
+
+def bound() -> float:
+    """The stop bound (s) at the machine's current load."""
+    return STOP_WITHIN * max(1.0, os.getloadavg()[0] / (os.cpu_count() or 1))
 
 STREAM = f'mg_stop_{uuid.uuid4().hex[:8]}'   # LSL names are host-wide
 
@@ -66,8 +75,11 @@ def start(spawn_node, tmp_path, module: str, params: dict, ready: str):
 def test_node_stops_within_a_second(spawn_node, tmp_path, case, module, params, ready, sig):
     proc = start(spawn_node, tmp_path, module, params, ready)
     took = stop_time(proc, sig)
-    print(f'STOP {case} {signal.Signals(sig).name}: {took:.3f} s')
-    assert took < STOP_WITHIN, f'{case}: {took:.2f} s\n{proc.output()[-3000:]}'
+    limit = bound()
+    print(f'STOP {case} {signal.Signals(sig).name}: {took:.3f} s (bound {limit:.1f} s)')
+    assert took < limit, f'{case}: {took:.2f} s\n{proc.output()[-3000:]}'
+    assert proc.poll() == 0, f'{case}: exit code {proc.poll()} (a stop is 0)\n{proc.output()}'
+    assert 'Traceback' not in proc.output(), proc.output()
 
 
 def test_acquisition_stops_promptly_while_streaming_and_while_the_stream_is_lost(spawn_node):
@@ -77,11 +89,11 @@ def test_acquisition_stops_promptly_while_streaming_and_while_the_stream_is_lost
     assert acq.wait_for_output('Connected to', 120.0), acq.output()
     took = stop_time(acq)
     print(f'STOP acquisition streaming SIGINT: {took:.3f} s')
-    assert took < STOP_WITHIN, acq.output()
+    assert took < bound(), acq.output()
     acq = spawn_node('mindgrasp_eeg.acquisition_node', stream_name=stream)
     assert acq.wait_for_output('Connected to', 120.0), acq.output()
     amp.stop()
     assert acq.wait_for_output('is lost', 120.0), acq.output()      # now reconnecting
     took = stop_time(acq)
     print(f'STOP acquisition stream lost (reconnecting) SIGINT: {took:.3f} s')
-    assert took < STOP_WITHIN, acq.output()
+    assert took < bound(), acq.output()

@@ -48,6 +48,7 @@ from collections.abc import Callable
 from typing import Any
 
 from mindgrasp_ros import rclpy
+from mindgrasp_ros.process import exit_if_main_program
 
 __all__ = ['EXIT_FAILED', 'EXIT_OK', 'EXIT_REFUSED', 'NodeFailure', 'declare_duration',
            'end_after', 'error_text', 'exit_code', 'fail', 'is_done', 'run_node']
@@ -198,4 +199,7 @@ def run_node(node_class: Callable[[], Any], args: list[str] | None = None, *,
         if node is not None:
             node.destroy_node()
         rclpy.try_shutdown()
+    # run as a program: end right after the cleanup (the interpreter's teardown of torch/scipy
+    # took 2-5 s on a loaded machine; a node must stop within 1 s of SIGINT)
+    exit_if_main_program(code, getattr(node_class, '__module__', ''))
     return code

@@ -17,9 +17,11 @@ from __future__ import annotations
 import logging
 import os
 import sys
+import traceback
+from collections.abc import Callable
 from pathlib import Path
 
-__all__ = ['exit_if_main_program', 'is_main_program']
+__all__ = ['exit_if_main_program', 'exit_process', 'is_main_program', 'run_program']
 
 
 def is_main_program(module: str) -> bool:
@@ -39,12 +41,38 @@ def is_main_program(module: str) -> bool:
 def exit_if_main_program(code: int, module: str) -> None:
     """End the process now with ``code`` when ``module`` is the program being run (after flushing
     the logs and the standard streams); return otherwise."""
-    if not is_main_program(module):
-        return
+    if is_main_program(module):
+        exit_process(code)
+
+
+def exit_process(code: int | None) -> None:
+    """End the process now with ``code`` (None means 0), after flushing the logs and the
+    standard streams. For a node module's ``if __name__ == '__main__':`` line."""
     logging.shutdown()
     for stream in (sys.stdout, sys.stderr):
         try:
             stream.flush()
         except (OSError, ValueError):   # closed or broken pipe: nothing more to say
             pass
-    os._exit(code)
+    os._exit(0 if code is None else int(code))
+
+
+def run_program(main: Callable[[], int | None]) -> None:
+    """Run a node module's ``main()`` as the program and end the process right after it:
+    ``if __name__ == '__main__': run_program(main)``.
+
+    Ctrl-C or SIGTERM before the node's own handling took over (while it starts) ends it with 0,
+    as a stop; any other exception is printed and ends it with 1.
+    """
+    try:
+        code = main()
+    except KeyboardInterrupt:
+        code = 0
+    except SystemExit as exc:
+        code = exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 1)
+        if not isinstance(exc.code, int) and exc.code is not None:
+            print(exc.code, file=sys.stderr)
+    except BaseException:
+        traceback.print_exc()
+        code = 1
+    exit_process(code)

@@ -14,8 +14,6 @@ the last trial, or after ``duration`` seconds when that is > 0.
 
 from __future__ import annotations
 
-import sys
-
 from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import MIPrediction, Prompt
 from mindgrasp_ros.interfaces.sensor_msgs.msg import Image
 
@@ -167,4 +165,6 @@ def main(args: list[str] | None = None) -> int:
 
 
 if __name__ == '__main__':
-    sys.exit(main())
+    from mindgrasp_ros.process import run_program
+
+    run_program(main)   # ends right after the node's cleanup: no slow interpreter teardown
