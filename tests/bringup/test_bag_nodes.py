@@ -172,11 +172,13 @@ def test_bag_play_cli_republishes_identical_bytes_with_original_timing(recorded)
     assert [r[2] for r in got_text] == [hashlib.sha1(d).hexdigest()
                                         for _, d in recorded[f'{prefix}/chatter']]
     # Relative timing: publication times (DDS source timestamps, taken by the player process)
-    # against the bag's timestamps.
-    stamps = [s for s, _ in recorded[f'{prefix}/eeg']]
+    # against the bag's timestamps, relative to their median offset (not to the first message,
+    # which alone may go out late on a loaded machine and shift every other error).
+    stamps = np.array([s for s, _ in recorded[f'{prefix}/eeg']], dtype=np.int64)
     sent = np.array([int(r[1]) for r in got_eeg], dtype=np.int64)
-    errors = np.abs((sent - sent[0]) - (np.array(stamps) - stamps[0])) / 1e6
-    assert errors.max() < 5.0, errors
+    offset = sent - stamps
+    errors = np.abs(offset - np.median(offset)) / 1e6
+    assert np.median(errors) < 5.0 and errors.max() < 50.0, errors
     # --clock 20: /clock at ~20 Hz during the ~2 s of playback.
     assert 20 <= sum(1 for r in rows if r[0] == '/clock') <= 60
 
@@ -186,7 +188,7 @@ def test_bag_play_missing_bag_is_a_clear_error(tmp_path):
                           str(tmp_path / 'nope')], capture_output=True, text=True, env=_env(),
                          timeout=60)
     assert out.returncode == 1
-    assert 'does not exist; pass the path of a bag directory' in out.stderr
+    assert 'does not exist; pass a run directory (runs/<run>) or its bag folder' in out.stderr
 
 
 def test_recorder_node_full_disk_stops_recording_and_keeps_running(tmp_path):

@@ -90,37 +90,53 @@ CHILD = textwrap.dedent('''
 ''')
 
 
+def on_disk(bag: Path) -> int:
+    """Messages a reader finds in the (possibly unfinished) bag right now; 0 before any flush."""
+    try:
+        with BagReader(bag) as reader:
+            return sum(1 for _ in reader.messages())
+    except Exception:  # not written yet, or cut mid-chunk: nothing readable
+        return 0
+
+
 @pytest.mark.slow
 def test_sigkill_during_recording_leaves_a_readable_bag(tmp_path, capsys):
     bag = tmp_path / 'killed'
     proc = subprocess.Popen([sys.executable, '-c', CHILD, str(bag), str(Path(__file__).parent)],
                             stdout=subprocess.PIPE, text=True)
-    lines = []
+    lines, flushed = [], 0
+    deadline = time.monotonic() + 120
     try:
         for line in proc.stdout:
             lines.append(line.split())
-            # Record for 1.5 s after the first message (start-up time varies with the load).
-            if time.monotonic() - float(lines[0][1]) > 1.5:
-                break
+            # Kill once the writer has flushed a good part of the recording to disk: a condition
+            # (what a reader sees in the file), not a duration, since a loaded machine flushes late.
+            if len(lines) % 10 == 0:
+                flushed = on_disk(bag)
+                if flushed >= 50 or time.monotonic() > deadline:
+                    break
     finally:
         os.kill(proc.pid, signal.SIGKILL)
         proc.wait(10)
         proc.stdout.close()
-    killed_at = time.monotonic()
+    assert flushed >= 50, f'the writer flushed {flushed} message(s) of {len(lines)} pushed'
     assert not (bag / 'metadata.yaml').exists()
-    # Everything pushed more than flush_interval (0.2 s) + margin before the kill is on disk.
-    safe = max(int(k) for k, t in lines if float(t) < killed_at - 0.7)
     with BagReader(bag) as reader:
         assert not reader.complete
         got = [d for _, _, d in reader.messages()]
-    assert len(got) >= safe
+    # Nothing that was on disk before the kill is lost, and what is there is intact and in order.
+    with capsys.disabled():     # the figure for the reliability note (-s)
+        print(f'\nKILLED RECORDER kept {len(got)} of {len(lines)} pushed messages (100 Hz; '
+              f'{len(lines) - len(got)} in the last flush interval)')
+    assert len(got) >= flushed
     assert got == [image(k, 32, 24) for k in range(len(got))]
-    # bag info rebuilds metadata.yaml from the unfinished file.
+    # bag info rebuilds metadata.yaml from the unfinished file, and reports the damage (exit 1)
     capsys.readouterr()
-    assert cli_main(['bag', 'info', str(bag)]) == 0
+    assert cli_main(['bag', 'info', str(bag)]) == 1
     out = capsys.readouterr().out
     assert f'Messages:          {len(got)}' in out
     assert 'rebuilt' in out and (bag / 'metadata.yaml').exists()
+    assert 'without a footer (the recorder was killed)' in out
     # --fix finishes the file, so tools without a recovery path (rosbags) read it too.
     assert cli_main(['bag', 'info', '--fix', str(bag)]) == 0
     assert 'rewritten with its summary' in capsys.readouterr().out
