@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 import pytest
 
@@ -75,6 +77,23 @@ def test_fsm_node_turns_on_left_hand_and_stops_when_predictions_end(rclpy_ctx, s
     n = len(commands)
     assert spin_until(node, lambda: len(commands) > n + 5, 60.0)
     assert all(np.all(c == 0) for c in commands[n - 1:])   # and it stays stopped
+    # stopped, the state is published on change and at most once per second (its reason
+    # carries a changing age): an upper bound, which a loaded machine can only lower
+    k = len(states)
+    t0 = time.monotonic()
+    spin_until(node, lambda: False, 3.0)
+    assert len(states) - k <= (time.monotonic() - t0) + 2, [s.reason for s in states[k:]]
+
+    # the EEG comes back, still decoding left hand: the arm does not start by itself
+    # (resume_after_stale: require_new_command) until one class was held for resume_hold (1 s)
+    n = len(commands)
+    send_predictions[0] = True
+    assert spin_until(node, lambda: 'waiting for a new command' in states[-1].reason, 60.0), \
+        [s.reason for s in states[-3:]]
+    assert all(np.all(c == 0) for c in commands[n:])
+    assert spin_until(node, lambda: not states[-1].stopped, 60.0), proc.output()
+    assert spin_until(node, lambda: abs(commands[-1][0] - 0.4) < 1e-9, 60.0)
+    assert 'fresh decision after the prediction loss: left hand' in proc.output()
     node.destroy_node()
     assert proc.stop() in (0, -2, 130), proc.output()
 

@@ -8,6 +8,7 @@ import re
 import numpy as np
 import pytest
 
+from mindgrasp_fsm.errors import FsmError
 from mindgrasp_fsm.grasp_fsm import GraspFsm, clamp_to_limits
 from mindgrasp_fsm.params import FsmParams
 from mindgrasp_fsm.types import (
@@ -16,6 +17,7 @@ from mindgrasp_fsm.types import (
     GripperState,
     JointStateIn,
     MiClass,
+    Prediction,
     State,
 )
 
@@ -325,8 +327,51 @@ def test_watchdog_stops_every_joint(fsm: GraspFsm, kw: dict, match: str) -> None
     assert out.stopped
     assert np.all(out.joint_velocities == 0)
     assert re.search(match, out.reason), out.reason
-    # recovers when the inputs are good again
+    # recovers when the inputs are good again (after a prediction loss: a fresh decision first)
+    if 'prediction' in kw and kw['prediction'] == 'stale':
+        fsm.params.resume_after_stale = 'resume'
     assert not fsm.tick(inputs(t + 0.02, cls=MiClass.LEFT_HAND, obs=None)).stopped
+
+
+def test_after_a_prediction_loss_the_arm_waits_for_a_fresh_decision(fsm: GraspFsm) -> None:
+    """resume_after_stale: require_new_command (default): predictions that come back do not move
+    the arm until one class was decoded without a break for resume_hold (1 s)."""
+    assert fsm.params.resume_after_stale == 'require_new_command'
+    outs, t = run(fsm, 0.0, 0.5, cls=MiClass.LEFT_HAND, obs=None)
+    assert outs[-1].joint_velocities[0] > 0                 # turning left
+    lost = inputs(t + 0.5, cls=MiClass.LEFT_HAND, obs=None)
+    lost.prediction = Prediction(MiClass.LEFT_HAND, 1.0, t)  # EEG lost: 0.5 s old
+    assert fsm.tick(lost).stopped
+    # the EEG is back and still decodes left hand: the arm does not start by itself
+    outs, t = run(fsm, t + 0.52, 0.6, cls=MiClass.LEFT_HAND, obs=None)
+    assert all(o.stopped and np.all(o.joint_velocities == 0) for o in outs)
+    assert 'waiting for a new command' in outs[-1].reason
+    # a change of class starts the count again
+    outs, t = run(fsm, t, 0.6, cls=MiClass.RIGHT_HAND, obs=None)
+    assert all(o.stopped for o in outs)
+    # right hand held for 1 s in all: the fresh decision; the arm turns right
+    outs, t = run(fsm, t, 0.5, cls=MiClass.RIGHT_HAND, obs=None)
+    moving = [o for o in outs if not o.stopped]
+    assert moving and moving[0].joint_velocities[0] < 0
+    assert any('fresh decision' in e for o in outs for e in o.events)
+    first = next(i for i, o in enumerate(outs) if not o.stopped)
+    assert 0.35 <= first * 0.02 <= 0.45                     # 1.0 s after the class changed
+
+
+def test_resume_after_stale_resume_goes_on_at_once(fsm: GraspFsm) -> None:
+    fsm.params.resume_after_stale = 'resume'
+    _, t = run(fsm, 0.0, 0.5, cls=MiClass.LEFT_HAND, obs=None)
+    lost = inputs(t + 0.5, cls=MiClass.LEFT_HAND, obs=None)
+    lost.prediction = Prediction(MiClass.LEFT_HAND, 1.0, t)
+    assert fsm.tick(lost).stopped
+    assert not fsm.tick(inputs(t + 0.52, cls=MiClass.LEFT_HAND, obs=None)).stopped
+
+
+def test_resume_after_stale_must_be_a_known_mode(params: FsmParams) -> None:
+    params.resume_after_stale = 'sometimes'
+    with pytest.raises(FsmError, match="'resume_after_stale' is 'sometimes'; use one of "
+                                       'require_new_command, resume'):
+        params.validate()
 
 
 def test_autonomous_mode_needs_no_predictions(params: FsmParams) -> None:

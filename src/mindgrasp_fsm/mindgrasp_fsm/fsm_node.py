@@ -16,7 +16,7 @@ that time, for launch tests).
 
 from __future__ import annotations
 
-import sys
+import re
 
 import numpy as np
 from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import DetectionArray, FsmState, MIPrediction
@@ -49,6 +49,8 @@ from mindgrasp_ros.topics import (
     JOINT_STATES,
     VISION_DETECTIONS,
 )
+
+_NUMBER = re.compile(r'\d+(\.\d+)?')
 
 
 class FsmNode(rclpy.node.Node):
@@ -173,7 +175,11 @@ class FsmNode(rclpy.node.Node):
             self.get_logger().info(f'State: {event}')
 
     def _publish_state(self, out: FsmOutput, now: float) -> None:
-        key = (int(out.state), out.locked, out.stopped, out.reason, out.object_of_interest)
+        """/fsm/state on every change, else at most once per second. A stop reason carries a
+        changing age ("0.53 s old"): numbers do not count as a change, so a stopped controller
+        says so once per second, not at the control rate."""
+        reason = _NUMBER.sub('#', out.reason) if out.stopped else out.reason
+        key = (int(out.state), out.locked, out.stopped, reason, out.object_of_interest)
         if key == self._last_state_msg and now - self._last_state_pub < 1.0:
             return
         if out.stopped and (self._last_state_msg is None or not self._last_state_msg[2]):
@@ -185,7 +191,6 @@ class FsmNode(rclpy.node.Node):
                        stopped=bool(out.stopped), reason=out.reason)
         msg.header.stamp = self.get_clock().now().to_msg()
         self.state_pub.publish(msg)
-
 
     def destroy_node(self) -> None:
         """Stop the arm (when the context still runs) and say how long the controller ran."""

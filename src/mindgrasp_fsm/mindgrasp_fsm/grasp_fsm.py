@@ -27,6 +27,12 @@ proportional on the pixel error, joint 1 from x and joint 5 from y. A watchdog s
 when predictions (BCI mode) or joint states are older than ``watchdog_timeout``, when joint states
 hold NaN, or when no camera frames arrive; the output says why. Commands never drive a joint past
 its limits.
+
+After the MI predictions went stale and came back (``resume_after_stale: require_new_command``,
+the default) the arm does not move again by itself: it holds still until a *fresh decision*, one
+MI class decoded in every prediction for ``resume_hold`` seconds (by the predictions' stamps),
+counting only predictions stamped after the first fresh one that followed the loss, so that no
+decision made before the loss carries over. ``resume`` goes on with whatever is decoded.
 """
 
 from __future__ import annotations
@@ -123,6 +129,11 @@ class GraspFsm:
         self._ignore_from: float | None = None
         self._gave_up_at = -math.inf
         self._both_since: float | None = None   # since when both-hands is decoded without break
+        # after a prediction loss: the stamp of the first fresh prediction (None: no loss
+        # pending), and the class held since which stamp
+        self._stale_pred = False
+        self._back_at: float | None = None
+        self._fresh: tuple[int, float] | None = None
         self._return_lift: bool | None = None
         self._attempt = 0
         self._outcome = ''
@@ -205,7 +216,7 @@ class GraspFsm:
         self._last_time = now
 
         # --- watchdog: nothing moves on stale or broken inputs -------------------------------
-        why = self._watchdog(inputs, now)
+        why = self._watchdog(inputs, now) or self._await_fresh_decision(inputs)
         if why:
             return self._stop(why)    # the active clock does not advance while stopped
         self._clock += dt
@@ -258,6 +269,8 @@ class GraspFsm:
                 return 'stopped: no MI prediction received yet'
             age = now - pred.stamp
             if age > p.watchdog_timeout:
+                self._stale_pred = True
+                self._back_at = self._fresh = None
                 return (f'stopped: the latest MI prediction is {age:.2f} s old (limit '
                         f'{p.watchdog_timeout:.2f} s); check the classifier and EEG stream')
         if inputs.vision is None:
@@ -267,6 +280,36 @@ class GraspFsm:
             return (f'stopped: no camera images for {age:.2f} s (limit {p.camera_timeout:.2f} s);'
                     ' holding still')
         return ''
+
+    def _await_fresh_decision(self, inputs: FsmInputs) -> str:
+        """'' once the controller may move after a prediction loss, else why it holds still.
+
+        A fresh decision: every prediction stamped from the first fresh one after the loss on
+        decodes the same class for ``resume_hold`` s. A prediction of another class starts the
+        count again.
+        """
+        p = self.params
+        if not self._stale_pred or p.autonomous:
+            return ''
+        if p.resume_after_stale == 'resume':
+            self._stale_pred = False
+            return ''
+        pred = inputs.prediction
+        assert pred is not None            # the watchdog passed: fresh predictions arrive
+        if self._back_at is None:
+            self._back_at = pred.stamp
+        if pred.stamp >= self._back_at and (self._fresh is None or
+                                            self._fresh[0] != pred.class_index):
+            self._fresh = (pred.class_index, pred.stamp)
+        held = pred.stamp - self._fresh[1] if self._fresh is not None else 0.0
+        if held >= p.resume_hold:
+            self._stale_pred = False
+            self._back_at = self._fresh = None
+            self._events.append('fresh decision after the prediction loss: '
+                                f'{_CLASS_WORDS.get(pred.class_index, pred.class_index)}')
+            return ''
+        return ('stopped: the MI predictions are back after a loss; waiting for a new command '
+                f'(one class for {p.resume_hold:.1f} s, resume_after_stale)')
 
     def _observe(self, vision: VisionFrame | None, t: float) -> None:
         ooi = vision.object_of_interest if vision is not None else None

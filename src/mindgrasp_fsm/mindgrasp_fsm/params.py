@@ -27,6 +27,7 @@ from mindgrasp_fsm.errors import FsmError
 from mindgrasp_ros.params import param
 
 SHAPES = ('cube', 'cylinder', 'sphere')
+RESUME_MODES = ('require_new_command', 'resume')
 
 
 @dataclass
@@ -65,6 +66,14 @@ class FsmParams:
                                     live=True)
     camera_timeout: float = param(0.5, 'without detections for this long the arm holds still',
                                   unit='s', min=0.01, max=10.0, live=True)
+    # after the MI predictions went stale (EEG or classifier lost) and came back: wait for a
+    # fresh decision (one class decoded without a break for resume_hold, on windows that began
+    # after the loss) or go on with whatever is decoded (resume)
+    resume_after_stale: str = param('require_new_command', 'after an EEG/prediction loss: '
+                                    'require_new_command (hold still until a fresh decision) '
+                                    'or resume', choices=RESUME_MODES, live=True)
+    resume_hold: float = param(1.0, 'a fresh decision after a loss: one class decoded without '
+                               'a break for this long', unit='s', min=0.0, max=10.0, live=True)
     # --- BCI -----------------------------------------------------------------------------------
     certainty_threshold: float = param(0.5, 'certainty below which state 3 uses the default '
                                        'slow approach', min=0.0, max=100.0, live=True)
@@ -301,6 +310,10 @@ class FsmParams:
         if self.measure_frames < 1:
             msg = (f"'measure_frames' must be >= 1 camera frame, got {self.measure_frames}; "
                    'use 3 with a noisy depth camera.')
+            raise FsmError(msg)
+        if self.resume_after_stale not in RESUME_MODES:
+            msg = (f"'resume_after_stale' is {self.resume_after_stale!r}; use one of "
+                   f"{', '.join(RESUME_MODES)}.")
             raise FsmError(msg)
         if self.grasp_retries < 0:
             msg = f"'grasp_retries' must be >= 0, got {self.grasp_retries}."

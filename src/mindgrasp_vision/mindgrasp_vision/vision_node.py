@@ -14,7 +14,6 @@ The algorithms are :class:`mindgrasp_vision.pipeline.VisionPipeline`.
 
 from __future__ import annotations
 
-import sys
 import threading
 
 from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import (
