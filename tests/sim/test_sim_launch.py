@@ -41,3 +41,30 @@ def test_sim_launch_runs_and_records(tmp_path):
     for topic in ('/joint_states', '/camera/color/image_raw', '/camera/depth/image_raw',
                   '/camera/color/camera_info', '/ee_pose', '/sim/objects', '/clock'):
         assert f'name: {topic}\n' in metadata, topic
+
+
+@pytest.mark.parametrize('text', [
+    "1'.split('x')[0]) or __import__('os').system('touch /tmp/pwned') or int('1",
+    '{0.__class__.__mro__}x1@1',
+    '640x480',
+    '640x480@',
+    'x480@30',
+    '640 x 480 @ 30; rm -rf /',
+    '0x480@30',
+    '640x480@1e3',
+])
+def test_camera_argument_is_parsed_never_evaluated(text):
+    """Hostile or malformed camera:= text: one clear error naming the form, nothing run."""
+    from mindgrasp_bringup.launch_system import LaunchError
+
+    with pytest.raises(LaunchError, match=r'camera:=.* e\.g\. camera:=640x480@30'):
+        sim_process('record:=false', f'camera:={text}')
+
+
+def test_parse_camera():
+    from mindgrasp_bringup.launch_args import parse_camera
+
+    assert parse_camera('640x480@30') == (640, 480, 30.0)
+    assert parse_camera(' 128x96@7.5 ') == (128, 96, 7.5)
+    with pytest.raises(ValueError, match='is not WIDTHxHEIGHT@HZ'):
+        parse_camera('640x480')

@@ -55,6 +55,7 @@ _SOURCES: dict[str, tuple[str, str]] = {
     'SetRemap': ('launch_ros.actions', _OWN),
     # ours, with a real-launch twin
     'SplitArguments': ('mindgrasp_bringup.launch_ros_extras', _OWN),
+    'CameraSpec': ('mindgrasp_bringup.launch_ros_extras', _OWN),
 }
 
 #: our helpers, the same under both launchers (they build actions through this module)

@@ -12,6 +12,28 @@ from launch.substitutions.substitution_failure import SubstitutionFailure
 from launch.utilities import normalize_to_list_of_substitutions, perform_substitutions
 
 
+class CameraSpec(Substitution):
+    """One field (``'width'``, ``'height'`` or ``'rate'``) of a ``WIDTHxHEIGHT@HZ`` text: parsed
+    by :func:`mindgrasp_bringup.launch_args.parse_camera`, never evaluated."""
+
+    def __init__(self, value: SomeSubstitutionsType, field: str) -> None:
+        super().__init__()
+        self.value = normalize_to_list_of_substitutions(value)
+        self.field = field
+
+    def describe(self) -> str:
+        return f'CameraSpec({" + ".join(s.describe() for s in self.value)}, {self.field!r})'
+
+    def perform(self, context: LaunchContext) -> str:
+        from mindgrasp_bringup.launch_args import CAMERA_FIELDS, parse_camera
+
+        try:
+            values = parse_camera(perform_substitutions(context, self.value))
+        except ValueError as exc:
+            raise SubstitutionFailure(str(exc)) from None
+        return str(values[CAMERA_FIELDS.index(self.field)])
+
+
 class SplitArguments(Substitution):
     """``arguments=[SplitArguments(LaunchConfiguration('driver_args'))]``.
 

@@ -12,21 +12,19 @@ Parameters: mindgrasp_sim/param/sim.yaml, then the launch arguments below.
 """
 
 from mindgrasp_bringup.launch_api import (
+    CameraSpec,
     DeclareLaunchArgument,
     LaunchConfiguration,
     LaunchDescription,
     Node,
-    PythonExpression,
     config_files,
 )
 
 
 def generate_launch_description() -> LaunchDescription:
     camera = LaunchConfiguration('camera')
-    # "WxH@R" -> width, height, rate
-    width = PythonExpression(["int('", camera, "'.split('x')[0])"])
-    height = PythonExpression(["int('", camera, "'.split('x')[1].split('@')[0])"])
-    rate = PythonExpression(["float('", camera, "'.split('@')[1])"])
+    # "WxH@R" -> width, height, rate: parsed, never evaluated (the text is the user's)
+    width, height, rate = (CameraSpec(camera, field) for field in ('width', 'height', 'rate'))
     return LaunchDescription([
         DeclareLaunchArgument('scene', default_value='set_locations',
                               description='scene name in mindgrasp_sim/scenes/ or a scene YAML '

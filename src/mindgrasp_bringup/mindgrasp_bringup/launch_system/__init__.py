@@ -50,6 +50,7 @@ from mindgrasp_bringup.launch_system.errors import LaunchError
 from mindgrasp_bringup.launch_system.params import config_files
 from mindgrasp_bringup.launch_system.service import LaunchService
 from mindgrasp_bringup.launch_system.substitutions import (
+    CameraSpec,
     EnvironmentVariable,
     LaunchConfiguration,
     PathJoinSubstitution,
@@ -60,7 +61,7 @@ from mindgrasp_bringup.launch_system.substitutions import (
 )
 
 __all__ = [
-    'Action', 'DeclareLaunchArgument', 'EnvironmentVariable',
+    'Action', 'CameraSpec', 'DeclareLaunchArgument', 'EnvironmentVariable',
     'ExecuteProcess', 'GroupAction', 'IfCondition', 'IncludeLaunchDescription',
     'LaunchConfiguration', 'LaunchConfigurationEquals', 'LaunchConfigurationNotEquals',
     'LaunchContext', 'LaunchDescription', 'LaunchError', 'LaunchService', 'LogInfo', 'Node',

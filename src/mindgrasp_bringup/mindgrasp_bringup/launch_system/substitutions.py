@@ -131,6 +131,28 @@ class PythonExpression(Substitution):
         return str(value).lower() if isinstance(value, bool) else str(value)
 
 
+class CameraSpec(Substitution):
+    """One field (``'width'``, ``'height'`` or ``'rate'``) of a ``WIDTHxHEIGHT@HZ`` text, e.g.
+    ``CameraSpec(LaunchConfiguration('camera'), 'width')``: parsed, never evaluated."""
+
+    def __init__(self, value: SomeSubstitutions, field: str) -> None:
+        from mindgrasp_bringup.launch_args import CAMERA_FIELDS
+
+        if field not in CAMERA_FIELDS:
+            msg = f'CameraSpec field {field!r} is unknown; use one of {CAMERA_FIELDS}.'
+            raise LaunchError(msg)
+        self.value, self.field = value, field
+
+    def perform(self, context: LaunchContext) -> str:
+        from mindgrasp_bringup.launch_args import CAMERA_FIELDS, parse_camera
+
+        try:
+            values = parse_camera(perform_substitutions(context, self.value))
+        except ValueError as exc:
+            raise LaunchError(str(exc)) from None
+        return str(values[CAMERA_FIELDS.index(self.field)])
+
+
 class SplitArguments(Substitution):
     """In ``arguments=[...]``/``cmd=[...]``: the resolved text split into several arguments with
     shell quoting rules, e.g. ``SplitArguments(LaunchConfiguration('driver_args'))``."""
