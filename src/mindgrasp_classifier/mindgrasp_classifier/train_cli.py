@@ -15,6 +15,7 @@ from mindgrasp_classifier.errors import ClassifierError
 from mindgrasp_classifier.model import class_index, model_paths
 from mindgrasp_classifier.pipelines import PIPELINES
 from mindgrasp_classifier.training import TrainingConfig, train
+from mindgrasp_common.cli_checks import non_negative_int, positive_float, positive_int
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -30,15 +31,18 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                    help='classes to keep, e.g. left_hand,right_hand (default: all in the data)')
     g.add_argument('--band', type=float, nargs=2, default=(8.0, 30.0), metavar=('LOW', 'HIGH'),
                    help='band-pass (Hz, 8 30)')
-    g.add_argument('--filter-order', type=int, default=4, help='Butterworth order (4)')
-    g.add_argument('--window', type=float, default=1.0, help='window length (s, 1.0)')
-    g.add_argument('--step', type=float, default=1 / 16, help='online window step (s, 0.0625)')
-    g.add_argument('--train-step', type=float, default=1 / 16,
+    g.add_argument('--filter-order', type=positive_int, default=4, help='Butterworth order (4)')
+    g.add_argument('--window', type=positive_float, default=1.0, help='window length (s, 1.0)')
+    g.add_argument('--step', type=positive_float, default=1 / 16,
+                   help='online window step (s, 0.0625)')
+    g.add_argument('--train-step', type=positive_float, default=1 / 16,
                    help='step of training windows inside an epoch (s, 0.0625)')
     g.add_argument('--estimator', default='oas', help='pyRiemann covariance estimator (oas)')
-    g.add_argument('--cv', type=int, default=5, help='cross-validation folds, 0 for none (5)')
-    g.add_argument('--min-trials', type=int, default=5, help='fewest trials per class (5)')
-    g.add_argument('--seed', type=int, default=0, help='seed of the fold shuffling (0)')
+    g.add_argument('--cv', type=non_negative_int, default=5,
+                   help='cross-validation folds, 0 for none (5)')
+    g.add_argument('--min-trials', type=positive_int, default=5, help='fewest trials per class (5)')
+    g.add_argument('--seed', type=non_negative_int, default=0,
+                   help='seed of the fold shuffling (0)')
     parser.add_argument('--json', action='store_true',
                         help='print the cross-validation report as JSON on the last line')
 

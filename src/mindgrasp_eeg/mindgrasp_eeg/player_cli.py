@@ -11,6 +11,8 @@ from __future__ import annotations
 import argparse
 import sys
 
+from mindgrasp_common.cli_checks import non_negative_float, positive_float
+
 from . import EEGError
 
 
@@ -23,10 +25,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help='LSL stream name (markers: <name>-markers)')
     parser.add_argument('--source-id', default='', help='LSL source_id (default: the name)')
     parser.add_argument('--type', default='EEG', help='LSL stream type')
-    parser.add_argument('--rate', type=float, default=1.0,
+    parser.add_argument('--rate', type=positive_float, default=1.0,
                         help='playback speed, 1 = real time, 2 = twice as fast')
     parser.add_argument('--loop', action='store_true', help='start again at the end')
-    parser.add_argument('--duration', type=float, default=0.0,
+    parser.add_argument('--duration', type=non_negative_float, default=0.0,
                         help='stop after this many seconds of wall time (0: at the end)')
 
 

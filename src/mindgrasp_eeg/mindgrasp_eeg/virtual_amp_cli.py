@@ -20,6 +20,8 @@ import argparse
 import sys
 import time
 
+from mindgrasp_common.cli_checks import non_negative_float, non_negative_int, probability
+
 from . import EEGError
 
 
@@ -28,18 +30,19 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--name', default='MIndGrasp-VirtualAmp', help='LSL stream name')
     parser.add_argument('--mode', choices=['noise', 'follow', 'pursue'], default='noise',
                         help='virtual subject mode')
-    parser.add_argument('--seed', type=int, default=0, help='EEG and decision seed')
-    parser.add_argument('--accuracy', type=float, default=0.9,
+    parser.add_argument('--seed', type=non_negative_int, default=0, help='EEG and decision seed')
+    parser.add_argument('--accuracy', type=probability, default=0.9,
                         help='probability of the right class')
-    parser.add_argument('--reaction-delay', type=float, default=0.5, help='s')
-    parser.add_argument('--lapse-rate', type=float, default=0.0, help='follow: missed trials')
-    parser.add_argument('--blinks', type=float, default=0.0, help='blink rate (1/s)')
-    parser.add_argument('--emg', type=float, default=0.0, help='EMG burst rate (1/s)')
-    parser.add_argument('--duration', type=float, default=0.0, help='s, 0 = until Ctrl-C')
+    parser.add_argument('--reaction-delay', type=non_negative_float, default=0.5, help='s')
+    parser.add_argument('--lapse-rate', type=probability, default=0.0, help='follow: missed trials')
+    parser.add_argument('--blinks', type=non_negative_float, default=0.0, help='blink rate (1/s)')
+    parser.add_argument('--emg', type=non_negative_float, default=0.0, help='EMG burst rate (1/s)')
+    parser.add_argument('--duration', type=non_negative_float, default=0.0,
+                        help='s, 0 = until Ctrl-C')
     parser.add_argument('--use-sim-time', action='store_true', help='pace by /clock')
     parser.add_argument('--no-ros', action='store_true',
                         help='stream without ROS (internal cue schedule with --cues)')
-    parser.add_argument('--cues', type=int, default=0,
+    parser.add_argument('--cues', type=non_negative_int, default=0,
                         help='--no-ros: number of cued trials (0 = none, the subject rests)')
     parser.add_argument('ros_args', nargs=argparse.REMAINDER,
                         help='--ros-args ... passed to the node')

@@ -15,6 +15,7 @@ import csv
 import json
 import sys
 
+from mindgrasp_common.cli_checks import non_negative_float, non_negative_int, positive_int
 from mindgrasp_trainer.graz import GrazProtocol
 from mindgrasp_trainer.protocol import CLASS_NAMES, NO_CLASS, PromptEvent, TrainerError
 from mindgrasp_trainer.trainer import TrainerProtocol
@@ -24,12 +25,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--paradigm', choices=('graz', 'trainer'), default='graz',
                         help='graz: the full phase timeline; trainer: move/wait per trial '
                              '(resets are not known in advance)')  # fmt: skip
-    parser.add_argument('--n-trials', type=int, default=40, help='total trials (default 40)')
+    parser.add_argument('--n-trials', type=positive_int, default=40,
+                        help='total trials (default 40)')
     parser.add_argument('--classes', type=int, nargs='+', default=[0, 1, 2, 3],
                         help='class indices (0 left hand, 1 right hand, 2 both hands, 3 feet)')
-    parser.add_argument('--seed', type=int, default=0)
-    parser.add_argument('--start-delay', type=float, default=5.0, help='s before the first trial')
-    parser.add_argument('--max-repeat', type=int, default=0,
+    parser.add_argument('--seed', type=non_negative_int, default=0)
+    parser.add_argument('--start-delay', type=non_negative_float, default=5.0,
+                        help='s before the first trial')
+    parser.add_argument('--max-repeat', type=non_negative_int, default=0,
                         help='graz: longest run of one class, 0 = no limit')  # fmt: skip
     parser.add_argument('--unbalanced', action='store_true',
                         help='trainer: independent draw per trial, as in the paper')

@@ -17,6 +17,7 @@ import sys
 import time
 from pathlib import Path
 
+from mindgrasp_common.cli_checks import non_negative_int, positive_int, probability
 from mindgrasp_trainer.session import (
     Session,
     SessionError,
@@ -42,13 +43,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--display', choices=['off', 'window', 'fullscreen', 'headless'],
                         default=None, help="the participant's screen (default: window with "
                                            '--amp lsl, else headless)')
-    parser.add_argument('--seed', type=int, default=None, help='seed of every phase (0)')
+    parser.add_argument('--seed', type=non_negative_int, default=None,
+                        help='seed of every phase (0)')
     if getattr(parser, 'prog', '').endswith('calibrate'):
         parser.set_defaults(plan='calibrate')
-        parser.add_argument('--virtual-accuracy', type=float, required=True, metavar='A',
+        parser.add_argument('--virtual-accuracy', type=probability, required=True, metavar='A',
                             help='probability that the virtual subject imagines the prompted '
                                  'class (0..1)')
-        parser.add_argument('--trials-per-class', type=int, required=True, metavar='N',
+        parser.add_argument('--trials-per-class', type=positive_int, required=True, metavar='N',
                             help='trials of each class in every training phase and in the '
                                  'held-out run')
         parser.add_argument('--json', action='store_true',

@@ -26,6 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
+from mindgrasp_common.cli_checks import non_negative_int, positive_float, positive_int, probability
 from mindgrasp_common.resources import resource_path
 from mindgrasp_vision._checks import VisionError
 from mindgrasp_vision.config import DEFAULT_SHAPE_MODEL
@@ -35,17 +36,19 @@ __all__ = ['add_arguments', 'main', 'split_indices']
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Options of ``mindgrasp train vision``."""
-    parser.add_argument('--n-images', type=int, default=600,
+    parser.add_argument('--n-images', type=positive_int, default=600,
                         help='simulator depth images to collect for training + validation '
                              '(default 600; the paper used about 500)')
-    parser.add_argument('--test-images', type=int, default=150,
+    parser.add_argument('--test-images', type=non_negative_int, default=150,
                         help='independent test images, drawn with seed + 1000 (default 150; 0 = '
                              'none)')
-    parser.add_argument('--seed', type=int, default=0, help='seed of data, split and training')
-    parser.add_argument('--epochs', type=int, default=12, help='training epochs (default 12)')
-    parser.add_argument('--batch-size', type=int, default=16)
-    parser.add_argument('--learning-rate', type=float, default=1e-3)
-    parser.add_argument('--val-fraction', type=float, default=0.2,
+    parser.add_argument('--seed', type=non_negative_int, default=0,
+                        help='seed of data, split and training')
+    parser.add_argument('--epochs', type=positive_int, default=12,
+                        help='training epochs (default 12)')
+    parser.add_argument('--batch-size', type=positive_int, default=16)
+    parser.add_argument('--learning-rate', type=positive_float, default=1e-3)
+    parser.add_argument('--val-fraction', type=probability, default=0.2,
                         help='validation share of the collected images (default 0.2)')
     parser.add_argument('--output', default=DEFAULT_SHAPE_MODEL,
                         help=f'model path without suffix (default {DEFAULT_SHAPE_MODEL})')
@@ -55,7 +58,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--realism', default='none',
                         help="camera realism of the training and test images: none (default), "
                              'default or a profile YAML path (mindgrasp_sim.realism)')
-    parser.add_argument('--threads', type=int, default=1, help='torch CPU threads (default 1)')
+    parser.add_argument('--threads', type=positive_int, default=1,
+                        help='torch CPU threads (default 1)')
     parser.add_argument('--json', action='store_true',
                         help='print one JSON object with the figures as the last line')
     parser.add_argument('--quiet', action='store_true', help='no per-epoch output')

@@ -6,16 +6,17 @@ import argparse
 import sys
 
 from mindgrasp_bringup.bag.ros_glue import param_args
+from mindgrasp_common.cli_checks import non_negative_float, positive_float
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Options in the manner of ``ros2 bag play``."""
     parser.add_argument('bag', help='run directory (runs/<run>), bag directory (holding '
                                     'metadata.yaml), or an .mcap/.db3 file')
-    parser.add_argument('-r', '--rate', type=float, default=1.0,
+    parser.add_argument('-r', '--rate', type=positive_float, default=1.0,
                         help='playback speed factor (default: 1.0, real time)')
     parser.add_argument('-l', '--loop', action='store_true', help='play again from the start')
-    parser.add_argument('--start-offset', type=float, default=0.0,
+    parser.add_argument('--start-offset', type=non_negative_float, default=0.0,
                         help='skip this many seconds of the bag beginning')
     parser.add_argument('--topics', nargs='+', default=[], help='play only these topics')
     parser.add_argument('-e', '--regex', default='', help='play only topics matching this regex')
@@ -23,12 +24,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help='do not play topics matching this regex')
     parser.add_argument('--remap', '-m', nargs='+', default=[], metavar='FROM:=TO',
                         help='publish a topic under another name, e.g. /eeg/raw:=/eeg/replayed')
-    parser.add_argument('--clock', nargs='?', type=float, const=40.0, default=0.0, metavar='HZ',
+    parser.add_argument('--clock', nargs='?', type=non_negative_float, const=40.0, default=0.0,
+                        metavar='HZ',
                         help='publish /clock with the bag time (default 40 Hz when given)')
     parser.add_argument('--priority', type=int, default=0, metavar='1-99',
                         help='real-time (SCHED_FIFO) priority of the playback thread, for timing '
                              'within ~0.1 ms on a loaded machine (needs root or CAP_SYS_NICE)')
-    parser.add_argument('--delay', type=float, default=0.5,
+    parser.add_argument('--delay', type=non_negative_float, default=0.5,
                         help='wait this many seconds after creating publishers, so subscribers '
                              'match before the first message (default: 0.5)')
     parser.add_argument('--no-progress', action='store_true',

@@ -5,6 +5,12 @@ from __future__ import annotations
 import argparse
 
 from mindgrasp_bringup.bag.ros_glue import param_args
+from mindgrasp_common.cli_checks import (
+    non_negative_float,
+    non_negative_int,
+    positive_float,
+    positive_int,
+)
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -17,18 +23,18 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help='do not record topics matching this regex')
     parser.add_argument('-o', '--output', default='',
                         help='bag directory to create (default: rosbag2_<date>-<time>)')
-    parser.add_argument('-b', '--max-bag-size', type=int, default=0,
+    parser.add_argument('-b', '--max-bag-size', type=non_negative_int, default=0,
                         help='start a new .mcap file at this size in bytes (0: never)')
-    parser.add_argument('-d', '--max-bag-duration', type=float, default=0.0,
+    parser.add_argument('-d', '--max-bag-duration', type=non_negative_float, default=0.0,
                         help='start a new .mcap file after this many seconds (0: never)')
     parser.add_argument('--compression', choices=('none', 'zstd', 'lz4'), default='none',
                         help='MCAP chunk compression (default: none)')
-    parser.add_argument('--flush-interval', type=float, default=1.0,
+    parser.add_argument('--flush-interval', type=positive_float, default=1.0,
                         help='longest time in s before written messages reach the file, which '
                              'bounds the loss if the recorder is killed (default: 1.0)')
-    parser.add_argument('--max-queue-mb', type=int, default=512,
+    parser.add_argument('--max-queue-mb', type=positive_int, default=512,
                         help='memory for messages waiting for the disk, MiB (default: 512)')
-    parser.add_argument('--duration', type=float, default=0.0,
+    parser.add_argument('--duration', type=non_negative_float, default=0.0,
                         help='stop after this many seconds (default: until Ctrl-C)')
 
 

@@ -14,17 +14,21 @@ import json
 import math
 import sys
 
+from mindgrasp_common.cli_checks import non_negative_int, positive_float, positive_int
+
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Arguments of ``mindgrasp experiment random-locations``."""
-    parser.add_argument('--trials', type=int, default=90, help='number of trials (default 90)')
-    parser.add_argument('--seed', type=int, default=0, help='seed of the placements (default 0)')
+    parser.add_argument('--trials', type=positive_int, default=90,
+                        help='number of trials (default 90)')
+    parser.add_argument('--seed', type=non_negative_int, default=0,
+                        help='seed of the placements (default 0)')
     parser.add_argument('--json', action='store_true',
                         help='print one JSON object with the figures as the last line')
     parser.add_argument('--params-file', default=None,
                         help='controller parameters (ROS YAML, default: mindgrasp_fsm '
                              'param/fsm.yaml)')
-    parser.add_argument('--timeout', type=float, default=120.0,
+    parser.add_argument('--timeout', type=positive_float, default=120.0,
                         help='simulated seconds per trial before it counts as failed (default 120)')
     parser.add_argument('--shape-model', default=None,
                         help="depth shape CNN (default the vision default; 'none' to disable)")

@@ -10,6 +10,7 @@ import sys
 from mindgrasp_bringup.launch_system import LaunchError, LaunchService, profiles
 from mindgrasp_bringup.launch_system.description import LAUNCH_SUFFIX, PROFILE_DIR
 from mindgrasp_bringup.launch_system.service import format_arguments
+from mindgrasp_common.cli_checks import non_negative_float, positive_float
 
 EPILOG = """examples:
   mindgrasp launch demo                      headless demo, recorded to runs/<UTC time>_demo/
@@ -25,18 +26,18 @@ def _options(parser: argparse.ArgumentParser) -> None:
                         help='run the node modules in one process (mindgrasp_ros composition)')
     parser.add_argument('--run-dir', metavar='DIR',
                         help='run directory (default: runs/<UTC timestamp>_<profile>/)')
-    parser.add_argument('--duration', type=float, metavar='S',
+    parser.add_argument('--duration', type=non_negative_float, metavar='S',
                         help='end the launch after S seconds (same as duration:=S)')
     parser.add_argument('-s', '--show-args', action='store_true',
                         help='print the launch arguments of the profile and exit')
     parser.add_argument('--dry-run', action='store_true',
                         help='print the processes and their command lines, start nothing')
     parser.add_argument('--list', action='store_true', help='list the profiles and exit')
-    parser.add_argument('--sigint-timeout', type=float, default=10.0, metavar='S',
+    parser.add_argument('--sigint-timeout', type=positive_float, default=10.0, metavar='S',
                         help='seconds a node gets to stop after SIGINT before SIGTERM '
                              '(default 10: Python nodes may take seconds to leave DDS on a '
                              'loaded machine)')
-    parser.add_argument('--sigterm-timeout', type=float, default=5.0, metavar='S',
+    parser.add_argument('--sigterm-timeout', type=positive_float, default=5.0, metavar='S',
                         help='seconds after SIGTERM before SIGKILL (default 5)')
 
 

@@ -18,6 +18,8 @@ import sys
 
 import yaml
 
+from mindgrasp_common.cli_checks import probability
+
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """``mindgrasp replay RUN [--controller] [--model M] [-p node.name:=value] ...``."""
@@ -32,7 +34,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              'classifier.min_certainty:=0.6 (YAML value)')
     parser.add_argument('-o', '--output', default=None,
                         help='report directory (default: <run>/replays/<UTC time>)')
-    parser.add_argument('--min-agreement', type=float, default=0.0, metavar='0-1',
+    parser.add_argument('--min-agreement', type=probability, default=0.0, metavar='0-1',
                         help='exit 1 when the prediction agreement is below this (a regression '
                              'check after changing code)')
     parser.add_argument('--json', action='store_true',

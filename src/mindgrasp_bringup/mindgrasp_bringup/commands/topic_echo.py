@@ -13,19 +13,20 @@ from mindgrasp_bringup.ros_cli import (
     print_error,
     resolve_field,
 )
+from mindgrasp_common.cli_checks import non_negative_float, non_negative_int
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('topic', help='topic name, e.g. /joint_states')
     parser.add_argument('type', nargs='?', help='message type (default: as discovered)')
     parser.add_argument('--once', action='store_true', help='print one message and exit')
-    parser.add_argument('--times', type=int, default=0, help='exit after N messages')
+    parser.add_argument('--times', type=non_negative_int, default=0, help='exit after N messages')
     parser.add_argument('--field', help='print only this field, e.g. header.stamp')
-    parser.add_argument('--truncate-length', type=int, default=128,
+    parser.add_argument('--truncate-length', type=non_negative_int, default=128,
                         help='longest array/string printed in full (0: no limit; default 128)')
     parser.add_argument('--qos-reliability', choices=['reliable', 'best_effort'],
                         default='best_effort', help='best_effort (default) matches any writer')
-    parser.add_argument('--timeout', type=float, default=0.0,
+    parser.add_argument('--timeout', type=non_negative_float, default=0.0,
                         help='give up after this many seconds without a message (0: never)')
 
 

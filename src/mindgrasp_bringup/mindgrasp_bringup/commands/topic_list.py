@@ -5,12 +5,13 @@ from __future__ import annotations
 import argparse
 
 from mindgrasp_bringup.ros_cli import cli_node, wait_for_graph
+from mindgrasp_common.cli_checks import non_negative_float
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('-t', '--show-types', action='store_true', help='also print types')
     parser.add_argument('-c', '--count-topics', action='store_true', help='print the count')
-    parser.add_argument('--spin-time', type=float, default=1.0,
+    parser.add_argument('--spin-time', type=non_negative_float, default=1.0,
                         help='seconds of unchanged discovery before answering (default 1)')
 
 

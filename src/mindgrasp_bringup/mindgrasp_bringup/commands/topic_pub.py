@@ -8,6 +8,7 @@ import time
 import yaml
 
 from mindgrasp_bringup.ros_cli import CliError, cli_node, print_error, set_fields
+from mindgrasp_common.cli_checks import non_negative_int, positive_float
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -15,10 +16,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('type', help='message type, e.g. std_msgs/msg/Float64MultiArray')
     parser.add_argument('values', nargs='?', default='{}',
                         help='YAML of the fields, e.g. "{data: [0.1, 0, 0, 0, 0, 0]}"')
-    parser.add_argument('-r', '--rate', type=float, default=1.0, help='Hz (default 1)')
+    parser.add_argument('-r', '--rate', type=positive_float, default=1.0, help='Hz (default 1)')
     parser.add_argument('-1', '--once', action='store_true', help='publish once and exit')
-    parser.add_argument('-t', '--times', type=int, default=0, help='publish N times and exit')
-    parser.add_argument('-w', '--wait-matching-subscriptions', type=int, default=1,
+    parser.add_argument('-t', '--times', type=non_negative_int, default=0,
+                        help='publish N times and exit')
+    parser.add_argument('-w', '--wait-matching-subscriptions', type=non_negative_int, default=1,
                         help='wait for this many subscribers before publishing (default 1)')
     parser.add_argument('--qos-durability', choices=['volatile', 'transient_local'],
                         default='volatile')

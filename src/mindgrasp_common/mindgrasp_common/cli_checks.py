@@ -1,0 +1,79 @@
+"""argparse ``type=`` checkers for numbers on the command line (ROS-free, shared by every CLI).
+
+``parser.add_argument('--seed', type=non_negative_int)``: a bad value ends the command the way
+argparse does, with one line naming the option, the value and what it must be, and exit code 2
+(``--seed -1`` used to end in a traceback from numpy).
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+
+__all__ = ['non_negative_float', 'non_negative_int', 'positive_float', 'positive_int',
+           'probability']
+
+
+def _int(text: str) -> int:
+    try:
+        return int(text)
+    except ValueError:
+        msg = f'{text!r} is not a whole number'
+        raise argparse.ArgumentTypeError(msg) from None
+
+
+def _float(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        msg = f'{text!r} is not a number'
+        raise argparse.ArgumentTypeError(msg) from None
+    if not math.isfinite(value):
+        msg = f'{text!r} is not a finite number'
+        raise argparse.ArgumentTypeError(msg)
+    return value
+
+
+def non_negative_int(text: str) -> int:
+    """A whole number >= 0 (seeds, counts where 0 means "no limit")."""
+    value = _int(text)
+    if value < 0:
+        msg = f'must be >= 0, got {value}'
+        raise argparse.ArgumentTypeError(msg)
+    return value
+
+
+def positive_int(text: str) -> int:
+    """A whole number >= 1 (numbers of trials, images, epochs)."""
+    value = _int(text)
+    if value < 1:
+        msg = f'must be >= 1, got {value}'
+        raise argparse.ArgumentTypeError(msg)
+    return value
+
+
+def non_negative_float(text: str) -> float:
+    """A finite number >= 0 (durations and delays where 0 means "none" or "no limit")."""
+    value = _float(text)
+    if value < 0:
+        msg = f'must be >= 0, got {value:g}'
+        raise argparse.ArgumentTypeError(msg)
+    return value
+
+
+def positive_float(text: str) -> float:
+    """A finite number > 0 (rates, timeouts)."""
+    value = _float(text)
+    if value <= 0:
+        msg = f'must be > 0, got {value:g}'
+        raise argparse.ArgumentTypeError(msg)
+    return value
+
+
+def probability(text: str) -> float:
+    """A number in [0, 1] (accuracies, rates of events per trial)."""
+    value = _float(text)
+    if not 0.0 <= value <= 1.0:
+        msg = f'must be between 0 and 1, got {value:g}'
+        raise argparse.ArgumentTypeError(msg)
+    return value
