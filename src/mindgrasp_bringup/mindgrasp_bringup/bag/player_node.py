@@ -114,6 +114,8 @@ class PlayerNode(rclpy.node.Node):
             self.clock_publisher.publish(  # type: ignore[union-attr]
                 bytes(store.serialize_cdr(msg, CLOCK_TYPE)))
 
+        # rosbags builds a type's serializer on its first use (several ms): not on the schedule
+        store.serialize_cdr(clock_class(clock=time_class(sec=0, nanosec=0)), CLOCK_TYPE)
         try:
             self.stats = self.player.run(
                 publish,
