@@ -176,7 +176,14 @@ def replay(cfg: ReplayConfig) -> ReplayResult:
                 path = output / 'params' / f'{name}.yaml'
                 path.write_text(yaml.safe_dump({f'/{name}': {'ros__parameters': params}},
                                                sort_keys=True))
-                nodes.append(runner.add(Component(module, ['--params-file', str(path)])))
+                try:
+                    nodes.append(runner.add(Component(module, ['--params-file', str(path)])))
+                except Exception as exc:  # each node package raises its own error type
+                    msg = (f'The {key} node cannot start with the parameters of the run '
+                           f'({type(exc).__name__}: {exc}); override the parameter with '
+                           f'-p {key}.NAME:=VALUE (e.g. a path of a run made by an older '
+                           'version).')
+                    raise BagError(msg) from None
             outputs = {p.topic_name for n in nodes for p in n.publishers}
             inputs = {s.topic_name for n in nodes for s in n.subscriptions}
             feed = sorted(t for t in inputs if t in reader.topics and t not in outputs
