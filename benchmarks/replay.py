@@ -4,8 +4,9 @@ Run: ``.venv/bin/python benchmarks/replay.py runs/<time>_demo [--controller]``
 (record one first: ``mindgrasp launch demo duration:=60``).
 
 Prints, for the classifier alone and (with ``--controller``) the classifier and the controller:
-seconds of recording replayed, wall time of the replay itself (lock-step feeding, comparison
-and report), speed as a multiple of real time, and the agreement per topic.
+seconds of recording replayed, wall time of the replay itself (reading the bag, lock-step
+feeding, comparison and report; the node modules are imported before), speed as a multiple of
+real time, and the agreement per topic.
 """
 
 from __future__ import annotations
@@ -24,6 +25,11 @@ def main() -> None:
     parser.add_argument('--controller', action='store_true', help='also with the controller')
     args = parser.parse_args()
     variants = [False, True] if args.controller else [False]
+    t0 = time.perf_counter()
+    import mindgrasp_classifier.classifier_node  # noqa: F401 - pyRiemann imports torch: seconds
+    import mindgrasp_fsm.fsm_node  # noqa: F401
+    print(f'importing the node modules: {time.perf_counter() - t0:.1f} s (once per process)',
+          flush=True)
     with tempfile.TemporaryDirectory(prefix='replay-bench-') as tmp:
         for controller in variants:
             out = Path(tmp) / ('controller' if controller else 'classifier')

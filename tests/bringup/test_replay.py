@@ -15,6 +15,7 @@ import uuid
 from pathlib import Path
 
 import pytest
+from conftest_bag import EEG, eeg_chunk
 from launch_fixtures.runner import launch_cmd, launch_env, run_launch
 
 from mindgrasp_bringup.bag import BagWriter
@@ -110,6 +111,17 @@ def test_replay_bad_input_is_one_clear_line(tmp_path):
         writer.write('/chatter', 1, bytes([0, 1, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0]))
     done = _mindgrasp('replay', str(tmp_path / 'bag'), '--no-progress')
     assert done.returncode == 2 and 'has no /eeg/raw messages' in done.stderr
+    assert 'Traceback' not in done.stderr
+    run = tmp_path / 'old_run'                   # a run whose classifier model is gone
+    with BagWriter(run / 'bag') as writer:
+        writer.add_topic('/eeg/raw', EEG)
+        writer.write('/eeg/raw', 1, eeg_chunk(0))
+    (run / 'params.yaml').write_text('/classifier:\n  ros__parameters: {model: /no/model.json}\n')
+    done = _mindgrasp('replay', str(run), '--no-progress')
+    assert done.returncode == 2, done.stderr
+    last = done.stderr.strip().splitlines()[-1]
+    assert last.startswith('mindgrasp replay: The classifier node cannot start with the '
+                           'parameters of the run (') and '-p classifier.NAME:=VALUE' in last
     assert 'Traceback' not in done.stderr
 
 

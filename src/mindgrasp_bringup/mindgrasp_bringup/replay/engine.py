@@ -111,12 +111,10 @@ def _node_params(run_dir: Path | None, name: str) -> dict[str, Any]:
     return {}
 
 
-def _segment_starts(reader: BagReader, store: Any) -> list[int]:
+def _segment_starts(statuses: list[bytes], store: Any) -> list[int]:
     """Samples where the live classifier (re)started its filter, in order (from /bci/status)."""
-    if STATUS_TOPIC not in reader.topics:
-        return []
     starts: list[int] = []
-    for _, _, data in reader.messages([STATUS_TOPIC]):
+    for data in statuses:
         msg = store.deserialize_cdr(data, 'diagnostic_msgs/msg/DiagnosticArray')
         for status in msg.status:
             if status.name != 'classifier':
@@ -155,9 +153,6 @@ def replay(cfg: ReplayConfig) -> ReplayResult:
             msg = (f'The bag {bag} has no {EEG_TOPIC} messages, so the classifier has nothing to '
                    'decode; replay a run recorded with the EEG (record:=true, the default).')
             raise BagError(msg)
-        recorded = {topic: [(t, d) for _, t, d in reader.messages([topic])]
-                    for topic in COMPARED_TOPICS if topic in reader.topics}
-        starts = _segment_starts(reader, store)
         output.mkdir(parents=True, exist_ok=False)
         (output / 'params').mkdir()
         runner = LockstepRunner(start_time_s=0.0)
@@ -206,11 +201,25 @@ def replay(cfg: ReplayConfig) -> ReplayResult:
                 pubs[topic] = io.create_publisher(info.type, topic, qos_profile(rclpy, qos),
                                                   raw=True)
             runner.spin_until_quiescent()
+            # one pass over the bag (images and other large topics are skipped by the index)
+            recorded: dict[str, list[tuple[int, bytes]]] = {
+                t: [] for t in COMPARED_TOPICS if t in reader.topics}
+            statuses: list[bytes] = []
+            inputs: list[tuple[str, int, bytes]] = []
+            wanted = set(feed) | set(recorded) | ({STATUS_TOPIC} & set(reader.topics))
+            for topic, t_ns, data in reader.messages(sorted(wanted)):
+                if topic in recorded:
+                    recorded[topic].append((t_ns, data))
+                if topic == STATUS_TOPIC:
+                    statuses.append(data)
+                if topic in pubs:
+                    inputs.append((topic, t_ns, data))
+            starts = _segment_starts(statuses, store)
             result = ReplayResult(bag, run_dir, output, keys, recorded, replayed,
                                   dict.fromkeys(feed, 0), 0, None, None, reader.start_ns,
                                   reader.end_ns)
             max_step = cfg.max_step_s or (0.01 if cfg.controller else 0.1)
-            _feed(runner, reader, pubs, store, starts, result, max_step, cfg.progress)
+            _feed(runner, inputs, pubs, store, starts, result, max_step, cfg.progress)
         finally:
             runner.close()
     finally:
@@ -223,13 +232,13 @@ def replay(cfg: ReplayConfig) -> ReplayResult:
     return result
 
 
-def _feed(runner: Any, reader: BagReader, pubs: dict[str, Any], store: Any, starts: list[int],
-          result: ReplayResult, max_step_s: float, progress: bool) -> None:
+def _feed(runner: Any, inputs: list[tuple[str, int, bytes]], pubs: dict[str, Any], store: Any,
+          starts: list[int], result: ReplayResult, max_step_s: float, progress: bool) -> None:
     """Publish every recorded input at its recorded time; the graph settles after each."""
     from tqdm import tqdm
 
     max_step_ns = max(1, round(max_step_s * 1e9))
-    total = sum(reader.topics[t].message_count for t in pubs)
+    total = len(inputs)
     later_starts = set(starts[1:])
 
     def advance(t_ns: int) -> None:
@@ -239,7 +248,7 @@ def _feed(runner: Any, reader: BagReader, pubs: dict[str, Any], store: Any, star
     bar = tqdm(total=total, unit='msg', desc='replay', disable=not progress, file=sys.stderr,
                leave=True)
     try:
-        for topic, t_ns, data in reader.messages(list(pubs)):
+        for topic, t_ns, data in inputs:
             bar.update(1)
             if topic == EEG_TOPIC:
                 chunk = store.deserialize_cdr(data, EEG_TYPE)
@@ -259,7 +268,7 @@ def _feed(runner: Any, reader: BagReader, pubs: dict[str, Any], store: Any, star
             pubs[topic].publish(data)
             result.fed[topic] += 1
             runner.spin_until_quiescent()
-        advance(reader.end_ns + 1_000_000_000)  # one more second: the last timers run
+        advance(result.end_ns + 1_000_000_000)  # one more second: the last timers run
     finally:
         bar.close()
 
