@@ -2,9 +2,9 @@
 
     ROS_DOMAIN_ID=15 .venv/bin/python benchmarks/grasp.py [--trials 30] [--seed 0] [--vision-only]
 
-Runs the random-locations protocol in-process and in lock-step (the same Simulation,
-VisionPipeline and GraspFsm the nodes use): one object per trial, 0.2-0.7 m from the base,
-autonomous search, approach and grasp. Prints success per shape and overall (target >= 95 % per
+Runs the random-locations protocol through the nodes, composed in lock-step
+(mindgrasp_experiments): one object per trial, 0.2-0.7 m from the base, autonomous search,
+approach and grasp. Prints success per shape and overall (target >= 95 % per
 shape; the paper: cube 60.5 %, cylinder 17.6 %, sphere 13.3 %), the simulated time to grasp, the
 wall time per trial and the real-time factor. Then times the vision pipeline per frame on
 rendered simulator frames at 128x128 and 640x480 (targets <= 3 ms and <= 15 ms), detection only
@@ -21,29 +21,32 @@ import numpy as np
 
 
 def grasp_figures(trials: int, seed: int) -> None:
-    from mindgrasp_fsm.experiment import run_random_locations
-    from mindgrasp_fsm.params import FsmParams, default_params_path
+    """The random-locations protocol through the nodes in lock-step (mindgrasp_experiments)."""
+    import tempfile
+    from pathlib import Path
 
-    params = FsmParams.from_yaml(default_params_path())
-    summary = run_random_locations(trials, seed, params)
-    print(f'Grasp success over {summary["trials"]} random placements (seed {seed}, shape model '
-          f'{summary["shape_model"]}):')
-    for shape, rate in summary['success_by_shape'].items():
-        c = summary['counts_by_shape'][shape]
-        print(f'  {shape:8s} {100 * rate:5.1f} %  ({c["successes"]}/{c["trials"]})')
-    print(f'  overall  {100 * summary["success_rate"]:5.1f} %  '
-          f'({summary["successes"]}/{summary["trials"]})')
-    times = [r['time_to_grasp'] for r in summary['results'] if r['success']]
+    from mindgrasp_experiments.engine import lockstep_components
+    from mindgrasp_experiments.summary import summarise
+    from mindgrasp_experiments.workers import run_trials
+
+    comps = lockstep_components('experiment', {'protocol': 'random_locations',
+                                               'subject': 'autonomous', 'seed': str(seed)},
+                                Path(tempfile.mkdtemp()) / 'params', log=lambda _t: None)
+    wall0 = time.perf_counter()
+    runs = list(run_trials(comps, range(1, trials + 1), seed=seed))
+    wall = time.perf_counter() - wall0
+    records = [r.record for r in runs]
+    s = summarise(records)
+    print(f'Grasp success over {s["trials"]} random placements (seed {seed}), through the nodes:')
+    for shape, r in s['success_by_shape'].items():
+        print(f'  {shape:8s} {100 * r["rate"]:5.1f} %  ({r["count"]}/{r["trials"]})')
+    print(f'  overall  {100 * s["success_rate"]:5.1f} %  ({s["success_count"]}/{s["trials"]})')
+    times = [r.time_to_grasp_s for r in records if r.success]
     if times:
         print(f'Time to grasp (simulated): mean {statistics.fmean(times):.1f} s, median '
               f'{statistics.median(times):.1f} s, max {max(times):.1f} s')
-    print(f'Wall time per trial: {summary["wall_time_s"] / summary["trials"]:.1f} s; '
-          f'real-time factor {summary["real_time_factor"]:.2f}')
-    print(f'Vision in the loop: {summary["vision_ms_per_frame"]:.2f} ms per frame '
-          f'(128x128, shape CNN while approaching)')
-    if not np.isnan(summary['shape_accuracy']):
-        print(f'Shape classification at the final approach: {100 * summary["shape_accuracy"]:.1f}'
-              ' % correct')
+    sim = sum(r.sim_s for r in runs)
+    print(f'Wall time per trial: {wall / len(runs):.1f} s; real-time factor {sim / wall:.2f}')
 
 
 def vision_figures(frames: int = 50) -> None:

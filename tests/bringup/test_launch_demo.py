@@ -39,6 +39,13 @@ def test_demo_runs_headless_ends_cleanly_and_records_the_session(tmp_path: Path)
         'vision', 'fsm', 'foxglove_bridge'}
     log = (run_dir / 'logs' / 'trial_manager.log').read_text()
     assert 'Trial 1 (red cube): correct object grasped' in log, log[-2000:]
+    # the live trial manager writes the same records as the lock-step experiments
+    from mindgrasp_experiments.records import TrialRecord, read_records
+
+    (record,) = read_records(run_dir / 'trials')
+    assert isinstance(record, TrialRecord) and record.correct_and_successful
+    assert (run_dir / 'trials' / 'records.csv').read_text().splitlines()[0].split(',') == \
+        TrialRecord.columns()
     for label in ('sim', 'eeg_acquisition', 'classifier', 'vision', 'fsm'):
         assert (run_dir / 'logs' / f'{label}.log').stat().st_size > 0, label
     from mindgrasp_bringup.bag.reader import BagReader

@@ -55,7 +55,9 @@ COMMANDS: dict[str, str | dict[str, str]] = {
         'classifier': 'mindgrasp_classifier.evaluate_cli',
     },
     'experiment': {
-        'random-locations': 'mindgrasp_bringup.commands.experiment_random_locations',
+        'set-locations': 'mindgrasp_experiments.commands.set_locations',
+        'random-locations': 'mindgrasp_experiments.commands.random_locations',
+        'report': 'mindgrasp_experiments.commands.report',
     },
     'export': {
         'eeg': 'mindgrasp_eeg.export_cli',

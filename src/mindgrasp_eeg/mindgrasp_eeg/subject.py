@@ -14,6 +14,8 @@ Modes (all seeded: same seed and same inputs, same decisions):
     Acts as a competent user of the MIndGrasp controller (see :func:`pursue_class`), from the task
     target, the scene objects, the base joint angle and the controller state. Every
     ``decision_period`` seconds it re-decides; the decision is right with probability ``accuracy``.
+    A new target cancels what was still to come for the old one: the subject rests and decides
+    afresh for the new target (it aims first: both hands only once the arm faces the target).
 
 Times are seconds on any monotonic clock the caller chooses (ROS time in the node).
 """
@@ -49,6 +51,14 @@ def find_target(objects: Sequence[SceneObject], object_id: int = -1, colour: str
     return None
 
 
+def same_object(seen: str, wanted: str) -> bool:
+    """Whether the controller's object of interest ``seen`` ("<colour> <shape>", shape
+    ``unknown`` until the shape CNN has named it) can be the ``wanted`` object."""
+    colour, _, shape = seen.partition(' ')
+    w_colour, _, w_shape = wanted.partition(' ')
+    return colour == w_colour and shape in (w_shape, 'unknown', '')
+
+
 def pursue_class(target: SceneObject | None, base_yaw: float, fsm_state: int,
                  object_of_interest: str = '', *, heading_tolerance: float = 0.1) -> int | None:
     """What a competent user imagines to reach ``target`` (pure function).
@@ -79,11 +89,12 @@ def pursue_class(target: SceneObject | None, base_yaw: float, fsm_state: int,
     if target is None or fsm_state in (State.FINAL_APPROACH, State.GRASP_OBJECT,
                                         State.RETURN_TO_START):
         return None
-    wrong = bool(object_of_interest) and object_of_interest != target.label
+    wrong = bool(object_of_interest) and not same_object(object_of_interest, target.label)
     if fsm_state == State.CENTER_OBJECT:
         return BOTH_FEET if wrong else None
-    if fsm_state == State.INITIAL_APPROACH and wrong:
-        return BOTH_FEET
+    if fsm_state == State.INITIAL_APPROACH:
+        # the controller keeps the object centred itself: push on to it, or back off a wrong one
+        return BOTH_FEET if wrong else BOTH_HANDS
     error = wrap_angle(math.atan2(target.y, target.x) - base_yaw)
     if error > heading_tolerance:
         return LEFT_HAND
@@ -142,6 +153,7 @@ class VirtualSubject:
         # pursue inputs
         self.objects: list[SceneObject] = []
         self.target_id, self.target_colour, self.target_shape = -1, '', ''
+        self._target_changed = False
         self.base_yaw, self.fsm_state, self.object_of_interest = 0.0, 0, ''
         #: (time, asked class or None, imagined class or None) for every decision taken
         self.decisions: list[tuple[float, int | None, int | None]] = []
@@ -164,8 +176,11 @@ class VirtualSubject:
 
     # -- pursue --------------------------------------------------------------------------------
     def set_target(self, object_id: int, colour: str, shape: str) -> None:
-        """The desired object (``/task/target``)."""
-        self.target_id, self.target_colour, self.target_shape = object_id, colour, shape
+        """The desired object (``/task/target``); a new one cancels pending decisions."""
+        new = (object_id, colour, shape)
+        if new != (self.target_id, self.target_colour, self.target_shape):
+            self._target_changed = True
+        self.target_id, self.target_colour, self.target_shape = new
 
     def set_objects(self, objects: Sequence[SceneObject]) -> None:
         """Scene objects in the base frame (``/sim/objects``)."""
@@ -196,6 +211,13 @@ class VirtualSubject:
             self._next_decision = -math.inf
             self._schedule = [(min(te, t), c) for te, c in self._schedule[-1:]]
         self._last_t = t
+        if self.mode == 'pursue' and self._target_changed:
+            # imagery meant for the old target (e.g. both hands to select it) must not select
+            # whatever is in front now: stop, and decide for the new target from here
+            self._target_changed = False
+            self._schedule = []
+            self._current = None
+            self._next_decision = t
         if self.mode == 'pursue' and t >= self._next_decision:
             self._next_decision = t + self.decision_period
             right = self.competent_class()

@@ -1,9 +1,14 @@
-"""Virtual amplifier node: synthetic EEG of a virtual subject as an LSL stream.
+"""Virtual amplifier node: synthetic EEG of a virtual subject as an LSL stream (or on /eeg/raw).
 
     python -m mindgrasp_eeg.virtual_amp_node --ros-args -p subject_mode:=follow -p seed:=3
+    python -m mindgrasp_eeg.virtual_amp_node --ros-args -p output:=ros -p use_sim_time:=true
 
-The LSL outlet (``stream_name``, 32 g.Nautilus channels at 250 Hz in microvolts by default) lives
-in this process, like an amplifier app; the acquisition node reads it as any other amplifier.
+``output:=lsl`` (default, live runs): the LSL outlet (``stream_name``, 32 g.Nautilus channels at
+250 Hz in microvolts by default) lives in this process, like an amplifier app; the acquisition
+node reads it as any other amplifier. ``output:=ros`` (lock-step experiments): LSL runs on wall
+time, so the node publishes ``/eeg/raw`` (mindgrasp_msgs/EEGChunk, volts, sensor-data QoS depth
+100) itself, each chunk stamped with the node-clock time of its first sample, and no acquisition
+node is needed.
 Subscriptions depend on ``subject_mode``: ``follow`` listens to ``/trainer/prompt``; ``pursue`` to
 ``/task/target``, ``/sim/objects``, ``/joint_states`` and ``/fsm/state``; ``noise`` to nothing.
 Samples are paced by the node clock: wall time, or ``/clock`` with ``use_sim_time``. The imagined
@@ -15,16 +20,18 @@ from __future__ import annotations
 
 import sys
 
-from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import FsmState, Prompt, TaskTarget
+import numpy as np
+from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import EEGChunk, FsmState, Prompt, TaskTarget
 from mindgrasp_ros.interfaces.sensor_msgs.msg import JointState
 from mindgrasp_ros.interfaces.std_msgs.msg import String
 from mindgrasp_ros.interfaces.visualization_msgs.msg import MarkerArray
 
 from mindgrasp_common.markers import objects_from_markers
+from mindgrasp_eeg import EEGError
 from mindgrasp_eeg.lsl import EEGOutlet, MarkerOutlet
 from mindgrasp_eeg.montage import NAUTILUS_32, class_name
 from mindgrasp_eeg.node_main import run_node
-from mindgrasp_eeg.ros_conversions import base_yaw_from_joint_state, time_to_s
+from mindgrasp_eeg.ros_conversions import base_yaw_from_joint_state, ns_to_time_fields, time_to_s
 from mindgrasp_eeg.subject import VirtualSubject
 from mindgrasp_eeg.synthetic import SyntheticEEG
 from mindgrasp_eeg.virtual_amp import VirtualAmplifier
@@ -41,8 +48,10 @@ PARAMETERS = [
     ('mu_rms', 6e-6), ('beta_rms', 3e-6), ('sensor_noise_rms', 0.5e-6), ('erd_depth', 0.5),
     ('erd_tau', 0.3), ('blink_rate', 0.0), ('blink_amplitude', 100e-6), ('emg_rate', 0.0),
     ('emg_rms', 20e-6), ('line_noise', 0.0), ('line_freq', 50.0),
-    ('push_period', 1.0 / 32.0), ('block', 8), ('duration', 0.0),
+    ('push_period', 1.0 / 32.0), ('block', 8), ('duration', 0.0), ('output', 'lsl'),
+    ('frame_id', 'eeg'),
 ]
+OUTPUTS = ('lsl', 'ros')
 
 
 class VirtualAmpNode(rclpy.node.Node):
@@ -53,6 +62,10 @@ class VirtualAmpNode(rclpy.node.Node):
         self.declare_parameters('', PARAMETERS)
         p = {name: self.get_parameter(name).value for name, _ in PARAMETERS}
         self.p = p
+        if p['output'] not in OUTPUTS:
+            msg = (f"The parameter 'output' is {p['output']!r}; use 'lsl' (an LSL stream, live "
+                   "runs) or 'ros' (/eeg/raw on the node clock, lock-step experiments).")
+            raise EEGError(msg)
         gen = SyntheticEEG(
             list(p['channel_names']), p['sample_rate'], seed=p['seed'], head_seed=p['head_seed'],
             background_rms=p['background_rms'], alpha_rms=p['alpha_rms'], mu_rms=p['mu_rms'],
@@ -77,12 +90,19 @@ class VirtualAmpNode(rclpy.node.Node):
                                      rclpy.qos.qos_profile_sensor_data)
             self.create_subscription(FsmState, '/fsm/state', self.fsm_callback, latched)
         self.pub_intent = self.create_publisher(String, '/virtual_subject/intent', latched)
-        # the outlets last, so streaming starts soon after the stream becomes visible
-        outlet = EEGOutlet(p['stream_name'], list(p['channel_names']), p['sample_rate'],
-                           stream_type=p['stream_type'], source_id=p['source_id'],
-                           unit=p['unit'])
-        self.markers = MarkerOutlet(f'{p["stream_name"]}-markers',
-                                    f'{p["source_id"] or p["stream_name"]}-markers')
+        outlet, self.markers, self.pub_raw = None, None, None
+        if p['output'] == 'ros':
+            qos_raw = rclpy.qos.QoSProfile(depth=100,
+                                           reliability=rclpy.qos.ReliabilityPolicy.BEST_EFFORT,
+                                           durability=rclpy.qos.DurabilityPolicy.VOLATILE)
+            self.pub_raw = self.create_publisher(EEGChunk, '/eeg/raw', qos_raw)
+        else:
+            # the outlets last, so streaming starts soon after the stream becomes visible
+            outlet = EEGOutlet(p['stream_name'], list(p['channel_names']), p['sample_rate'],
+                               stream_type=p['stream_type'], source_id=p['source_id'],
+                               unit=p['unit'])
+            self.markers = MarkerOutlet(f'{p["stream_name"]}-markers',
+                                        f'{p["source_id"] or p["stream_name"]}-markers')
         sim_time = bool(self.get_parameter('use_sim_time').value)
         self.amp = VirtualAmplifier(gen, self.subject, outlet, realtime_stamps=not sim_time,
                                     block=p['block'], max_catch_up=1.0 if sim_time else None)
@@ -91,9 +111,10 @@ class VirtualAmpNode(rclpy.node.Node):
         self.create_timer(p['push_period'], self.push_callback)
         self._start = self.now_s()
         self.done = False
+        where = f"LSL stream '{p['stream_name']}'" if outlet is not None else '/eeg/raw'
         self.get_logger().info(
-            f"Virtual amplifier '{p['stream_name']}': {len(p['channel_names'])} channels at "
-            f"{p['sample_rate']:g} Hz in {p['unit']}, subject mode {mode!r}, seed {p['seed']}, "
+            f"Virtual amplifier on {where}: {len(p['channel_names'])} channels at "
+            f"{p['sample_rate']:g} Hz, subject mode {mode!r}, seed {p['seed']}, "
             f"paced by {'/clock' if sim_time else 'wall time'}.")
 
     def now_s(self) -> float:
@@ -128,19 +149,37 @@ class VirtualAmpNode(rclpy.node.Node):
         now = self.now_s()
         if self.sim_time and now <= 0.0:
             return                                   # no /clock yet
-        self.amp.step(now)
+        first = self.amp.n_samples
+        data = self.amp.step(now)
+        if self.pub_raw is not None and len(data):
+            self.publish_chunk(data, first)
         if self.amp.current_class != self._last_intent:
             self._last_intent = self.amp.current_class
             name = class_name(self.amp.current_class)
-            self.markers.push(name)
+            if self.markers is not None:
+                self.markers.push(name)
             self.pub_intent.publish(String(data=name))
         if self.p['duration'] > 0 and now - self._start > self.p['duration']:
             self.done = True
 
+    def publish_chunk(self, data: np.ndarray, first: int) -> None:
+        """``output:=ros``: one EEGChunk of ``data`` (n_samples, n_channels; volts) whose first
+        sample is sample ``first`` of the stream, stamped on the node clock."""
+        fs = float(self.p['sample_rate'])
+        stamp_ns = round((self.amp.t_start + first / fs) * 1e9)
+        msg = EEGChunk(sample_rate=fs, channel_names=list(self.p['channel_names']),
+                       n_samples=len(data), first_sample_index=first, unit='V',
+                       data=np.ascontiguousarray(data, dtype=np.float32).ravel())
+        msg.header.stamp.sec, msg.header.stamp.nanosec = ns_to_time_fields(stamp_ns)
+        msg.header.frame_id = self.p['frame_id']
+        self.pub_raw.publish(msg)
+
     def destroy_node(self) -> None:
         """Withdraw the LSL streams, then the node."""
-        self.amp.outlet.close()
-        self.markers.close()
+        if self.amp.outlet is not None:
+            self.amp.outlet.close()
+        if self.markers is not None:
+            self.markers.close()
         super().destroy_node()
 
 

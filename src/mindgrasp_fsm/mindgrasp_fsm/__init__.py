@@ -9,8 +9,6 @@ Layers (no ROS below the node):
 - :mod:`~mindgrasp_fsm.grasp_policy`: the autonomous final approach and grasp (depth + camera model
   + inverse kinematics, force-limited closing, contact and lift checks, one retry).
 - :mod:`~mindgrasp_fsm.kinematics`: forward/inverse kinematics from the robot's URDF.
-- :mod:`~mindgrasp_fsm.lockstep`, :mod:`~mindgrasp_fsm.experiment`: the in-process closed loop with
-  the simulator and the vision pipeline, and the random-locations experiment.
 - :mod:`~mindgrasp_fsm.fsm_node`: the ROS node.
 """
 

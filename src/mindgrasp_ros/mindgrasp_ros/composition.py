@@ -19,14 +19,15 @@ import contextlib
 import contextvars
 import importlib
 import inspect
+import time
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
 from mindgrasp_ros.errors import RosError
 
-__all__ = ['Component', 'CompositionError', 'LockstepRunner', 'component_arguments',
-           'load_node_class', 'run_composed']
+__all__ = ['Component', 'CompositionError', 'LockstepRunner', 'NodeCallbackError',
+           'component_arguments', 'load_node_class', 'run_composed']
 
 _pending_args: contextvars.ContextVar[list[str] | None] = contextvars.ContextVar(
     'mindgrasp_component_args', default=None)
@@ -34,6 +35,14 @@ _pending_args: contextvars.ContextVar[list[str] | None] = contextvars.ContextVar
 
 class CompositionError(RosError):
     """A component could not be loaded or constructed."""
+
+
+class NodeCallbackError(CompositionError):
+    """A callback of a composed node raised; ``node`` names it, ``error`` is the exception."""
+
+    def __init__(self, node: str, error: BaseException) -> None:
+        self.node, self.error = node, error
+        super().__init__(f'node {node!r} raised {type(error).__name__}: {error}')
 
 
 def pending_component_arguments() -> list[str] | None:
@@ -161,6 +170,9 @@ class LockstepRunner:
         self._clock_pub = self._clock_node.create_publisher(self._clock_cls, '/clock',
                                                             qos_profile_clock)
         self.nodes: list[Any] = []
+        #: wall seconds spent in each node's callbacks (by node name), and in collecting work
+        self.node_time: dict[str, float] = {}
+        self.collect_time = 0.0
 
     @property
     def time_s(self) -> float:
@@ -188,18 +200,64 @@ class LockstepRunner:
         self._clock_pub.publish(self._clock_cls(clock=stamp))
 
     def spin_until_quiescent(self) -> int:
-        """Run ready callbacks until none is ready; returns how many rounds ran."""
+        """Run ready callbacks until none is ready; returns how many rounds ran.
+
+        A callback that raises ends the round with :class:`NodeCallbackError` naming its node.
+        """
         rounds = 0
+        clock = time.perf_counter
+        times = self.node_time
         while rounds < self._max_rounds:
-            work = self.executor._collect()
+            t0 = clock()
+            work = self._collect()
+            self.collect_time += clock() - t0
             if not work:
                 return rounds
             for entity, item in work:
-                self.executor._run(entity, item)
+                t0 = clock()
+                try:
+                    entity.execute(item)
+                except (KeyboardInterrupt, SystemExit):
+                    raise
+                except Exception as exc:
+                    raise NodeCallbackError(entity.node.get_name(), exc) from exc
+                finally:
+                    name = entity.node.get_name()
+                    times[name] = times.get(name, 0.0) + clock() - t0
             rounds += 1
         msg = (f'The composed graph did not settle within {self._max_rounds} rounds at '
                f't={self.time_s:.6f} s: a callback keeps producing work.')
         raise CompositionError(msg)
+
+    def _collect(self) -> list[tuple[Any, Any]]:
+        """Ready work in the executor's order (timers, subscriptions, services, guards), for a
+        DDS-less context run by one thread: only queues and due timers are looked at, which
+        is what makes lock-step cheaper than a generic executor scan."""
+        work: list[tuple[Any, Any]] = []
+        for node in self.executor._nodes:
+            for timer in node.timers:
+                if timer._canceled:
+                    continue
+                now = timer.clock._override_ns
+                if now is not None and timer._last_ns <= now < timer._next_ns:
+                    continue                      # on sim time and not due yet
+                if timer.is_ready():
+                    timer._mark_called()
+                    work.append((timer, None))
+            for sub in node.subscriptions:
+                if sub._queue:
+                    work.extend((sub, item) for item in sub.take())
+            for srv in node.services:
+                if srv._local:
+                    work.extend((srv, item) for item in srv.take())
+            for client in node.clients:
+                if client._reader is not None:
+                    work.extend((client, item) for item in client.take())
+            for guard in node.guards:
+                if guard._triggered:
+                    guard._triggered = False
+                    work.append((guard, None))
+        return work
 
     def step(self, dt_s: float) -> None:
         """Advance the clock by ``dt_s`` seconds and run the graph until it settles."""

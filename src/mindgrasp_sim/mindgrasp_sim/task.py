@@ -1,5 +1,7 @@
 """Grasp outcome detection (ROS-free): an object lifted above the success height in the gripper is a
-success; a lifted object that leaves the gripper and falls is a drop.
+success; a lifted object that leaves the gripper and falls is a drop. This is the one success
+definition of the project: the trial records (mindgrasp_experiments.records) take
+``GraspResult.success`` from here.
 
 The node feeds :meth:`TaskMonitor.update` with the simulation after every control tick and
 publishes what it returns as ``/task/result`` (mindgrasp_msgs/GraspResult).
@@ -8,8 +10,10 @@ publishes what it returns as ``/task/result`` (mindgrasp_msgs/GraspResult).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
-from mindgrasp_sim.simulation import Simulation
+if TYPE_CHECKING:
+    from mindgrasp_sim.simulation import Simulation
 
 #: object centre height (m) that counts as a successful lift (the original code's 0.22 m)
 SUCCESS_HEIGHT = 0.22

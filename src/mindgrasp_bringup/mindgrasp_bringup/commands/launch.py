@@ -18,12 +18,17 @@ EPILOG = """examples:
   mindgrasp launch hardware eeg_stream:=MyAmp arm_driver:=my_arm_driver
   mindgrasp launch demo --show-args          the arguments of a profile
   mindgrasp launch my_setup.launch.py record:=false
+  mindgrasp launch experiment subject:=oracle trials:=2 --lockstep
 """
 
 
 def _options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--composed', action='store_true',
                         help='run the node modules in one process (mindgrasp_ros composition)')
+    parser.add_argument('--lockstep', action='store_true',
+                        help='compose the nodes in one process on simulated time, stepped as '
+                             'fast as the CPU allows (deterministic for a seed; LSL nodes are '
+                             'left out, the virtual amplifier publishes /eeg/raw itself)')
     parser.add_argument('--run-dir', metavar='DIR',
                         help='run directory (default: runs/<UTC timestamp>_<profile>/)')
     parser.add_argument('--duration', type=non_negative_float, metavar='S',
@@ -85,6 +90,30 @@ def profile_summaries() -> list[tuple[str, str]]:
     return out
 
 
+def _run_lockstep(args: argparse.Namespace, service: LaunchService,
+                  launch_arguments: list[str]) -> int:
+    """``--lockstep``: every node composed on simulated time (mindgrasp_experiments.engine);
+    ``duration:=S`` counts simulated seconds. Returns 1 when a node failed."""
+    from mindgrasp_bringup.launch_system import rundir
+    from mindgrasp_experiments import ExperimentError
+    from mindgrasp_experiments.engine import lockstep_components, run_lockstep
+
+    service.plan()    # argument problems are reported before anything is created
+    run_dir = rundir.create_run_dir(service.name, args.run_dir, service.runs_root)
+    given = dict(a.split(':=', 1) for a in launch_arguments)
+    duration = float(given.pop('duration', 0) or 0)
+    try:
+        components = lockstep_components(service.launch_file, given, run_dir / 'params')
+    except ExperimentError as exc:
+        raise LaunchError(str(exc)) from None
+    print(f'lock-step: composing {len(components)} node(s) on simulated time: '
+          + ', '.join(c.label for c in components) + f'; run directory {run_dir}', flush=True)
+    import os
+
+    os.environ['MINDGRASP_RUN_DIR'] = str(run_dir)
+    return run_lockstep(components, duration_s=duration)
+
+
 def main(args: argparse.Namespace) -> int:
     """Run ``mindgrasp launch``; 0 when every node ended cleanly, 1 on a failure, 2 on bad
     input."""
@@ -116,6 +145,8 @@ def main(args: argparse.Namespace) -> int:
                 if spec.problem:
                     print(f'      cannot start: {spec.problem}')
             return 2 if any(spec.problem for spec in plan.processes) else 0
+        if args.lockstep:
+            return _run_lockstep(args, service, launch_arguments)
         return service.run()
     except LaunchError as exc:
         print(f'mindgrasp launch: error: {exc}', file=sys.stderr)

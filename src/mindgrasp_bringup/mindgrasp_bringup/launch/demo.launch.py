@@ -70,7 +70,7 @@ def generate_launch_description() -> LaunchDescription:
         *display_arguments(),
         *live_view_arguments(),
         # 0 the trials: which object to grasp, reset between grasps
-        Node(package='mindgrasp_bringup', executable='trial_manager_node', name='trial_manager',
+        Node(package='mindgrasp_experiments', executable='trial_manager_node', name='trial_manager',
              parameters=[*config_files('demo'),
                          {'targets': LaunchConfiguration('targets'),
                           'n_trials': LaunchConfiguration('trials'), 'seed': seed}],

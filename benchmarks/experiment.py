@@ -1,0 +1,84 @@
+"""Speed of the lock-step experiment engine: real-time factor, CPU s per simulated s, and where the
+time goes per node (wall s in each node's callbacks) and per function (``--profile``).
+
+    python benchmarks/experiment.py                         # 2 set-location trials, virtual 0.8
+    python benchmarks/experiment.py --subject oracle --trials 3
+    python benchmarks/experiment.py --protocol random_locations --subject autonomous
+    python benchmarks/experiment.py --profile 25            # + the 25 costliest functions
+
+The trials run in this process, one after the other (``--workers`` of the CLI multiplies the
+real-time factor by up to the number of free cores). The machine's load counts: the CPU figure
+is the one to compare between runs.
+"""
+
+from __future__ import annotations
+
+import argparse
+import cProfile
+import pstats
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument('--protocol', default='set_locations',
+                        choices=['set_locations', 'random_locations'])
+    parser.add_argument('--subject', default='virtual',
+                        choices=['noise', 'virtual', 'oracle', 'autonomous'])
+    parser.add_argument('--accuracy', type=float, default=0.8)
+    parser.add_argument('--trials', type=int, default=2)
+    parser.add_argument('--seed', type=int, default=0)
+    parser.add_argument('--step', type=float, default=0.02)
+    parser.add_argument('--profile', type=int, default=0, metavar='N',
+                        help='profile with cProfile and print the N costliest functions')
+    args = parser.parse_args(argv)
+
+    from mindgrasp_experiments.cli import NOISE_MODEL
+    from mindgrasp_experiments.engine import lockstep_components, run_trial
+
+    launch_args = {'protocol': args.protocol, 'subject': args.subject,
+                   'accuracy': str(args.accuracy), 'seed': str(args.seed)}
+    if args.subject == 'noise':
+        launch_args['model'] = str(NOISE_MODEL.with_suffix('.json'))
+    comps = lockstep_components('experiment', launch_args, Path(tempfile.mkdtemp()) / 'params',
+                                log=lambda _text: None)
+    prof = cProfile.Profile() if args.profile else None
+    runs = []
+    wall0 = time.perf_counter()
+    for trial in range(1, args.trials + 1):
+        if prof is not None:
+            prof.enable()
+        run = run_trial(comps, trial, seed=args.seed, step_s=args.step, log_level='warn')
+        if prof is not None:
+            prof.disable()
+        runs.append(run)
+        r = run.record
+        print(f'trial {trial}: {r.desired:16s} success {r.success!s:5} correct '
+              f'{r.correct_and_successful!s:5} {run.sim_s:6.1f} sim s in {run.wall_s:6.1f} wall s '
+              f'(graph built in {run.build_s:.2f} s), {r.failure or "ok"}', flush=True)
+    wall = time.perf_counter() - wall0
+    sim = sum(r.sim_s for r in runs)
+    cpu = sum(r.cpu_s for r in runs)
+    print(f'\n{args.protocol}, subject {args.subject}: {len(runs)} trials, {sim:.0f} simulated s '
+          f'in {wall:.0f} s wall: real-time factor {sim / wall:.1f}; {cpu / sim:.3f} CPU s per '
+          f'simulated s (= {sim / cpu:.1f}x real time per free core)')
+    node_s: dict[str, float] = {}
+    for r in runs:
+        for name, sec in r.node_s.items():
+            node_s[name] = node_s.get(name, 0.0) + sec
+    total = sum(node_s.values())
+    print('\nwall s per node (callbacks), per simulated s:')
+    for name, sec in sorted(node_s.items(), key=lambda kv: -kv[1]):
+        print(f'  {name:18s} {sec:7.1f} s  {1e3 * sec / sim:6.1f} ms/sim s  '
+              f'{100 * sec / total:4.0f} %')
+    if prof is not None:
+        print()
+        pstats.Stats(prof, stream=sys.stdout).sort_stats('tottime').print_stats(args.profile)
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())

@@ -1,0 +1,118 @@
+"""The grasp experiments of the paper: the trial manager runs set-locations or random-locations
+trials through the full node graph (simulator, EEG, classifier, vision, controller).
+
+    mindgrasp launch experiment subject:=virtual accuracy:=0.8 trials:=6 --lockstep
+    mindgrasp launch experiment protocol:=random_locations subject:=autonomous trials:=3
+    mindgrasp experiment set-locations --trials 160 --subject noise     # records and report
+
+Subjects: ``noise`` (the paper's unworn cap: EEG without imagery, decoded by a classifier trained
+on noise; give it with model:=), ``virtual`` (the virtual subject pursues the target at
+``accuracy``; the default classifier was calibrated on the same simulated subject with another
+seed), ``oracle`` (no EEG: the subject's intended class is published as the prediction) and
+``autonomous`` (no BCI: the controller searches and grasps by itself, as in random locations).
+With ``--lockstep`` every node runs in one process on simulated time; the virtual amplifier then
+publishes /eeg/raw itself and the LSL acquisition node is left out.
+
+Parameters: config/params/<package>.yaml, then config/params/experiment.yaml, then the launch
+arguments below.
+"""
+
+from mindgrasp_bringup.launch_system import (
+    DeclareLaunchArgument,
+    IfCondition,
+    LaunchConfiguration,
+    LaunchConfigurationEquals,
+    LaunchDescription,
+    Node,
+    PythonExpression,
+    Shutdown,
+    config_files,
+)
+
+
+def _eeg(*extra: object) -> IfCondition:
+    """True for the EEG subjects (noise, virtual) when ``extra`` (more of the Python expression,
+    text and substitutions) holds too."""
+    return IfCondition(PythonExpression([
+        "'", LaunchConfiguration('subject'), "' in ('noise', 'virtual')", *extra]))
+
+
+def _when(subject: str) -> LaunchConfigurationEquals:
+    return LaunchConfigurationEquals('subject', subject)
+
+
+def generate_launch_description() -> LaunchDescription:
+    seed = LaunchConfiguration('seed')
+    subject = LaunchConfiguration('subject')
+    stream = LaunchConfiguration('eeg_stream')
+    manager = [*config_files('experiment'),
+               {'protocol': LaunchConfiguration('protocol'), 'n_trials': LaunchConfiguration(
+                   'trials'), 'first_trial': LaunchConfiguration('first_trial'), 'seed': seed,
+                'subject': subject}]
+    waits = {'noise': ['/eeg/raw', '/bci/prediction', '/vision/detections'],
+             'virtual': ['/eeg/raw', '/bci/prediction', '/vision/detections'],
+             'oracle': ['/bci/prediction', '/vision/detections'],
+             'autonomous': ['/vision/detections']}
+    eeg = config_files('eeg', 'experiment')
+    classifier = config_files('classifier', 'experiment')
+    return LaunchDescription([
+        DeclareLaunchArgument('protocol', default_value='set_locations',
+                              choices=['set_locations', 'random_locations'],
+                              description='set_locations (9 objects at 0.5 m, a desired object '
+                                          'per trial) or random_locations (one object per '
+                                          'trial at 0.2-0.7 m)'),
+        DeclareLaunchArgument('subject', default_value='virtual',
+                              choices=['noise', 'virtual', 'oracle', 'autonomous'],
+                              description='who drives the controller (see the profile help)'),
+        DeclareLaunchArgument('accuracy', default_value='0.8',
+                              description='virtual subject: probability (0-1) that a decision '
+                                          'is the right class'),
+        DeclareLaunchArgument('trials', default_value='3',
+                              description='trials before the launch ends (0: until Ctrl-C)'),
+        DeclareLaunchArgument('first_trial', default_value='1',
+                              description='number of the first trial (trials are drawn from '
+                                          '(seed, trial), so a batch can start anywhere)'),
+        DeclareLaunchArgument('seed', default_value='0',
+                              description='seed of the protocol draws, the EEG and the subject'),
+        DeclareLaunchArgument('model', default_value='',
+                              description='classifier model (.json); empty: the default model '
+                                          '(the noise subject needs a noise-trained one)'),
+        DeclareLaunchArgument('eeg_stream', default_value='MIndGrasp-Experiment',
+                              description='LSL stream name of the virtual amplifier (live runs)'),
+        DeclareLaunchArgument('gui', default_value='false', choices=['true', 'false'],
+                              description='open the PyBullet window (needs a display)'),
+        *[Node(package='mindgrasp_experiments', executable='trial_manager_node',
+               name='trial_manager', parameters=[*manager, {'wait_for': topics}],
+               condition=_when(name), on_exit=Shutdown())
+          for name, topics in waits.items()],
+        Node(package='mindgrasp_sim', executable='sim_node', name='sim',
+             parameters=[*config_files('sim', 'experiment'),
+                         {'gui': LaunchConfiguration('gui'), 'seed': seed,
+                          'scene': PythonExpression(["'random_locations' if '",
+                                                     LaunchConfiguration('protocol'),
+                                                     "' == 'random_locations' else "
+                                                     "'set_locations'"])}]),
+        Node(package='mindgrasp_eeg', executable='virtual_amp_node', name='virtual_amp',
+             parameters=[*eeg, {'stream_name': stream, 'source_id': stream, 'seed': seed,
+                                'accuracy': LaunchConfiguration('accuracy'),
+                                'subject_mode': PythonExpression([
+                                    "'pursue' if '", subject, "' == 'virtual' else 'noise'"])}],
+             condition=_eeg()),
+        Node(package='mindgrasp_eeg', executable='acquisition_node', name='eeg_acquisition',
+             parameters=[*eeg, {'stream_name': stream, 'source_id': stream}],
+             condition=_eeg()),
+        Node(package='mindgrasp_classifier', executable='classifier_node', name='classifier',
+             parameters=classifier,
+             condition=_eeg(" and '", LaunchConfiguration('model'), "' == ''")),
+        Node(package='mindgrasp_classifier', executable='classifier_node', name='classifier',
+             parameters=[*classifier, {'model': LaunchConfiguration('model')}],
+             condition=_eeg(" and '", LaunchConfiguration('model'), "' != ''")),
+        Node(package='mindgrasp_experiments', executable='oracle_subject_node',
+             name='oracle_subject', parameters=[{'seed': seed}], condition=_when('oracle')),
+        Node(package='mindgrasp_vision', executable='vision_node', name='vision',
+             parameters=config_files('vision', 'experiment')),
+        Node(package='mindgrasp_fsm', executable='fsm_node', name='fsm',
+             parameters=[*config_files('fsm', 'experiment'),
+                         {'autonomous': PythonExpression(["'", subject, "' == 'autonomous'"])}]),
+    ])
+

@@ -1,0 +1,179 @@
+"""``mindgrasp experiment set-locations | random-locations``: the paper's protocols in lock-step.
+
+The experiment launch profile's own nodes (simulator, virtual amplifier, classifier, vision,
+controller, trial manager) are composed in one process on simulated time, one fresh graph per
+trial seeded from ``(seed, trial)``; ``--workers N`` runs trials in N processes with the same
+records. The run directory (``--out``, default ``runs/<UTC>_<protocol>/``) gets records.csv,
+records.parquet, summary.json, report.md and the plots; ``--json`` prints one JSON object as the
+last line. Ctrl-C writes the records and report of the trials done so far.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+import time
+from pathlib import Path
+
+PROTOCOL_SUBJECTS = {'set_locations': ('noise', 'virtual', 'oracle'),
+                     'random_locations': ('autonomous',)}
+NOISE_MODEL = Path(__file__).resolve().parents[3] / 'models' / 'noise_classifier'
+
+
+def add_common_arguments(parser: argparse.ArgumentParser, trials: int) -> None:
+    parser.add_argument('--trials', type=int, default=trials,
+                        help=f'number of trials (default {trials})')
+    parser.add_argument('--seed', type=int, default=0,
+                        help='seed of the trial draws, the EEG and the subject (default 0)')
+    parser.add_argument('--workers', type=int, default=1,
+                        help='worker processes; the same seed gives the same records whatever '
+                             'the number (default 1)')
+    parser.add_argument('--out', metavar='DIR', default=None,
+                        help='run directory (default runs/<UTC time>_<protocol>/)')
+    parser.add_argument('--launch', metavar='FILE', default=None,
+                        help='a launch file whose nodes replace the experiment\'s nodes of the '
+                             'same name (e.g. your own controller named fsm) or are added')
+    parser.add_argument('--json', action='store_true',
+                        help='print one JSON object with the figures as the last line')
+    parser.add_argument('--step', type=float, default=0.02, metavar='S',
+                        help='lock-step clock step in simulated s (default 0.02)')
+    parser.add_argument('--stall-timeout', type=float, default=120.0, metavar='S',
+                        help='abort a trial after S simulated s without a controller state '
+                             'change (default 120)')
+    parser.add_argument('--trial-timeout', type=float, default=600.0, metavar='S',
+                        help='end a trial without a grasp after S simulated s (default 600)')
+    parser.add_argument('--no-progress', action='store_true', help='no progress bar')
+
+
+def fail(command: str, text: str) -> int:
+    """One clear line on stderr, exit code 2."""
+    print(f'mindgrasp experiment {command}: {text}', file=sys.stderr)
+    return 2
+
+
+def check(args: argparse.Namespace, command: str) -> str | None:
+    """The problem with the arguments, in one sentence, or None."""
+    if args.trials < 1:
+        return f'--trials must be a whole number >= 1, got {args.trials}.'
+    if args.seed < 0:
+        return f'--seed must be >= 0, got {args.seed}.'
+    if args.workers < 1:
+        return f'--workers must be >= 1, got {args.workers}.'
+    accuracy = getattr(args, 'accuracy', None)
+    if accuracy is not None and not (0.0 <= accuracy <= 1.0):
+        return f'--accuracy must be within 0..1 (a probability), got {accuracy}.'
+    if not (0 < args.step <= 0.1):
+        return f'--step must be within (0, 0.1] simulated seconds, got {args.step}.'
+    if args.stall_timeout <= 0:
+        return f'--stall-timeout must be > 0 s, got {args.stall_timeout}.'
+    if args.trial_timeout <= 0:
+        return f'--trial-timeout must be > 0 s, got {args.trial_timeout}.'
+    if args.launch is not None and not Path(args.launch).is_file():
+        return f'--launch {args.launch}: no such launch file; give a *.launch.py path.'
+    return None
+
+
+def run_experiment(args: argparse.Namespace, protocol: str, command: str) -> int:
+    """Run the protocol with ``args``; write the run directory; print the figures."""
+    from tqdm import tqdm
+
+    from mindgrasp_bringup.launch_system import LaunchError
+    from mindgrasp_bringup.launch_system.rundir import create_run_dir
+    from mindgrasp_experiments import ExperimentError
+    from mindgrasp_experiments.engine import lockstep_components
+    from mindgrasp_experiments.report import finite, write_run
+    from mindgrasp_experiments.workers import run_trials
+
+    problem = check(args, command)
+    if problem:
+        return fail(command, problem)
+    subject = getattr(args, 'subject', 'autonomous')
+    try:
+        out = create_run_dir(protocol, args.out)
+    except LaunchError as exc:
+        return fail(command, str(exc))
+    launch_args = {'protocol': protocol, 'subject': subject, 'seed': str(args.seed),
+                   'trials': '1'}
+    if getattr(args, 'accuracy', None) is not None:
+        launch_args['accuracy'] = str(args.accuracy)
+    if subject == 'noise':
+        from mindgrasp_experiments.subjects import noise_model
+
+        model = NOISE_MODEL.with_suffix('.json')
+        if not model.exists():
+            print('Training the classifier on noise (once) ...', file=sys.stderr)
+            model = noise_model(out / 'noise_classifier')
+        launch_args['model'] = str(model)
+    log = [] if args.json else None
+    try:
+        components = lockstep_components('experiment', launch_args, out / 'params',
+                                         overlay=args.launch,
+                                         log=log.append if log is not None else print)
+    except ExperimentError as exc:
+        return fail(command, str(exc))
+    for comp in components:
+        if comp.module.endswith('trial_manager_node'):
+            comp.ros_args += ['-p', f'stall_timeout:={args.stall_timeout}',
+                              '-p', f'trial_timeout:={args.trial_timeout}']
+    trials = list(range(1, args.trials + 1))
+    runs = []
+    interrupted = False
+    wall0, cpu0 = time.perf_counter(), time.process_time()
+    bar = tqdm(total=len(trials), unit='trial', disable=args.no_progress, file=sys.stderr,
+               desc=f'{protocol} ({subject})', dynamic_ncols=True)
+    try:
+        for run in run_trials(components, trials, seed=args.seed, workers=args.workers,
+                              step_s=args.step):
+            runs.append(run)
+            done = [r.record for r in runs]
+            bar.update(1)
+            bar.set_postfix(success=f'{sum(r.success for r in done)}/{len(done)}',
+                            rtf=f'{sum(r.sim_s for r in runs) / (time.perf_counter() - wall0):.1f}')
+    except KeyboardInterrupt:
+        interrupted = True
+        print(f'\nInterrupted: writing the {len(runs)} finished trial(s).', file=sys.stderr)
+    finally:
+        bar.close()
+    wall = time.perf_counter() - wall0
+    sim = sum(r.sim_s for r in runs)
+    # CPU of this process and of the worker processes (the parent mostly waits with workers)
+    cpu = sum(r.cpu_s for r in runs) + (time.process_time() - cpu0 if args.workers > 1 else 0.0)
+    node_s: dict[str, float] = {}
+    for r in runs:
+        for name, sec in r.node_s.items():
+            node_s[name] = node_s.get(name, 0.0) + sec
+    records = sorted((r.record for r in runs), key=lambda rec: rec.trial)
+    info = {
+        'command': ' '.join(['mindgrasp', 'experiment', command, *sys.argv[3:]]),
+        'protocol': protocol, 'subject': subject, 'seed': args.seed,
+        'accuracy': getattr(args, 'accuracy', None), 'workers': args.workers,
+        'trials_requested': args.trials, 'interrupted': interrupted,
+        'launch_overlay': args.launch, 'step_s': args.step,
+        'trial_timeout_s': args.trial_timeout, 'stall_timeout_s': args.stall_timeout,
+        'sim_s': sim, 'wall_s': wall, 'cpu_s': cpu,
+        'real_time_factor': sim / wall if wall > 0 else math.nan,
+        'cpu_s_per_sim_s': cpu / sim if sim > 0 else math.nan,
+        'build_s': sum(r.build_s for r in runs), 'node_s': node_s,
+    }
+    doc = write_run(out, records, info)
+    s = doc['summary']
+    print(f"{protocol.replace('_', ' ').capitalize()}, subject {subject}: {s['trials']} trials "
+          f"in {out}")
+    print(f"  grasp success {_pct(s['success_rate'])}, correct choice "
+          f"{_pct(s['correct_choice_rate'])}, correct and successful "
+          f"{_pct(s['correct_and_successful_rate'])}; mean trial {s['mean_duration_s']:.1f} s")
+    print(f'  simulated {sim:.0f} s in {wall:.0f} s wall: real-time factor '
+          f"{info['real_time_factor']:.1f}, {info['cpu_s_per_sim_s']:.3f} CPU s per simulated s")
+    print(f"  report: {out / 'report.md'}")
+    if args.json:
+        print(json.dumps(finite({**s, 'run_dir': str(out), 'report_path': str(out / 'report.md'),
+                                 'real_time_factor': info['real_time_factor'],
+                                 'cpu_s_per_sim_s': info['cpu_s_per_sim_s'],
+                                 'wall_s': wall, 'sim_s': sim, 'interrupted': interrupted})))
+    return 130 if interrupted else 0
+
+
+def _pct(rate: float) -> str:
+    return 'n/a' if not math.isfinite(rate) else f'{100 * rate:.1f} %'

@@ -1,0 +1,1 @@
+"""``mindgrasp experiment <verb>`` modules (``add_arguments(parser)``, ``main(args)``)."""

@@ -1,0 +1,113 @@
+"""The oracle subject: a perfect decoder of a competent user, publishing ``/bci/prediction``.
+
+    python -m mindgrasp_experiments.oracle_subject_node --ros-args -p use_sim_time:=true
+
+No EEG and no classifier: the virtual subject in pursue mode (:class:`~mindgrasp_eeg.subject.
+VirtualSubject`, accuracy 1) decides what to imagine from ``/task/target``, ``/sim/objects``,
+``/joint_states`` and ``/fsm/state``, and that class is published every ``period`` seconds as an
+MIPrediction with ``certainty``. While the subject rests, it publishes both feet with certainty 0
+(below every threshold of the controller, which then acts on its own). The upper bound of what
+the controller achieves with a BCI.
+"""
+
+from __future__ import annotations
+
+import sys
+
+import numpy as np
+from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import FsmState, MIPrediction, TaskTarget
+from mindgrasp_ros.interfaces.sensor_msgs.msg import JointState
+from mindgrasp_ros.interfaces.std_msgs.msg import String
+from mindgrasp_ros.interfaces.visualization_msgs.msg import MarkerArray
+
+from mindgrasp_eeg.montage import class_name
+from mindgrasp_eeg.ros_conversions import base_yaw_from_joint_state, markers_to_objects
+from mindgrasp_eeg.subject import VirtualSubject
+from mindgrasp_ros import rclpy
+
+CLASS_NAMES = ['left_hand', 'right_hand', 'both_hands', 'both_feet']
+PARAMETERS = [('period', 1.0 / 16.0), ('certainty', 1.0), ('reaction_delay', 0.3),
+              ('decision_period', 0.25), ('heading_tolerance', 0.1), ('seed', 0),
+              ('duration', 0.0)]
+
+
+class OracleSubjectNode(rclpy.node.Node):
+    """Publishes the pursuing subject's intended class as the prediction."""
+
+    def __init__(self, **kwargs) -> None:
+        super().__init__('oracle_subject', **kwargs)
+        self.declare_parameters('', PARAMETERS)
+        p = {name: self.get_parameter(name).value for name, _ in PARAMETERS}
+        self.p = p
+        self.subject = VirtualSubject('pursue', accuracy=1.0,
+                                      reaction_delay=p['reaction_delay'], seed=p['seed'],
+                                      decision_period=p['decision_period'],
+                                      heading_tolerance=p['heading_tolerance'])
+        latched = rclpy.qos.QoSProfile(depth=10,
+                                       reliability=rclpy.qos.ReliabilityPolicy.RELIABLE,
+                                       durability=rclpy.qos.DurabilityPolicy.TRANSIENT_LOCAL)
+        self.create_subscription(TaskTarget, '/task/target', self.target_callback, latched)
+        self.create_subscription(MarkerArray, '/sim/objects', self.objects_callback, latched)
+        self.create_subscription(JointState, '/joint_states', self.joints_callback,
+                                 rclpy.qos.qos_profile_sensor_data)
+        self.create_subscription(FsmState, '/fsm/state', self.fsm_callback, latched)
+        self.pub = self.create_publisher(MIPrediction, '/bci/prediction', 10)
+        self.pub_intent = self.create_publisher(String, '/virtual_subject/intent', latched)
+        self._last_intent: object = 'unset'
+        self.create_timer(p['period'], self.predict_callback)
+        self._start = self.now_s()
+        self.done = False
+
+    def now_s(self) -> float:
+        return self.get_clock().now().nanoseconds * 1e-9
+
+    def target_callback(self, msg: TaskTarget) -> None:
+        self.subject.set_target(int(msg.object_id), msg.colour, msg.shape)
+
+    def objects_callback(self, msg: MarkerArray) -> None:
+        self.subject.set_objects(markers_to_objects(msg.markers))
+
+    def joints_callback(self, msg: JointState) -> None:
+        yaw = base_yaw_from_joint_state(msg.name, msg.position)
+        if yaw is not None:
+            self.subject.set_base_yaw(yaw)
+
+    def fsm_callback(self, msg: FsmState) -> None:
+        self.subject.set_fsm(int(msg.state), msg.object_of_interest)
+
+    def predict_callback(self) -> None:
+        now = self.now_s()
+        if now <= 0.0:
+            return                                    # no /clock yet
+        intent = self.subject.intent(now)
+        cls, certainty = (3, 0.0) if intent is None else (int(intent), self.p['certainty'])
+        distances = np.full(4, 1.0 + certainty, dtype=np.float32)
+        distances[cls] = 1.0
+        msg = MIPrediction(class_index=cls, class_names=CLASS_NAMES, certainty=float(certainty),
+                           distances=distances, window_length=0.0)
+        msg.header.stamp = self.get_clock().now().to_msg()
+        self.pub.publish(msg)
+        if intent != self._last_intent:
+            self._last_intent = intent
+            self.pub_intent.publish(String(data=class_name(intent)))
+        if self.p['duration'] > 0 and now - self._start > self.p['duration']:
+            self.done = True
+
+
+def main(args: list[str] | None = None) -> int:
+    """Run until Ctrl-C or ``duration``."""
+    rclpy.init(args=args)
+    node = OracleSubjectNode()
+    try:
+        while rclpy.ok() and not node.done:
+            rclpy.spin_once(node, timeout_sec=0.1)
+    except KeyboardInterrupt:
+        pass
+    finally:
+        node.destroy_node()
+        rclpy.try_shutdown()
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())

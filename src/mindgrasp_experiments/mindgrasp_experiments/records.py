@@ -1,0 +1,275 @@
+"""One trial record and one success definition, for the live trial manager and the experiments.
+
+A grasp trial succeeds when an object is lifted above :data:`SUCCESS_HEIGHT` (0.22 m, the original
+MIndGrasp code's threshold); the simulator's task monitor reports that lift on ``/task/result``
+(``GraspResult.success``). The choice is correct when the object the controller went for is the
+desired one. :class:`TrialTracker` (ROS-free) turns what the trial manager node hears during a
+trial (controller states, predictions, the subject's intent, the end-effector pose, the grasp
+result) into a :class:`TrialRecord`; :func:`write_records` stores them as CSV and Parquet.
+
+    >>> tracker = TrialTracker()
+    >>> tracker.start(trial=1, desired='red cube', desired_id=0, t=10.0)
+    >>> tracker.on_state(5, 'red cube', t=30.0)
+    >>> tracker.on_result('red cube', True, t=33.0)
+    >>> tracker.finish(t=40.0).correct_and_successful
+    True
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from collections.abc import Iterable, Sequence
+from dataclasses import asdict, dataclass, fields
+from pathlib import Path
+
+from mindgrasp_sim.task import SUCCESS_HEIGHT
+
+__all__ = ['FAILURES', 'SUCCESS_HEIGHT', 'TrialRecord', 'TrialTracker', 'read_records',
+           'write_records']
+
+#: why a trial ended without a grasp result ('' = it ended normally)
+FAILURES = ('', 'no_grasp', 'timeout', 'stalled', 'node_error', 'interrupted')
+
+#: classes as the virtual subject's intent names them (mindgrasp_eeg.montage.class_name)
+_INTENT_CLASSES = {'left_hand': 0, 'right_hand': 1, 'both_hands': 2, 'both_feet': 3}
+
+
+@dataclass
+class TrialRecord:
+    """One grasp trial. Times are simulated (node-clock) seconds; positions metres in the world
+    frame (arm base at the origin); labels ``"<colour> <shape>"``."""
+
+    trial: int                       # 1-based trial number
+    protocol: str = ''               # set_locations | random_locations | demo
+    subject: str = ''                # noise | virtual | oracle | autonomous | ...
+    seed: int = 0
+    desired: str = ''                # the object the subject was asked to grasp
+    desired_id: int = -1             # its id in /sim/objects
+    desired_x: float = math.nan      # its position at the start of the trial (m)
+    desired_y: float = math.nan
+    chosen: str = ''                 # the controller's object of interest when it began to
+                                     # grasp: colour + shape CNN, as the paper names it
+    grasped: str = ''                # ground truth: the object lifted or dropped ('' = none)
+    success: bool = False            # an object was lifted above SUCCESS_HEIGHT
+    correct_choice: bool = False     # the object gone for is the desired one
+    correct_and_successful: bool = False
+    lift_height: float = math.nan    # m, highest lift of the grasped object (centre height)
+    time_to_grasp_s: float = math.nan   # from the target to the successful lift
+    duration_s: float = 0.0          # from the target to the end of the trial
+    states: str = ''                 # controller states visited, in order ("1-2-3-4-5-6")
+    path_length_m: float = 0.0       # end-effector path length
+    class_switches: int = 0          # changes of the decoded class
+    n_predictions: int = 0
+    decoder_accuracy: float = math.nan  # predictions equal to the subject's intent (when known)
+    mean_certainty: float = math.nan
+    failure: str = ''                # one of FAILURES
+    reason: str = ''                 # how the trial ended, in words
+
+    @classmethod
+    def columns(cls) -> list[str]:
+        return [f.name for f in fields(cls)]
+
+    def to_row(self) -> dict:
+        return asdict(self)
+
+
+def _label_shape(label: str) -> str:
+    return label.rpartition(' ')[2]
+
+
+class TrialTracker:
+    """Builds the :class:`TrialRecord` of the running trial from what a trial manager hears.
+
+    Call :meth:`start` when the target is named, the ``on_*`` methods as messages arrive (``t``:
+    node-clock seconds), and :meth:`finish` when the trial ends.
+    """
+
+    def __init__(self, protocol: str = '', subject: str = '', seed: int = 0) -> None:
+        self.protocol, self.subject, self.seed = protocol, subject, seed
+        self.record: TrialRecord | None = None
+        self._t0 = 0.0
+        self._states: list[int] = []
+        self._last_pos: tuple[float, float, float] | None = None
+        self._intent: int | None = None
+        self._last_class: int | None = None
+        self._certainties: list[float] = []
+        self._hits = 0
+        self._judged = 0
+        self.last_state_change = 0.0
+
+    @property
+    def active(self) -> bool:
+        return self.record is not None
+
+    def start(self, trial: int, desired: str, desired_id: int = -1, t: float = 0.0,
+              desired_xy: Sequence[float] = (math.nan, math.nan), state: int = 0) -> None:
+        """A new trial: the target ``desired`` is named at time ``t`` (s)."""
+        self.record = TrialRecord(trial=trial, protocol=self.protocol, subject=self.subject,
+                                  seed=self.seed, desired=desired, desired_id=desired_id,
+                                  desired_x=float(desired_xy[0]), desired_y=float(desired_xy[1]))
+        self._t0 = t
+        self._states = [state] if state else []
+        self._last_pos = None
+        self._last_class = None
+        self._certainties = []
+        self._hits = self._judged = 0
+        self.last_state_change = t
+
+    def on_state(self, state: int, object_of_interest: str, t: float) -> None:
+        """``/fsm/state``: records the states visited and the object chosen for the grasp."""
+        if self.record is None:
+            return
+        if not self._states or self._states[-1] != state:
+            self._states.append(state)
+            self.last_state_change = t
+        if state == 5 and not self.record.chosen and object_of_interest:
+            self.record.chosen = object_of_interest
+
+    def on_prediction(self, class_index: int, certainty: float, t: float) -> None:
+        """``/bci/prediction``: class switches, online accuracy against the intent, certainty."""
+        if self.record is None:
+            return
+        rec = self.record
+        rec.n_predictions += 1
+        if self._last_class is not None and class_index != self._last_class:
+            rec.class_switches += 1
+        self._last_class = class_index
+        if math.isfinite(certainty):
+            self._certainties.append(float(certainty))
+        if self._intent is not None:
+            self._judged += 1
+            self._hits += int(class_index == self._intent)
+
+    def on_intent(self, name: str) -> None:
+        """``/virtual_subject/intent``: the class the subject imagines (``rest``: none)."""
+        self._intent = _INTENT_CLASSES.get(name.strip().lower().replace(' ', '_'))
+
+    def on_ee_pose(self, x: float, y: float, z: float) -> None:
+        """``/ee_pose``: adds to the path length (m)."""
+        if self.record is None:
+            return
+        if self._last_pos is not None:
+            lx, ly, lz = self._last_pos
+            self.record.path_length_m += math.sqrt((x - lx) ** 2 + (y - ly) ** 2 + (z - lz) ** 2)
+        self._last_pos = (x, y, z)
+
+    def on_result(self, grasped: str, success: bool, t: float,
+                  lift_height: float = math.nan) -> None:
+        """``/task/result``: the first lift (or drop) of the trial."""
+        rec = self.record
+        if rec is None or rec.grasped:
+            return
+        rec.grasped, rec.success, rec.lift_height = grasped, bool(success), float(lift_height)
+        if success:
+            rec.time_to_grasp_s = t - self._t0
+
+    def finish(self, t: float, failure: str = '', reason: str = '') -> TrialRecord:
+        """End the trial at ``t`` (s); returns its record."""
+        if self.record is None:
+            msg = 'TrialTracker.finish() called without a trial; call start() first.'
+            raise RuntimeError(msg)
+        if failure not in FAILURES:
+            msg = f'Unknown trial failure {failure!r}; use one of {FAILURES}.'
+            raise ValueError(msg)
+        rec, self.record = self.record, None
+        rec.duration_s = t - self._t0
+        rec.states = '-'.join(str(s) for s in self._states)
+        rec.decoder_accuracy = self._hits / self._judged if self._judged else math.nan
+        rec.mean_certainty = (math.fsum(self._certainties) / len(self._certainties)
+                              if self._certainties else math.nan)
+        # the object gone for: ground truth when something was lifted, else the controller's
+        # named choice (colour + CNN shape)
+        gone_for = rec.grasped or rec.chosen
+        rec.correct_choice = bool(gone_for) and gone_for == rec.desired
+        rec.correct_and_successful = rec.success and rec.grasped == rec.desired
+        if not failure and not rec.grasped:
+            failure = 'no_grasp'
+        rec.failure = failure
+        rec.reason = reason or ('object lifted above '
+                                f'{SUCCESS_HEIGHT:.2f} m' if rec.success else failure)
+        return rec
+
+
+def shape_of(label: str) -> str:
+    """``"red cube"`` -> ``"cube"``."""
+    return _label_shape(label)
+
+
+def write_records(records: Iterable[TrialRecord], directory: str | Path,
+                  stem: str = 'records') -> tuple[Path, Path]:
+    """Write ``<directory>/<stem>.csv`` and ``.parquet`` (one row per trial, in trial order)."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    directory = Path(directory)
+    directory.mkdir(parents=True, exist_ok=True)
+    rows = [r.to_row() for r in sorted(records, key=lambda r: r.trial)]
+    columns = TrialRecord.columns()
+    csv_path = directory / f'{stem}.csv'
+    with csv_path.open('w', newline='', encoding='utf-8') as f:
+        writer = csv.DictWriter(f, fieldnames=columns, lineterminator='\n')
+        writer.writeheader()
+        for row in rows:
+            writer.writerow({k: _csv_value(v) for k, v in row.items()})
+    table = pa.Table.from_pylist(rows, schema=_schema()) if rows else _schema().empty_table()
+    parquet_path = directory / f'{stem}.parquet'
+    pq.write_table(table, parquet_path)
+    return csv_path, parquet_path
+
+
+def _csv_value(value: object) -> object:
+    if isinstance(value, float):
+        return '' if math.isnan(value) else repr(value)
+    return value
+
+
+def _schema():
+    import pyarrow as pa
+
+    types = {int: pa.int64(), float: pa.float64(), bool: pa.bool_(), str: pa.string()}
+    return pa.schema([(f.name, types[eval_type(f.type)]) for f in fields(TrialRecord)])
+
+
+def eval_type(annotation: object) -> type:
+    """The builtin type of a TrialRecord field annotation (``'float'`` -> float)."""
+    return {'int': int, 'float': float, 'bool': bool, 'str': str}[str(annotation)]
+
+
+def read_records(path: str | Path) -> list[TrialRecord]:
+    """Records from ``records.parquet`` or ``records.csv`` (a run directory: its parquet)."""
+    path = Path(path)
+    if path.is_dir():
+        path = path / 'records.parquet' if (path / 'records.parquet').exists() \
+            else path / 'records.csv'
+    if not path.exists():
+        msg = (f'No trial records at {path}: give a run directory of mindgrasp experiment (with '
+               'records.csv or records.parquet).')
+        raise FileNotFoundError(msg)
+    kinds = {f.name: eval_type(f.type) for f in fields(TrialRecord)}
+    if path.suffix == '.parquet':
+        import pyarrow.parquet as pq
+
+        rows = pq.read_table(path).to_pylist()
+    else:
+        with path.open(encoding='utf-8') as f:
+            rows = []
+            for row in csv.DictReader(f):
+                conv = {}
+                for k, v in row.items():
+                    kind = kinds.get(k)
+                    if kind is bool:
+                        conv[k] = v == 'True'
+                    elif kind is float:
+                        conv[k] = float(v) if v != '' else math.nan
+                    elif kind is int:
+                        conv[k] = int(v)
+                    elif kind is str:
+                        conv[k] = v
+                rows.append(conv)
+    out = []
+    for row in rows:
+        clean = {k: (math.nan if kinds.get(k) is float and v is None else v)
+                 for k, v in row.items() if k in kinds}
+        out.append(TrialRecord(**clean))
+    return out

@@ -1,0 +1,372 @@
+"""Runs grasp trials: prepares the scene, names the desired object, keeps one record per trial.
+
+    python -m mindgrasp_experiments.trial_manager_node --ros-args -p n_trials:=5 -p seed:=1
+
+Per trial: reset the scene (``/sim/reset``; random locations: ``/sim/load_scene`` with the
+trial's one-object scene), wait until every topic of ``wait_for`` is publishing (the EEG, the
+classifier, the vision: it says what it waits for, and gives up after ``ready_timeout`` s),
+publish ``/task/target`` (mindgrasp_msgs/TaskTarget, transient local), then follow the trial
+until the grasp result (``/task/result``), a grasp attempt that ends without one, no controller
+state change for ``stall_timeout`` s, or ``trial_timeout`` s. Every time is on the node clock
+(simulated time with ``use_sim_time``), so lock-step experiments and live runs behave alike.
+
+Records (:class:`~mindgrasp_experiments.records.TrialRecord`) are kept in ``records``; with
+``records_dir`` (default ``$MINDGRASP_RUN_DIR/trials`` in a launch) they are also written as
+records.csv and records.parquet after every trial. The node ends after ``n_trials`` (0: never)
+and logs the tally.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import sys
+import tempfile
+from pathlib import Path
+
+import yaml
+from mindgrasp_ros.interfaces.geometry_msgs.msg import PoseStamped
+from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import (
+    FsmState,
+    GraspResult,
+    MIPrediction,
+    TaskTarget,
+)
+from mindgrasp_ros.interfaces.mindgrasp_msgs.srv import LoadScene, ResetSim
+from mindgrasp_ros.interfaces.std_msgs.msg import String
+from mindgrasp_ros.interfaces.visualization_msgs.msg import MarkerArray
+
+from mindgrasp_experiments.protocols import (
+    PROTOCOLS,
+    random_locations_trial,
+    set_locations_target,
+)
+from mindgrasp_experiments.records import TrialRecord, TrialTracker, write_records
+from mindgrasp_experiments.summary import summarise
+from mindgrasp_ros import rclpy
+
+PARAMETERS = [
+    ('protocol', 'set_locations'), ('n_trials', 0), ('first_trial', 1), ('seed', 0),
+    ('targets', ''), ('subject', ''), ('trial_timeout', 600.0), ('stall_timeout', 120.0),
+    ('settle_time', 3.0), ('wait_for', ['/eeg/raw', '/bci/prediction', '/vision/detections']),
+    ('ready_timeout', 60.0), ('service_timeout', 10.0), ('records_dir', ''),
+    ('scene', 'set_locations'),
+]
+
+
+class TrialManagerNode(rclpy.node.Node):
+    """Trial loop of the grasp protocols (see the module docstring)."""
+
+    def __init__(self, **kwargs) -> None:
+        super().__init__('trial_manager', **kwargs)
+        self.declare_parameters('', PARAMETERS)
+        p = {name: self.get_parameter(name).value for name, _ in PARAMETERS}
+        self.p = p
+        if p['protocol'] not in PROTOCOLS:
+            msg = (f"The parameter 'protocol' is {p['protocol']!r}; use one of "
+                   f'{list(PROTOCOLS)}.')
+            raise ValueError(msg)
+        self.targets = [t.strip() for t in str(p['targets']).split(',') if t.strip()]
+        self.tracker = TrialTracker(p['protocol'], p['subject'], int(p['seed']))
+        self.records: list[TrialRecord] = []
+        records_dir = p['records_dir'] or (
+            str(Path(os.environ['MINDGRASP_RUN_DIR']) / 'trials')
+            if os.environ.get('MINDGRASP_RUN_DIR') else '')
+        self.records_dir = Path(records_dir) if records_dir else None
+        latched = rclpy.qos.QoSProfile(depth=1,
+                                       durability=rclpy.qos.DurabilityPolicy.TRANSIENT_LOCAL)
+        self.target_pub = self.create_publisher(TaskTarget, '/task/target', latched)
+        self.create_subscription(MarkerArray, '/sim/objects', self.objects_callback, latched)
+        self.create_subscription(GraspResult, '/task/result', self.result_callback, 10)
+        self.create_subscription(FsmState, '/fsm/state', self.fsm_callback, latched)
+        self.create_subscription(MIPrediction, '/bci/prediction', self.prediction_callback, 10)
+        self.create_subscription(String, '/virtual_subject/intent', self.intent_callback,
+                                 rclpy.qos.QoSProfile(
+                                     depth=10,
+                                     durability=rclpy.qos.DurabilityPolicy.TRANSIENT_LOCAL))
+        self.create_subscription(PoseStamped, '/ee_pose', self.ee_callback, 10)
+        # readiness: any message type will do; the last arrival time of each topic is kept
+        self.last_seen: dict[str, float] = {}
+        for topic in p['wait_for']:
+            if topic and topic not in ('/bci/prediction',):
+                self._watch(topic)
+        self.reset_client = self.create_client(ResetSim, '/sim/reset')
+        self.load_client = self.create_client(LoadScene, '/sim/load_scene')
+        self.scene: dict[int, tuple[str, float, float]] = {}   # id -> (label, x, y)
+        self.fsm_state = 0
+        self.trial = int(p['first_trial']) - 1
+        self.n_done = 0
+        self.target_id = -1
+        self.target_label = ''
+        self.result: GraspResult | None = None
+        self.phase = 'preparing'
+        self.phase_since = self.now_s()
+        self.future = None
+        self.said_waiting = ''
+        self.done = False
+        self.error: str | None = None
+        self._scene_dir: Path | None = None
+        self._enter('starting')
+        self.create_timer(0.1, self.tick)
+
+    # ------------------------------------------------------------------ inputs
+    def now_s(self) -> float:
+        """Node clock (s): wall time, or simulated time with use_sim_time."""
+        return self.get_clock().now().nanoseconds * 1e-9
+
+    def _watch(self, topic: str) -> None:
+        from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import DetectionArray, EEGChunk
+
+        kinds = {'/eeg/raw': (EEGChunk, rclpy.qos.qos_profile_sensor_data),
+                 '/vision/detections': (DetectionArray, 10)}
+        if topic not in kinds:
+            msg = (f"wait_for lists {topic!r}; the trial manager can wait for "
+                   f"{sorted([*kinds, '/bci/prediction'])}.")
+            raise ValueError(msg)
+        kind, qos = kinds[topic]
+        self.create_subscription(kind, topic, lambda _m, t=topic: self._seen(t), qos)
+
+    def _seen(self, topic: str) -> None:
+        self.last_seen[topic] = self.now_s()
+
+    def objects_callback(self, msg: MarkerArray) -> None:
+        scene = {}
+        for m in msg.markers:
+            if m.text:
+                scene[int(m.id)] = (m.text, float(m.pose.position.x), float(m.pose.position.y))
+        self.scene = scene
+
+    def result_callback(self, msg: GraspResult) -> None:
+        if self.phase == 'trial' and self.result is None:
+            self.result = msg
+            self.tracker.on_result(msg.grasped_object, bool(msg.success), self.now_s(),
+                                   float(msg.lift_height))
+
+    def fsm_callback(self, msg: FsmState) -> None:
+        self.fsm_state = int(msg.state)
+        if self.phase == 'trial':
+            self.tracker.on_state(int(msg.state), msg.object_of_interest, self.now_s())
+
+    def prediction_callback(self, msg: MIPrediction) -> None:
+        self._seen('/bci/prediction')
+        if self.phase == 'trial':
+            self.tracker.on_prediction(int(msg.class_index), float(msg.certainty), self.now_s())
+
+    def intent_callback(self, msg: String) -> None:
+        self.tracker.on_intent(msg.data)
+
+    def ee_callback(self, msg: PoseStamped) -> None:
+        if self.phase == 'trial':
+            p = msg.pose.position
+            self.tracker.on_ee_pose(float(p.x), float(p.y), float(p.z))
+
+    # ------------------------------------------------------------------ trial loop
+    def _enter(self, phase: str) -> None:
+        self.phase, self.phase_since = phase, self.now_s()
+
+    def tick(self) -> None:
+        """Every 0.1 s of node time: move the trial loop on."""
+        if self.done:
+            return
+        now = self.now_s()
+        if self.phase == 'starting':
+            # trial 1 waits for the simulator's services (nodes may start in any order)
+            client = self.load_client if self.p['protocol'] == 'random_locations' \
+                else self.reset_client
+            if client.service_is_ready() or now - self.phase_since > self.p['service_timeout']:
+                self._begin_trial()
+        elif self.phase == 'preparing':
+            if self.future is None or self.future.done():
+                ok = self.future is None or self.future.result() is None or \
+                    self.future.result().success
+                if not ok:
+                    self.fail(f'The simulator could not prepare trial {self.trial}: '
+                              f'{self.future.result().message}')
+                    return
+                self.future = None
+                self._enter('waiting')
+            elif now - self.phase_since > self.p['service_timeout']:
+                self.fail(f'The simulator did not answer the scene reset of trial {self.trial} '
+                          f"within {self.p['service_timeout']:g} s; is the sim node running?")
+        elif self.phase == 'waiting':
+            self._wait_until_ready(now)
+        elif self.phase == 'trial':
+            self._follow_trial(now)
+        elif self.phase == 'settling' and (
+                (self.fsm_state in (FsmState.OBJECT_SEARCH, 0)
+                 and now - self.phase_since > self.p['settle_time'])
+                or now - self.phase_since > 30.0):
+            # the controller brought the arm home before the scene is reset under it
+            self._begin_trial()
+
+    def _begin_trial(self) -> None:
+        """Reset the scene for the next trial (or end after ``n_trials``)."""
+        if self.p['n_trials'] and self.n_done >= self.p['n_trials']:
+            self._report()
+            self.done = True
+            self._enter('finished')
+            return
+        self.trial += 1
+        self.result = None
+        self.scene = {}
+        if self.p['protocol'] == 'random_locations':
+            spec = random_locations_trial(int(self.p['seed']), self.trial)
+            path = self._scene_file(spec.scene())
+            self.future = self._call(self.load_client, LoadScene.Request(scene=str(path),
+                                                                         seed=-1))
+        else:
+            self.future = self._call(self.reset_client, ResetSim.Request(seed=-1))
+        self._enter('preparing')
+
+    def _call(self, client, request):
+        if not client.service_is_ready():
+            self.get_logger().warning(f'{client.srv_name} is not available; trial '
+                                      f'{self.trial} starts without a scene reset.')
+            return None
+        return client.call_async(request)
+
+    def _scene_file(self, scene: dict) -> Path:
+        if self._scene_dir is None:
+            base = self.records_dir.parent if self.records_dir is not None else None
+            self._scene_dir = Path(tempfile.mkdtemp(prefix='scenes_', dir=base))
+        path = self._scene_dir / f"{scene['name']}.yaml"
+        path.write_text(yaml.safe_dump(scene, sort_keys=False), encoding='utf-8')
+        return path
+
+    def _wait_until_ready(self, now: float) -> None:
+        missing = [t for t in self.p['wait_for']
+                   if t and now - self.last_seen.get(t, -math.inf) > 1.0]
+        if self.scene == {}:
+            missing.insert(0, '/sim/objects')
+        if missing:
+            waited = now - self.phase_since
+            text = ', '.join(missing)
+            if text != self.said_waiting:
+                self.said_waiting = text
+                self.get_logger().info(f'Trial {self.trial} waits for {text} to publish '
+                                       f"(up to {self.p['ready_timeout']:g} s).")
+            if waited > self.p['ready_timeout']:
+                self.fail(f'Gave up before trial {self.trial}: no messages on {text} after '
+                          f"{self.p['ready_timeout']:g} s. Check that the nodes publishing "
+                          f'them run (mindgrasp topic hz {missing[0]}).')
+            return
+        self.said_waiting = ''
+        self._start_trial(now)
+
+    def _choose_target(self) -> tuple[int, str]:
+        ids = sorted(self.scene)
+        if self.p['protocol'] == 'random_locations':
+            return ids[0], self.scene[ids[0]][0]
+        if self.targets:
+            label = self.targets[(self.trial - 1) % len(self.targets)]
+            for i in ids:
+                if self.scene[i][0] == label:
+                    return i, label
+            known = ', '.join(sorted(v[0] for v in self.scene.values()))
+            msg = f'Target {label!r} is not in the scene; the scene has: {known}.'
+            raise ValueError(msg)
+        i = ids[set_locations_target(int(self.p['seed']), self.trial, len(ids))]
+        return i, self.scene[i][0]
+
+    def _start_trial(self, now: float) -> None:
+        try:
+            self.target_id, self.target_label = self._choose_target()
+        except ValueError as exc:
+            self.fail(str(exc))
+            return
+        _label, x, y = self.scene[self.target_id]
+        self.tracker.start(self.trial, self.target_label, self.target_id, now, (x, y),
+                           state=self.fsm_state)
+        colour, _, shape = self.target_label.partition(' ')
+        msg = TaskTarget(trial=self.trial, object_id=self.target_id, colour=colour, shape=shape,
+                         scene=str(self.p['protocol']))
+        msg.header.stamp = self.get_clock().now().to_msg()
+        self.target_pub.publish(msg)
+        self.get_logger().info(f'Trial {self.trial}: grasp the {self.target_label}.')
+        self._enter('trial')
+
+    def _follow_trial(self, now: float) -> None:
+        tracker = self.tracker
+        if self.result is not None:
+            self._finish(now, '', '')
+        elif self.p['trial_timeout'] > 0 and now - tracker._t0 > self.p['trial_timeout']:
+            self._finish(now, 'timeout', f"no grasp within {self.p['trial_timeout']:g} s")
+        elif self.p['stall_timeout'] > 0 and \
+                now - tracker.last_state_change > self.p['stall_timeout']:
+            self._finish(now, 'stalled', f'no controller state change for '
+                                         f"{self.p['stall_timeout']:g} s (state "
+                                         f'{self.fsm_state})')
+        elif tracker._states[-3:] in ([5, 6, 1], [4, 6, 1]):
+            self._finish(now, 'no_grasp', 'the grasp attempt ended without a lift')
+
+    def _finish(self, now: float, failure: str, reason: str) -> None:
+        rec = self.tracker.finish(now, failure, reason)
+        self.records.append(rec)
+        self.n_done += 1
+        verdict = ('correct object grasped' if rec.correct_and_successful else
+                   f'grasped the {rec.grasped}' if rec.success else
+                   f'failed ({rec.failure}: {rec.reason})')
+        self.get_logger().info(f'Trial {rec.trial} ({rec.desired}): {verdict} after '
+                               f'{rec.duration_s:.1f} s.')
+        if self.records_dir is not None:
+            write_records(self.records, self.records_dir)
+        last = self.p['n_trials'] and self.n_done >= self.p['n_trials']
+        if last:
+            self._begin_trial()          # ends the node
+        else:
+            self._enter('settling')
+
+    def finish_interrupted(self, reason: str, failure: str = 'interrupted') -> None:
+        """End the running trial now (Ctrl-C, a node error): recorded as a failure."""
+        if self.tracker.active:
+            rec = self.tracker.finish(self.now_s(), failure, reason)
+            self.records.append(rec)
+            if self.records_dir is not None:
+                write_records(self.records, self.records_dir)
+
+    def fail(self, reason: str) -> None:
+        """Stop the trials with an error (the node ends, exit code 1)."""
+        self.error = reason
+        self.get_logger().error(reason)
+        self.done = True
+        self._enter('failed')
+
+    def _report(self) -> None:
+        if not self.records:
+            return
+        s = summarise(self.records)
+        self.get_logger().info(
+            f"{s['trials']} trials: grasp success {100 * s['success_rate']:.1f} %, correct "
+            f"choice {100 * s['correct_choice_rate']:.1f} %, correct and successful "
+            f"{100 * s['correct_and_successful_rate']:.1f} %, mean trial time "
+            f"{s['mean_duration_s']:.1f} s.")
+
+
+def main(args: list[str] | None = None) -> int:
+    """Run trials until ``n_trials`` are done or Ctrl-C; log the tally. Exit 1 on an error."""
+    rclpy.init(args=args)
+    try:
+        node = TrialManagerNode()
+    except ValueError as exc:
+        print(f'[trial_manager] ERROR: {exc}', file=sys.stderr)
+        rclpy.try_shutdown()
+        return 2
+    executor = rclpy.executors.SingleThreadedExecutor()
+    executor.add_node(node)
+    try:
+        while rclpy.ok() and not node.done:
+            executor.spin_once(timeout_sec=0.1)
+    except KeyboardInterrupt:
+        node.finish_interrupted('stopped by Ctrl-C')
+        node._report()
+    finally:
+        node.destroy_node()
+        rclpy.try_shutdown()
+    if node.error is not None:
+        print(f'[trial_manager] ERROR: {node.error}', file=sys.stderr)
+        return 1
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())

@@ -1,0 +1,127 @@
+"""``mindgrasp experiment ...`` end to end: the experiment profile's real nodes (simulator, virtual
+amplifier, classifier, vision, controller, trial manager) composed in lock-step on simulated
+time, in subprocesses as a user runs them."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from mindgrasp_experiments.records import read_records
+
+HERE = Path(__file__).resolve().parent
+FILES = ('records.csv', 'records.parquet', 'summary.json', 'report.md', 'time_to_grasp.png',
+         'time_to_grasp.svg')
+
+
+def mindgrasp(*args: str, timeout: float = 1200.0) -> subprocess.CompletedProcess:
+    env = dict(os.environ)
+    # the user's own nodes (tests/experiments/user_nodes) for --launch
+    env['PYTHONPATH'] = f"{HERE}{os.pathsep}{env.get('PYTHONPATH', '')}"
+    return subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', *args],
+                          capture_output=True, text=True, timeout=timeout, env=env, check=False)
+
+
+def last_json(result: subprocess.CompletedProcess) -> dict:
+    assert result.returncode == 0, result.stderr[-3000:]
+    return json.loads(result.stdout.strip().splitlines()[-1])
+
+
+@pytest.mark.parametrize(('args', 'message'), [
+    (['set-locations', '--trials', '0'], '--trials must be a whole number >= 1, got 0'),
+    (['set-locations', '--accuracy', '1.5'], '--accuracy must be within 0..1'),
+    (['set-locations', '--seed', '-3'], '--seed must be >= 0'),
+    (['random-locations', '--workers', '0'], '--workers must be >= 1'),
+    (['random-locations', '--launch', 'nowhere.launch.py'], 'no such launch file'),
+    (['report', 'no/such/run'], 'is not a directory'),
+])
+def test_bad_input_is_one_clear_line_and_exit_2(args: list[str], message: str) -> None:
+    result = mindgrasp('experiment', *args, timeout=120)
+    assert result.returncode == 2, result.stderr
+    lines = [ln for ln in result.stderr.splitlines() if ln.startswith('mindgrasp experiment')]
+    assert len(lines) == 1 and message in lines[0], result.stderr
+    assert 'Traceback' not in result.stderr
+
+
+@pytest.mark.slow
+def test_virtual_subject_at_accuracy_1_picks_the_desired_object_and_every_file_is_written(
+        tmp_path: Path) -> None:
+    out = tmp_path / 'run'
+    result = mindgrasp('experiment', 'set-locations', '--trials', '3', '--subject', 'virtual',
+                       '--accuracy', '1.0', '--seed', '2', '--out', str(out), '--json',
+                       '--no-progress')
+    s = last_json(result)
+    for name in (*FILES, 'set_location_map.png', 'set_location_map.svg'):
+        assert (out / name).stat().st_size > 0, name
+    records = read_records(out)
+    assert [r.trial for r in records] == [1, 2, 3]
+    # the subject aims before it selects: every trial goes for the desired object
+    assert all(r.correct_choice for r in records), [(r.desired, r.chosen, r.grasped, r.states)
+                                                    for r in records]
+    assert s['trials'] == 3 and s['real_time_factor'] > 0 and s['cpu_s_per_sim_s'] > 0
+    report = (out / 'report.md').read_text()
+    assert '35.6 %' in report and 'Wilson 95 % CI' in report and 'real-time factor' in report
+    # the report is rebuilt from the records alone
+    (out / 'report.md').unlink()
+    assert mindgrasp('experiment', 'report', str(out), timeout=300).returncode == 0
+    assert (out / 'report.md').read_text() == report
+
+
+@pytest.mark.slow
+def test_oracle_subject_grasps_the_desired_objects(tmp_path: Path) -> None:
+    s = last_json(mindgrasp('experiment', 'set-locations', '--trials', '3', '--subject',
+                            'oracle', '--seed', '0', '--out', str(tmp_path / 'run'), '--json',
+                            '--no-progress'))
+    assert s['correct_and_successful_count'] >= 2, s
+
+
+@pytest.mark.slow
+def test_same_seed_same_csv_with_1_and_2_workers_and_noise_runs(tmp_path: Path) -> None:
+    csv = []
+    for workers in ('1', '2'):
+        out = tmp_path / f'w{workers}'
+        s = last_json(mindgrasp('experiment', 'set-locations', '--trials', '2', '--subject',
+                                'noise', '--seed', '7', '--workers', workers,
+                                '--trial-timeout', '12', '--out', str(out), '--json',
+                                '--no-progress'))
+        assert s['trials'] == 2
+        csv.append((out / 'records.csv').read_text())
+    assert csv[0] == csv[1]
+    records = read_records(tmp_path / 'w1')
+    assert all(r.subject == 'noise' and r.n_predictions > 0 for r in records)
+
+
+@pytest.mark.slow
+def test_random_locations_and_a_users_own_controller(tmp_path: Path) -> None:
+    s = last_json(mindgrasp('experiment', 'random-locations', '--trials', '1', '--seed', '1',
+                            '--out', str(tmp_path / 'auto'), '--json', '--no-progress'))
+    assert s['trials'] == 1
+    assert (tmp_path / 'auto' / 'random_location_scatter.svg').exists()
+    # the user's controller replaces the node named fsm; it never grasps, so the trial is
+    # aborted when its state stops changing
+    out = tmp_path / 'own'
+    s = last_json(mindgrasp('experiment', 'random-locations', '--trials', '1', '--seed', '1',
+                            '--launch', str(HERE / 'user_nodes' / 'simple_controller.launch.py'),
+                            '--stall-timeout', '4', '--out', str(out), '--json',
+                            '--no-progress'))
+    (rec,) = read_records(out)
+    assert rec.failure == 'stalled' and 'no controller state change for 4 s' in rec.reason
+    assert rec.states.startswith('1') and rec.path_length_m > 0.01
+
+
+@pytest.mark.slow
+def test_a_node_raising_fails_its_trial_and_the_experiment_goes_on(tmp_path: Path) -> None:
+    out = tmp_path / 'faulty'
+    s = last_json(mindgrasp('experiment', 'random-locations', '--trials', '2', '--seed', '1',
+                            '--launch', str(HERE / 'user_nodes' / 'faulty_controller.launch.py'),
+                            '--out', str(out), '--json', '--no-progress'))
+    assert s['trials'] == 2 and s['node_errors'] == 2
+    for rec in read_records(out):
+        assert rec.failure == 'node_error'
+        assert "fsm" in rec.reason and 'simulated controller fault' in rec.reason
+

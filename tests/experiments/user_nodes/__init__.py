@@ -1,0 +1,1 @@
+"""A user's own nodes, as a researcher would write them, for the --launch tests."""

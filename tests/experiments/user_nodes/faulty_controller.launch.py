@@ -1,0 +1,10 @@
+"""A controller that raises 2 s into each trial."""
+
+from mindgrasp_bringup.launch_system import LaunchDescription, Node
+
+
+def generate_launch_description() -> LaunchDescription:
+    return LaunchDescription([
+        Node(package='user_nodes', executable='simple_controller_node', name='fsm',
+             parameters=[{'raise_after': 2.0}]),
+    ])

@@ -1,0 +1,9 @@
+"""My own controller in place of the MIndGrasp one (the node named fsm is replaced)."""
+
+from mindgrasp_bringup.launch_system import LaunchDescription, Node
+
+
+def generate_launch_description() -> LaunchDescription:
+    return LaunchDescription([
+        Node(package='user_nodes', executable='simple_controller_node', name='fsm'),
+    ])
