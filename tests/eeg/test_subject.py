@@ -100,6 +100,8 @@ def test_pursue_class_like_a_competent_user() -> None:
     assert pursue_class(left, 1.4, 1) == 1                     # overshot: turn right
     assert pursue_class(left, 0.68, 1) == 2                    # centred: stop and approach
     assert pursue_class(ahead, 0.0, 3) == 2                    # approach the right one
+    assert pursue_class(left, 0.0, 3, 'blue unknown') == 2     # shape not named yet: same colour
+    assert pursue_class(ahead, 0.0, 3, 'blue unknown') == 3    # another colour: back away
     assert pursue_class(ahead, 0.0, 3, 'blue cylinder') == 3   # wrong object: back away
     assert pursue_class(ahead, 0.0, 2, 'blue cylinder') == 3
     assert pursue_class(ahead, 0.0, 2, 'red cube') is None     # centring is autonomous
@@ -128,6 +130,24 @@ def test_pursue_mode_uses_its_inputs_and_accuracy() -> None:
         noisy.intent(k * 0.1)
     right = np.mean([a == c for _, a, c in noisy.decisions])
     assert right == pytest.approx(0.5, abs=0.06)
+
+
+def test_pursue_aims_at_a_new_target_before_it_selects() -> None:
+    """A new target cancels the both-hands imagery meant for the object in front: the subject
+    rests, then turns towards the new target (a 6-trial live run once selected the object in
+    front 0.3 s after a new target appeared)."""
+    ahead = SceneObject(0, 'red', 'cube', 0.5, 0.0)
+    left = SceneObject(1, 'blue', 'cylinder', 0.5 * math.cos(0.7), 0.5 * math.sin(0.7))
+    s = VirtualSubject('pursue', reaction_delay=0.5, decision_period=0.5, seed=0)
+    s.set_objects([ahead, left])
+    s.set_fsm(1)
+    s.set_target(0, 'red', 'cube')
+    s.intent(10.0)                          # decides both hands (it faces the red cube) ...
+    assert s.intent(10.45) is None
+    s.set_target(1, 'blue', 'cylinder')     # ... but the target changes before that starts
+    imagined = [s.intent(10.5 + 0.01 * k) for k in range(60)]
+    assert 2 not in imagined                # never both hands while facing the wrong object
+    assert imagined[0] is None and imagined[-1] == 0      # rest, then turn left to the target
 
 
 def test_bad_parameters() -> None:

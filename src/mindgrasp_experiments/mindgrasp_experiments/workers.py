@@ -33,13 +33,22 @@ def run_trials(components: Sequence[LockstepComponent], trials: Sequence[int], *
             yield run_trial(components, trial, seed=seed, step_s=step_s, log_level=log_level)
         return
     ctx = multiprocessing.get_context('spawn')
-    with concurrent.futures.ProcessPoolExecutor(max_workers=workers, mp_context=ctx,
-                                                initializer=_worker_init) as pool:
-        futures = [pool.submit(run_trial, list(components), trial, seed=seed, step_s=step_s,
-                               log_level=log_level) for trial in trials]
-        try:
-            for future in concurrent.futures.as_completed(futures):
-                yield future.result()
-        finally:
-            for future in futures:
-                future.cancel()
+    pool = concurrent.futures.ProcessPoolExecutor(max_workers=workers, mp_context=ctx,
+                                                  initializer=_worker_init)
+    futures = [pool.submit(run_trial, list(components), trial, seed=seed, step_s=step_s,
+                           log_level=log_level) for trial in trials]
+    finished = False
+    try:
+        for future in concurrent.futures.as_completed(futures):
+            yield future.result()
+        finished = True
+    finally:
+        if finished:
+            pool.shutdown(wait=True)
+        else:
+            # Ctrl-C (or an error): the trials still running are abandoned; stop our workers
+            processes = list((getattr(pool, '_processes', None) or {}).values())
+            pool.shutdown(wait=False, cancel_futures=True)
+            for process in processes:
+                if process.is_alive():
+                    process.terminate()
