@@ -43,6 +43,7 @@ def _run_chunk(profile: dict | None, seed: int, n_trials: int, indices: list[int
     """Worker: run the trials ``indices`` of ``draw_trials(n_trials, seed)`` with a profile
     (as a dict; None = no realism). Returns one record per trial."""
     from mindgrasp_fsm.experiment import build_loop, draw_trials
+
     from mindgrasp_fsm.params import FsmParams, default_params_path
     from mindgrasp_sim.realism import RealismProfile
 

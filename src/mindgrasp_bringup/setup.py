@@ -47,7 +47,6 @@ setup(
     license='MIT',
     entry_points={
         'console_scripts': [
-            'trial_manager_node = mindgrasp_bringup.trial_manager_node:main',
             'foxglove_bridge_node = mindgrasp_bringup.foxglove_bridge_node:main',
             'replay_node = mindgrasp_bringup.replay.replay_node:main',
             'recorder_node = mindgrasp_bringup.bag.recorder_node:main',

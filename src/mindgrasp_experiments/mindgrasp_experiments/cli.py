@@ -72,6 +72,15 @@ def check(args: argparse.Namespace, command: str) -> str | None:
         return f'--trial-timeout must be > 0 s, got {args.trial_timeout}.'
     if args.launch is not None and not Path(args.launch).is_file():
         return f'--launch {args.launch}: no such launch file; give a *.launch.py path.'
+    realism = getattr(args, 'realism', None)
+    if realism is not None:
+        from mindgrasp_sim.errors import SimError
+        from mindgrasp_sim.realism import RealismProfile
+
+        try:
+            RealismProfile.load(realism)
+        except SimError as exc:
+            return f'--realism: {exc}'
     return None
 
 
@@ -98,6 +107,8 @@ def run_experiment(args: argparse.Namespace, protocol: str, command: str) -> int
                    'trials': '1'}
     if getattr(args, 'accuracy', None) is not None:
         launch_args['accuracy'] = str(args.accuracy)
+    if getattr(args, 'realism', None) is not None:
+        launch_args['realism'] = str(args.realism)
     if subject == 'noise':
         from mindgrasp_experiments.subjects import noise_model
 
@@ -149,6 +160,7 @@ def run_experiment(args: argparse.Namespace, protocol: str, command: str) -> int
         'command': ' '.join(['mindgrasp', 'experiment', command, *sys.argv[3:]]),
         'protocol': protocol, 'subject': subject, 'seed': args.seed,
         'accuracy': getattr(args, 'accuracy', None), 'workers': args.workers,
+        'realism': getattr(args, 'realism', None),
         'trials_requested': args.trials, 'interrupted': interrupted,
         'launch_overlay': args.launch, 'step_s': args.step,
         'trial_timeout_s': args.trial_timeout, 'stall_timeout_s': args.stall_timeout,

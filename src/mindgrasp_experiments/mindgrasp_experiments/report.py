@@ -52,8 +52,8 @@ def render_report(summary: Mapping[str, Any], run: Mapping[str, Any]) -> str:
     paper = PAPER.get(protocol, {})
     lines = [f"# {protocol.replace('_', ' ').capitalize() or 'Experiment'}: "
              f"{summary['trials']} trials, subject {run.get('subject', '?')}", '']
-    settings = ', '.join(f'{k} {run[k]}' for k in ('seed', 'accuracy', 'workers') if k in run
-                         and run[k] is not None)
+    settings = ', '.join(f'{k} {run[k]}' for k in ('seed', 'accuracy', 'realism', 'workers')
+                         if k in run and run[k] is not None)
     if settings:
         lines += [f'Settings: {settings}. Command: `{run.get("command", "")}`', '']
     lines += ['| figure | ours | Wilson 95 % CI | paper |', '|---|---|---|---|']

@@ -95,17 +95,13 @@ def _run_lockstep(args: argparse.Namespace, service: LaunchService,
     """``--lockstep``: every node composed on simulated time (mindgrasp_experiments.engine);
     ``duration:=S`` counts simulated seconds. Returns 1 when a node failed."""
     from mindgrasp_bringup.launch_system import rundir
-    from mindgrasp_experiments import ExperimentError
-    from mindgrasp_experiments.engine import lockstep_components, run_lockstep
+    from mindgrasp_bringup.launch_system.lockstep import lockstep_components, run_lockstep
 
     service.plan()    # argument problems are reported before anything is created
     run_dir = rundir.create_run_dir(service.name, args.run_dir, service.runs_root)
     given = dict(a.split(':=', 1) for a in launch_arguments)
     duration = float(given.pop('duration', 0) or 0)
-    try:
-        components = lockstep_components(service.launch_file, given, run_dir / 'params')
-    except ExperimentError as exc:
-        raise LaunchError(str(exc)) from None
+    components = lockstep_components(service.launch_file, given, run_dir / 'params')
     print(f'lock-step: composing {len(components)} node(s) on simulated time: '
           + ', '.join(c.label for c in components) + f'; run directory {run_dir}', flush=True)
     import os

@@ -79,6 +79,10 @@ def generate_launch_description() -> LaunchDescription:
                                           '(the noise subject needs a noise-trained one)'),
         DeclareLaunchArgument('eeg_stream', default_value='MIndGrasp-Experiment',
                               description='LSL stream name of the virtual amplifier (live runs)'),
+        DeclareLaunchArgument('realism', default_value='none',
+                              description='simulator realism: none, default or a profile YAML '
+                                          '(sensor noise, camera mount error, arm lag, object '
+                                          'spread; mindgrasp_sim.realism), seeded by seed'),
         DeclareLaunchArgument('gui', default_value='false', choices=['true', 'false'],
                               description='open the PyBullet window (needs a display)'),
         *[Node(package='mindgrasp_experiments', executable='trial_manager_node',
@@ -88,6 +92,7 @@ def generate_launch_description() -> LaunchDescription:
         Node(package='mindgrasp_sim', executable='sim_node', name='sim',
              parameters=[*config_files('sim', 'experiment'),
                          {'gui': LaunchConfiguration('gui'), 'seed': seed,
+                          'realism': LaunchConfiguration('realism'), 'realism_seed': seed,
                           'scene': PythonExpression(["'random_locations' if '",
                                                      LaunchConfiguration('protocol'),
                                                      "' == 'random_locations' else "

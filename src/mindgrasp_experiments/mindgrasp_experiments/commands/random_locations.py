@@ -2,6 +2,7 @@
 from the base; the controller finds, approaches and grasps it autonomously (lock-step, sim time).
 
     mindgrasp experiment random-locations --trials 507 --seed 0 --workers 2 --json
+    mindgrasp experiment random-locations --trials 90 --realism default
 """
 
 from __future__ import annotations
@@ -14,6 +15,9 @@ from mindgrasp_experiments.cli import add_common_arguments, run_experiment
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Arguments of ``mindgrasp experiment random-locations``."""
     add_common_arguments(parser, trials=507)
+    parser.add_argument('--realism', default='none',
+                        help='sensor noise and physical spread: none (default), default or a '
+                             'profile YAML path (mindgrasp_sim.realism), seeded per trial')
 
 
 def main(args: argparse.Namespace) -> int:
