@@ -133,3 +133,30 @@ def test_a_node_raising_fails_its_trial_and_the_experiment_goes_on(tmp_path: Pat
         assert rec.failure == 'node_error'
         assert "fsm" in rec.reason and 'simulated controller fault' in rec.reason
 
+
+
+@pytest.mark.slow
+def test_ctrl_c_writes_the_finished_trials(tmp_path: Path) -> None:
+    import signal
+    import time
+
+    out = tmp_path / 'stopped'
+    env = dict(os.environ)
+    proc = subprocess.Popen([sys.executable, '-m', 'mindgrasp_bringup', 'experiment',
+                             'random-locations', '--trials', '50', '--trial-timeout', '3',
+                             '--out', str(out), '--no-progress'],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+    # records.csv is rewritten after every finished trial: stop once it holds one
+    deadline = time.monotonic() + 900
+    csv = out / 'records.csv'
+    while time.monotonic() < deadline and proc.poll() is None and (
+            not csv.exists() or len(csv.read_text().splitlines()) < 2):
+        time.sleep(0.5)
+    proc.send_signal(signal.SIGINT)
+    _stdout, stderr = proc.communicate(timeout=300)
+    assert proc.returncode == 130, stderr[-2000:]
+    assert 'Interrupted: writing the' in stderr
+    records = read_records(out)
+    assert 0 < len(records) < 50
+    assert [r.trial for r in records] == list(range(1, len(records) + 1))
+    assert (out / 'report.md').exists() and 'Interrupted' in (out / 'report.md').read_text()

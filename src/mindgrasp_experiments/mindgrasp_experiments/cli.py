@@ -92,6 +92,7 @@ def run_experiment(args: argparse.Namespace, protocol: str, command: str) -> int
     from mindgrasp_bringup.launch_system.rundir import create_run_dir
     from mindgrasp_experiments import ExperimentError
     from mindgrasp_experiments.engine import lockstep_components
+    from mindgrasp_experiments.records import write_records
     from mindgrasp_experiments.report import finite, write_run
     from mindgrasp_experiments.workers import run_trials
 
@@ -139,6 +140,7 @@ def run_experiment(args: argparse.Namespace, protocol: str, command: str) -> int
                               step_s=args.step):
             runs.append(run)
             done = [r.record for r in runs]
+            write_records(done, out)      # on disk as they finish: nothing is lost on a crash
             bar.update(1)
             bar.set_postfix(success=f'{sum(r.success for r in done)}/{len(done)}',
                             rtf=f'{sum(r.sim_s for r in runs) / (time.perf_counter() - wall0):.1f}')
