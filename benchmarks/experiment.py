@@ -36,13 +36,13 @@ def main(argv: list[str] | None = None) -> int:
                         help='profile with cProfile and print the N costliest functions')
     args = parser.parse_args(argv)
 
-    from mindgrasp_experiments.cli import NOISE_MODEL
+    from mindgrasp_experiments.cli import noise_model_path
     from mindgrasp_experiments.engine import lockstep_components, run_trial
 
     launch_args = {'protocol': args.protocol, 'subject': args.subject,
                    'accuracy': str(args.accuracy), 'seed': str(args.seed)}
     if args.subject == 'noise':
-        launch_args['model'] = str(NOISE_MODEL.with_suffix('.json'))
+        launch_args['model'] = noise_model_path(Path(tempfile.mkdtemp()))
     comps = lockstep_components('experiment', launch_args, Path(tempfile.mkdtemp()) / 'params',
                                 log=lambda _text: None)
     prof = cProfile.Profile() if args.profile else None

@@ -19,9 +19,10 @@ and prints a table of the success rates (plot with ``--plot``).
 ``cnn`` measures the depth shape CNN's accuracy on simulator views collected with the realism
 profile and without it (independent images, seed + 1000 as ``mindgrasp train vision`` uses).
 
-Each trial runs in lock-step in-process (the Simulation, VisionPipeline and GraspFsm classes the
-nodes run); trials are spread over ``--workers`` processes and seeded by the trial index, so the
-figures do not depend on the number of workers. The last line is one JSON object.
+Each trial runs through the nodes composed in lock-step (mindgrasp_experiments.engine: the
+experiment profile's simulator, vision and controller nodes on simulated time); trials are spread
+over ``--workers`` processes and seeded by the trial index, so the figures do not depend on the
+number of workers. The last line is one JSON object.
 """
 
 from __future__ import annotations
@@ -40,34 +41,42 @@ SHAPES = ('cube', 'cylinder', 'sphere')
 
 def _run_chunk(profile: dict | None, seed: int, n_trials: int, indices: list[int],
                timeout: float) -> list[dict]:
-    """Worker: run the trials ``indices`` of ``draw_trials(n_trials, seed)`` with a profile
-    (as a dict; None = no realism). Returns one record per trial."""
-    from mindgrasp_fsm.experiment import build_loop, draw_trials
+    """Worker: run the random-locations trials ``indices`` (0-based) through the nodes in
+    lock-step (mindgrasp_experiments) with a profile (as a dict; None = no realism). Returns one
+    record per trial."""
+    import tempfile
+    from pathlib import Path
 
-    from mindgrasp_fsm.params import FsmParams, default_params_path
-    from mindgrasp_sim.realism import RealismProfile
+    import yaml
 
-    realism = None if profile is None else RealismProfile.from_dict(profile)
-    loop, _ = build_loop(FsmParams.from_yaml(default_params_path()), realism=realism,
-                         realism_seed=seed)
-    specs = draw_trials(n_trials, seed)
+    from mindgrasp_experiments.engine import lockstep_components, run_trial
+    from mindgrasp_experiments.protocols import random_locations_trial
+
+    work = Path(tempfile.mkdtemp(prefix='realism_'))
+    realism = 'none'
+    if profile is not None:
+        realism = str(work / 'profile.yaml')
+        Path(realism).write_text(yaml.safe_dump(profile), encoding='utf-8')
+    comps = lockstep_components('experiment', {'protocol': 'random_locations',
+                                               'subject': 'autonomous', 'seed': str(seed),
+                                               'realism': realism}, work / 'params',
+                                log=lambda _t: None)
+    for comp in comps:
+        if comp.module.endswith('trial_manager_node'):
+            comp.ros_args += ['-p', f'trial_timeout:={timeout}']
     out = []
-    try:
-        for i in indices:
-            spec = specs[i]
-            loop.sim.load_scene(spec.scene(), seed=spec.index)
-            t0 = time.perf_counter()
-            res = loop.run(0, timeout=timeout)
-            out.append({'index': i, 'shape': spec.shape, 'success': bool(res.success),
-                        'time_to_grasp': res.time_to_grasp, 'attempts': res.attempts,
-                        'detected_shape': res.detected_shape, 'reason': res.reason,
-                        'wall_s': time.perf_counter() - t0, 'radius': spec.radius,
-                        'angle_deg': spec.angle_deg})
-            print(f'    [{profile["name"] if profile else "off"}] trial {i}: {spec.shape} '
-                  f'{"grasped" if res.success else "FAILED"} ({out[-1]["wall_s"]:.0f} s wall)',
-                  flush=True)
-    finally:
-        loop.sim.close()
+    for i in indices:
+        spec = random_locations_trial(seed, i + 1)
+        run = run_trial(comps, i + 1, seed=seed, log_level='warn')
+        rec = run.record
+        out.append({'index': i, 'shape': spec.shape, 'success': bool(rec.success),
+                    'time_to_grasp': rec.time_to_grasp_s,
+                    'attempts': rec.states.split('-').count('5'),
+                    'detected_shape': rec.chosen.rpartition(' ')[2] or 'unknown',
+                    'reason': rec.reason, 'wall_s': run.wall_s, 'radius': spec.radius,
+                    'angle_deg': spec.angle_deg})
+        print(f'    [{profile["name"] if profile else "off"}] trial {i}: {spec.shape} '
+              f'{"grasped" if rec.success else "FAILED"} ({run.wall_s:.0f} s wall)', flush=True)
     return out
 
 

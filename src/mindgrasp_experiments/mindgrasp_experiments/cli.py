@@ -19,7 +19,21 @@ from pathlib import Path
 
 PROTOCOL_SUBJECTS = {'set_locations': ('noise', 'virtual', 'oracle'),
                      'random_locations': ('autonomous',)}
-NOISE_MODEL = Path(__file__).resolve().parents[3] / 'models' / 'noise_classifier'
+#: the classifier trained on labelled noise (mindgrasp_experiments.subjects.noise_model)
+NOISE_MODEL = 'package://mindgrasp_classifier/models/noise_classifier.json'
+
+
+def noise_model_path(fallback_dir: Path) -> str:
+    """The packaged noise-trained model, else one trained now into ``fallback_dir``."""
+    from mindgrasp_common.resources import ResourceNotFoundError, resource_path
+
+    try:
+        return str(resource_path('mindgrasp_classifier', 'models', 'noise_classifier.json'))
+    except ResourceNotFoundError:
+        from mindgrasp_experiments.subjects import noise_model
+
+        print('Training the classifier on noise (once) ...', file=sys.stderr)
+        return str(noise_model(fallback_dir / 'noise_classifier'))
 
 
 def add_common_arguments(parser: argparse.ArgumentParser, trials: int) -> None:
@@ -111,13 +125,7 @@ def run_experiment(args: argparse.Namespace, protocol: str, command: str) -> int
     if getattr(args, 'realism', None) is not None:
         launch_args['realism'] = str(args.realism)
     if subject == 'noise':
-        from mindgrasp_experiments.subjects import noise_model
-
-        model = NOISE_MODEL.with_suffix('.json')
-        if not model.exists():
-            print('Training the classifier on noise (once) ...', file=sys.stderr)
-            model = noise_model(out / 'noise_classifier')
-        launch_args['model'] = str(model)
+        launch_args['model'] = noise_model_path(out)
     log = [] if args.json else None
     try:
         components = lockstep_components('experiment', launch_args, out / 'params',

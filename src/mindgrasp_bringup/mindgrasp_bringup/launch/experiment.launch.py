@@ -13,11 +13,11 @@ seed), ``oracle`` (no EEG: the subject's intended class is published as the pred
 With ``--lockstep`` every node runs in one process on simulated time; the virtual amplifier then
 publishes /eeg/raw itself and the LSL acquisition node is left out.
 
-Parameters: config/params/<package>.yaml, then config/params/experiment.yaml, then the launch
-arguments below.
+Parameters: <package>/param/<package>.yaml, then mindgrasp_bringup/param/experiment.yaml, then
+the launch arguments below.
 """
 
-from mindgrasp_bringup.launch_system import (
+from mindgrasp_bringup.launch_api import (
     DeclareLaunchArgument,
     IfCondition,
     LaunchConfiguration,
