@@ -56,10 +56,10 @@ def test_trial_manager_waits_for_the_eeg_says_so_and_gives_up(caplog) -> None:
         manager = runner.add(TrialManagerNode, ros_args=[
             '-p', 'n_trials:=1', '-p', "wait_for:=['/eeg/raw']", '-p', 'ready_timeout:=2.0'])
         for _ in range(400):
-            if manager.done:
+            if manager.done.done():
                 break
             runner.step(0.02)
-    assert manager.done and not manager.records
+    assert manager.done.done() and not manager.records
     assert manager.error.startswith('Gave up before trial 1: no messages on /eeg/raw after 2 s')
 
 

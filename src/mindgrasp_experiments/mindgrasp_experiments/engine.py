@@ -89,6 +89,7 @@ def run_trial(components: Sequence[LockstepComponent], trial: int, *, seed: int,
     components; it is told ``first_trial:=trial n_trials:=1``.
     """
     from mindgrasp_ros.composition import LockstepRunner, NodeCallbackError, load_node_class
+    from mindgrasp_ros.node_main import error_text, is_done
 
     managers = [c for c in components if c.module == TRIAL_MANAGER]
     if len(managers) != 1:
@@ -128,13 +129,13 @@ def run_trial(components: Sequence[LockstepComponent], trial: int, *, seed: int,
             assert manager is not None
             try:
                 limit = runner.time_s + max_sim_s
-                while not manager.done and runner.time_s < limit:
+                while not is_done(manager) and runner.time_s < limit:
                     runner.step(step_s)
                 if manager.records:
                     record = manager.records[0]
-                elif manager.error is not None:
+                elif error_text(manager) is not None:
                     record = _failed_record(trial, managers[0].parameters, 'node_error',
-                                            f'trial_manager: {manager.error}')
+                                            f'trial_manager: {error_text(manager)}')
                 else:
                     manager.finish_interrupted(f'no end after {max_sim_s:g} simulated s',
                                                'timeout')

@@ -13,6 +13,7 @@ the controller achieves with a BCI.
 from __future__ import annotations
 
 import sys
+from dataclasses import dataclass
 
 import numpy as np
 from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import FsmState, MIPrediction, TaskTarget
@@ -24,11 +25,24 @@ from mindgrasp_eeg.montage import class_name
 from mindgrasp_eeg.ros_conversions import base_yaw_from_joint_state, markers_to_objects
 from mindgrasp_eeg.subject import VirtualSubject
 from mindgrasp_ros import rclpy
+from mindgrasp_ros.node_main import end_after, run_node
+from mindgrasp_ros.params import declare_params, param
 
 CLASS_NAMES = ['left_hand', 'right_hand', 'both_hands', 'both_feet']
-PARAMETERS = [('period', 1.0 / 16.0), ('certainty', 1.0), ('reaction_delay', 0.3),
-              ('decision_period', 0.25), ('heading_tolerance', 0.1), ('seed', 0),
-              ('duration', 0.0)]
+
+
+@dataclass
+class OracleParams:
+    """Parameters of the oracle subject."""
+
+    period: float = param(1.0 / 16.0, 'time between predictions', unit='s', min=1e-3)
+    certainty: float = param(1.0, 'certainty of the intended class', min=0.0)
+    reaction_delay: float = param(0.3, 'from a decision to its prediction', unit='s', min=0.0)
+    decision_period: float = param(0.25, 'time between decisions', unit='s', min=1e-3)
+    heading_tolerance: float = param(0.1, 'heading error taken as centred', unit='rad',
+                                     min=0.0)
+    seed: int = param(0, 'seed of the subject', min=0)
+    duration: float = param(0.0, 'end after this long (0 = until stopped)', unit='s', min=0.0)
 
 
 class OracleSubjectNode(rclpy.node.Node):
@@ -36,8 +50,8 @@ class OracleSubjectNode(rclpy.node.Node):
 
     def __init__(self, **kwargs) -> None:
         super().__init__('oracle_subject', **kwargs)
-        self.declare_parameters('', PARAMETERS)
-        p = {name: self.get_parameter(name).value for name, _ in PARAMETERS}
+        self.done = rclpy.task.Future()
+        p = vars(declare_params(self, OracleParams))
         self.p = p
         self.subject = VirtualSubject('pursue', accuracy=1.0,
                                       reaction_delay=p['reaction_delay'], seed=p['seed'],
@@ -55,8 +69,7 @@ class OracleSubjectNode(rclpy.node.Node):
         self.pub_intent = self.create_publisher(String, '/virtual_subject/intent', latched)
         self._last_intent: object = 'unset'
         self.create_timer(p['period'], self.predict_callback)
-        self._start = self.now_s()
-        self.done = False
+        end_after(self, p['duration'])
 
     def now_s(self) -> float:
         return self.get_clock().now().nanoseconds * 1e-9
@@ -90,23 +103,11 @@ class OracleSubjectNode(rclpy.node.Node):
         if intent != self._last_intent:
             self._last_intent = intent
             self.pub_intent.publish(String(data=class_name(intent)))
-        if self.p['duration'] > 0 and now - self._start > self.p['duration']:
-            self.done = True
 
 
 def main(args: list[str] | None = None) -> int:
     """Run until Ctrl-C or ``duration``."""
-    rclpy.init(args=args)
-    node = OracleSubjectNode()
-    try:
-        while rclpy.ok() and not node.done:
-            rclpy.spin_once(node, timeout_sec=0.1)
-    except KeyboardInterrupt:
-        pass
-    finally:
-        node.destroy_node()
-        rclpy.try_shutdown()
-    return 0
+    return run_node(OracleSubjectNode, args)
 
 
 if __name__ == '__main__':

@@ -22,6 +22,7 @@ import math
 import os
 import sys
 import tempfile
+from dataclasses import dataclass
 from pathlib import Path
 
 import yaml
@@ -44,14 +45,44 @@ from mindgrasp_experiments.protocols import (
 from mindgrasp_experiments.records import TrialRecord, TrialTracker, write_records
 from mindgrasp_experiments.summary import summarise
 from mindgrasp_ros import rclpy
+from mindgrasp_ros.node_main import fail, run_node
+from mindgrasp_ros.params import declare_params, param
 
-PARAMETERS = [
-    ('protocol', 'set_locations'), ('n_trials', 0), ('first_trial', 1), ('seed', 0),
-    ('targets', ''), ('subject', ''), ('trial_timeout', 600.0), ('stall_timeout', 120.0),
-    ('settle_time', 3.0), ('wait_for', ['/eeg/raw', '/bci/prediction', '/vision/detections']),
-    ('ready_timeout', 60.0), ('service_timeout', 10.0), ('records_dir', ''),
-    ('scene', 'set_locations'),
-]
+#: topics the trial manager can wait for before a trial (any message counts)
+WAITABLE = ('/eeg/raw', '/bci/prediction', '/vision/detections')
+
+
+@dataclass
+class TrialManagerParams:
+    """Parameters of the trial manager (seconds of the node clock)."""
+
+    protocol: str = param('set_locations', 'the grasp protocol', choices=PROTOCOLS)
+    n_trials: int = param(0, 'trials before the node ends (0: never)', min=0)
+    first_trial: int = param(1, 'number of the first trial (draws depend on seed and trial)',
+                             min=1)
+    seed: int = param(0, 'seed of the protocol draws', min=0)
+    targets: str = param('', "set locations: labels to ask for in turn ('red cube, blue "
+                             "sphere'); '' draws them from the seed")
+    subject: str = param('', 'who drives the controller, written into the records')
+    trial_timeout: float = param(600.0, 'a trial without a grasp ends then (0 never)', unit='s',
+                                 min=0.0)
+    stall_timeout: float = param(120.0, 'a trial without a controller state change ends then '
+                                        '(0 never)', unit='s', min=0.0)
+    settle_time: float = param(3.0, 'after a grasp, before the scene is reset', unit='s',
+                               min=0.0)
+    wait_for: list[str] = param(list(WAITABLE), 'topics that must publish before a trial')
+    ready_timeout: float = param(60.0, 'give up when they do not publish by then', unit='s',
+                                 min=0.0)
+    service_timeout: float = param(10.0, 'wait this long for the simulator services', unit='s',
+                                   min=0.0)
+    records_dir: str = param('', "folder for records.csv/.parquet ('' = $MINDGRASP_RUN_DIR/"
+                                 "trials in a launch, else none)")
+
+    def __post_init__(self) -> None:
+        unknown = [t for t in self.wait_for if t and t not in WAITABLE]
+        if unknown:
+            msg = (f'wait_for lists {unknown}; the trial manager can wait for {list(WAITABLE)}.')
+            raise ValueError(msg)
 
 
 class TrialManagerNode(rclpy.node.Node):
@@ -59,13 +90,10 @@ class TrialManagerNode(rclpy.node.Node):
 
     def __init__(self, **kwargs) -> None:
         super().__init__('trial_manager', **kwargs)
-        self.declare_parameters('', PARAMETERS)
-        p = {name: self.get_parameter(name).value for name, _ in PARAMETERS}
+        self.done = rclpy.task.Future()
+        self.params = declare_params(self, TrialManagerParams)
+        p = vars(self.params)
         self.p = p
-        if p['protocol'] not in PROTOCOLS:
-            msg = (f"The parameter 'protocol' is {p['protocol']!r}; use one of "
-                   f'{list(PROTOCOLS)}.')
-            raise ValueError(msg)
         self.targets = [t.strip() for t in str(p['targets']).split(',') if t.strip()]
         self.tracker = TrialTracker(p['protocol'], p['subject'], int(p['seed']))
         self.records: list[TrialRecord] = []
@@ -88,7 +116,7 @@ class TrialManagerNode(rclpy.node.Node):
         # readiness: any message type will do; the last arrival time of each topic is kept
         self.last_seen: dict[str, float] = {}
         for topic in p['wait_for']:
-            if topic and topic not in ('/bci/prediction',):
+            if topic and topic != '/bci/prediction':
                 self._watch(topic)
         self.reset_client = self.create_client(ResetSim, '/sim/reset')
         self.load_client = self.create_client(LoadScene, '/sim/load_scene')
@@ -103,7 +131,6 @@ class TrialManagerNode(rclpy.node.Node):
         self.phase_since = self.now_s()
         self.future = None
         self.said_waiting = ''
-        self.done = False
         self.error: str | None = None
         self._scene_dir: Path | None = None
         self._enter('starting')
@@ -119,10 +146,6 @@ class TrialManagerNode(rclpy.node.Node):
 
         kinds = {'/eeg/raw': (EEGChunk, rclpy.qos.qos_profile_sensor_data),
                  '/vision/detections': (DetectionArray, 10)}
-        if topic not in kinds:
-            msg = (f"wait_for lists {topic!r}; the trial manager can wait for "
-                   f"{sorted([*kinds, '/bci/prediction'])}.")
-            raise ValueError(msg)
         kind, qos = kinds[topic]
         self.create_subscription(kind, topic, lambda _m, t=topic: self._seen(t), qos)
 
@@ -166,7 +189,7 @@ class TrialManagerNode(rclpy.node.Node):
 
     def tick(self) -> None:
         """Every 0.1 s of node time: move the trial loop on."""
-        if self.done:
+        if self.done.done():
             return
         now = self.now_s()
         if self.phase == 'starting':
@@ -203,8 +226,8 @@ class TrialManagerNode(rclpy.node.Node):
         """Reset the scene for the next trial (or end after ``n_trials``)."""
         if self.p['n_trials'] and self.n_done >= self.p['n_trials']:
             self._report()
-            self.done = True
             self._enter('finished')
+            self.done.set_result(0)
             return
         self.trial += 1
         self.result = None
@@ -316,6 +339,14 @@ class TrialManagerNode(rclpy.node.Node):
         else:
             self._enter('settling')
 
+    def destroy_node(self) -> None:
+        """Stopped before the trials were done (Ctrl-C): the running trial is recorded as
+        interrupted and the tally logged."""
+        if self.tracker.active:
+            self.finish_interrupted('stopped before the trial ended')
+            self._report()
+        super().destroy_node()
+
     def finish_interrupted(self, reason: str, failure: str = 'interrupted') -> None:
         """End the running trial now (Ctrl-C, a node error): recorded as a failure."""
         if self.tracker.active:
@@ -327,9 +358,8 @@ class TrialManagerNode(rclpy.node.Node):
     def fail(self, reason: str) -> None:
         """Stop the trials with an error (the node ends, exit code 1)."""
         self.error = reason
-        self.get_logger().error(reason)
-        self.done = True
         self._enter('failed')
+        fail(self, reason)
 
     def _report(self) -> None:
         if not self.records:
@@ -344,28 +374,7 @@ class TrialManagerNode(rclpy.node.Node):
 
 def main(args: list[str] | None = None) -> int:
     """Run trials until ``n_trials`` are done or Ctrl-C; log the tally. Exit 1 on an error."""
-    rclpy.init(args=args)
-    try:
-        node = TrialManagerNode()
-    except ValueError as exc:
-        print(f'[trial_manager] ERROR: {exc}', file=sys.stderr)
-        rclpy.try_shutdown()
-        return 2
-    executor = rclpy.executors.SingleThreadedExecutor()
-    executor.add_node(node)
-    try:
-        while rclpy.ok() and not node.done:
-            executor.spin_once(timeout_sec=0.1)
-    except KeyboardInterrupt:
-        node.finish_interrupted('stopped by Ctrl-C')
-        node._report()
-    finally:
-        node.destroy_node()
-        rclpy.try_shutdown()
-    if node.error is not None:
-        print(f'[trial_manager] ERROR: {node.error}', file=sys.stderr)
-        return 1
-    return 0
+    return run_node(TrialManagerNode, args)
 
 
 if __name__ == '__main__':

@@ -116,6 +116,7 @@ def run_lockstep(components: Sequence[LockstepComponent], *, step_s: float = 0.0
     (``done``), ``duration_s`` simulated seconds (> 0) or Ctrl-C. Returns 1 when a node raised
     or reports an ``error``, else 0."""
     from mindgrasp_ros.composition import LockstepRunner, NodeCallbackError, load_node_class
+    from mindgrasp_ros.node_main import error_text, is_done
 
     runner = LockstepRunner(start_time_s=1.0)
     wall0, cpu0 = time.perf_counter(), time.process_time()
@@ -123,9 +124,9 @@ def run_lockstep(components: Sequence[LockstepComponent], *, step_s: float = 0.0
     try:
         nodes = [runner.add(load_node_class(c.module), ros_args=c.ros_args) for c in components]
         end = runner.time_s + duration_s if duration_s > 0 else math.inf
-        while runner.time_s < end and not any(getattr(n, 'done', False) for n in nodes):
+        while runner.time_s < end and not any(is_done(n) for n in nodes):
             runner.step(step_s)
-        errors = [(n.get_name(), n.error) for n in nodes if getattr(n, 'error', None)]
+        errors = [(n.get_name(), error_text(n)) for n in nodes if error_text(n)]
         for name, error in errors:
             log(f'[{name}] ERROR: {error}')
         code = 1 if errors else 0
