@@ -27,11 +27,12 @@ def test_demo_runs_headless_ends_cleanly_and_records_the_session(tmp_path: Path)
     # generous stop timeout: this machine may be loaded by other test runs
     # one trial: the virtual subject (pursue) must drive the arm to grasp the red cube; the
     # trial manager then ends the launch (duration is only a safety net)
-    # the live view on a free port: several test runs share this host
-    result = run_launch('demo', 'duration:=150', f'eeg_stream:={stream}', 'trials:=1',
+    # the live view on a free port: several test runs share this host. The trial manager waits
+    # until EEG, classifier and vision publish (a minute on a loaded machine) before the trial
+    result = run_launch('demo', 'duration:=400', f'eeg_stream:={stream}', 'trials:=1',
                         'live_view_port:=0',
                         "targets:=red cube", '--sigint-timeout', '20', '--run-dir', str(run_dir),
-                        timeout=400)
+                        timeout=900)
     assert result.returncode == 0, result.stderr[-4000:]
     summary = yaml.safe_load((run_dir / 'summary.yaml').read_text())
     assert {p['label'] for p in summary['processes']} == {

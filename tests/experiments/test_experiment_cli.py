@@ -51,6 +51,7 @@ def test_bad_input_is_one_clear_line_and_exit_2(args: list[str], message: str) -
 
 
 @pytest.mark.slow
+@pytest.mark.timeout(1800)   # whole experiments in subprocesses, on a loaded machine
 def test_a_subject_that_decides_right_picks_the_desired_object_and_every_file_is_written(
         tmp_path: Path) -> None:
     """The oracle subject: the pursuing virtual subject at accuracy 1 with a perfect decoder
@@ -77,6 +78,7 @@ def test_a_subject_that_decides_right_picks_the_desired_object_and_every_file_is
 
 
 @pytest.mark.slow
+@pytest.mark.timeout(1800)   # whole experiments in subprocesses, on a loaded machine
 def test_same_seed_same_csv_with_1_and_2_workers(tmp_path: Path) -> None:
     """EEG synthesis, decoding, vision and physics in the loop: the records depend on the seed
     only. Trials are cut at 12 simulated s to keep the test short."""
@@ -96,6 +98,7 @@ def test_same_seed_same_csv_with_1_and_2_workers(tmp_path: Path) -> None:
 
 
 @pytest.mark.slow
+@pytest.mark.timeout(1800)   # whole experiments in subprocesses, on a loaded machine
 def test_noise_subject_runs(tmp_path: Path) -> None:
     s = last_json(mindgrasp('experiment', 'set-locations', '--trials', '1', '--subject',
                             'noise', '--trial-timeout', '8', '--out', str(tmp_path / 'noise'),
@@ -105,6 +108,7 @@ def test_noise_subject_runs(tmp_path: Path) -> None:
 
 
 @pytest.mark.slow
+@pytest.mark.timeout(1800)   # whole experiments in subprocesses, on a loaded machine
 def test_random_locations_and_a_users_own_controller(tmp_path: Path) -> None:
     s = last_json(mindgrasp('experiment', 'random-locations', '--trials', '1', '--seed', '1',
                             '--out', str(tmp_path / 'auto'), '--json', '--no-progress'))
@@ -123,6 +127,7 @@ def test_random_locations_and_a_users_own_controller(tmp_path: Path) -> None:
 
 
 @pytest.mark.slow
+@pytest.mark.timeout(1800)   # whole experiments in subprocesses, on a loaded machine
 def test_a_node_raising_fails_its_trial_and_the_experiment_goes_on(tmp_path: Path) -> None:
     out = tmp_path / 'faulty'
     s = last_json(mindgrasp('experiment', 'random-locations', '--trials', '2', '--seed', '1',
@@ -136,6 +141,7 @@ def test_a_node_raising_fails_its_trial_and_the_experiment_goes_on(tmp_path: Pat
 
 
 @pytest.mark.slow
+@pytest.mark.timeout(1800)   # whole experiments in subprocesses, on a loaded machine
 def test_ctrl_c_writes_the_finished_trials(tmp_path: Path) -> None:
     import signal
     import time
@@ -160,3 +166,19 @@ def test_ctrl_c_writes_the_finished_trials(tmp_path: Path) -> None:
     assert 0 < len(records) < 50
     assert [r.trial for r in records] == list(range(1, len(records) + 1))
     assert (out / 'report.md').exists() and 'Interrupted' in (out / 'report.md').read_text()
+
+
+@pytest.mark.slow
+@pytest.mark.timeout(1800)   # whole experiments in subprocesses, on a loaded machine
+def test_launch_a_profile_in_lockstep(tmp_path: Path) -> None:
+    """``mindgrasp launch <profile> --lockstep``: the profile's nodes on simulated time; the
+    trial manager ends the launch and writes its record into the run directory."""
+    run_dir = tmp_path / 'run'
+    result = mindgrasp('launch', 'experiment', 'protocol:=random_locations',
+                       'subject:=autonomous', 'trials:=1', 'seed:=3', '--lockstep',
+                       '--run-dir', str(run_dir))
+    assert result.returncode == 0, result.stderr[-3000:]
+    assert "'eeg_acquisition'" not in result.stdout     # autonomous: no EEG nodes at all
+    assert 'real-time factor' in result.stdout + result.stderr
+    (rec,) = read_records(run_dir / 'trials')
+    assert rec.trial == 1 and rec.protocol == 'random_locations' and rec.states.startswith('1')
