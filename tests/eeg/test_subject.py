@@ -136,8 +136,8 @@ def test_pursue_aims_at_a_new_target_before_it_selects() -> None:
     """A new target cancels the both-hands imagery meant for the object in front: the subject
     rests, then turns towards the new target (a 6-trial live run once selected the object in
     front 0.3 s after a new target appeared)."""
-    ahead = SceneObject(0, 'red', 'cube', 0.5, 0.0)
-    left = SceneObject(1, 'blue', 'cylinder', 0.5 * math.cos(0.7), 0.5 * math.sin(0.7))
+    ahead = SceneObject(0, 'red', 'cube', (0.5, 0.0, 0.0))
+    left = SceneObject(1, 'blue', 'cylinder', (0.5 * math.cos(0.7), 0.5 * math.sin(0.7), 0.0))
     s = VirtualSubject('pursue', reaction_delay=0.5, decision_period=0.5, seed=0)
     s.set_objects([ahead, left])
     s.set_fsm(1)

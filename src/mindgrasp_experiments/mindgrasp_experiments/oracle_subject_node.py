@@ -21,8 +21,9 @@ from mindgrasp_ros.interfaces.sensor_msgs.msg import JointState
 from mindgrasp_ros.interfaces.std_msgs.msg import String
 from mindgrasp_ros.interfaces.visualization_msgs.msg import MarkerArray
 
+from mindgrasp_common.markers import objects_from_markers
 from mindgrasp_eeg.montage import class_name
-from mindgrasp_eeg.ros_conversions import base_yaw_from_joint_state, markers_to_objects
+from mindgrasp_eeg.ros_conversions import base_yaw_from_joint_state
 from mindgrasp_eeg.subject import VirtualSubject
 from mindgrasp_ros import rclpy
 from mindgrasp_ros.node_main import end_after, run_node
@@ -78,7 +79,7 @@ class OracleSubjectNode(rclpy.node.Node):
         self.subject.set_target(int(msg.object_id), msg.colour, msg.shape)
 
     def objects_callback(self, msg: MarkerArray) -> None:
-        self.subject.set_objects(markers_to_objects(msg.markers))
+        self.subject.set_objects(objects_from_markers(msg.markers))
 
     def joints_callback(self, msg: JointState) -> None:
         yaw = base_yaw_from_joint_state(msg.name, msg.position)

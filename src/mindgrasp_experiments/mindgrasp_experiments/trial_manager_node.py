@@ -37,6 +37,7 @@ from mindgrasp_ros.interfaces.mindgrasp_msgs.srv import LoadScene, ResetSim
 from mindgrasp_ros.interfaces.std_msgs.msg import String
 from mindgrasp_ros.interfaces.visualization_msgs.msg import MarkerArray
 
+from mindgrasp_common.markers import objects_from_markers
 from mindgrasp_experiments.protocols import (
     PROTOCOLS,
     random_locations_trial,
@@ -153,11 +154,8 @@ class TrialManagerNode(rclpy.node.Node):
         self.last_seen[topic] = self.now_s()
 
     def objects_callback(self, msg: MarkerArray) -> None:
-        scene = {}
-        for m in msg.markers:
-            if m.text:
-                scene[int(m.id)] = (m.text, float(m.pose.position.x), float(m.pose.position.y))
-        self.scene = scene
+        self.scene = {o.object_id: (o.label, float(o.position[0]), float(o.position[1]))
+                      for o in objects_from_markers(msg.markers)}
 
     def result_callback(self, msg: GraspResult) -> None:
         if self.phase == 'trial' and self.result is None:
