@@ -98,7 +98,7 @@ def run_trial(components: Sequence[LockstepComponent], trial: int, *, seed: int,
         raise ExperimentError(msg)
     wall0, cpu0 = time.perf_counter(), time.process_time()
     set_log_level(log_level)
-    runner = LockstepRunner(start_time_s=1.0)
+    runner = LockstepRunner(start_time_s=0.0)   # nodes start with the clock at 0: no jump
     manager = None
     record: TrialRecord | None = None
     build_s = 0.0
@@ -146,7 +146,7 @@ def run_trial(components: Sequence[LockstepComponent], trial: int, *, seed: int,
                 manager.finish_interrupted(reason, 'node_error')
                 record = manager.records[-1] if manager.records else _failed_record(
                     trial, managers[0].parameters, 'node_error', reason)
-        sim_s = runner.time_s - 1.0
+        sim_s = runner.time_s
         node_s = dict(runner.node_time)
         node_s['(executor)'] = runner.collect_time
     finally:

@@ -617,7 +617,8 @@ class Simulation:
         r = self._robot(robot)
         for body, fingers in self._finger_contacts(r.body).items():
             if len(fingers) >= 2 and not self._p.getContactPoints(body, self._ground):
-                return next(o for o in self.objects() if o.body == body)
+                # the common SceneObject has no PyBullet body: match through the layout index
+                return next(o for o in self.objects() if self._objects[o.object_id][1] == body)
         return None
 
     def collisions(self, robot: str = 'user') -> list[str]:

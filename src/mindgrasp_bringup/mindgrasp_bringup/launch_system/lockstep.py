@@ -118,7 +118,7 @@ def run_lockstep(components: Sequence[LockstepComponent], *, step_s: float = 0.0
     from mindgrasp_ros.composition import LockstepRunner, NodeCallbackError, load_node_class
     from mindgrasp_ros.node_main import error_text, is_done
 
-    runner = LockstepRunner(start_time_s=1.0)
+    runner = LockstepRunner(start_time_s=0.0)   # nodes start with the clock at 0: no jump
     wall0, cpu0 = time.perf_counter(), time.process_time()
     code = 0
     try:
@@ -137,7 +137,7 @@ def run_lockstep(components: Sequence[LockstepComponent], *, step_s: float = 0.0
         pass
     finally:
         wall = time.perf_counter() - wall0
-        sim = runner.time_s - 1.0
+        sim = runner.time_s
         cpu = time.process_time() - cpu0
         log(f'lock-step: simulated {sim:.1f} s in {wall:.1f} s wall time (real-time factor '
             f'{sim / max(wall, 1e-9):.1f}, {cpu / max(sim, 1e-9):.3f} CPU s per simulated s).')
