@@ -34,10 +34,11 @@ def last_json(result: subprocess.CompletedProcess) -> dict:
 
 
 @pytest.mark.parametrize(('args', 'message'), [
-    (['set-locations', '--trials', '0'], '--trials must be a whole number >= 1, got 0'),
-    (['set-locations', '--accuracy', '1.5'], '--accuracy must be within 0..1'),
-    (['set-locations', '--seed', '-3'], '--seed must be >= 0'),
-    (['random-locations', '--workers', '0'], '--workers must be >= 1'),
+    (['set-locations', '--trials', '0'], 'argument --trials: must be >= 1, got 0'),
+    (['set-locations', '--accuracy', '1.5'], 'argument --accuracy: must be between 0 and 1'),
+    (['set-locations', '--seed', '-3'], 'argument --seed: must be >= 0, got -3'),
+    (['random-locations', '--workers', '0'], 'argument --workers: must be >= 1, got 0'),
+    (['random-locations', '--stall-timeout', 'nan'], "argument --stall-timeout: 'nan' is not"),
     (['random-locations', '--launch', 'nowhere.launch.py'], 'no such launch file'),
     (['random-locations', '--realism', 'foggy'], "--realism: Unknown realism profile 'foggy'"),
     (['report', 'no/such/run'], 'is not a directory'),

@@ -37,11 +37,14 @@ def noise_model_path(fallback_dir: Path) -> str:
 
 
 def add_common_arguments(parser: argparse.ArgumentParser, trials: int) -> None:
-    parser.add_argument('--trials', type=int, default=trials,
+    """Options of every ``mindgrasp experiment`` protocol (numbers checked by argparse)."""
+    from mindgrasp_common.cli_checks import non_negative_int, positive_float, positive_int
+
+    parser.add_argument('--trials', type=positive_int, default=trials,
                         help=f'number of trials (default {trials})')
-    parser.add_argument('--seed', type=int, default=0,
+    parser.add_argument('--seed', type=non_negative_int, default=0,
                         help='seed of the trial draws, the EEG and the subject (default 0)')
-    parser.add_argument('--workers', type=int, default=1,
+    parser.add_argument('--workers', type=positive_int, default=1,
                         help='worker processes; the same seed gives the same records whatever '
                              'the number (default 1)')
     parser.add_argument('--out', metavar='DIR', default=None,
@@ -51,12 +54,12 @@ def add_common_arguments(parser: argparse.ArgumentParser, trials: int) -> None:
                              'same name (e.g. your own controller named fsm) or are added')
     parser.add_argument('--json', action='store_true',
                         help='print one JSON object with the figures as the last line')
-    parser.add_argument('--step', type=float, default=0.02, metavar='S',
+    parser.add_argument('--step', type=positive_float, default=0.02, metavar='S',
                         help='lock-step clock step in simulated s (default 0.02)')
-    parser.add_argument('--stall-timeout', type=float, default=120.0, metavar='S',
+    parser.add_argument('--stall-timeout', type=positive_float, default=120.0, metavar='S',
                         help='abort a trial after S simulated s without a controller state '
                              'change (default 120)')
-    parser.add_argument('--trial-timeout', type=float, default=600.0, metavar='S',
+    parser.add_argument('--trial-timeout', type=positive_float, default=600.0, metavar='S',
                         help='end a trial without a grasp after S simulated s (default 600)')
     parser.add_argument('--no-progress', action='store_true', help='no progress bar')
 

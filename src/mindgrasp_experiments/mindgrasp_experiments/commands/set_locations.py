@@ -15,12 +15,14 @@ from mindgrasp_experiments.cli import add_common_arguments, run_experiment
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Arguments of ``mindgrasp experiment set-locations``."""
+    from mindgrasp_common.cli_checks import probability
+
     add_common_arguments(parser, trials=160)
     parser.add_argument('--subject', choices=['noise', 'virtual', 'oracle'], default='virtual',
                         help='noise (unworn cap, classifier trained on noise), virtual (the '
                              'virtual subject pursues the target at --accuracy) or oracle (its '
                              'intent is the prediction); default virtual')
-    parser.add_argument('--accuracy', type=float, default=0.8,
+    parser.add_argument('--accuracy', type=probability, default=0.8,
                         help='virtual subject: probability of imagining the right class '
                              '(default 0.8)')
 
