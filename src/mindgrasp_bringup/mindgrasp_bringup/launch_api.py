@@ -61,6 +61,8 @@ _SOURCES: dict[str, tuple[str, str]] = {
 #: our helpers, the same under both launchers (they build actions through this module)
 _HELPERS = {
     'config_files': 'mindgrasp_bringup.launch_system.params',
+    'number_argument': 'mindgrasp_bringup.launch_system.number_argument',
+    'file_argument': 'mindgrasp_bringup.launch_system.number_argument',
     'classifier_nodes': 'mindgrasp_bringup.launch_system.common',
     'eeg_source_arguments': 'mindgrasp_bringup.launch_system.common',
     'eeg_source_nodes': 'mindgrasp_bringup.launch_system.common',

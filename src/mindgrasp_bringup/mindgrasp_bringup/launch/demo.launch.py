@@ -29,8 +29,10 @@ from mindgrasp_bringup.launch_api import (
     config_files,
     display_arguments,
     display_nodes,
+    file_argument,
     live_view_arguments,
     live_view_nodes,
+    number_argument,
     sim_scene_camera,
 )
 
@@ -42,9 +44,9 @@ def generate_launch_description() -> LaunchDescription:
     return LaunchDescription([
         DeclareLaunchArgument('gui', default_value='false', choices=['true', 'false'],
                               description='open the PyBullet window (needs a display)'),
-        DeclareLaunchArgument('seed', default_value='0',
-                              description='seed of the scene, the virtual subject and the '
-                                          'synthetic EEG (same seed, same run)'),
+        number_argument('seed', default_value='0', minimum=0,
+                        description='seed of the scene, the virtual subject and the synthetic '
+                                    'EEG (same seed, same run)'),
         DeclareLaunchArgument('realism', default_value='none',
                               description='simulator realism: none, default or a profile YAML '
                                           'path (noisy camera, miscalibration, arm lag, object '
@@ -57,16 +59,16 @@ def generate_launch_description() -> LaunchDescription:
                               description='virtual subject: noise (no imagery), follow (imagines '
                                           'what /trainer/prompt asks), pursue (imagines what '
                                           'brings the arm to /task/target)'),
-        DeclareLaunchArgument('model', default_value='',
-                              description='classifier model (.json written by mindgrasp train '
-                                          'classifier); empty: the one in '
-                                          'mindgrasp_classifier/param/classifier.yaml'),
+        file_argument('model', default_value='',
+                      description='classifier model (.json written by mindgrasp train '
+                                  'classifier); empty: the one in '
+                                  'mindgrasp_classifier/param/classifier.yaml'),
         DeclareLaunchArgument('targets', default_value='red cube, blue cylinder, yellow sphere',
                               description='objects to grasp in turn, comma-separated ("red cube, '
                                           'blue sphere"); empty: drawn at random from the scene'),
-        DeclareLaunchArgument('trials', default_value='3',
-                              description='grasp trials before the demo ends (0: until duration '
-                                          'or Ctrl-C)'),
+        number_argument('trials', default_value='3', minimum=0,
+                        description='grasp trials before the demo ends (0: until duration or '
+                                    'Ctrl-C)'),
         *display_arguments(),
         *live_view_arguments(),
         # 0 the trials: which object to grasp, reset between grasps

@@ -23,6 +23,7 @@ from mindgrasp_bringup.launch_api import (
     display_nodes,
     eeg_source_arguments,
     eeg_source_nodes,
+    file_argument,
 )
 
 
@@ -38,10 +39,10 @@ def generate_launch_description() -> LaunchDescription:
         DeclareLaunchArgument('feedback', default_value='false', choices=['true', 'false'],
                               description='run the classifier so the display shows a feedback '
                                           'bar (needs a trained model)'),
-        DeclareLaunchArgument('model', default_value='',
-                              description='classifier model for feedback:=true (.json written '
-                                          'by mindgrasp train classifier); empty: the one in '
-                                          'mindgrasp_classifier/param/classifier.yaml'),
+        file_argument('model', default_value='',
+                      description='classifier model for feedback:=true (.json written '
+                                  'by mindgrasp train classifier); empty: the one in '
+                                  'mindgrasp_classifier/param/classifier.yaml'),
         *eeg_source_nodes(config_files('eeg'), seed, 'follow'),
         GroupAction(classifier_nodes(config_files('classifier')),
                     condition=IfCondition(LaunchConfiguration('feedback'))),

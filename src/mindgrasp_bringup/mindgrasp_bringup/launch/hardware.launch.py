@@ -23,6 +23,7 @@ from mindgrasp_bringup.launch_api import (
     SplitArguments,
     classifier_nodes,
     config_files,
+    file_argument,
 )
 
 
@@ -38,10 +39,10 @@ def generate_launch_description() -> LaunchDescription:
         DeclareLaunchArgument('arm_driver_args', default_value='',
                               description='command-line arguments of the arm driver (shell '
                                           'quoting)'),
-        DeclareLaunchArgument('model', default_value='',
-                              description='classifier model (.json written by mindgrasp train '
-                                          'classifier); empty: the one in '
-                                          'mindgrasp_classifier/param/classifier.yaml'),
+        file_argument('model', default_value='',
+                      description='classifier model (.json written by mindgrasp train '
+                                  'classifier); empty: the one in '
+                                  'mindgrasp_classifier/param/classifier.yaml'),
         DeclareLaunchArgument('camera_driver', default_value='',
                               description='camera driver started like arm_driver (empty: the '
                                           'arm driver or another system publishes the camera)'),

@@ -18,6 +18,7 @@ from mindgrasp_bringup.launch_api import (
     LaunchDescription,
     Node,
     Shutdown,
+    file_argument,
 )
 
 
@@ -28,9 +29,9 @@ def generate_launch_description() -> LaunchDescription:
         DeclareLaunchArgument('controller', default_value='false', choices=['true', 'false'],
                               description='re-run the controller too (open loop: the camera '
                                           'and joint states are the recorded ones)'),
-        DeclareLaunchArgument('model', default_value='',
-                              description='classifier model (.json written by mindgrasp train '
-                                          'classifier); empty: the one the run used'),
+        file_argument('model', default_value='',
+                      description='classifier model (.json written by mindgrasp train '
+                                  'classifier); empty: the one the run used'),
         DeclareLaunchArgument('output', default_value='',
                               description='report directory; empty: <run>/replays/<time>'),
         Node(package='mindgrasp_bringup', executable='replay_node', name='replay',

@@ -20,6 +20,7 @@ from mindgrasp_bringup.launch_api import (
     display_nodes,
     eeg_source_arguments,
     eeg_source_nodes,
+    file_argument,
     sim_scene_camera,
 )
 
@@ -39,10 +40,10 @@ def generate_launch_description() -> LaunchDescription:
                               description='seed of the trial order, scene and virtual subject'),
         DeclareLaunchArgument('gui', default_value='false', choices=['true', 'false'],
                               description='open the PyBullet window (needs a display)'),
-        DeclareLaunchArgument('model', default_value='',
-                              description='classifier model (.json written by mindgrasp train '
-                                          'classifier); empty: the one in '
-                                          'mindgrasp_classifier/param/classifier.yaml'),
+        file_argument('model', default_value='',
+                      description='classifier model (.json written by mindgrasp train '
+                                  'classifier); empty: the one in '
+                                  'mindgrasp_classifier/param/classifier.yaml'),
         *[Node(package='mindgrasp_sim', executable='sim_node', name='sim',
                parameters=[*config_files('sim'),
                            {'gui': LaunchConfiguration('gui'), 'seed': seed,

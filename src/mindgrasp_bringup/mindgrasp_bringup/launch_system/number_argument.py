@@ -1,0 +1,96 @@
+"""Launch arguments that must be numbers, checked before any process starts.
+
+``launch``'s ``DeclareLaunchArgument`` knows ``choices`` but no type: a ``seed:=abc`` reached
+every node, which then crashed with a traceback. :func:`number_argument` declares a whole number
+or a finite number with an optional lower bound; under ``mindgrasp launch`` a bad value is one
+line naming the argument, the value and an example, exit 2, nothing started::
+
+    number_argument('seed', default_value='0', description='layout seed', minimum=0)
+
+:func:`file_argument` does the same for a file (``model:=``): when given, it must exist.
+
+Under ``ros2 launch`` they are plain ``DeclareLaunchArgument`` s (the nodes' parameter descriptors
+check the value there).
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+from mindgrasp_bringup.launch_system.actions.declare_launch_argument import (
+    DeclareLaunchArgument,
+)
+from mindgrasp_bringup.launch_system.errors import LaunchError
+
+__all__ = ['FileLaunchArgument', 'NumberLaunchArgument', 'check_number', 'file_argument',
+           'number_argument']
+
+
+def check_number(name: str, text: str, kind: type, minimum: float | None) -> None:
+    """Raise :class:`LaunchError` unless ``text`` is a ``kind`` (int or float) >= ``minimum``."""
+    what = 'a whole number' if kind is int else 'a number'
+    if minimum is not None:
+        what += f' >= {minimum:g}'
+    example = f'{name}:={max(int(minimum or 0), 3) if kind is int else 1.5}'
+    try:
+        value = kind(text.strip())
+        ok = math.isfinite(value) and (minimum is None or value >= minimum)
+    except ValueError:
+        ok = False
+    if not ok:
+        msg = f"launch argument '{name}' is {text!r}: {what} is expected, e.g. {example}."
+        raise LaunchError(msg)
+
+
+class NumberLaunchArgument(DeclareLaunchArgument):
+    """A :class:`DeclareLaunchArgument` whose value must be a number (checked when declared)."""
+
+    def __init__(self, name: str, *, kind: type = int, minimum: float | None = None,
+                 **kwargs: Any) -> None:
+        super().__init__(name, **kwargs)
+        self.kind, self.minimum = kind, minimum
+
+    def execute(self, context: Any) -> None:
+        super().execute(context)
+        check_number(self.name, context.launch_configurations[self.name], self.kind,
+                     self.minimum)
+
+
+def number_argument(name: str, *, default_value: str, description: str, kind: type = int,
+                    minimum: float | None = None) -> Any:
+    """Declare ``name`` as a number argument (see the module docstring)."""
+    from mindgrasp_bringup import launch_api
+
+    if launch_api.using_real_launch():
+        return launch_api.DeclareLaunchArgument(name, default_value=default_value,
+                                                description=description)
+    return NumberLaunchArgument(name, kind=kind, minimum=minimum, default_value=default_value,
+                                description=description)
+
+
+_REPO = Path(__file__).resolve().parents[4]
+
+
+class FileLaunchArgument(DeclareLaunchArgument):
+    """A :class:`DeclareLaunchArgument` naming a file: empty (the default) or an existing file,
+    relative to the working directory or the repository."""
+
+    def execute(self, context: Any) -> None:
+        super().execute(context)
+        text = context.launch_configurations[self.name].strip()
+        if text and not (Path(text).expanduser().is_file() or (_REPO / text).is_file()):
+            msg = (f"launch argument '{self.name}' is {text!r}, which is not a file; give the "
+                   f'path of an existing file ({self.description}).')
+            raise LaunchError(msg)
+
+
+def file_argument(name: str, *, default_value: str, description: str) -> Any:
+    """Declare ``name`` as a file argument (see the module docstring)."""
+    from mindgrasp_bringup import launch_api
+
+    if launch_api.using_real_launch():
+        return launch_api.DeclareLaunchArgument(name, default_value=default_value,
+                                                description=description)
+    return FileLaunchArgument(name, default_value=default_value, description=description)

@@ -1,0 +1,41 @@
+"""Launch arguments are checked before any process starts: one line naming the argument, the
+value and the fix, exit 2, no run directory, no node started."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import pytest
+
+from mindgrasp_bringup.launch_system import LaunchError, LaunchService
+
+
+@pytest.mark.parametrize(('args', 'message'), [
+    (['seed:=abc'], "launch argument 'seed' is 'abc': a whole number >= 0 is expected"),
+    (['seed:=-1'], "launch argument 'seed' is '-1': a whole number >= 0 is expected"),
+    (['trials:=x'], "launch argument 'trials' is 'x': a whole number >= 0 is expected"),
+    (['model:=/no/such/model.json'], "launch argument 'model' is '/no/such/model.json', which is "
+                                     'not a file'),
+    (['subject:=telepathy'], "launch argument 'subject' got 'telepathy', which is not one of"),
+])
+def test_demo_arguments_are_checked_in_the_plan(args, message):
+    with pytest.raises(LaunchError, match=message):
+        LaunchService('demo', args).plan(strict=True)
+
+
+def test_bad_argument_starts_nothing_and_exits_2(tmp_path):
+    run_dir = tmp_path / 'run'
+    out = subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', 'launch', 'demo',
+                          'seed:=abc', '--run-dir', str(run_dir)],
+                         capture_output=True, text=True, timeout=120)
+    assert out.returncode == 2
+    lines = out.stderr.strip().splitlines()
+    assert lines == ["mindgrasp launch: error: launch argument 'seed' is 'abc': a whole number "
+                     '>= 0 is expected, e.g. seed:=3.'], out.stderr
+    assert not run_dir.exists()
+
+
+def test_good_arguments_pass():
+    plan = LaunchService('demo', ['seed:=4', 'trials:=0', 'model:=']).plan(strict=True)
+    assert {p.label for p in plan.processes} >= {'sim', 'fsm', 'classifier'}
