@@ -38,7 +38,10 @@ def test_demo_starts_every_node_after_the_recorder() -> None:
     assert 'recorder' not in procs and procs['sim'].parameters['gui'] is True
 
 
-def test_hardware_has_drivers_and_no_simulator() -> None:
+def test_hardware_has_drivers_and_no_simulator(tmp_path, monkeypatch) -> None:
+    monkeypatch.chdir(tmp_path)            # model:= must name an existing file
+    (tmp_path / 'models').mkdir()
+    (tmp_path / 'models' / 'alice.json').write_text('{}')
     procs = processes('hardware', 'eeg_stream:=gNautilus', 'arm_driver:=true',
                       'arm_driver_args:=--ip "10.0.0.2" --rate 100')
     assert 'sim' not in procs and 'virtual_amp' not in procs and 'camera_driver' not in procs
@@ -68,7 +71,9 @@ def test_hardware_has_drivers_and_no_simulator() -> None:
                                    'record:=false']).plan()
 
 
-def test_replay_runs_the_lockstep_replay_process_with_its_arguments() -> None:
+def test_replay_runs_the_lockstep_replay_process_with_its_arguments(tmp_path, monkeypatch) -> None:
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / 'x.json').write_text('{}')
     procs = processes('replay', 'bag:=/data/run')
     assert list(procs) == ['recorder', 'replay']
     node = procs['replay']
@@ -79,7 +84,9 @@ def test_replay_runs_the_lockstep_replay_process_with_its_arguments() -> None:
     assert procs['replay'].parameters['model'] == 'x.json'
 
 
-def test_trainer_and_graz_end_with_their_prompter() -> None:
+def test_trainer_and_graz_end_with_their_prompter(tmp_path, monkeypatch) -> None:
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / 'm.json').write_text('{}')
     procs = processes('trainer', 'trials:=8', 'amp:=lsl', 'eeg_stream:=amp')
     assert 'virtual_amp' not in procs and list(procs)[-1] == 'trainer'
     assert procs['trainer'].shutdown_on_exit and procs['trainer'].parameters['n_trials'] == 8
