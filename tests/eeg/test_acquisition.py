@@ -173,3 +173,25 @@ def test_bad_parameters() -> None:
         EEGAcquisition('x', stream_unit='furlongs')
     with pytest.raises(EEGError, match='No LSL stream selector given'):
         EEGAcquisition('', stream_type='').connect(timeout=0.1)
+
+
+@pytest.mark.parametrize(('unit', 'scale'), [
+    ('microvolts', 1e-6), ('uV', 1e-6), ('µV', 1e-6), ('V', 1.0), ('volts', 1.0),
+    ('mV', 1e-3), ('nanovolts', 1e-9),
+    ('0', 1.0), ('-6', 1e-6), ('-3', 1e-3), ('-9', 1e-9), ('+0', 1.0),   # MNE-LSL exponents
+])
+def test_units_of_other_lsl_tools(unit, scale) -> None:
+    from mindgrasp_eeg.lsl import unit_scale
+
+    assert unit_scale(unit) == pytest.approx(scale)
+
+
+def test_mne_lsl_style_exponent_unit_from_a_real_outlet(lsl_source, stream_name) -> None:
+    """A stream whose channels say "-6" (MNE-LSL's PlayerLSL for microvolts) is read in volts."""
+    lsl_source(stream_name, '--unit=-6', '--duration', '120')
+    acq = EEGAcquisition(stream_name, n_channels=32, sample_rate=250, channel_names=NAUTILUS_32)
+    desc = acq.connect(timeout=30)
+    assert desc.unit == '-6' and acq.scale == pytest.approx(1e-6)
+    data = np.vstack([c.data for c in collect(acq, 250)])
+    assert 3e-6 < float(np.std(data)) < 50e-6            # microvolts on the wire, volts out
+    acq.close()

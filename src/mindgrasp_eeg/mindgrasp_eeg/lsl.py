@@ -4,6 +4,15 @@ inlet, stream description, validation).
 Units: LSL carries numbers without a mandatory unit. Outlets made here declare the unit of each
 channel in the stream description (``<channels><channel><unit>microvolts</unit>``), as g.tec's and
 most other amplifiers' LSL apps do; :func:`unit_scale` turns that unit into the factor to volts.
+What other LSL tools write (all accepted):
+
+- BrainVision LSL Connector, g.tec, LabRecorder/XDF files: a unit name (``microvolts``; the XDF
+  meta-data convention of the LSL project names SI units in full);
+- MNE-LSL (``PlayerLSL``, ``StreamInfo.set_channel_units``): the power-of-ten exponent of volts as
+  an integer string, ``"0"`` volts, ``"-6"`` microvolts (MNE's FIFF unit multiplier);
+- abbreviations ``V``, ``mV``, ``uV``/``µV``, ``nV``;
+- OpenBCI GUI and BrainFlow's streamers declare no unit and send microvolts: an empty unit is
+  taken as microvolts with a warning (``stream_unit`` overrides it).
 
 Time: LSL timestamps are seconds of ``pylsl.local_clock()`` (a monotonic clock, CLOCK_MONOTONIC on
 Linux) of the sending host. An inlet opened with :data:`PROC_FLAGS` adds the estimated offset
@@ -15,6 +24,7 @@ with a linear regression over sample index (dejitter), so pulled timestamps are 
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -38,11 +48,15 @@ PROC_FLAGS = pylsl.proc_clocksync | pylsl.proc_dejitter
 
 
 def unit_scale(unit: str) -> float:
-    """Factor that converts values in ``unit`` (e.g. ``'microvolts'``, ``'uV'``) to volts."""
+    """Factor that converts values in ``unit`` (e.g. ``'microvolts'``, ``'uV'``, or MNE-LSL's
+    power-of-ten exponent of volts ``'-6'``) to volts."""
     key = unit.strip().lower()
+    if re.fullmatch(r'[+-]?\d{1,2}', key) and -12 <= int(key) <= 3:
+        return 10.0 ** int(key)           # MNE-LSL: "0" volts, "-3" millivolts, "-6" microvolts
     if key not in UNIT_SCALES:
         msg = (f'The EEG unit {unit!r} is unknown; use one of volts, millivolts, microvolts, '
-               f'nanovolts (or V, mV, uV, nV), or set the stream_unit parameter.')
+               f'nanovolts (or V, mV, uV, nV, or a power of ten of volts such as -6, as MNE-LSL '
+               f'writes), or set the stream_unit parameter.')
         raise EEGError(msg)
     return UNIT_SCALES[key]
 
