@@ -100,14 +100,18 @@ def test_respawn_restarts_a_dead_node(tmp_path: Path) -> None:
     marker = tmp_path / 'crashed-once'
     result = run_launch(fixture('respawn.launch.py'), 'record:=false', f'marker:={marker}',
                         '--run-dir', str(tmp_path / 'run'))
-    assert result.returncode == 0, result.stderr
+    # respawned, but the run is not clean: a node died during it (last line, exit code, summary)
+    assert result.returncode == 1, result.stderr
+    assert re.search(r"the launch ended with failures: phoenix \(finished, 0; died and was "
+                     r"respawned 1 time\(s\)\)", result.stderr.strip().splitlines()[-1])
     assert re.search(r"process 'phoenix' \(pid \d+\) died: exit code 3; respawning in 0\.2 s "
                      r"\(respawn=True, restart 1\)", result.stderr)
     assert '    | crashing once on purpose' in result.stderr
     log = (tmp_path / 'run' / 'logs' / 'phoenix.log').read_text()
     assert '--- launch: restarting' in log and 'phoenix done, exit code 0' in log
     summary = read_yaml(tmp_path / 'run' / 'summary.yaml')
-    assert summary['processes'][0]['restarts'] == 1 and summary['processes'][0]['clean']
+    assert summary['processes'][0]['restarts'] == 1 and not summary['processes'][0]['clean']
+    assert summary['exit_code'] == 1 and summary['clean'] is False
     # without respawn the same death ends the launch with a failure
     marker.unlink()
     result = run_launch(fixture('respawn.launch.py'), 'record:=false', f'marker:={marker}',

@@ -2,7 +2,8 @@
 
 ``LaunchService('demo', ['duration:=30']).run()`` creates the run directory, writes the resolved
 parameters, arguments and provenance there, starts the recorder (``record:=true``) and every
-process, and returns 0 when every process ended cleanly, 1 otherwise.
+process, and returns 0 when every process ended cleanly, 1 otherwise (a process that died and
+was respawned counts as a failure).
 """
 
 from __future__ import annotations
@@ -323,14 +324,18 @@ class LaunchService:
                                     duration=plan.duration, printer=self.printer, env=env)
             self.results = supervisor.run()
             self.stop_reason = supervisor.stop_reason
-            code = 0 if all(r.clean for r in self.results) else 1
+            # a process that died is a failure even when respawn brought it back: the run lost
+            # that node's work for a while (a controller, a recorder), so it is not clean
+            code = 0 if all(r.clean and not r.restarts for r in self.results) else 1
             self._write_summary(run_dir, code)
             if code == 0:
                 logger.info('every process ended cleanly; run directory: %s', run_dir)
             else:
-                bad = ', '.join(f'{r.label} ({r.how}, '
-                                f'{"no exit code" if r.returncode is None else r.returncode})'
-                                for r in self.results if not r.clean)
+                bad = ', '.join(
+                    f'{r.label} ({r.how}, '
+                    f'{"no exit code" if r.returncode is None else r.returncode}'
+                    + (f'; died and was respawned {r.restarts} time(s)' if r.restarts else '')
+                    + ')' for r in self.results if not r.clean or r.restarts)
                 logger.error('the launch ended with failures: %s. Logs: %s', bad,
                              run_dir / 'logs')
             return code
@@ -341,8 +346,11 @@ class LaunchService:
         rundir.write_yaml(run_dir / 'summary.yaml', {
             'ended_utc': dt.datetime.now(dt.timezone.utc).isoformat(timespec='seconds'),
             'exit_code': code,
+            'clean': code == 0,
             'stop_reason': self.stop_reason,
-            'processes': [{'label': r.label, 'returncode': r.returncode, 'clean': r.clean,
-                           'how': r.how, 'restarts': r.restarts, 'pid': r.pid}
+            # clean: the process ended cleanly and never died (a respawned process is not clean)
+            'processes': [{'label': r.label, 'returncode': r.returncode,
+                           'clean': r.clean and not r.restarts, 'how': r.how,
+                           'restarts': r.restarts, 'pid': r.pid}
                           for r in self.results],
         })
