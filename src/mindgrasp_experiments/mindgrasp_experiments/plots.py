@@ -38,6 +38,18 @@ def _base(ax) -> None:
     ax.grid(alpha=0.3)
 
 
+def _set_location_places() -> dict[str, tuple[float, float]]:
+    """Label -> (x, y) of the 9 objects of the set-locations scene (m), as the simulator places
+    them; empty when the scene cannot be read."""
+    try:
+        from mindgrasp_sim.scene import load_scene
+
+        return {o.label: (float(o.position[0]), float(o.position[1]))
+                for o in load_scene('set_locations').objects}
+    except Exception:      # the plot then shows the places recorded in the trials only
+        return {}
+
+
 def write_plots(records: Sequence[TrialRecord], run_dir: str | Path,
                 protocol: str = '') -> list[Path]:
     """Write the plots that fit ``protocol``; returns the files written."""
@@ -49,21 +61,26 @@ def write_plots(records: Sequence[TrialRecord], run_dir: str | Path,
     run_dir = Path(run_dir)
     out: list[Path] = []
     placed = [r for r in records if math.isfinite(r.desired_x) and math.isfinite(r.desired_y)]
-    if protocol == 'set_locations' and placed:
-        fig, ax = plt.subplots(figsize=(6, 6))
-        places: dict[str, tuple[float, float]] = {}
+    if protocol == 'set_locations' and records:
+        fig, ax = plt.subplots(figsize=(6.5, 6.5))
+        places = _set_location_places()
         for r in placed:
             places.setdefault(r.desired, (r.desired_x, r.desired_y))
         for label, (x, y) in places.items():
-            asked = [r for r in placed if r.desired == label]
-            won = sum(r.correct_and_successful for r in asked)
-            colour, shape = label.split(' ', 1)
-            ax.scatter(x, y, s=80 + 40 * len(asked), marker=_MARKERS.get(shape, 'o'),
-                       c=_COLOURS.get(colour, 'grey'), edgecolors='k', alpha=0.8)
-            ax.annotate(f'{label}\n{won}/{len(asked)} grasped', (x, y), fontsize=7,
-                        textcoords='offset points', xytext=(8, 6))
+            asked = sum(r.desired == label for r in records)
+            gone_for = sum((r.grasped or r.chosen) == label for r in records)
+            lifted = sum(r.success and r.grasped == label for r in records)
+            right = sum(r.correct_and_successful and r.desired == label for r in records)
+            colour, _, shape = label.partition(' ')
+            ax.scatter(x, y, s=90 + 60 * gone_for, marker=_MARKERS.get(shape, 'o'),
+                       c=_COLOURS.get(colour, 'grey'), edgecolors='k', alpha=0.85)
+            ax.annotate(f'{label}\nasked {asked}, attempted {gone_for}\nlifted {lifted}, '
+                        f'correct {right}', (x, y), fontsize=7, textcoords='offset points',
+                        xytext=(9, 5))
         _base(ax)
-        ax.set_title('Set locations: desired object, correct grasps / attempts')
+        ax.margins(0.18)
+        ax.set_title('Set locations: per object, trials asking for it, grasps attempted on it\n'
+                     '(marker size), lifts, and correct successful grasps')
         out += _save(fig, run_dir, 'set_location_map')
         plt.close(fig)
     if protocol == 'random_locations' and placed:
