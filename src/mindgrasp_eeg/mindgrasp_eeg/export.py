@@ -148,11 +148,13 @@ def read_session(path: str | Path, eeg_topic: str = '/eeg/raw') -> Session:
     # controller states: one annotation per change, lasting until the next change (s)
     states.sort()
     changes = [st for k, st in enumerate(states) if k == 0 or st[1] != states[k - 1][1]]
-    for (t, desc), nxt in zip(changes, [c[0] for c in changes[1:]] + [None], strict=True):
+    for (t, desc), nxt in zip(changes, [c[0] for c in changes[1:]] + [None] * bool(changes),
+                               strict=True):  # no states (no controller): no annotation
         events.append((t, 1e9 if nxt is None else (nxt - t) * 1e-9, desc))  # last: to the end
     # a target is in force until the next one
     targets.sort()
-    for (t, desc), nxt in zip(targets, [c[0] for c in targets[1:]] + [None], strict=True):
+    for (t, desc), nxt in zip(targets, [c[0] for c in targets[1:]] + [None] * bool(targets),
+                               strict=True):
         events.append((t, 1e9 if nxt is None else (nxt - t) * 1e-9, desc))
     chunks.sort(key=lambda c: c[0])
     i0 = chunks[0][0]
