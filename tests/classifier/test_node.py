@@ -138,12 +138,17 @@ def test_node_refuses_a_stream_that_does_not_match(spawn_node, source, model_pat
 def test_node_refuses_missing_model_and_wrong_classes(spawn_node, tmp_path, model_path):
     proc = spawn_node('mindgrasp_classifier.classifier_node', '--ros-args', '-p',
                       f'model:={tmp_path / "nope.json"}')
-    assert proc.wait(60) == 1
+    # a node refuses to start with a bad parameter: exit code 2 (mindgrasp_ros.node_main)
+    assert proc.wait(180) == 2   # start-up alone takes a minute on a loaded machine
     assert 'does not exist; train one with' in proc.output()
     proc = spawn_node('mindgrasp_classifier.classifier_node', '--ros-args', '-p',
                       f'model:={model_path}', '-p', 'classes:=[left_hand, right_hand]')
-    assert proc.wait(60) == 1
+    assert proc.wait(180) == 2   # start-up alone takes a minute on a loaded machine
     assert "are expected; train the model on those classes" in proc.output()
+    proc = spawn_node('mindgrasp_classifier.classifier_node', '--ros-args', '-p',
+                      f'model:={model_path}', '-p', 'adaptation:=wild')
+    assert proc.wait(180) == 2   # start-up alone takes a minute on a loaded machine
+    assert "The parameter 'adaptation' is 'wild'; use one of none, supervised" in proc.output()
 
 
 def test_node_adapts_class_means_from_prompts(spawn_node, source, model_path, rclpy_ctx):

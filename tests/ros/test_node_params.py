@@ -17,6 +17,9 @@ from mindgrasp_ros.params import _flat_fields, _info, describe
 NODES = [
     ('fsm', 'mindgrasp_fsm.params', 'FsmParams', 'mindgrasp_fsm', 'fsm.yaml'),
     ('vision', 'mindgrasp_vision.config', 'VisionConfig', 'mindgrasp_vision', 'vision.yaml'),
+    ('classifier', 'mindgrasp_classifier.classifier_node', 'ClassifierParams',
+     'mindgrasp_classifier', 'classifier.yaml'),
+    ('sim', 'mindgrasp_sim.sim_node', 'SimParams', 'mindgrasp_sim', 'sim.yaml'),
 ]
 IDS = [n[0] for n in NODES]
 

@@ -269,7 +269,7 @@ def test_training_robot_has_the_same_contract(rclpy_ctx, spawn_node):
 @pytest.mark.parametrize(('param', 'message'), [
     ('time_mode:=bogus', "Parameter 'time_mode' is 'bogus'"),
     ('scene:=no_such_scene', "Unknown scene 'no_such_scene'"),
-    ('camera_width:=0', 'Camera width must be an integer'),
+    ('camera_width:=0', "Invalid value 0 for parameter 'camera_width': must be within [1, 8192]"),
 ])
 def test_bad_parameters_exit_with_the_fix(spawn_node, param, message):
     proc = spawn_node('mindgrasp_sim.sim_node', '--ros-args', '-p', param)

@@ -16,6 +16,7 @@ All decoding is done by :class:`~mindgrasp_classifier.decoder.MiDecoder`.
 from __future__ import annotations
 
 import sys
+from dataclasses import dataclass
 
 import numpy as np
 from mindgrasp_ros.interfaces.diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
@@ -23,6 +24,8 @@ from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import EEGChunk, MIPrediction, 
 from threadpoolctl import threadpool_limits
 
 from mindgrasp_classifier.decoder import (
+    ADAPT_MODES,
+    RECENTER_MODES,
     AdaptationConfig,
     CueLabels,
     MiDecoder,
@@ -32,14 +35,47 @@ from mindgrasp_classifier.decoder import (
 from mindgrasp_classifier.errors import ClassifierError
 from mindgrasp_classifier.model import CLASS_NAMES, DEFAULT_MODEL, MiModel
 from mindgrasp_ros import rclpy
+from mindgrasp_ros.node_main import declare_duration, fail, run_node
+from mindgrasp_ros.params import declare_params, param
+from mindgrasp_ros.topics import BCI_PREDICTION, BCI_STATUS, EEG_RAW, TRAINER_PROMPT
 
-PARAMETERS = [
-    ('model', DEFAULT_MODEL), ('classes', list(CLASS_NAMES)),
-    ('adaptation', 'none'), ('adaptation_rate', 0.005), ('min_certainty', 0.5),
-    ('recenter', 'fixed'), ('recenter_rate', 0.005), ('label_tmin', 0.5), ('label_tmax', 2.5),
-    ('flat_threshold', 1e-8), ('status_period', 1.0), ('frame_id', 'eeg'), ('duration', 0.0),
-    ('blas_threads', 1),
-]
+
+@dataclass
+class ClassifierParams:
+    """ROS parameters of the classifier node (read-only: the model and decoder are built at
+    start; restart the node to change them)."""
+
+    model: str = param(DEFAULT_MODEL, 'model written by `mindgrasp train classifier` (.json next '
+                       'to its .npz): a path or a package:// URI')
+    classes: list[str] = param(list(CLASS_NAMES), 'classes the application needs; a model with '
+                               'other classes is refused ([] = any)')
+    adaptation: str = param('none', 'adaptive class means', choices=ADAPT_MODES)
+    adaptation_rate: float = param(0.005, 'geodesic step of an adaptive update per window',
+                                   min=0.0, max=1.0)
+    min_certainty: float = param(0.5, 'certainty needed for an unsupervised update', min=0.0,
+                                 max=1000.0)
+    recenter: str = param('fixed', 'Riemannian re-centering: the training reference or the '
+                          "session's running mean", choices=RECENTER_MODES)
+    recenter_rate: float = param(0.005, 'smallest weight of a new window in the running session '
+                                 'mean', min=0.0, max=1.0)
+    label_tmin: float = param(0.5, 'windows in [cue + label_tmin, cue + label_tmax] get the '
+                              "cue's class for supervised adaptation", unit='s', min=-60.0,
+                              max=60.0)
+    label_tmax: float = param(2.5, 'end of the labelled span after a cue', unit='s', min=-60.0,
+                              max=60.0)
+    flat_threshold: float = param(1e-8, 'filtered channel std below this = flat electrode',
+                                  unit='V', min=0.0, max=1.0)
+    status_period: float = param(1.0, 'between /bci/status messages', unit='s', min=0.01,
+                                 max=3600.0)
+    frame_id: str = param('eeg', 'frame_id of the predictions')
+    blas_threads: int = param(1, 'BLAS threads (small matrices: 1 gives the lowest latency; 0 '
+                              'leaves the default)', min=0, max=256)
+
+    def __post_init__(self) -> None:
+        if self.label_tmax <= self.label_tmin:
+            msg = (f"'label_tmax' ({self.label_tmax} s) must be after 'label_tmin' "
+                   f'({self.label_tmin} s).')
+            raise ClassifierError(msg)
 
 
 class ClassifierNode(rclpy.node.Node):
@@ -47,57 +83,50 @@ class ClassifierNode(rclpy.node.Node):
 
     def __init__(self, **kwargs) -> None:
         super().__init__('classifier', **kwargs)
-        self.declare_parameters('', PARAMETERS)
-        self.p = {name: self.get_parameter(name).value for name, _ in PARAMETERS}
-        if self.p['blas_threads'] > 0:
+        self.p = declare_params(self, ClassifierParams)
+        if self.p.blas_threads > 0:
             # small matrices: multi-threaded BLAS only adds latency, worst on a busy machine
-            threadpool_limits(limits=int(self.p['blas_threads']))
-        self.model = MiModel.load(self.p['model'])
-        if self.p['classes']:
-            check_classes(self.model, self.p['classes'])
+            threadpool_limits(limits=int(self.p.blas_threads))
+        self.model = MiModel.load(self.p.model)
+        if self.p.classes:
+            check_classes(self.model, self.p.classes)
         self.adaptation = AdaptationConfig(
-            mode=self.p['adaptation'], rate=self.p['adaptation_rate'],
-            min_certainty=self.p['min_certainty'], recenter=self.p['recenter'],
-            recenter_rate=self.p['recenter_rate'])
+            mode=self.p.adaptation, rate=self.p.adaptation_rate,
+            min_certainty=self.p.min_certainty, recenter=self.p.recenter,
+            recenter_rate=self.p.recenter_rate)
         self.adaptation.check()
-        self.cues = CueLabels(self.p['label_tmin'], self.p['label_tmax'])
+        self.cues = CueLabels(self.p.label_tmin, self.p.label_tmax)
         self._last_trial = -1
         self.decoder: MiDecoder | None = None
-        self.error: str | None = None
         self.n_predictions = 0
         self._state = (DiagnosticStatus.WARN, f'Waiting for EEG on /eeg/raw '
                        f'({len(self.model.channels)} channels at {self.model.rate:g} Hz).')
         self._last_sent = None
-        qos_raw = rclpy.qos.QoSProfile(depth=100,
-                                       reliability=rclpy.qos.ReliabilityPolicy.BEST_EFFORT,
-                                       durability=rclpy.qos.DurabilityPolicy.VOLATILE)
-        qos_prompt = rclpy.qos.QoSProfile(depth=10,
-                                          reliability=rclpy.qos.ReliabilityPolicy.RELIABLE,
-                                          durability=rclpy.qos.DurabilityPolicy.TRANSIENT_LOCAL)
-        self.pub_pred = self.create_publisher(MIPrediction, '/bci/prediction', 10)
-        self.pub_status = self.create_publisher(DiagnosticArray, '/bci/status', 10)
-        self.create_subscription(EEGChunk, '/eeg/raw', self.eeg_callback, qos_raw)
-        self.create_subscription(Prompt, '/trainer/prompt', self.prompt_callback, qos_prompt)
-        self.create_timer(self.p['status_period'], self.status_callback)
-        self._start_ns = self.get_clock().now().nanoseconds
-        self.create_timer(0.1, self.duration_callback)
-        self.done = False
+        self.pub_pred = self.create_publisher(MIPrediction, BCI_PREDICTION.name,
+                                              BCI_PREDICTION.qos)
+        self.pub_status = self.create_publisher(DiagnosticArray, BCI_STATUS.name, BCI_STATUS.qos)
+        self.create_subscription(EEGChunk, EEG_RAW.name, self.eeg_callback, EEG_RAW.qos)
+        self.create_subscription(Prompt, TRAINER_PROMPT.name, self.prompt_callback,
+                                 TRAINER_PROMPT.qos)
+        self.create_timer(self.p.status_period, self.status_callback)
+        self.done = rclpy.task.Future()
+        declare_duration(self)
         self.get_logger().info(
-            f'Loaded {self.p["model"]}: {self.model.pipeline}, classes {self.model.class_names}, '
+            f'Loaded {self.p.model}: {self.model.pipeline}, classes {self.model.class_names}, '
             f'{len(self.model.channels)} channels at {self.model.rate:g} Hz, window '
             f'{self.model.window:g} s every {self.model.step * 1e3:.1f} ms; adaptation '
             f'{self.adaptation.mode}, re-centering {self.adaptation.recenter}.')
 
     def eeg_callback(self, msg: EEGChunk) -> None:
         """Decode a chunk; publish a prediction per completed window."""
-        if self.error is not None:
+        if self.done.done():
             return
         n_ch = len(msg.channel_names)
         layout = (list(msg.channel_names), float(msg.sample_rate))
         if self.decoder is None:
             try:
                 self.decoder = MiDecoder(self.model, layout[0], layout[1],
-                                         self.adaptation, self.p['flat_threshold'])
+                                         self.adaptation, self.p.flat_threshold)
             except ClassifierError as exc:
                 self.fail(str(exc))
                 return
@@ -117,7 +146,7 @@ class ClassifierNode(rclpy.node.Node):
         if unit_scale is None:
             self.fail(f'The EEG stream has unit {msg.unit!r}; publish EEG in V (or mV/uV).')
             return
-        stamp_s = msg.header.stamp.sec + 1e-9 * msg.header.stamp.nanosec
+        stamp_s = rclpy.time.Time.from_msg(msg.header.stamp).nanoseconds * 1e-9
         first = int(msg.first_sample_index)
         rate = float(msg.sample_rate)
         dec = self.decoder
@@ -149,9 +178,8 @@ class ClassifierNode(rclpy.node.Node):
                            certainty=float(pred.certainty),
                            distances=np.asarray(pred.distances, dtype=np.float32),
                            window_length=float(self.model.window))
-        ns = round(end_s * 1e9)
-        msg.header.stamp.sec, msg.header.stamp.nanosec = ns // 1_000_000_000, ns % 1_000_000_000
-        msg.header.frame_id = self.p['frame_id']
+        msg.header.stamp = rclpy.time.Time(nanoseconds=round(end_s * 1e9)).to_msg()
+        msg.header.frame_id = self.p.frame_id
         self.pub_pred.publish(msg)
         self.n_predictions += 1
 
@@ -161,16 +189,14 @@ class ClassifierNode(rclpy.node.Node):
         if (msg.class_index != Prompt.NO_CLASS and msg.phase in ('cue', 'move')
                 and msg.trial != self._last_trial):
             self._last_trial = msg.trial
-            self.cues.add(msg.header.stamp.sec + 1e-9 * msg.header.stamp.nanosec,
+            self.cues.add(rclpy.time.Time.from_msg(msg.header.stamp).nanoseconds * 1e-9,
                           int(msg.class_index))
 
     def fail(self, reason: str) -> None:
-        """Refuse to run: log, publish an ERROR status, end the node."""
-        self.error = reason
-        self.get_logger().error(reason)
+        """Refuse to run: publish an ERROR status, end the node (exit code 1 with the reason)."""
         self.set_state(DiagnosticStatus.ERROR, reason)
         self.status_callback()
-        self.done = True
+        fail(self, reason)
 
     def set_state(self, level: int, message: str) -> None:
         """Change the status; published at once when the level or reason changes."""
@@ -186,7 +212,7 @@ class ClassifierNode(rclpy.node.Node):
         """Publish /bci/status."""
         level, message = self._state
         dec = self.decoder
-        values = {'model': str(self.p['model']), 'pipeline': self.model.pipeline,
+        values = {'model': str(self.p.model), 'pipeline': self.model.pipeline,
                   'predictions': str(self.n_predictions),
                   'adaptation': self.adaptation.mode, 'recenter': self.adaptation.recenter}
         if dec is not None:
@@ -202,37 +228,12 @@ class ClassifierNode(rclpy.node.Node):
         msg.header.stamp = self.get_clock().now().to_msg()
         self.pub_status.publish(msg)
 
-    def duration_callback(self) -> None:
-        """End after ``duration`` seconds when it is > 0."""
-        duration = self.p['duration']
-        if duration > 0 and self.get_clock().now().nanoseconds - self._start_ns > duration * 1e9:
-            self.done = True
 
 
 def main(args: list[str] | None = None) -> int:
-    """Run the node until Ctrl-C or ``duration``; exit 1 with a message on bad input."""
-    rclpy.init(args=args)
-    node = None
-    code = 0
-    try:
-        node = ClassifierNode()
-        executor = rclpy.executors.SingleThreadedExecutor()
-        executor.add_node(node)
-        while rclpy.ok() and not node.done:
-            executor.spin_once(timeout_sec=0.1)
-        if node.error is not None:
-            print(f'[classifier] ERROR: {node.error}', file=sys.stderr, flush=True)
-            code = 1
-    except ClassifierError as exc:
-        print(f'[classifier] ERROR: {exc}', file=sys.stderr, flush=True)
-        code = 1
-    except KeyboardInterrupt:
-        pass
-    finally:
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
-    return code
+    """Run the node until Ctrl-C or ``duration``; exit 2 on a bad parameter or model, 1 when the
+    stream does not fit the model."""
+    return run_node(ClassifierNode, args, errors=(ClassifierError,))
 
 
 if __name__ == '__main__':

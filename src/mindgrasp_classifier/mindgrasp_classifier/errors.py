@@ -3,5 +3,5 @@
 from __future__ import annotations
 
 
-class ClassifierError(Exception):
+class ClassifierError(ValueError):
     """Bad input, model or data for the MI classifier; the message names the problem and the fix."""

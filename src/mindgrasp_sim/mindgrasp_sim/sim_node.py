@@ -18,7 +18,7 @@ realism, any surface), ``/ee_pose``
 ``/scene/image_raw`` (rgb8, a third-person view of both robots for the participant's display;
 ``scene_camera_rate`` > 0), ``/task/result`` (mindgrasp_msgs/GraspResult) and ``/sim/status``
 (diagnostic_msgs/DiagnosticArray: scene, simulated time, real-time factor, collisions). With
-``trainer_robot:=true`` (alias ``training_robot``) the training robot has the same arm topics
+``trainer_robot:=true`` the training robot has the same arm topics
 under ``/trainer_robot/``.
 As robot_state_publisher would for a real arm: ``/robot_description`` (std_msgs/String, the URDF,
 transient local), ``/tf_static`` (``world`` -> ``base_link`` and the URDF's fixed joints: camera
@@ -41,6 +41,7 @@ with ``use_sim_time:=true``); ``lockstep`` advances only on ``/sim/step`` and pu
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 import sys
@@ -65,6 +66,8 @@ from mindgrasp_ros.interfaces.tf2_msgs.msg import TFMessage
 from mindgrasp_ros.interfaces.visualization_msgs.msg import MarkerArray
 
 from mindgrasp_ros import rclpy
+from mindgrasp_ros.node_main import run_node
+from mindgrasp_ros.params import declare_params, param
 from mindgrasp_ros.topics import ROBOT_DESCRIPTION, TF, TF_STATIC
 from mindgrasp_sim import messages as msgs
 from mindgrasp_sim.control import CommandGate, gripper_closure
@@ -75,18 +78,60 @@ from mindgrasp_sim.tf_tree import TfTree, Transform
 
 TIME_MODES = ('realtime', 'fast', 'lockstep')
 
-_PARAMS = (
-    ('scene', 'set_locations'), ('seed', 0), ('n_objects', -1), ('physics_hz', 240.0),
-    ('camera_width', 128), ('camera_height', 128), ('camera_rate', 10.0),
-    ('camera_fov_deg', 60.0), ('camera_renderer', 'tiny'), ('joint_state_rate', 100.0),
-    ('objects_rate', 2.0),
-    ('time_mode', 'realtime'), ('command_timeout', 0.25), ('trainer_robot', False),
-    ('training_robot', False), ('gui', False), ('duration', 0.0), ('sim_duration', 0.0),
-    ('success_height', 0.22), ('frame_id', 'world'), ('max_catch_up', 0.25),
-    ('tf_publish_frequency', 20.0),
-    ('scene_camera_rate', 0.0), ('scene_camera_width', 320), ('scene_camera_height', 240),
-    ('realism', 'none'), ('realism_seed', 0),
-)  # fmt: skip
+@dataclass
+class SimParams:
+    """ROS parameters of the sim node (``param/sim.yaml``); read-only: the simulation is built at
+    start, restart the node (or call /sim/load_scene) to change them."""
+
+    scene: str = param('set_locations', 'scene name in mindgrasp_sim/scenes/ '
+                       '(set_locations, random_locations) or a path')
+    seed: int = param(0, 'random scenes: layout seed (same seed, same layout)', min=0)
+    n_objects: int = param(-1, "random scenes: number of objects, -1 = the scene file's",
+                           min=-1, max=100)
+    physics_hz: float = param(240.0, 'physics rate; contacts are tuned for 240 Hz', unit='Hz',
+                              min=10.0, max=10000.0)
+    camera_width: int = param(128, 'eye-in-hand RGB-D camera width', unit='px', min=1, max=8192)
+    camera_height: int = param(128, 'eye-in-hand RGB-D camera height', unit='px', min=1,
+                               max=8192)
+    camera_rate: float = param(10.0, 'camera frame rate (simulated time)', unit='Hz', min=0.1,
+                               max=1000.0)
+    camera_fov_deg: float = param(60.0, 'vertical field of view', unit='deg', min=1.0,
+                                  max=179.0)
+    camera_renderer: str = param('tiny', 'tiny (CPU TinyRenderer) or egl (OpenGL via EGL)',
+                                 choices=('tiny', 'egl'))
+    joint_state_rate: float = param(100.0, '/joint_states, /ee_pose, /gripper/* rate (simulated '
+                                    'time)', unit='Hz', min=0.1, max=10000.0)
+    objects_rate: float = param(2.0, '/sim/objects rate', unit='Hz', min=0.01, max=1000.0)
+    time_mode: str = param('realtime', 'realtime, fast (publishes /clock) or lockstep '
+                           '(/sim/step)')
+    command_timeout: float = param(0.25, 'a velocity command older than this means zero '
+                                   'velocity', unit='s', min=0.001, max=60.0)
+    trainer_robot: bool = param(False, 'also simulate the green training robot under '
+                                '/trainer_robot/')
+    gui: bool = param(False, 'PyBullet window (needs a display)')
+    duration: float = param(0.0, 'end after this many wall seconds; 0 = run until stopped',
+                            unit='s', min=0.0)
+    sim_duration: float = param(0.0, 'end after this many simulated seconds; 0 = no limit',
+                                unit='s', min=0.0)
+    success_height: float = param(0.22, '/task/result success: held object centre above this '
+                                  'height', unit='m', min=0.0, max=10.0)
+    frame_id: str = param('world', 'frame of /ee_pose and /sim/objects (the arm base is at its '
+                          'origin)')
+    max_catch_up: float = param(0.25, 'realtime: lag beyond this is skipped, not raced through',
+                                unit='s', min=0.0, max=60.0)
+    tf_publish_frequency: float = param(20.0, 'most /tf messages per second, as '
+                                        "robot_state_publisher's publish_frequency", unit='Hz',
+                                        min=0.1, max=10000.0)
+    scene_camera_rate: float = param(0.0, '/scene/image_raw, third-person view for the '
+                                     'participant display; 0 = off', unit='Hz', min=0.0)
+    scene_camera_width: int = param(320, 'scene camera width', unit='px', min=1, max=8192)
+    scene_camera_height: int = param(240, 'scene camera height', unit='px', min=1, max=8192)
+    realism: str = param('none', 'none, default or the path of a realism profile YAML (sensor '
+                         'noise, physical spread)')
+    realism_seed: int = param(0, 'seed of the realism draws (same seed, same noise)', min=0)
+
+    def __post_init__(self) -> None:
+        _check_params(dataclasses.asdict(self))
 
 
 @dataclass
@@ -125,11 +170,9 @@ class SimNode(rclpy.node.Node):
 
     def __init__(self, **kwargs) -> None:
         super().__init__('sim', **kwargs)
-        self.declare_parameters('', list(_PARAMS))
-        p = {name: self.get_parameter(name).value for name, _ in _PARAMS}
-        self.p = p
+        self.params = declare_params(self, SimParams)
+        p = self.p = dataclasses.asdict(self.params)
         try:
-            _check_params(p)
             gui = bool(p['gui'])
             if gui and not os.environ.get('DISPLAY') and sys.platform.startswith('linux'):
                 self.get_logger().warning(
@@ -141,14 +184,14 @@ class SimNode(rclpy.node.Node):
                                     float(p['camera_rate']), float(p['camera_fov_deg']),
                                     renderer=str(p['camera_renderer'])),
                 physics_hz=float(p['physics_hz']),
-                trainer_robot=bool(p['trainer_robot'] or p['training_robot']), gui=gui,
+                trainer_robot=bool(p['trainer_robot']), gui=gui,
                 n_objects=None if int(p['n_objects']) < 0 else int(p['n_objects']),
                 realism=str(p['realism']), realism_seed=int(p['realism_seed']))
         except SimError as err:
             self.get_logger().error(str(err))
             raise
         self.mode = p['time_mode']
-        self.finished = False
+        self.done = rclpy.task.Future()
         self.monitor = TaskMonitor(success_height=float(p['success_height']))
         self.monitor.new_trial(0.0)
         self.desired = ''
@@ -170,6 +213,7 @@ class SimNode(rclpy.node.Node):
         self._collisions: list[str] = []
         self._last_state_step = -1
         self._wall_start = time.monotonic()
+        self._cpu_start = time.process_time()
         self._last_warning: dict[str, float] = {}
 
         reliable = rclpy.qos.QoSProfile(depth=10)
@@ -288,7 +332,7 @@ class SimNode(rclpy.node.Node):
             self.clock_pub.publish(Clock(clock=self._stamp()))
         limit = float(self.p['sim_duration'])
         if limit > 0 and self.total_steps * sim.dt >= limit:
-            self.finished = True
+            self._finish()
 
     def realtime_callback(self) -> None:
         """Catch up with the node's clock (wall, or /clock with use_sim_time)."""
@@ -317,13 +361,13 @@ class SimNode(rclpy.node.Node):
     def fast_callback(self) -> None:
         """Fast mode: step as fast as possible for about 2 ms of wall time."""
         end = time.monotonic() + 0.002
-        while not self.finished and time.monotonic() < end:
+        while not self.done.done() and time.monotonic() < end:
             self.fast_iteration()
 
     def duration_callback(self) -> None:
         limit = float(self.p['duration'])
         if limit > 0 and time.monotonic() - self._wall_start >= limit:
-            self.finished = True
+            self._finish()
 
     # ------------------------------------------------------------------ commands
     def _warn_throttled(self, key: str, period: float, text: str) -> None:
@@ -516,43 +560,31 @@ class SimNode(rclpy.node.Node):
         self.status_pub.publish(msgs.status(self._header(), ok, text, values))
 
     # ------------------------------------------------------------------ lifecycle
-    def run(self) -> None:
-        """Spin until ``duration`` / ``sim_duration`` is over (or forever)."""
-        self._wall_start = time.monotonic()
-        cpu0 = time.process_time()
-        steps0 = self.total_steps
-        try:
-            while rclpy.ok() and not self.finished:
-                rclpy.spin_once(self, timeout_sec=0.05)
-        finally:    # also after Ctrl-C
-            wall = time.monotonic() - self._wall_start
-            simulated = (self.total_steps - steps0) * self.sim.dt
-            cpu = time.process_time() - cpu0
-            self.get_logger().info(
-                f'Simulated {simulated:.2f} s in {wall:.2f} s wall time: real-time factor '
-                f'{simulated / max(wall, 1e-9):.2f}x ({simulated / max(cpu, 1e-9):.2f}x per CPU '
-                'second of this process).')
+    @property
+    def finished(self) -> bool:
+        """True once ``duration`` / ``sim_duration`` is over."""
+        return self.done.done()
+
+    def _finish(self) -> None:
+        if not self.done.done():
+            self.done.set_result(0)
 
     def destroy_node(self) -> None:
+        """Log the real-time factor of the run (also after Ctrl-C), close the simulation."""
+        wall = time.monotonic() - self._wall_start
+        simulated = self.total_steps * self.sim.dt
+        cpu = time.process_time() - self._cpu_start
+        self.get_logger().info(
+            f'Simulated {simulated:.2f} s in {wall:.2f} s wall time: real-time factor '
+            f'{simulated / max(wall, 1e-9):.2f}x ({simulated / max(cpu, 1e-9):.2f}x per CPU '
+            'second of this process).')
         self.sim.close()
         super().destroy_node()
 
 
 def main(args: list[str] | None = None) -> int:
-    rclpy.init(args=args)
-    try:
-        node = SimNode()
-    except SimError:
-        rclpy.try_shutdown()
-        return 2
-    try:
-        node.run()
-    except KeyboardInterrupt:
-        pass
-    finally:
-        node.destroy_node()
-        rclpy.try_shutdown()
-    return 0
+    """Run the simulator until Ctrl-C, ``duration`` (wall s) or ``sim_duration`` (simulated s)."""
+    return run_node(SimNode, args, errors=(SimError,))
 
 
 if __name__ == '__main__':

@@ -18,6 +18,8 @@ from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import MIPrediction, Prompt
 from mindgrasp_ros.interfaces.sensor_msgs.msg import Image
 
 from mindgrasp_ros import rclpy
+from mindgrasp_ros.node_main import run_node
+from mindgrasp_ros.topics import BCI_PREDICTION, TRAINER_DISPLAY, TRAINER_PROMPT
 from mindgrasp_trainer.display import render_display
 from mindgrasp_trainer.graz import GrazProtocol, PromptSequencer
 from mindgrasp_trainer.protocol import TrainerError
@@ -25,8 +27,6 @@ from mindgrasp_trainer.ros_common import (
     EegGate,
     check_rate,
     fixed_parameters_callback,
-    prompt_qos,
-    spin_until_finished,
     to_msg,
 )
 
@@ -77,13 +77,13 @@ class GrazNode(rclpy.node.Node):
         # busy machine would otherwise miss the first trials)
         self.eeg_gate = EegGate(self) if self.get_parameter('wait_for_eeg').value else None
 
-        self.prompt_pub = self.create_publisher(Prompt, '/trainer/prompt', prompt_qos())
-        self.create_subscription(MIPrediction, '/bci/prediction', self.prediction_callback, 10)
+        self.prompt_pub = self.create_publisher(Prompt, TRAINER_PROMPT.name, TRAINER_PROMPT.qos)
+        self.create_subscription(MIPrediction, BCI_PREDICTION.name, self.prediction_callback,
+                                 BCI_PREDICTION.qos)
         self.create_timer(1.0 / rate, self.tick_callback)
         if display_rate > 0:
-            self.display_pub = self.create_publisher(
-                Image, '/trainer/display', rclpy.qos.qos_profile_sensor_data
-            )
+            self.display_pub = self.create_publisher(Image, TRAINER_DISPLAY.name,
+                                                     TRAINER_DISPLAY.qos)
             self.create_timer(1.0 / display_rate, self.display_callback)
         self.add_on_set_parameters_callback(fixed_parameters_callback({
             'feedback': lambda v: self._set_display('feedback', str(v)),
@@ -147,21 +147,9 @@ class GrazNode(rclpy.node.Node):
 
 
 def main(args: list[str] | None = None) -> int:
-    rclpy.init(args=args)
-    try:
-        node = GrazNode()
-    except TrainerError:
-        rclpy.shutdown()
-        return 2
-    try:
-        spin_until_finished(node)
-    except KeyboardInterrupt:
-        pass
-    finally:
-        node.destroy_node()
-        if rclpy.ok():
-            rclpy.shutdown()
-    return 0
+    """Run the session until it ends (exit code of ``done``), Ctrl-C or a bad parameter (2); the
+    last prompts get 0.5 s to reach reliable readers."""
+    return run_node(GrazNode, args, errors=(TrainerError,), linger_sec=0.5)
 
 
 if __name__ == '__main__':

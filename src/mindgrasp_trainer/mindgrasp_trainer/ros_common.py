@@ -1,5 +1,5 @@
-"""ROS plumbing shared by the trainer nodes: prompt QoS and message, rate and parameter checks,
-spinning until a session ends. Imports the client layer; the protocols themselves do not.
+"""ROS plumbing shared by the trainer nodes: prompt QoS and message, rate and parameter checks.
+Imports the client layer; the protocols themselves do not.
 """
 
 from __future__ import annotations
@@ -15,7 +15,6 @@ __all__ = [
     'check_rate',
     'fixed_parameters_callback',
     'prompt_qos',
-    'spin_until_finished',
     'to_msg',
 ]
 
@@ -54,13 +53,10 @@ class EegGate:
 
 
 def prompt_qos() -> rclpy.qos.QoSProfile:
-    """QoS of /trainer/prompt: reliable, transient local, keep last 1 (DESIGN.md topic table)."""
-    return rclpy.qos.QoSProfile(
-        depth=1,
-        history=rclpy.qos.HistoryPolicy.KEEP_LAST,
-        reliability=rclpy.qos.ReliabilityPolicy.RELIABLE,
-        durability=rclpy.qos.DurabilityPolicy.TRANSIENT_LOCAL,
-    )
+    """QoS of /trainer/prompt (the topic table, :data:`mindgrasp_ros.topics.TRAINER_PROMPT`)."""
+    from mindgrasp_ros.topics import TRAINER_PROMPT
+
+    return TRAINER_PROMPT.qos
 
 
 def check_rate(name: str, value: float, allow_zero: bool = False) -> float:
@@ -111,14 +107,3 @@ def to_msg(event: PromptEvent, stamp) -> Prompt:
     )
     msg.header.stamp = stamp
     return msg
-
-
-def spin_until_finished(node: rclpy.node.Node, linger: float = 0.5) -> None:
-    """Spin until ``node.done`` completes, then ``linger`` s more so reliable readers get the end.
-
-    One executor for the whole run (``rclpy.spin_once`` in a loop adds and removes the node each
-    call, which costs a quarter of a core).
-    """
-    rclpy.spin_until_future_complete(node, node.done)
-    if rclpy.ok():
-        rclpy.spin_until_future_complete(node, rclpy.task.Future(), timeout_sec=linger)

@@ -27,13 +27,21 @@ from mindgrasp_ros.interfaces.sensor_msgs.msg import JointState
 from mindgrasp_ros.interfaces.std_msgs.msg import Float64, Float64MultiArray
 
 from mindgrasp_ros import rclpy
+from mindgrasp_ros.node_main import run_node
+from mindgrasp_ros.topics import (
+    ARM_COMMANDS,
+    EE_POSE,
+    FSM_STATE,
+    JOINT_STATES,
+    TRAINER_EE_DISTANCE,
+    TRAINER_PROMPT,
+    TRAINER_ROBOT,
+)
 from mindgrasp_trainer.protocol import CLASS_NAMES, TrainerError
 from mindgrasp_trainer.ros_common import (
     EegGate,
     check_rate,
     fixed_parameters_callback,
-    prompt_qos,
-    spin_until_finished,
     to_msg,
 )
 from mindgrasp_trainer.trainer import TrainerProtocol, ee_distance
@@ -89,24 +97,16 @@ class TrainerNode(rclpy.node.Node):
         self.done = rclpy.task.Future()  # result: exit code, set when the session has ended
         self.eeg_gate = EegGate(self) if self.get_parameter('wait_for_eeg').value else None
 
-        self.prompt_pub = self.create_publisher(Prompt, '/trainer/prompt', prompt_qos())
-        self.command_pub = self.create_publisher(
-            Float64MultiArray, '/trainer_robot/arm_controller/commands', 10
-        )
-        self.distance_pub = self.create_publisher(Float64, '/trainer/ee_distance', 10)
-        self.create_subscription(
-            JointState, '/trainer_robot/joint_states', self.joint_states_callback, 10
-        )
-        self.create_subscription(
-            PoseStamped, '/trainer_robot/ee_pose', self.trainer_pose_callback, 10
-        )
-        self.create_subscription(PoseStamped, '/ee_pose', self.user_pose_callback, 10)
-        fsm_qos = rclpy.qos.QoSProfile(
-            depth=10,
-            reliability=rclpy.qos.ReliabilityPolicy.RELIABLE,
-            durability=rclpy.qos.DurabilityPolicy.TRANSIENT_LOCAL,
-        )
-        self.create_subscription(FsmState, '/fsm/state', self.fsm_callback, fsm_qos)
+        self.prompt_pub = self.create_publisher(Prompt, TRAINER_PROMPT.name, TRAINER_PROMPT.qos)
+        arm, joints, pose = (t.in_namespace(TRAINER_ROBOT)
+                             for t in (ARM_COMMANDS, JOINT_STATES, EE_POSE))
+        self.command_pub = self.create_publisher(Float64MultiArray, arm.name, arm.qos)
+        self.distance_pub = self.create_publisher(Float64, TRAINER_EE_DISTANCE.name,
+                                                  TRAINER_EE_DISTANCE.qos)
+        self.create_subscription(JointState, joints.name, self.joint_states_callback, joints.qos)
+        self.create_subscription(PoseStamped, pose.name, self.trainer_pose_callback, pose.qos)
+        self.create_subscription(PoseStamped, EE_POSE.name, self.user_pose_callback, EE_POSE.qos)
+        self.create_subscription(FsmState, FSM_STATE.name, self.fsm_callback, FSM_STATE.qos)
         self.reset_client = self.create_client(ResetSim, '/sim/reset')
         self.create_timer(1.0 / rate, self.tick_callback)
         self.add_on_set_parameters_callback(fixed_parameters_callback({
@@ -326,23 +326,17 @@ def _fmt(x: float) -> str:
     return f'{x:.4f}' if math.isfinite(x) else ''
 
 
-def main(args: list[str] | None = None) -> int:
-    rclpy.init(args=args)
-    try:
-        node = TrainerNode()
-    except TrainerError:
-        rclpy.shutdown()
-        return 2
-    try:
-        spin_until_finished(node)
-    except KeyboardInterrupt:
-        node.command_pub.publish(Float64MultiArray(data=np.zeros(node.protocol.n_joints)))
-    finally:
-        code = node.exit_code
-        node.destroy_node()
+    def destroy_node(self) -> None:
+        """The training robot stops when the node ends (also on Ctrl-C)."""
         if rclpy.ok():
-            rclpy.shutdown()
-    return code
+            self.command_pub.publish(Float64MultiArray(data=np.zeros(self.protocol.n_joints)))
+        super().destroy_node()
+
+
+def main(args: list[str] | None = None) -> int:
+    """Run the session until it ends (exit code of ``done``), Ctrl-C or a bad parameter (2); the
+    last prompts get 0.5 s to reach reliable readers."""
+    return run_node(TrainerNode, args, errors=(TrainerError,), linger_sec=0.5)
 
 
 if __name__ == '__main__':
