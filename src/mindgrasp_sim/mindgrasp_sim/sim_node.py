@@ -214,7 +214,6 @@ class SimNode(rclpy.node.Node):
         self._last_state_step = -1
         self._wall_start = time.monotonic()
         self._cpu_start = time.process_time()
-        self._last_warning: dict[str, float] = {}
 
         reliable = rclpy.qos.QoSProfile(depth=10)
         latched = rclpy.qos.QoSProfile(
@@ -340,9 +339,10 @@ class SimNode(rclpy.node.Node):
         cap = float(self.p['max_catch_up'])
         if due > cap:
             # the machine is too slow (or the clock jumped): drop the lag instead of racing
-            self._warn_throttled(
-                'behind', 5.0, f'The simulation is {due:.2f} s behind its clock; skipping '
-                'ahead. Lower camera_width/height or camera_rate, or use time_mode:=fast.')
+            self.get_logger().warning(
+                f'The simulation is {due:.2f} s behind its clock; skipping ahead. Lower '
+                'camera_width/height or camera_rate, or use time_mode:=fast.',
+                throttle_duration_sec=5.0)
             self._set_t0(self._t0 + due - cap)
             for io in self.robots.values():
                 # commands that arrived during the lag were stamped before the skip; without
@@ -370,15 +370,9 @@ class SimNode(rclpy.node.Node):
             self._finish()
 
     # ------------------------------------------------------------------ commands
-    def _warn_throttled(self, key: str, period: float, text: str) -> None:
-        """Log ``text`` at most once per ``period`` wall seconds per ``key``."""
-        now = time.monotonic()
-        if now - self._last_warning.get(key, -math.inf) > period:
-            self.get_logger().warning(text)
-            self._last_warning[key] = now
-
     def _warn_bad(self, text: str) -> None:
-        self._warn_throttled('bad', 1.0, text)
+        """A bad command: at most one warning per second for all of them (one call site)."""
+        self.get_logger().warning(text, throttle_duration_sec=1.0)
 
     def arm_command_callback(self, msg: Float64MultiArray, io: _RobotIO) -> None:
         """Joint velocities (rad/s); a bad command stops the arm and is reported."""
