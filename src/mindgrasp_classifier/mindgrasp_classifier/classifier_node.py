@@ -15,7 +15,6 @@ All decoding is done by :class:`~mindgrasp_classifier.decoder.MiDecoder`.
 
 from __future__ import annotations
 
-import sys
 from dataclasses import dataclass
 
 import numpy as np

@@ -312,6 +312,12 @@ class TrainerNode(rclpy.node.Node):
             return
         self.get_logger().info(f'Trial log written to {path}.')
 
+    def destroy_node(self) -> None:
+        """The training robot stops when the node ends (also on Ctrl-C)."""
+        if rclpy.ok():
+            self.command_pub.publish(Float64MultiArray(data=np.zeros(self.protocol.n_joints)))
+        super().destroy_node()
+
 
 def _rounded(value: object) -> object:
     """Floats to 4 decimals (0.1 mm), recursively, for a readable log line."""
@@ -324,13 +330,6 @@ def _rounded(value: object) -> object:
 
 def _fmt(x: float) -> str:
     return f'{x:.4f}' if math.isfinite(x) else ''
-
-
-    def destroy_node(self) -> None:
-        """The training robot stops when the node ends (also on Ctrl-C)."""
-        if rclpy.ok():
-            self.command_pub.publish(Float64MultiArray(data=np.zeros(self.protocol.n_joints)))
-        super().destroy_node()
 
 
 def main(args: list[str] | None = None) -> int:
