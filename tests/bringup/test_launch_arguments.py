@@ -17,6 +17,9 @@ from mindgrasp_bringup.launch_system import LaunchError, LaunchService
     (['trials:=x'], "launch argument 'trials' is 'x': a whole number >= 0 is expected"),
     (['model:=/no/such/model.json'], "launch argument 'model' is '/no/such/model.json', which is "
                                      'not a file'),
+    (['model:=package://mindgrasp_classifier/models/nope.json'],
+     "launch argument 'model' is 'package://mindgrasp_classifier/models/nope.json', which is not "
+     'a file'),
     (['subject:=telepathy'], "launch argument 'subject' got 'telepathy', which is not one of"),
 ])
 def test_demo_arguments_are_checked_in_the_plan(args, message):
@@ -39,3 +42,7 @@ def test_bad_argument_starts_nothing_and_exits_2(tmp_path):
 def test_good_arguments_pass():
     plan = LaunchService('demo', ['seed:=4', 'trials:=0', 'model:=']).plan(strict=True)
     assert {p.label for p in plan.processes} >= {'sim', 'fsm', 'classifier'}
+    model = 'package://mindgrasp_classifier/models/default_classifier.json'   # package data
+    plan = LaunchService('demo', [f'model:={model}']).plan(strict=True)
+    classifier = next(p for p in plan.processes if p.label == 'classifier')
+    assert classifier.parameters['model'] == model

@@ -21,14 +21,13 @@ from mindgrasp_ros.interfaces.std_msgs.msg import String
 from mindgrasp_ros.interfaces.visualization_msgs.msg import MarkerArray
 
 from mindgrasp_common.markers import objects_from_markers
+from mindgrasp_common.mi import CLASS_NAMES
 from mindgrasp_eeg.montage import class_name
 from mindgrasp_eeg.ros_conversions import base_yaw_from_joint_state
 from mindgrasp_eeg.subject import VirtualSubject
 from mindgrasp_ros import rclpy
 from mindgrasp_ros.node_main import end_after, run_node
 from mindgrasp_ros.params import declare_params, param
-
-CLASS_NAMES = ['left_hand', 'right_hand', 'both_hands', 'both_feet']
 
 
 @dataclass
@@ -96,8 +95,8 @@ class OracleSubjectNode(rclpy.node.Node):
         cls, certainty = (3, 0.0) if intent is None else (int(intent), self.p['certainty'])
         distances = np.full(4, 1.0 + certainty, dtype=np.float32)
         distances[cls] = 1.0
-        msg = MIPrediction(class_index=cls, class_names=CLASS_NAMES, certainty=float(certainty),
-                           distances=distances, window_length=0.0)
+        msg = MIPrediction(class_index=cls, class_names=list(CLASS_NAMES),
+                           certainty=float(certainty), distances=distances, window_length=0.0)
         msg.header.stamp = self.get_clock().now().to_msg()
         self.pub.publish(msg)
         if intent != self._last_intent:

@@ -16,13 +16,13 @@ check the value there).
 from __future__ import annotations
 
 import math
-from pathlib import Path
 from typing import Any
 
 from mindgrasp_bringup.launch_system.actions.declare_launch_argument import (
     DeclareLaunchArgument,
 )
 from mindgrasp_bringup.launch_system.errors import LaunchError
+from mindgrasp_common.resources import ResourceNotFoundError, resolve_path
 
 __all__ = ['FileLaunchArgument', 'NumberLaunchArgument', 'check_number', 'file_argument',
            'number_argument']
@@ -70,17 +70,23 @@ def number_argument(name: str, *, default_value: str, description: str, kind: ty
                                 description=description)
 
 
-_REPO = Path(__file__).resolve().parents[4]
+def _is_file(text: str) -> bool:
+    """``text`` names an existing file: a path (absolute or from the working directory) or a
+    ``package://<package>/<path>`` URI."""
+    try:
+        return resolve_path(text, 'mindgrasp_bringup').is_file()
+    except ResourceNotFoundError:
+        return False
 
 
 class FileLaunchArgument(DeclareLaunchArgument):
     """A :class:`DeclareLaunchArgument` naming a file: empty (the default) or an existing file,
-    relative to the working directory or the repository."""
+    relative to the working directory, or a ``package://<package>/<path>`` URI."""
 
     def execute(self, context: Any) -> None:
         super().execute(context)
         text = context.launch_configurations[self.name].strip()
-        if text and not (Path(text).expanduser().is_file() or (_REPO / text).is_file()):
+        if text and not _is_file(text):
             msg = (f"launch argument '{self.name}' is {text!r}, which is not a file; give the "
                    f'path of an existing file ({self.description}).')
             raise LaunchError(msg)
