@@ -193,7 +193,8 @@ def sweep(args: argparse.Namespace) -> dict:
                   file=sys.stderr)
             raise SystemExit(2)
         records = prior.get('records_on') or _records_from_lines(text, profile.name)
-        records = [r for r in records if r['index'] < args.trials]
+        # the same placements only when the compare run drew as many trials (the shapes are
+        # shuffled over all of them)
         if len(records) == args.trials:
             done[json.dumps(_profile_dict(profile), sort_keys=True)] = records
     for factor, label, p in sweep_levels(profile):
@@ -303,8 +304,8 @@ def main() -> int:
     parser.add_argument('--plot', default='', help='write a PNG plot here')
     parser.add_argument('--images', type=int, default=150, help='cnn: test views per condition')
     parser.add_argument('--reuse', default='',
-                        help="sweep: a compare run's output whose realism trials stand for the "
-                             "profile's own level")
+                        help="sweep: a compare run's output (same --trials, --seed, --profile) "
+                             "whose realism trials stand for the profile's own level")
     parser.add_argument('--skip-off', action='store_true',
                         help='compare, cnn: run the realism condition only')
     parser.add_argument('--model', default='', help='cnn: shape model (default the vision one)')
