@@ -20,6 +20,7 @@ def _missing_modules(profile: str) -> list[str]:
     return [str(spec.module) for spec in plan.processes if spec.problem]
 
 
+@pytest.mark.timeout(1200)   # start-up waits for EEG, classifier and vision on a loaded machine
 def test_demo_runs_headless_ends_cleanly_and_records_the_session(tmp_path: Path) -> None:
     assert not _missing_modules('demo'), 'every node of the demo is part of the project'
     run_dir = tmp_path / 'run'
