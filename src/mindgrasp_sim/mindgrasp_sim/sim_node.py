@@ -68,7 +68,28 @@ from mindgrasp_ros.interfaces.visualization_msgs.msg import MarkerArray
 from mindgrasp_ros import rclpy
 from mindgrasp_ros.node_main import run_node
 from mindgrasp_ros.params import declare_params, param
-from mindgrasp_ros.topics import ROBOT_DESCRIPTION, TF, TF_STATIC
+from mindgrasp_ros.topics import (
+    ARM_COMMANDS,
+    CLOCK,
+    COLOR_IMAGE,
+    COLOR_INFO,
+    DEPTH_IMAGE,
+    DEPTH_INFO,
+    EE_POSE,
+    GRIPPER_COMMANDS,
+    GRIPPER_CONTACTS,
+    GRIPPER_JOINT_STATES,
+    JOINT_STATES,
+    ROBOT_DESCRIPTION,
+    SCENE_IMAGE,
+    SIM_OBJECTS,
+    SIM_STATUS,
+    TASK_RESULT,
+    TASK_TARGET,
+    TF,
+    TF_STATIC,
+    TRAINER_ROBOT,
+)
 from mindgrasp_sim import messages as msgs
 from mindgrasp_sim.control import CommandGate, gripper_closure
 from mindgrasp_sim.errors import SimError
@@ -215,45 +236,39 @@ class SimNode(rclpy.node.Node):
         self._wall_start = time.monotonic()
         self._cpu_start = time.process_time()
 
-        reliable = rclpy.qos.QoSProfile(depth=10)
-        latched = rclpy.qos.QoSProfile(
-            depth=1, reliability=rclpy.qos.ReliabilityPolicy.RELIABLE,
-            durability=rclpy.qos.DurabilityPolicy.TRANSIENT_LOCAL)
-        sensor = rclpy.qos.qos_profile_sensor_data
         self.robots: dict[str, _RobotIO] = {}
         for name in self.sim.robots:
-            prefix = '' if name == 'user' else '/trainer_robot'
+            prefix = '' if name == 'user' else TRAINER_ROBOT
             io = _RobotIO(name, prefix, CommandGate(float(p['command_timeout'])))
-            io.pubs['js'] = self.create_publisher(JointState, f'{prefix}/joint_states', reliable)
-            io.pubs['gripper'] = self.create_publisher(
-                JointState, f'{prefix}/gripper/joint_states', reliable)
-            io.pubs['contacts'] = self.create_publisher(
-                UInt8MultiArray, f'{prefix}/gripper/contacts', reliable)
-            io.pubs['ee'] = self.create_publisher(PoseStamped, f'{prefix}/ee_pose', reliable)
+            js, fingers, contacts, ee, arm, gripper = (t.in_namespace(prefix) for t in (
+                JOINT_STATES, GRIPPER_JOINT_STATES, GRIPPER_CONTACTS, EE_POSE, ARM_COMMANDS,
+                GRIPPER_COMMANDS))
+            io.pubs['js'] = self.create_publisher(JointState, js.name, js.qos)
+            io.pubs['gripper'] = self.create_publisher(JointState, fingers.name, fingers.qos)
+            io.pubs['contacts'] = self.create_publisher(UInt8MultiArray, contacts.name,
+                                                        contacts.qos)
+            io.pubs['ee'] = self.create_publisher(PoseStamped, ee.name, ee.qos)
+            self.create_subscription(Float64MultiArray, arm.name,
+                                     lambda msg, io=io: self.arm_command_callback(msg, io), arm.qos)
             self.create_subscription(
-                Float64MultiArray, f'{prefix}/arm_controller/commands',
-                lambda msg, io=io: self.arm_command_callback(msg, io), reliable)
-            self.create_subscription(
-                Float64MultiArray, f'{prefix}/gripper_controller/commands',
-                lambda msg, io=io: self.gripper_command_callback(msg, io), reliable)
+                Float64MultiArray, gripper.name,
+                lambda msg, io=io: self.gripper_command_callback(msg, io), gripper.qos)
             self.robots[name] = io
-        self.color_pub = self.create_publisher(Image, '/camera/color/image_raw', sensor)
-        self.depth_pub = self.create_publisher(Image, '/camera/depth/image_raw', sensor)
-        self.info_pub = self.create_publisher(CameraInfo, '/camera/color/camera_info', sensor)
-        self.depth_info_pub = self.create_publisher(CameraInfo, '/camera/depth/camera_info',
-                                                    sensor)
-        self.scene_pub = (self.create_publisher(Image, '/scene/image_raw', sensor)
+        self.color_pub = self.create_publisher(Image, COLOR_IMAGE.name, COLOR_IMAGE.qos)
+        self.depth_pub = self.create_publisher(Image, DEPTH_IMAGE.name, DEPTH_IMAGE.qos)
+        self.info_pub = self.create_publisher(CameraInfo, COLOR_INFO.name, COLOR_INFO.qos)
+        self.depth_info_pub = self.create_publisher(CameraInfo, DEPTH_INFO.name, DEPTH_INFO.qos)
+        self.scene_pub = (self.create_publisher(Image, SCENE_IMAGE.name, SCENE_IMAGE.qos)
                           if self.scene_every < math.inf else None)
-        self.objects_pub = self.create_publisher(MarkerArray, '/sim/objects', latched)
-        self.result_pub = self.create_publisher(GraspResult, '/task/result', reliable)
-        self.status_pub = self.create_publisher(DiagnosticArray, '/sim/status', reliable)
+        self.objects_pub = self.create_publisher(MarkerArray, SIM_OBJECTS.name, SIM_OBJECTS.qos)
+        self.result_pub = self.create_publisher(GraspResult, TASK_RESULT.name, TASK_RESULT.qos)
+        self.status_pub = self.create_publisher(DiagnosticArray, SIM_STATUS.name, SIM_STATUS.qos)
         self._status_mark = (time.monotonic(), 0)
         self.clock_pub = None
         if self.mode in ('fast', 'lockstep'):
-            self.clock_pub = self.create_publisher(
-                Clock, '/clock', rclpy.qos.QoSProfile(
-                    depth=1, reliability=rclpy.qos.ReliabilityPolicy.BEST_EFFORT))
-        self.create_subscription(TaskTarget, '/task/target', self.target_callback, latched)
+            self.clock_pub = self.create_publisher(Clock, CLOCK.name, CLOCK.qos)
+        self.create_subscription(TaskTarget, TASK_TARGET.name, self.target_callback,
+                                 TASK_TARGET.qos)
         self.create_service(ResetSim, '/sim/reset', self.reset_callback)
         self.create_service(LoadScene, '/sim/load_scene', self.load_scene_callback)
         self.create_service(Step, '/sim/step', self.step_callback)
