@@ -58,6 +58,7 @@ COMMANDS: dict[str, str | dict[str, str]] = {
         'set-locations': 'mindgrasp_experiments.commands.set_locations',
         'random-locations': 'mindgrasp_experiments.commands.random_locations',
         'report': 'mindgrasp_experiments.commands.report',
+        'sweep': 'mindgrasp_experiments.commands.sweep',
     },
     'export': {
         'eeg': 'mindgrasp_eeg.export_cli',

@@ -62,6 +62,10 @@ class TrialRecord:
     class_switches: int = 0          # changes of the decoded class
     n_predictions: int = 0
     decoder_accuracy: float = math.nan  # predictions equal to the subject's intent (when known)
+    decoder_windows: int = 0         # predictions (classifier windows) made while an intent held
+    decoder_hits: int = 0            #   ... of which equal to the intent
+    decoder_decisions: int = 0       # spans of one held intent with predictions in them
+    decoder_decision_hits: int = 0   #   ... whose most frequent predicted class is the intent
     mean_certainty: float = math.nan
     failure: str = ''                # one of FAILURES
     reason: str = ''                 # how the trial ended, in words
@@ -96,6 +100,7 @@ class TrialTracker:
         self._certainties: list[float] = []
         self._hits = 0
         self._judged = 0
+        self._span: dict[int, int] = {}    # predicted class -> count, in the current intent span
         self.last_state_change = 0.0
 
     @property
@@ -114,6 +119,7 @@ class TrialTracker:
         self._last_class = None
         self._certainties = []
         self._hits = self._judged = 0
+        self._span = {}
         self.last_state_change = t
 
     def on_state(self, state: int, object_of_interest: str, t: float) -> None:
@@ -140,10 +146,23 @@ class TrialTracker:
         if self._intent is not None:
             self._judged += 1
             self._hits += int(class_index == self._intent)
+            self._span[class_index] = self._span.get(class_index, 0) + 1
 
     def on_intent(self, name: str) -> None:
         """``/virtual_subject/intent``: the class the subject imagines (``rest``: none)."""
-        self._intent = _INTENT_CLASSES.get(name.strip().lower().replace(' ', '_'))
+        intent = _INTENT_CLASSES.get(name.strip().lower().replace(' ', '_'))
+        if intent != self._intent:
+            self._close_span()
+        self._intent = intent
+
+    def _close_span(self) -> None:
+        """One decision of the decoder: its most frequent class over the span of one held
+        intent (ties: the lower class index), judged against that intent."""
+        if self.record is not None and self._span and self._intent is not None:
+            decided = max(sorted(self._span), key=self._span.__getitem__)
+            self.record.decoder_decisions += 1
+            self.record.decoder_decision_hits += int(decided == self._intent)
+        self._span = {}
 
     def on_ee_pose(self, x: float, y: float, z: float) -> None:
         """``/ee_pose``: adds to the path length (m)."""
@@ -172,8 +191,10 @@ class TrialTracker:
         if failure not in FAILURES:
             msg = f'Unknown trial failure {failure!r}; use one of {FAILURES}.'
             raise ValueError(msg)
+        self._close_span()
         rec, self.record = self.record, None
         rec.duration_s = t - self._t0
+        rec.decoder_windows, rec.decoder_hits = self._judged, self._hits
         rec.states = '-'.join(str(s) for s in self._states)
         rec.decoder_accuracy = self._hits / self._judged if self._judged else math.nan
         rec.mean_certainty = (math.fsum(self._certainties) / len(self._certainties)

@@ -1,0 +1,322 @@
+"""Accuracy sweeps: the set-locations protocol at several BCI accuracies (and parameter values).
+
+Each point of a sweep is an ordinary experiment run (records, summary.json, report.md and plots
+written by :func:`mindgrasp_experiments.report.write_run`) in ``<out>/points/<point>/``; this
+module turns the points into one table (``sweep.csv``, ``sweep.json``), the sweep plots (success
+and time to grasp against accuracy, PNG and SVG) and ``report.md``.
+
+Per point: grasp success, correct choice, correct and successful (Wilson 95 % CIs, from
+:func:`~mindgrasp_experiments.summary.summarise`), the mean time to a successful grasp (Student-t
+95 % CI) and the decoder's realised online accuracy against the subject's intent, over classifier
+windows and over decisions (a decision: the most frequent decoded class over one span of a held
+intent), each with its Wilson 95 % CI.
+
+    >>> parse_accuracies('0.3,0.55,1')
+    [0.3, 0.55, 1.0]
+    >>> parse_param('fsm.certainty_threshold=0.3,0.5')
+    ('fsm', 'certainty_threshold', ['0.3', '0.5'])
+"""
+
+from __future__ import annotations
+
+import csv
+import itertools
+import json
+import math
+import re
+import statistics
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+from mindgrasp_experiments import ExperimentError
+from mindgrasp_experiments.records import TrialRecord
+from mindgrasp_experiments.report import finite
+from mindgrasp_experiments.summary import summarise, wilson
+
+__all__ = ['Param', 'apply_params', 'check_params', 'combinations', 'parse_accuracies',
+           'parse_param', 'point_figures', 'point_name', 'write_sweep']
+
+#: ``node.parameter=v1,v2,...``
+Param = tuple[str, str, list[str]]
+
+_PARAM = re.compile(r'^([A-Za-z_][\w]*)\.([A-Za-z_][\w.]*)=(.+)$')
+
+
+def parse_accuracies(text: str) -> list[float]:
+    """``'0.3,0.4,1.0'`` -> accuracies, each within (0, 1] (a probability of the right class)."""
+    out = []
+    for part in text.split(','):
+        try:
+            value = float(part)
+        except ValueError:
+            msg = (f'--accuracy: {part.strip()!r} is not a number; give accuracies within (0, 1] '
+                   'separated by commas, e.g. 0.3,0.55,1.0.')
+            raise ExperimentError(msg) from None
+        if not (0.0 < value <= 1.0) or not math.isfinite(value):
+            msg = (f'--accuracy: {value:g} is outside (0, 1]; an accuracy is the probability '
+                   'that the subject imagines the right class, e.g. 0.3,0.55,1.0.')
+            raise ExperimentError(msg)
+        out.append(value)
+    if len(set(out)) != len(out):
+        msg = f'--accuracy: {text} repeats an accuracy; give each once.'
+        raise ExperimentError(msg)
+    return out
+
+
+def parse_param(text: str) -> Param:
+    """``'fsm.certainty_threshold=0.3,0.5'`` -> (node, parameter, values as given)."""
+    match = _PARAM.match(text.strip())
+    values = [v.strip() for v in match.group(3).split(',')] if match else []
+    if not match or not all(values):
+        msg = (f'--param {text!r}: give node.parameter=v1,v2,... with the node and parameter '
+               'names of the profile\'s parameter files, e.g. fsm.certainty_threshold=0.3,0.5.')
+        raise ExperimentError(msg)
+    return match.group(1), match.group(2), values
+
+
+def _typed(value: str, like: Any, name: str) -> Any:
+    """``value`` (text) as the type of the parameter's value in the parameter files."""
+    try:
+        if isinstance(like, bool):
+            if value.lower() not in ('true', 'false'):
+                raise ValueError(value)
+            return value.lower() == 'true'
+        if isinstance(like, int):
+            return int(value)
+        if isinstance(like, float):
+            return float(value)
+    except ValueError:
+        kind = {bool: 'true or false', int: 'a whole number', float: 'a number'}[type(like)]
+        msg = f'--param {name}={value}: {name} takes {kind} (it is {like!r} in its parameter file).'
+        raise ExperimentError(msg) from None
+    if isinstance(like, str):
+        return value
+    msg = f'--param {name}: only boolean, integer, double and string parameters can be swept.'
+    raise ExperimentError(msg)
+
+
+def check_params(params: Sequence[Param], components: Sequence[Any]) -> list[Param]:
+    """The params with values typed as their parameter files have them; raises
+    :class:`ExperimentError` for an unknown node or parameter, a repeated one or a bad value."""
+    nodes = {c.label: c for c in components}
+    seen = set()
+    out = []
+    for node, name, values in params:
+        full = f'{node}.{name}'
+        if full in seen:
+            msg = f'--param {full} is given twice; give all its values in one --param.'
+            raise ExperimentError(msg)
+        seen.add(full)
+        if node not in nodes:
+            msg = (f'--param {full}: no node {node!r} in this experiment; the nodes are '
+                   f"{', '.join(sorted(nodes))}.")
+            raise ExperimentError(msg)
+        known = nodes[node].parameters
+        if name not in known:
+            msg = (f'--param {full}: {node} has no parameter {name!r} in its parameter files; '
+                   f'it has {", ".join(sorted(known))}.')
+            raise ExperimentError(msg)
+        out.append((node, name, [_typed(v, known[name], full) for v in values]))
+    return out
+
+
+def combinations(params: Sequence[Param]) -> list[dict[str, Any]]:
+    """Every combination of the swept values, as ``{'node.parameter': value}`` (one empty
+    combination without params)."""
+    names = [f'{node}.{name}' for node, name, _ in params]
+    return [dict(zip(names, combo, strict=True))
+            for combo in itertools.product(*(values for _, _, values in params))]
+
+
+def apply_params(components: Sequence[Any], combo: Mapping[str, Any]) -> list[Any]:
+    """Copies of ``components`` with the combination's parameters set (``-p name:=value`` after
+    the parameter file, so they win, as on a ``ros2 run`` command line)."""
+    import copy
+
+    out = []
+    for comp in components:
+        comp = copy.deepcopy(comp)
+        for full, value in combo.items():
+            node, name = full.split('.', 1)
+            if comp.label == node:
+                text = str(value).lower() if isinstance(value, bool) else str(value)
+                comp.ros_args += ['-p', f'{name}:={text}']
+                comp.parameters[name] = value
+        out.append(comp)
+    return out
+
+
+def point_name(accuracy: float, combo: Mapping[str, Any]) -> str:
+    """Directory name of a point: ``acc0.55`` or ``acc0.55_fsm.certainty_threshold-0.3``."""
+    return '_'.join([f'acc{accuracy:g}', *(f'{k}-{v}' for k, v in combo.items())])
+
+
+def _mean_ci(values: Sequence[float]) -> tuple[float, list[float]]:
+    """Mean and its Student-t 95 % interval (NaNs when fewer than 1 / 2 values)."""
+    values = [v for v in values if math.isfinite(v)]
+    if not values:
+        return math.nan, [math.nan, math.nan]
+    mean = statistics.fmean(values)
+    if len(values) < 2:
+        return mean, [math.nan, math.nan]
+    from scipy.stats import t
+
+    half = t.ppf(0.975, len(values) - 1) * statistics.stdev(values) / math.sqrt(len(values))
+    return mean, [mean - half, mean + half]
+
+
+def point_figures(records: Sequence[TrialRecord], accuracy: float,
+                  combo: Mapping[str, Any]) -> dict[str, Any]:
+    """One row of the sweep table: rates with Wilson 95 % CIs, mean time to grasp (s) with a
+    t interval, the decoder's online accuracy over windows and decisions."""
+    s = summarise(records)
+    row: dict[str, Any] = {'accuracy': accuracy, **combo, 'trials': s['trials']}
+    for field in ('success', 'correct_choice', 'correct_and_successful'):
+        row[f'{field}_rate'] = s[f'{field}_rate']
+        row[f'{field}_ci95'] = s[f'{field}_ci95']
+    row['correct_and_success_rate'] = s['correct_and_successful_rate']   # the JSON's name
+    windows = sum(r.decoder_windows for r in records)
+    hits = sum(r.decoder_hits for r in records)
+    decisions = sum(r.decoder_decisions for r in records)
+    decision_hits = sum(r.decoder_decision_hits for r in records)
+    row['online_accuracy'] = hits / windows if windows else math.nan
+    row['online_accuracy_ci95'] = list(wilson(hits, windows))
+    row['online_windows'] = windows
+    row['online_decision_accuracy'] = decision_hits / decisions if decisions else math.nan
+    row['online_decision_accuracy_ci95'] = list(wilson(decision_hits, decisions))
+    row['online_decisions'] = decisions
+    row['mean_time_s'], row['mean_time_ci95'] = _mean_ci(
+        [r.time_to_grasp_s for r in records if r.success])
+    row['mean_duration_s'] = s['mean_duration_s']
+    row['failures'] = s['failures']
+    return row
+
+
+def _pct(rate: float | None, ci: Sequence[float | None] | None = None) -> str:
+    if rate is None or not math.isfinite(rate):
+        return 'n/a'
+    text = f'{100 * rate:.1f} %'
+    if ci and ci[0] is not None and math.isfinite(ci[0]):
+        text += f' ({100 * ci[0]:.0f}-{100 * ci[1]:.0f})'
+    return text
+
+
+def _secs(value: float | None, ci: Sequence[float | None] | None = None) -> str:
+    if value is None or not math.isfinite(value):
+        return 'n/a'
+    text = f'{value:.1f} s'
+    if ci and ci[0] is not None and math.isfinite(ci[0]):
+        text += f' ({ci[0]:.1f}-{ci[1]:.1f})'
+    return text
+
+
+def _plots(points: Sequence[Mapping[str, Any]], varied: Sequence[str], out: Path) -> list[str]:
+    """success_vs_accuracy and time_vs_accuracy (PNG and SVG), one line per combination."""
+    import matplotlib
+
+    matplotlib.use('Agg')
+    import matplotlib.pyplot as plt
+
+    groups: dict[tuple, list[Mapping[str, Any]]] = {}
+    for p in points:
+        groups.setdefault(tuple(p.get(k) for k in varied), []).append(p)
+    written = []
+
+    def band(p: Mapping[str, Any], key: str, value: float) -> tuple[float, float]:
+        ci = p.get(key) or [math.nan, math.nan]
+        low = ci[0] if ci[0] is not None else math.nan
+        high = ci[1] if ci[1] is not None else math.nan
+        return value - low, high - value
+
+    for stem, ylabel, series in (
+            ('success_vs_accuracy', 'rate (Wilson 95 % CI)',
+             (('success', 'success_rate', 'success_ci95'),
+              ('correct and successful', 'correct_and_successful_rate',
+               'correct_and_successful_ci95'))),
+            ('time_vs_accuracy', 'mean time to a successful grasp (simulated s, 95 % CI)',
+             (('time to grasp', 'mean_time_s', 'mean_time_ci95'),))):
+        fig, ax = plt.subplots(figsize=(6.5, 4.2))
+        for key, group in groups.items():
+            group = sorted(group, key=lambda p: p['accuracy'])
+            suffix = ', '.join(f'{k}={v}' for k, v in zip(varied, key, strict=True))
+            for label, field, ci in series:
+                xs = [p['accuracy'] for p in group]
+                ys = [p[field] if p[field] is not None else math.nan for p in group]
+                err = [band(p, ci, y) for p, y in zip(group, ys, strict=True)]
+                ax.errorbar(xs, ys, yerr=list(zip(*err, strict=True)) if err else None,
+                            marker='o', capsize=3,
+                            label=f'{label} ({suffix})' if suffix else label)
+        ax.set_xlabel('virtual subject accuracy (probability of the right class)')
+        ax.set_ylabel(ylabel)
+        if stem == 'success_vs_accuracy':
+            ax.set_ylim(-0.02, 1.02)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7)
+        ax.set_title('Set locations against BCI accuracy')
+        for ext in ('png', 'svg'):
+            fig.savefig(out / f'{stem}.{ext}', dpi=120, bbox_inches='tight')
+            written.append(f'{stem}.{ext}')
+        plt.close(fig)
+    return written
+
+
+def _report(points: Sequence[Mapping[str, Any]], varied: Sequence[str],
+            run: Mapping[str, Any], plots: Sequence[str]) -> str:
+    lines = [f"# Accuracy sweep: set locations, {len(points)} points", '',
+             f"Command: `{run.get('command', '')}`. Seed {run.get('seed')}, "
+             f"{run.get('trials')} trials per point, subject {run.get('subject', 'virtual')}.", '',
+             'Rates with their Wilson 95 % CIs in brackets (%); the time to grasp over '
+             'successful trials, with a Student-t 95 % CI. Online accuracy: the decoder\'s '
+             'predictions against the subject\'s intent, per classifier window and per decision '
+             '(the most frequent class over one held intent).', '',
+             '| accuracy | ' + ''.join(f'{k} | ' for k in varied) + 'trials | success | '
+             'correct choice | correct and successful | time to grasp | online accuracy '
+             '(windows) | online accuracy (decisions) |',
+             '|---|' + '---|' * len(varied) + '---|---|---|---|---|---|---|']
+    for p in points:
+        lines.append(
+            f"| {p['accuracy']:g} | " + ''.join(f'{p.get(k)} | ' for k in varied)
+            + f"{p['trials']} | {_pct(p['success_rate'], p['success_ci95'])} | "
+            f"{_pct(p['correct_choice_rate'], p['correct_choice_ci95'])} | "
+            f"{_pct(p['correct_and_successful_rate'], p['correct_and_successful_ci95'])} | "
+            f"{_secs(p['mean_time_s'], p['mean_time_ci95'])} | "
+            f"{_pct(p['online_accuracy'], p['online_accuracy_ci95'])} of "
+            f"{p['online_windows']} | "
+            f"{_pct(p['online_decision_accuracy'], p['online_decision_accuracy_ci95'])} of "
+            f"{p['online_decisions']} |")
+    lines += ['', 'Plots: ' + ', '.join(f'[{p}]({p})' for p in plots), '',
+              'Each point\'s records, summary and report: '
+              + ', '.join(f"[{p['point']}](points/{p['point']}/report.md)" for p in points), '']
+    if 'wall_s' in run:
+        lines += [f"Ran in {run['wall_s']:.0f} s of wall time ({run['sim_s']:.0f} simulated s, "
+                  f"{run.get('workers', 1)} worker(s)).", '']
+    return '\n'.join(lines)
+
+
+def write_sweep(out: str | Path, points: Sequence[Mapping[str, Any]], varied: Sequence[str],
+                run: Mapping[str, Any]) -> dict[str, Any]:
+    """Write sweep.csv, sweep.json, the plots and report.md into ``out``; returns the sweep
+    document (``points``: one row per accuracy and combination)."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    points = [dict(p) for p in points]
+    columns = ['point', 'accuracy', *varied, 'trials', 'success_rate', 'success_ci95',
+               'correct_choice_rate', 'correct_choice_ci95', 'correct_and_successful_rate',
+               'correct_and_successful_ci95', 'mean_time_s', 'mean_time_ci95',
+               'online_accuracy', 'online_accuracy_ci95', 'online_windows',
+               'online_decision_accuracy', 'online_decision_accuracy_ci95', 'online_decisions']
+    with (out / 'sweep.csv').open('w', newline='', encoding='utf-8') as f:
+        writer = csv.writer(f, lineterminator='\n')
+        writer.writerow([c.replace('_ci95', '_ci95_low') for c in columns]
+                        + [c.replace('_ci95', '_ci95_high') for c in columns if 'ci95' in c])
+        for p in points:
+            values = [p.get(c)[0] if 'ci95' in c else p.get(c) for c in columns]
+            values += [p.get(c)[1] for c in columns if 'ci95' in c]
+            writer.writerow(['' if isinstance(v, float) and not math.isfinite(v) else v
+                             for v in values])
+    plots = _plots(points, varied, out)
+    doc = finite({'points': points, 'varied': list(varied), 'run': dict(run), 'plots': plots})
+    (out / 'sweep.json').write_text(json.dumps(doc, indent=2) + '\n', encoding='utf-8')
+    (out / 'report.md').write_text(_report(points, varied, run, plots), encoding='utf-8')
+    return doc

@@ -1,0 +1,149 @@
+"""``mindgrasp experiment sweep``: argument parsing and figures as plain functions, and one small
+sweep end to end (the experiment profile's real nodes in lock-step, in a subprocess)."""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+import os
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from mindgrasp_experiments import ExperimentError
+from mindgrasp_experiments.records import TrialRecord, TrialTracker, read_records
+from mindgrasp_experiments.sweep import (
+    combinations,
+    parse_accuracies,
+    parse_param,
+    point_figures,
+    point_name,
+)
+
+JSON_KEYS = ('accuracy', 'trials', 'success_rate', 'correct_and_success_rate',
+             'online_accuracy', 'mean_time_s')
+
+
+def mindgrasp(*args: str, timeout: float = 1500.0) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', *args],
+                          capture_output=True, text=True, timeout=timeout,
+                          env=dict(os.environ), check=False)
+
+
+@pytest.mark.parametrize(('text', 'message'), [
+    ('0,0.5', r'0 is outside \(0, 1\]'),
+    ('0.5,1.2', r'1.2 is outside \(0, 1\]'),
+    ('0.5,x', "'x' is not a number"),
+    ('0.5,0.5', 'repeats an accuracy'),
+])
+def test_bad_accuracies_are_named(text: str, message: str) -> None:
+    with pytest.raises(ExperimentError, match=message):
+        parse_accuracies(text)
+
+
+@pytest.mark.parametrize('text', ['fsm.certainty_threshold', 'certainty_threshold=0.3',
+                                  'fsm.certainty_threshold=', 'fsm.x=0.3,,0.5'])
+def test_bad_param_syntax_is_named(text: str) -> None:
+    with pytest.raises(ExperimentError, match=r'give node\.parameter=v1,v2'):
+        parse_param(text)
+
+
+def test_combinations_and_point_names() -> None:
+    params = [('fsm', 'certainty_threshold', [0.3, 0.5]), ('virtual_amp', 'decision_period',
+                                                           [0.5])]
+    combos = combinations(params)
+    assert combos == [{'fsm.certainty_threshold': 0.3, 'virtual_amp.decision_period': 0.5},
+                      {'fsm.certainty_threshold': 0.5, 'virtual_amp.decision_period': 0.5}]
+    assert point_name(0.55, combos[0]) == \
+        'acc0.55_fsm.certainty_threshold-0.3_virtual_amp.decision_period-0.5'
+    assert combinations([]) == [{}]
+
+
+def test_decisions_are_the_decoded_majority_over_a_held_intent() -> None:
+    tracker = TrialTracker()
+    tracker.start(trial=1, desired='red cube', t=0.0)
+    tracker.on_intent('left_hand')
+    for c in (0, 0, 1):                    # majority 0 = intent: a correct decision
+        tracker.on_prediction(c, 0.5, t=1.0)
+    tracker.on_intent('right_hand')
+    for c in (0, 0, 1):                    # majority 0, intent 1: a wrong decision
+        tracker.on_prediction(c, 0.5, t=2.0)
+    rec = tracker.finish(t=3.0)
+    assert (rec.decoder_windows, rec.decoder_hits) == (6, 3)
+    assert (rec.decoder_decisions, rec.decoder_decision_hits) == (2, 1)
+
+
+def test_point_figures_pool_windows_with_wilson_intervals() -> None:
+    records = [TrialRecord(trial=1, success=True, correct_and_successful=True,
+                           time_to_grasp_s=40.0, decoder_windows=10, decoder_hits=8,
+                           decoder_decisions=2, decoder_decision_hits=2),
+               TrialRecord(trial=2, success=True, time_to_grasp_s=60.0, decoder_windows=30,
+                           decoder_hits=12, decoder_decisions=2, decoder_decision_hits=1)]
+    p = point_figures(records, 0.7, {'fsm.certainty_threshold': 0.5})
+    assert p['online_accuracy'] == pytest.approx(20 / 40)     # pooled, not a mean of trials
+    assert p['online_decision_accuracy'] == pytest.approx(3 / 4)
+    low, high = p['online_accuracy_ci95']
+    assert low < 0.5 < high
+    assert p['success_rate'] == 1.0 and p['correct_and_success_rate'] == 0.5
+    assert p['mean_time_s'] == pytest.approx(50.0)
+    assert p['mean_time_ci95'][0] < 50.0 < p['mean_time_ci95'][1]
+    assert p['fsm.certainty_threshold'] == 0.5
+
+
+@pytest.mark.parametrize(('args', 'message'), [
+    (['--accuracy', '0.3,1.5'], r'--accuracy: 1.5 is outside \(0, 1\]'),
+    (['--param', 'fsm.certainty_threshold'], r'give node\.parameter=v1,v2'),
+    (['--param', 'nope.x=1'], "no node 'nope' in this experiment"),
+    (['--param', 'fsm.no_such_parameter=1'], "fsm has no parameter 'no_such_parameter'"),
+    (['--param', 'fsm.certainty_threshold=high'], 'certainty_threshold takes a number'),
+])
+def test_bad_input_is_one_clear_line_and_exit_2(tmp_path: Path, args: list[str],
+                                                message: str) -> None:
+    result = mindgrasp('experiment', 'sweep', *args, '--out', str(tmp_path / 'bad'),
+                       timeout=300)
+    assert result.returncode == 2, result.stderr[-2000:]
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and 'Traceback' not in result.stderr, result.stderr
+    assert re.search(message, lines[0]), lines[0]
+
+
+@pytest.mark.timeout(2400)   # 4 whole trials through the real nodes, on a loaded machine
+def test_a_small_sweep_writes_every_file_and_the_json(tmp_path: Path) -> None:
+    """2 accuracies x 2 trials (cut at 12 simulated s), with a swept parameter column."""
+    out = tmp_path / 'sweep'
+    result = mindgrasp('experiment', 'sweep', '--accuracy', '0.4,1.0', '--trials', '2',
+                       '--seed', '3', '--trial-timeout', '12', '--param',
+                       'fsm.certainty_threshold=0.5', '--out', str(out), '--json',
+                       '--no-progress')
+    assert result.returncode == 0, result.stderr[-3000:]
+    doc = json.loads(result.stdout.strip().splitlines()[-1])
+    points = doc['points']
+    assert [p['accuracy'] for p in points] == [0.4, 1.0]
+    for p in points:
+        assert all(k in p for k in JSON_KEYS), p
+        assert p['trials'] == 2 and p['fsm.certainty_threshold'] == 0.5
+        assert 0.0 <= p['success_rate'] <= 1.0
+        assert p['online_windows'] > 0 and 0.0 <= p['online_accuracy'] <= 1.0
+        point_dir = out / 'points' / p['point']
+        for name in ('records.csv', 'records.parquet', 'summary.json', 'report.md'):
+            assert (point_dir / name).is_file(), name
+        records = read_records(point_dir)
+        assert [r.trial for r in records] == [1, 2]
+        assert sum(r.decoder_windows for r in records) == p['online_windows']
+    # the decoder does better for the subject that always imagines the right class
+    assert points[1]['online_accuracy'] > points[0]['online_accuracy']
+    for name in ('sweep.csv', 'sweep.json', 'report.md', 'success_vs_accuracy.png',
+                 'success_vs_accuracy.svg', 'time_vs_accuracy.png', 'time_vs_accuracy.svg'):
+        assert (out / name).stat().st_size > 0, name
+    rows = list(csv.DictReader((out / 'sweep.csv').open(encoding='utf-8')))
+    assert [float(r['accuracy']) for r in rows] == [0.4, 1.0]
+    assert all(r['fsm.certainty_threshold'] == '0.5' for r in rows)
+    assert json.loads((out / 'sweep.json').read_text())['points'] == points
+    report = (out / 'report.md').read_text()
+    assert '| accuracy | fsm.certainty_threshold |' in report
+    assert 'success_vs_accuracy.png' in report
+    assert all(math.isfinite(p['online_accuracy']) for p in points)
