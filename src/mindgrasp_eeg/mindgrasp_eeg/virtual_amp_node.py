@@ -31,6 +31,7 @@ from mindgrasp_eeg import EEGError
 from mindgrasp_eeg.lsl import EEGOutlet, MarkerOutlet
 from mindgrasp_eeg.montage import NAUTILUS_32, class_name
 from mindgrasp_eeg.node_main import run_node
+from mindgrasp_eeg.replay_eeg import ReplayEEG, parse_replay_source
 from mindgrasp_eeg.ros_conversions import base_yaw_from_joint_state, ns_to_time_fields, time_to_s
 from mindgrasp_eeg.subject import VirtualSubject
 from mindgrasp_eeg.synthetic import SyntheticEEG
@@ -49,7 +50,7 @@ PARAMETERS = [
     ('erd_tau', 0.3), ('blink_rate', 0.0), ('blink_amplitude', 100e-6), ('emg_rate', 0.0),
     ('emg_rms', 20e-6), ('line_noise', 0.0), ('line_freq', 50.0),
     ('push_period', 1.0 / 32.0), ('block', 8), ('duration', 0.0), ('output', 'lsl'),
-    ('frame_id', 'eeg'),
+    ('frame_id', 'eeg'), ('eeg_source', 'synthetic'),
 ]
 OUTPUTS = ('lsl', 'ros')
 
@@ -66,7 +67,7 @@ class VirtualAmpNode(rclpy.node.Node):
             msg = (f"The parameter 'output' is {p['output']!r}; use 'lsl' (an LSL stream, live "
                    "runs) or 'ros' (/eeg/raw on the node clock, lock-step experiments).")
             raise EEGError(msg)
-        gen = SyntheticEEG(
+        gen = self.make_generator(p) if p['eeg_source'] != 'synthetic' else SyntheticEEG(
             list(p['channel_names']), p['sample_rate'], seed=p['seed'], head_seed=p['head_seed'],
             background_rms=p['background_rms'], alpha_rms=p['alpha_rms'], mu_rms=p['mu_rms'],
             beta_rms=p['beta_rms'], sensor_noise_rms=p['sensor_noise_rms'],
@@ -116,6 +117,14 @@ class VirtualAmpNode(rclpy.node.Node):
             f"Virtual amplifier on {where}: {len(p['channel_names'])} channels at "
             f"{p['sample_rate']:g} Hz, subject mode {mode!r}, seed {p['seed']}, "
             f"paced by {'/clock' if sim_time else 'wall time'}.")
+
+    @staticmethod
+    def make_generator(p: dict) -> ReplayEEG:
+        """``eeg_source:=eegmmidb:<subject>``: real EEG of that subject's imagery runs (the
+        channels and rate of the recordings replace channel_names and sample_rate)."""
+        gen = ReplayEEG.eegmmidb(parse_replay_source(str(p['eeg_source'])), seed=p['seed'])
+        p['channel_names'], p['sample_rate'] = list(gen.channel_names), gen.sample_rate
+        return gen
 
     def now_s(self) -> float:
         """Node clock (s): wall time, or simulated time with use_sim_time."""
