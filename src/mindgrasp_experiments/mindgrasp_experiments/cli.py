@@ -36,6 +36,35 @@ def noise_model_path(fallback_dir: Path) -> str:
         return str(noise_model(fallback_dir / 'noise_classifier'))
 
 
+def subject_launch_args(subject: str, out: Path) -> dict[str, str]:
+    """The experiment profile's launch arguments for ``subject``: a replay subject
+    (``eegmmidb:<n>``) is the pursuing virtual subject streaming that subject's real EEG, decoded
+    by a model calibrated on its other runs; the noise subject gets the noise-trained model."""
+    from mindgrasp_experiments.subjects import is_replay, replay_model
+
+    if is_replay(subject):
+        from mindgrasp_eeg.replay_eeg import parse_replay_source
+
+        number = parse_replay_source(subject)
+        print(f'Calibrating the classifier on EEGMMIDB S{number:03d} (once) ...', file=sys.stderr)
+        model = replay_model(subject, out / f'eegmmidb_s{number:03d}_classifier')
+        return {'subject': 'virtual', 'eeg_source': f'eegmmidb:{number}', 'model': str(model)}
+    if subject == 'noise':
+        return {'subject': 'noise', 'model': noise_model_path(out)}
+    return {'subject': subject}
+
+
+def subject_type(text: str) -> str:
+    """argparse type of --subject: noise, virtual, oracle or eegmmidb:<subject>."""
+    import argparse
+
+    if text in ('noise', 'virtual', 'oracle') or text.lower().startswith('eegmmidb:'):
+        return text
+    msg = (f'unknown subject {text!r}; use noise, virtual, oracle or eegmmidb:<subject> (real '
+           'EEG of an EEGMMIDB subject, e.g. eegmmidb:1)')
+    raise argparse.ArgumentTypeError(msg)
+
+
 def add_common_arguments(parser: argparse.ArgumentParser, trials: int) -> None:
     """Options of every ``mindgrasp experiment`` protocol (numbers checked by argparse)."""
     from mindgrasp_common.cli_checks import non_negative_int, positive_float, positive_int
@@ -107,6 +136,7 @@ def run_experiment(args: argparse.Namespace, protocol: str, command: str) -> int
 
     from mindgrasp_bringup.launch_system import LaunchError
     from mindgrasp_bringup.launch_system.rundir import create_run_dir
+    from mindgrasp_eeg import EEGError
     from mindgrasp_experiments import ExperimentError
     from mindgrasp_experiments.engine import lockstep_components
     from mindgrasp_experiments.records import write_records
@@ -121,14 +151,15 @@ def run_experiment(args: argparse.Namespace, protocol: str, command: str) -> int
         out = create_run_dir(protocol, args.out)
     except LaunchError as exc:
         return fail(command, str(exc))
-    launch_args = {'protocol': protocol, 'subject': subject, 'seed': str(args.seed),
-                   'trials': '1'}
+    try:
+        launch_args = subject_launch_args(subject, out)
+    except (ExperimentError, EEGError) as exc:
+        return fail(command, str(exc))
+    launch_args.update({'protocol': protocol, 'seed': str(args.seed), 'trials': '1'})
     if getattr(args, 'accuracy', None) is not None:
         launch_args['accuracy'] = str(args.accuracy)
     if getattr(args, 'realism', None) is not None:
         launch_args['realism'] = str(args.realism)
-    if subject == 'noise':
-        launch_args['model'] = noise_model_path(out)
     log = [] if args.json else None
     try:
         components = lockstep_components('experiment', launch_args, out / 'params',

@@ -11,6 +11,11 @@
     No EEG: the subject's intended class is the prediction (``oracle_subject_node``).
 ``autonomous``
     No BCI (random locations).
+``eegmmidb:<subject>``
+    The replay subject: the virtual subject pursues the target as ``virtual`` does, but the EEG it
+    streams is real (EEGMMIDB imagery epochs of the intended class, stitched with rest;
+    :class:`mindgrasp_eeg.replay_eeg.ReplayEEG`), decoded by a classifier that
+    :func:`replay_model` calibrates on other runs of the same subject.
 """
 
 from __future__ import annotations
@@ -19,9 +24,35 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ['SUBJECTS', 'noise_model']
+__all__ = ['SUBJECTS', 'is_replay', 'noise_model', 'replay_model']
 
 SUBJECTS = ('noise', 'virtual', 'oracle', 'autonomous')
+
+
+def is_replay(subject: str) -> bool:
+    """A replay subject (``eegmmidb:<subject>``)?"""
+    return subject.lower().startswith('eegmmidb:')
+
+
+def replay_model(source: str, path: str | Path) -> Path:
+    """Calibrate (once) an MDM for the replay subject ``source`` (``eegmmidb:<n>``) on its
+    calibration runs (:data:`~mindgrasp_eeg.replay_eeg.EEGMMIDB_CALIBRATION_RUNS`, never the runs
+    played in the loop) and save it as ``path`` (.json + .npz); returns the .json path."""
+    from mindgrasp_classifier.data import eegbci_files, load_edf
+    from mindgrasp_classifier.training import TrainingConfig, train
+    from mindgrasp_eeg.replay_eeg import EEGMMIDB_CALIBRATION_RUNS, parse_replay_source
+
+    subject = parse_replay_source(source)
+    path = Path(path).with_suffix('')
+    json_path = path.with_suffix('.json')
+    if json_path.exists():
+        return json_path
+    recordings = [load_edf(f) for f in eegbci_files(subject, EEGMMIDB_CALIBRATION_RUNS)]
+    model, _report = train(recordings, TrainingConfig(pipeline='mdm', channels='motor'))
+    model.provenance['generator'] = (f'mindgrasp_experiments.subjects.replay_model({source}): '
+                                     f'EEGMMIDB runs {list(EEGMMIDB_CALIBRATION_RUNS)}')
+    path.parent.mkdir(parents=True, exist_ok=True)
+    return Path(model.save(path))
 
 
 def noise_model(path: str | Path, *, trials_per_class: int = 20, seed: int = 100,

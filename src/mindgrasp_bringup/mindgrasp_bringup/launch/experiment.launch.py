@@ -67,6 +67,10 @@ def generate_launch_description() -> LaunchDescription:
         DeclareLaunchArgument('accuracy', default_value='0.8',
                               description='virtual subject: probability (0-1) that a decision '
                                           'is the right class'),
+        DeclareLaunchArgument('eeg_source', default_value='synthetic',
+                              description='EEG of the virtual subject: synthetic (head model) '
+                                          'or eegmmidb:<subject> (real imagery epochs of the '
+                                          'intended class; give the calibrated model:=)'),
         DeclareLaunchArgument('trials', default_value='3',
                               description='trials before the launch ends (0: until Ctrl-C)'),
         DeclareLaunchArgument('first_trial', default_value='1',
@@ -100,6 +104,7 @@ def generate_launch_description() -> LaunchDescription:
         Node(package='mindgrasp_eeg', executable='virtual_amp_node', name='virtual_amp',
              parameters=[*eeg, {'stream_name': stream, 'source_id': stream, 'seed': seed,
                                 'accuracy': LaunchConfiguration('accuracy'),
+                                'eeg_source': LaunchConfiguration('eeg_source'),
                                 'subject_mode': PythonExpression([
                                     "'pursue' if '", subject, "' == 'virtual' else 'noise'"])}],
              condition=_eeg()),

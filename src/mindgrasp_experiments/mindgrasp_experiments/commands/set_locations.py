@@ -4,13 +4,14 @@ trial, the subject drives the arm through EEG -> classifier -> controller (lock-
     mindgrasp experiment set-locations --trials 160 --subject noise --seed 0 --workers 2
     mindgrasp experiment set-locations --trials 160 --subject virtual --accuracy 0.8
     mindgrasp experiment set-locations --trials 6 --subject oracle --json
+    mindgrasp experiment set-locations --trials 10 --subject eegmmidb:1 --accuracy 0.9
 """
 
 from __future__ import annotations
 
 import argparse
 
-from mindgrasp_experiments.cli import add_common_arguments, run_experiment
+from mindgrasp_experiments.cli import add_common_arguments, run_experiment, subject_type
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -18,10 +19,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     from mindgrasp_common.cli_checks import probability
 
     add_common_arguments(parser, trials=160)
-    parser.add_argument('--subject', choices=['noise', 'virtual', 'oracle'], default='virtual',
+    parser.add_argument('--subject', type=subject_type, default='virtual',
                         help='noise (unworn cap, classifier trained on noise), virtual (the '
-                             'virtual subject pursues the target at --accuracy) or oracle (its '
-                             'intent is the prediction); default virtual')
+                             'virtual subject pursues the target at --accuracy), oracle (its '
+                             'intent is the prediction) or eegmmidb:<subject> (it pursues the '
+                             'target with real EEG of that EEGMMIDB subject); default virtual')
     parser.add_argument('--accuracy', type=probability, default=0.8,
                         help='virtual subject: probability of imagining the right class '
                              '(default 0.8)')

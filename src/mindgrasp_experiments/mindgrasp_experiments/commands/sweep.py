@@ -18,7 +18,7 @@ import json
 import sys
 import time
 
-from mindgrasp_experiments.cli import add_common_arguments, check, fail
+from mindgrasp_experiments.cli import add_common_arguments, check, fail, subject_type
 
 COMMAND = 'sweep'
 
@@ -29,6 +29,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--accuracy', default='0.3,0.4,0.55,0.7,0.85,1.0', metavar='A1,A2,...',
                         help='virtual subject accuracies within (0, 1], comma-separated '
                              '(default 0.3,0.4,0.55,0.7,0.85,1.0)')
+    parser.add_argument('--subject', type=subject_type, default='virtual',
+                        help='virtual (synthetic EEG, default) or eegmmidb:<subject> (the same '
+                             'pursuing subject streaming real EEG of that EEGMMIDB subject)')
     parser.add_argument('--param', action='append', default=[], metavar='NODE.PARAM=V1,V2,...',
                         help='also vary a parameter of a node (names as in the profile\'s '
                              'parameter files), e.g. fsm.certainty_threshold=0.3,0.5,0.7; '
@@ -40,7 +43,9 @@ def main(args: argparse.Namespace) -> int:
 
     from mindgrasp_bringup.launch_system import LaunchError
     from mindgrasp_bringup.launch_system.rundir import create_run_dir
+    from mindgrasp_eeg import EEGError
     from mindgrasp_experiments import ExperimentError
+    from mindgrasp_experiments.cli import subject_launch_args
     from mindgrasp_experiments.engine import lockstep_components
     from mindgrasp_experiments.records import write_records
     from mindgrasp_experiments.report import write_run
@@ -69,11 +74,18 @@ def main(args: argparse.Namespace) -> int:
         out = create_run_dir('sweep', args.out)
     except LaunchError as exc:
         return fail(COMMAND, str(exc))
+    if args.subject not in ('virtual',) and not args.subject.lower().startswith('eegmmidb:'):
+        return fail(COMMAND, f'--subject {args.subject}: a sweep varies the accuracy of a '
+                             'pursuing subject; use virtual or eegmmidb:<subject>.')
+    try:
+        subject_args = subject_launch_args(args.subject, out)
+    except (ExperimentError, EEGError) as exc:
+        return fail(COMMAND, str(exc))
     log = [] if args.json else None
 
     def components_at(accuracy: float, params_dir):
-        launch_args = {'protocol': 'set_locations', 'subject': 'virtual',
-                       'seed': str(args.seed), 'trials': '1', 'accuracy': str(accuracy)}
+        launch_args = {**subject_args, 'protocol': 'set_locations', 'seed': str(args.seed),
+                       'trials': '1', 'accuracy': str(accuracy)}
         comps = lockstep_components('experiment', launch_args, params_dir, overlay=args.launch,
                                     log=log.append if log is not None else print)
         for comp in comps:
@@ -120,7 +132,7 @@ def main(args: argparse.Namespace) -> int:
                     wall = time.perf_counter() - wall_p
                     write_run(point_dir, records, {
                         'command': f'mindgrasp experiment sweep (point {name})',
-                        'protocol': 'set_locations', 'subject': 'virtual', 'seed': args.seed,
+                        'protocol': 'set_locations', 'subject': args.subject, 'seed': args.seed,
                         'accuracy': accuracy, 'params': combo, 'workers': args.workers,
                         'trials_requested': args.trials, 'interrupted': interrupted,
                         'step_s': args.step, 'sim_s': sim, 'wall_s': wall,
@@ -139,7 +151,7 @@ def main(args: argparse.Namespace) -> int:
         bar.close()
     wall = time.perf_counter() - wall0
     run_info = {'command': ' '.join(['mindgrasp', 'experiment', COMMAND, *sys.argv[3:]]),
-                'subject': 'virtual', 'seed': args.seed, 'trials': args.trials,
+                'subject': args.subject, 'seed': args.seed, 'trials': args.trials,
                 'accuracies': accuracies, 'params': {f'{n}.{p}': v for n, p, v in params},
                 'workers': args.workers, 'step_s': args.step, 'wall_s': wall,
                 'sim_s': sim_total, 'interrupted': interrupted}
