@@ -147,3 +147,36 @@ def test_a_small_sweep_writes_every_file_and_the_json(tmp_path: Path) -> None:
     assert '| accuracy | fsm.certainty_threshold |' in report
     assert 'success_vs_accuracy.png' in report
     assert all(math.isfinite(p['online_accuracy']) for p in points)
+
+
+@pytest.mark.parametrize(('command', 'subject', 'message'), [
+    ('set-locations', 'eegmmidb:x', 'write eegmmidb:<subject>'),
+    ('sweep', 'eegmmidb:500', 'EEGMMIDB has subjects 1-109'),
+    ('sweep', 'oracle', 'a sweep varies the accuracy of a pursuing subject'),
+])
+def test_bad_subject_is_one_clear_line_and_exit_2(tmp_path: Path, command: str, subject: str,
+                                                  message: str) -> None:
+    result = mindgrasp('experiment', command, '--subject', subject, '--trials', '1', '--out',
+                       str(tmp_path / 'bad'), timeout=300)
+    assert result.returncode == 2, result.stderr[-2000:]
+    lines = [ln for ln in result.stderr.strip().splitlines() if not ln.startswith('Calibrating')]
+    assert len(lines) == 1 and message in lines[0], result.stderr
+
+
+@pytest.mark.timeout(1800)   # calibration and one whole trial through the real nodes
+def test_the_replay_subject_drives_the_experiment_with_real_eeg(tmp_path: Path) -> None:
+    """--subject eegmmidb:1: real S001 imagery epochs in the loop, decoded by a model calibrated
+    on runs 4 and 6 (never the played runs 8 and 10); one trial cut at 12 simulated s."""
+    out = tmp_path / 'replay'
+    result = mindgrasp('experiment', 'set-locations', '--subject', 'eegmmidb:1', '--accuracy',
+                       '1.0', '--trials', '1', '--seed', '2', '--trial-timeout', '12', '--out',
+                       str(out), '--json', '--no-progress')
+    assert result.returncode == 0, result.stderr[-3000:]
+    s = json.loads(result.stdout.strip().splitlines()[-1])
+    assert s['trials'] == 1 and s['node_errors'] == 0
+    model = json.loads((out / 'eegmmidb_s001_classifier.json').read_text())
+    assert 'runs [4, 6]' in json.dumps(model)
+    params = (out / 'params' / 'virtual_amp.yaml').read_text()
+    assert 'eegmmidb:1' in params
+    (record,) = read_records(out)
+    assert record.decoder_windows > 0 and 0.0 <= record.decoder_accuracy <= 1.0
