@@ -30,11 +30,13 @@ def test_trainer_drives_the_simulated_training_robot(ros, spawn_node, spin_until
     node.create_subscription(Float64, '/trainer/ee_distance', lambda m: distances.append(m.data),
                              10)  # fmt: skip
     sim = spawn_node('mindgrasp_sim.sim_node', trainer_robot=True, camera_rate=1.0, duration=300.0)
-    # left, right and an approach long enough to take the end-effector below 0.1 m (joint 2 must
-    # turn about 1 rad; it is commanded 2.25 rad, so that a simulator running slower than real time
-    # on a loaded machine still gets there)
+    # left, right and an approach long enough to take the end-effector below 0.1 m. The trainer
+    # runs on wall time and a simulator on a loaded machine realises only part of each move (its
+    # real-time factor, down to ~0.3 under heavy load), so the moves are long: joint 2 must turn
+    # about 1 rad and is commanded 0.45 rad/s for 12 s (5.4 rad; the reset ends it early), the
+    # turns 0.1 rad/s for 12 s (1.2 rad)
     trainer = spawn_node('mindgrasp_trainer.trainer_node', n_trials=3, classes='[0, 1, 2]', seed=0,
-                    balanced=True, approach_speed=0.45, turn_speed=0.3, move_duration=5.0,
+                    balanced=True, approach_speed=0.45, turn_speed=0.1, move_duration=12.0,
                     wait_duration=0.5, start_delay=0.5, settle_time=3.0,
                     robot_timeout=60.0)  # fmt: skip
     ok = spin_until(node, lambda: prompts and prompts[-1][0].phase == 'end', 240.0)
@@ -54,11 +56,11 @@ def test_trainer_drives_the_simulated_training_robot(ros, spawn_node, spin_until
             continue
         b, n_c = prompts[i + 1][0], prompts[i + 2][1]
         qa, qc = joints[n_a - 1], joints[n_c - 1]
-        if a.class_index in (0, 1):  # joint 1 turns at 0.3 rad/s for 5 s, left +, right -
+        if a.class_index in (0, 1):  # joint 1 turns at 0.1 rad/s for 12 s, left +, right -
             assert b.phase == 'wait'
             sign = 1 if a.class_index == 0 else -1
-            # at most 1.5 rad; less when the loaded machine keeps the simulator below real time
-            assert 0.5 < sign * (qc - qa)[0] < 1.6, f'dq {qc - qa}'
+            # at most 1.2 rad; less when the loaded machine keeps the simulator below real time
+            assert 0.1 < sign * (qc - qa)[0] < 1.3, f'dq {qc - qa}'
             assert abs((qc - qa)[1]) < 0.02
         else:  # approach: joint 2 forward until the end-effector went below 0.1 m
             assert b.phase == 'rest', f'no 0.1 m reset, min distance {min(distances)}'
