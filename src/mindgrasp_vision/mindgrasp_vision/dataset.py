@@ -254,7 +254,7 @@ def collect_shape_dataset(n_images: int, seed: int = 0, config: DatasetConfig = 
                 x = preprocess_depth(depth, det.bbox, det.mask, prep)
             except VisionError:
                 continue
-            label = next(o.shape for o in sim.objects() if o.id == 0)  # from the simulator
+            label = next(o.shape for o in sim.objects() if o.object_id == 0)  # from the simulator
             xs.append(x)
             ys.append(SHAPES.index(label))
             info.append({'colour': sample['colour'], 'size': sample['size'],
