@@ -23,7 +23,8 @@ fi
 # missing and apt-get can (root); otherwise those tests are skipped with the reason.
 if ! command -v Xvfb >/dev/null 2>&1; then
   if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
-    apt-get install -y -qq xvfb >/dev/null || echo "setup: could not install xvfb (window tests skip)"
+    { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq xvfb; } >/dev/null \
+      || echo "setup: could not install xvfb (window tests skip)"
   else
     echo "setup: Xvfb is missing; 'sudo apt-get install xvfb' runs the display window tests"
   fi
