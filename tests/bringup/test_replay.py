@@ -33,7 +33,8 @@ def demo_run(tmp_path_factory) -> Path:
     the bag holds a few seconds of predictions: start-up takes long on a loaded machine."""
     run_dir = tmp_path_factory.mktemp('replay') / 'run'
     stream = f'mg-replay-test-{uuid.uuid4().hex[:8]}'  # LSL names are host-wide
-    proc = subprocess.Popen(launch_cmd('demo', 'duration:=400', 'trials:=0',
+    # the live view on a free port: a demo in another suite or session may hold 8765
+    proc = subprocess.Popen(launch_cmd('demo', 'duration:=400', 'trials:=0', 'live_view_port:=0',
                                        f'eeg_stream:={stream}', '--sigint-timeout', '20',
                                        '--run-dir', str(run_dir)),
                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
