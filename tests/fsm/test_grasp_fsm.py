@@ -45,7 +45,7 @@ def _settle(fsm: GraspFsm, t: float, **kwargs: object) -> tuple[list, float]:
 # (name, start state, Center-Object continuation, autonomous, inputs, seconds, end state, locked)
 TRANSITIONS = [
     ('1->2 both hands selects the object', State.OBJECT_SEARCH, None, False,
-     {'cls': MiClass.BOTH_HANDS, 'obs': CENTRED}, 0.54, State.CENTER_OBJECT, False),
+     {'cls': MiClass.BOTH_HANDS, 'obs': CENTRED}, 1.54, State.CENTER_OBJECT, False),
     ('1->2 autonomous search sees an object', State.OBJECT_SEARCH, None, True,
      {'cls': None, 'obs': CENTRED}, 0.4, State.CENTER_OBJECT, False),
     ('2->3 centred after selection', State.CENTER_OBJECT, State.INITIAL_APPROACH, False,
@@ -280,7 +280,8 @@ def test_4_to_6_abort_when_out_of_reach(fsm: GraspFsm) -> None:
 
 # ------------------------------------------------------------------------- locks, watchdog
 def test_no_lock_into_and_out_of_center(fsm: GraspFsm) -> None:
-    outs, _ = run(fsm, 0.0, 0.54, cls=MiClass.BOTH_HANDS, obs=CENTRED)  # dwell, then select
+    dwell = fsm.params.bci_select_dwell + 0.04                   # dwell, then select
+    outs, _ = run(fsm, 0.0, dwell, cls=MiClass.BOTH_HANDS, obs=CENTRED)
     assert outs[-1].state == State.CENTER_OBJECT and not any(o.locked for o in outs)
 
 

@@ -35,7 +35,9 @@ class OracleParams:
     """Parameters of the oracle subject."""
 
     period: float = param(1.0 / 16.0, 'time between predictions', unit='s', min=1e-3)
-    certainty: float = param(1.0, 'certainty of the intended class', min=0.0)
+    # 0.2: the default decoder's mean certainty on the virtual subject (records' mean_certainty),
+    # so the arm moves as fast as with real decoding and the controller's gains fit both
+    certainty: float = param(0.2, 'certainty of the intended class', min=0.0)
     reaction_delay: float = param(0.3, 'from a decision to its prediction', unit='s', min=0.0)
     decision_period: float = param(0.25, 'time between decisions', unit='s', min=1e-3)
     heading_tolerance: float = param(0.1, 'heading error taken as centred', unit='rad',

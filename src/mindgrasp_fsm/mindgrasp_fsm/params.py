@@ -80,7 +80,9 @@ class FsmParams:
     certainty_cap: float = param(2.0, 'certainty that gives full speed (certainty is unbounded, '
                                  'Eq. 1)', min=0.01, max=100.0, live=True)
     # --- state 1: object search ----------------------------------------------------------------
-    search_gain: float = param(0.3, 'joint 1 velocity per unit certainty (left +, right -)',
+    # 1.0: at the virtual subject's typical certainty (0.2) the arm turns 0.2 rad/s, so reaching
+    # an object 80 deg away takes 7 s, not the 25 s in which misdecoded windows select others
+    search_gain: float = param(1.0, 'joint 1 velocity per unit certainty (left +, right -)',
                                unit='rad/s', min=0.0, max=3.0, live=True)
     autonomous_search_velocity: float = param(0.8, 'joint 1 velocity of the autonomous search '
                                               '(turn left)', unit='rad/s', min=0.0, max=3.0,
@@ -101,8 +103,10 @@ class FsmParams:
                                       'that could not be centred', unit='rad', min=0.0,
                                       max=6.3, live=True)
     # BCI mode: both-hands must be decoded without a break for this long before it selects the
-    # object in view; one misdecoded window of a left/right intent must not start a grasp
-    bci_select_dwell: float = param(0.5, 'unbroken both-hands predictions before an object is '
+    # object in view; one misdecoded window of a left/right intent must not start a grasp. With
+    # the default decoder 11-14 % of left/right windows read as both hands, in runs of 1 s or more
+    # 1-2 times a minute (benchmarks/selection.py); 1.5 s keeps wrong objects from being selected
+    bci_select_dwell: float = param(1.5, 'unbroken both-hands predictions before an object is '
                                     'selected', unit='s', min=0.0, max=10.0, live=True)
     bci_reselect_delay: float = param(3.0, 'after this long an object that could not be centred '
                                       'may be selected again', unit='s', min=0.0, max=60.0,
