@@ -15,7 +15,8 @@ the node subscribes to it (raw CDR, with the publishers' QoS: transient local fo
 an unwatched live view costs the graph nothing. A slow client loses its oldest messages beyond
 ``message_backlog_size``; the graph never waits for it. Listens on
 loopback only unless ``address`` says otherwise. A port in use ends the node with exit code 2 and
-one line naming the fix.
+one line naming the fix; with ``port_in_use:=any`` (the launch profiles) it serves on a free port
+instead and says which.
 """
 
 from __future__ import annotations
@@ -44,6 +45,10 @@ class BridgeParams:
     port: int = param(DEFAULT_PORT, 'TCP port of the WebSocket server (0: any free port)',
                       min=0, max=65535)
     address: str = param('127.0.0.1', 'address to listen on (loopback: this machine only)')
+    # the launch profiles say 'any': a second demo on this machine must not stop for its view
+    port_in_use: str = param('fail', "when the port is taken: 'fail' (exit 2, as "
+                             "foxglove_bridge) or 'any' (serve on a free port, with a warning)",
+                             choices=('fail', 'any'))
     # param() returns a dataclasses.field with a default_factory for lists
     topic_whitelist: list[str] = param(['.*'], 'regexes of the topics to serve')
     message_backlog_size: int = param(
@@ -70,8 +75,17 @@ class FoxgloveBridgeNode(rclpy.node.Node):
         self.params = declare_params(self, BridgeParams)
         self.done = rclpy.task.Future()
         self.whitelist = [re.compile(p) for p in self.params.topic_whitelist]
-        self.server = FoxgloveServer(self.params.address, self.params.port,
-                                     message_backlog_size=self.params.message_backlog_size)
+        try:
+            self.server = FoxgloveServer(self.params.address, self.params.port,
+                                         message_backlog_size=self.params.message_backlog_size)
+        except LiveViewError as exc:
+            if self.params.port_in_use != 'any' or 'in use' not in str(exc):
+                raise
+            self.server = FoxgloveServer(self.params.address, 0,
+                                         message_backlog_size=self.params.message_backlog_size)
+            self.get_logger().warning(
+                f'The live view port {self.params.port} is in use (another live view?); '
+                f'serving on port {self.server.port} instead.')
         self._types: dict[str, str] = {}                   # advertised topic -> type
         self._subscriptions: dict[str, Any] = {}           # watched topic -> subscription
         self._requested: dict[str, dict[str, Any]] = {}    # watched topic -> QoS

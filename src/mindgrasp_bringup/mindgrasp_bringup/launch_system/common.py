@@ -105,7 +105,8 @@ def live_view_arguments() -> list[Any]:
                                  description='serve the topics to Foxglove on '
                                              'ws://localhost:<live_view_port> (loopback only)'),
         la.DeclareLaunchArgument('live_view_port', default_value='8765',
-                                 description='TCP port of the live view (0: any free port, '
+                                 description='TCP port of the live view (0: any free port; '
+                                             'a port in use gives a free one; both are '
                                              'printed in its log)'),
     ]
 
@@ -116,6 +117,7 @@ def live_view_nodes() -> list[Any]:
     return [
         la.Node(package='mindgrasp_bringup', executable='foxglove_bridge_node',
                 name='foxglove_bridge',
-                parameters=[{'port': la.LaunchConfiguration('live_view_port')}],
+                parameters=[{'port': la.LaunchConfiguration('live_view_port'),
+                             'port_in_use': 'any'}],
                 condition=la.IfCondition(la.LaunchConfiguration('live_view'))),
     ]
