@@ -27,6 +27,24 @@ def test_demo_arguments_are_checked_in_the_plan(args, message):
         LaunchService('demo', args).plan(strict=True)
 
 
+@pytest.mark.parametrize(('profile', 'args', 'message'), [
+    ('experiment', ['seed:=-1'], "'seed' is '-1': a whole number >= 0 is expected"),
+    ('experiment', ['accuracy:=1.5'], "'accuracy' is '1.5': a number from 0 to 1 is expected"),
+    ('experiment', ['accuracy:=nan'], "'accuracy' is 'nan': a number from 0 to 1 is expected"),
+    ('experiment', ['first_trial:=0'], "'first_trial' is '0': a whole number >= 1 is expected"),
+    ('experiment', ['model:=nope.json'], "'model' is 'nope.json', which is not a file"),
+    ('sim', ['seed:=x'], "'seed' is 'x': a whole number >= 0 is expected"),
+    ('sim', ['realism_seed:=1.5'], "'realism_seed' is '1.5': a whole number >= 0"),
+    ('eeg', ['seed:=abc'], "'seed' is 'abc': a whole number >= 0 is expected"),
+    ('eeg', ['duration:=-2'], "'duration' is '-2': a number >= 0 is expected"),
+    ('trainer', ['trials:=0'], "'trials' is '0': a whole number >= 1 is expected"),
+    ('graz', ['seed:=__import__'], "'seed' is '__import__': a whole number >= 0"),
+])
+def test_every_profile_checks_its_numbers(profile, args, message):
+    with pytest.raises(LaunchError, match=message):
+        LaunchService(profile, args).plan(strict=True)
+
+
 def test_bad_argument_starts_nothing_and_exits_2(tmp_path):
     run_dir = tmp_path / 'run'
     out = subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', 'launch', 'demo',

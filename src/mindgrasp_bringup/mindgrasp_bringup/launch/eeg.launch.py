@@ -19,6 +19,7 @@ from mindgrasp_bringup.launch_api import (
     LaunchDescription,
     Node,
     config_files,
+    number_argument,
 )
 
 
@@ -40,9 +41,10 @@ def generate_launch_description() -> LaunchDescription:
         DeclareLaunchArgument('subject', default_value='noise',
                               choices=['noise', 'follow', 'pursue'],
                               description='virtual subject mode (with virtual_amp:=true)'),
-        DeclareLaunchArgument('seed', default_value='0', description='virtual subject/EEG seed'),
-        DeclareLaunchArgument('duration', default_value='0.0',
-                              description='seconds until the nodes end by themselves (0: never)'),
+        number_argument('seed', default_value='0', minimum=0,
+                        description='virtual subject/EEG seed'),
+        number_argument('duration', default_value='0.0', kind=float, minimum=0,
+                        description='seconds until the nodes end by themselves (0: never)'),
         Node(package='mindgrasp_eeg', executable='virtual_amp_node', name='virtual_amp',
              condition=IfCondition(LaunchConfiguration('virtual_amp')),
              parameters=[*config_files('eeg'),

@@ -27,6 +27,8 @@ from mindgrasp_bringup.launch_api import (
     PythonExpression,
     Shutdown,
     config_files,
+    file_argument,
+    number_argument,
 )
 
 
@@ -64,23 +66,23 @@ def generate_launch_description() -> LaunchDescription:
         DeclareLaunchArgument('subject', default_value='virtual',
                               choices=['noise', 'virtual', 'oracle', 'autonomous'],
                               description='who drives the controller (see the profile help)'),
-        DeclareLaunchArgument('accuracy', default_value='0.8',
-                              description='virtual subject: probability (0-1) that a decision '
-                                          'is the right class'),
+        number_argument('accuracy', default_value='0.8', kind=float, minimum=0, maximum=1,
+                        description='virtual subject: probability (0-1) that a decision '
+                                    'is the right class'),
         DeclareLaunchArgument('eeg_source', default_value='synthetic',
                               description='EEG of the virtual subject: synthetic (head model) '
                                           'or eegmmidb:<subject> (real imagery epochs of the '
                                           'intended class; give the calibrated model:=)'),
-        DeclareLaunchArgument('trials', default_value='3',
-                              description='trials before the launch ends (0: until Ctrl-C)'),
-        DeclareLaunchArgument('first_trial', default_value='1',
-                              description='number of the first trial (trials are drawn from '
-                                          '(seed, trial), so a batch can start anywhere)'),
-        DeclareLaunchArgument('seed', default_value='0',
-                              description='seed of the protocol draws, the EEG and the subject'),
-        DeclareLaunchArgument('model', default_value='',
-                              description='classifier model (.json); empty: the default model '
-                                          '(the noise subject needs a noise-trained one)'),
+        number_argument('trials', default_value='3', minimum=0,
+                        description='trials before the launch ends (0: until Ctrl-C)'),
+        number_argument('first_trial', default_value='1', minimum=1,
+                        description='number of the first trial (trials are drawn from '
+                                    '(seed, trial), so a batch can start anywhere)'),
+        number_argument('seed', default_value='0', minimum=0,
+                        description='seed of the protocol draws, the EEG and the subject'),
+        file_argument('model', default_value='',
+                      description='classifier model (.json); empty: the default model '
+                                  '(the noise subject needs a noise-trained one)'),
         DeclareLaunchArgument('eeg_stream', default_value='MIndGrasp-Experiment',
                               description='LSL stream name of the virtual amplifier (live runs)'),
         DeclareLaunchArgument('realism', default_value='none',

@@ -24,6 +24,7 @@ from mindgrasp_bringup.launch_api import (
     eeg_source_arguments,
     eeg_source_nodes,
     file_argument,
+    number_argument,
 )
 
 
@@ -32,10 +33,10 @@ def generate_launch_description() -> LaunchDescription:
     return LaunchDescription([
         *eeg_source_arguments(),
         *display_arguments(),
-        DeclareLaunchArgument('trials', default_value='40',
-                              description='number of trials (a multiple of 4 balances classes)'),
-        DeclareLaunchArgument('seed', default_value='0',
-                              description='seed of the cue order and the virtual subject'),
+        number_argument('trials', default_value='40', minimum=1,
+                        description='number of trials (a multiple of 4 balances classes)'),
+        number_argument('seed', default_value='0', minimum=0,
+                        description='seed of the cue order and the virtual subject'),
         DeclareLaunchArgument('feedback', default_value='false', choices=['true', 'false'],
                               description='run the classifier so the display shows a feedback '
                                           'bar (needs a trained model)'),

@@ -18,6 +18,7 @@ from mindgrasp_bringup.launch_api import (
     LaunchDescription,
     Node,
     config_files,
+    number_argument,
 )
 
 
@@ -29,8 +30,8 @@ def generate_launch_description() -> LaunchDescription:
         DeclareLaunchArgument('scene', default_value='set_locations',
                               description='scene name in mindgrasp_sim/scenes/ or a scene YAML '
                                           'path'),
-        DeclareLaunchArgument('seed', default_value='0',
-                              description='layout seed of random scenes'),
+        number_argument('seed', default_value='0', minimum=0,
+                        description='layout seed of random scenes'),
         DeclareLaunchArgument('time_mode', default_value='realtime',
                               choices=['realtime', 'fast', 'lockstep'],
                               description='realtime (wall clock), fast (as fast as possible, '
@@ -45,8 +46,8 @@ def generate_launch_description() -> LaunchDescription:
         DeclareLaunchArgument('realism', default_value='none',
                               description='sensor noise and physical spread: none, default or a '
                                           'profile YAML path (mindgrasp_sim.realism)'),
-        DeclareLaunchArgument('realism_seed', default_value='0',
-                              description='seed of the realism draws'),
+        number_argument('realism_seed', default_value='0', minimum=0,
+                        description='seed of the realism draws'),
         Node(package='mindgrasp_sim', executable='sim_node', name='sim',
              parameters=[*config_files('sim'),
                          {'scene': LaunchConfiguration('scene'),

@@ -21,6 +21,7 @@ from mindgrasp_bringup.launch_api import (
     eeg_source_arguments,
     eeg_source_nodes,
     file_argument,
+    number_argument,
     sim_scene_camera,
 )
 
@@ -34,10 +35,10 @@ def generate_launch_description() -> LaunchDescription:
                               choices=['noise', 'follow', 'pursue'],
                               description='virtual subject (amp:=virtual): follow imagines what '
                                           'the prompts ask'),
-        DeclareLaunchArgument('trials', default_value='40',
-                              description='number of trials (a multiple of 4 balances classes)'),
-        DeclareLaunchArgument('seed', default_value='0',
-                              description='seed of the trial order, scene and virtual subject'),
+        number_argument('trials', default_value='40', minimum=1,
+                        description='number of trials (a multiple of 4 balances classes)'),
+        number_argument('seed', default_value='0', minimum=0,
+                        description='seed of the trial order, scene and virtual subject'),
         DeclareLaunchArgument('gui', default_value='false', choices=['true', 'false'],
                               description='open the PyBullet window (needs a display)'),
         file_argument('model', default_value='',

@@ -28,15 +28,26 @@ __all__ = ['FileLaunchArgument', 'NumberLaunchArgument', 'check_number', 'file_a
            'number_argument']
 
 
-def check_number(name: str, text: str, kind: type, minimum: float | None) -> None:
-    """Raise :class:`LaunchError` unless ``text`` is a ``kind`` (int or float) >= ``minimum``."""
+def check_number(name: str, text: str, kind: type, minimum: float | None,
+                 maximum: float | None = None) -> None:
+    """Raise :class:`LaunchError` unless ``text`` is a ``kind`` (int or float) within
+    ``minimum``..``maximum`` (either bound may be None)."""
     what = 'a whole number' if kind is int else 'a number'
-    if minimum is not None:
+    if minimum is not None and maximum is not None:
+        what += f' from {minimum:g} to {maximum:g}'
+    elif minimum is not None:
         what += f' >= {minimum:g}'
-    example = f'{name}:={max(int(minimum or 0), 3) if kind is int else 1.5}'
+    elif maximum is not None:
+        what += f' <= {maximum:g}'
+    if kind is int:
+        example = f'{name}:={max(int(minimum or 0), 3)}'
+    else:
+        example = f'{name}:={(minimum + maximum) / 2:g}' if None not in (minimum, maximum) \
+            else f'{name}:=1.5'
     try:
         value = kind(text.strip())
-        ok = math.isfinite(value) and (minimum is None or value >= minimum)
+        ok = math.isfinite(value) and (minimum is None or value >= minimum) and (
+            maximum is None or value <= maximum)
     except ValueError:
         ok = False
     if not ok:
@@ -48,26 +59,26 @@ class NumberLaunchArgument(DeclareLaunchArgument):
     """A :class:`DeclareLaunchArgument` whose value must be a number (checked when declared)."""
 
     def __init__(self, name: str, *, kind: type = int, minimum: float | None = None,
-                 **kwargs: Any) -> None:
+                 maximum: float | None = None, **kwargs: Any) -> None:
         super().__init__(name, **kwargs)
-        self.kind, self.minimum = kind, minimum
+        self.kind, self.minimum, self.maximum = kind, minimum, maximum
 
     def execute(self, context: Any) -> None:
         super().execute(context)
         check_number(self.name, context.launch_configurations[self.name], self.kind,
-                     self.minimum)
+                     self.minimum, self.maximum)
 
 
 def number_argument(name: str, *, default_value: str, description: str, kind: type = int,
-                    minimum: float | None = None) -> Any:
+                    minimum: float | None = None, maximum: float | None = None) -> Any:
     """Declare ``name`` as a number argument (see the module docstring)."""
     from mindgrasp_bringup import launch_api
 
     if launch_api.using_real_launch():
         return launch_api.DeclareLaunchArgument(name, default_value=default_value,
                                                 description=description)
-    return NumberLaunchArgument(name, kind=kind, minimum=minimum, default_value=default_value,
-                                description=description)
+    return NumberLaunchArgument(name, kind=kind, minimum=minimum, maximum=maximum,
+                                default_value=default_value, description=description)
 
 
 def _is_file(text: str) -> bool:
