@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import subprocess
+import sys
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -195,3 +198,36 @@ def test_mne_lsl_style_exponent_unit_from_a_real_outlet(lsl_source, stream_name)
     data = np.vstack([c.data for c in collect(acq, 250)])
     assert 3e-6 < float(np.std(data)) < 50e-6            # microvolts on the wire, volts out
     acq.close()
+
+
+def test_an_edf_played_by_mne_lsl_playerlsl_is_read_in_volts(stream_name) -> None:
+    """MNE-LSL's PlayerLSL (another process) streams EEGMMIDB S001R04 with the unit "0"
+    (volts as a power-of-ten exponent); the samples arrive in volts, equal to the file's."""
+    import mne
+
+    from .test_player import eegbci_file
+
+    path = eegbci_file(4)
+    proc = subprocess.Popen([sys.executable, str(Path(__file__).with_name('mne_lsl_player.py')),
+                             path, stream_name], stdout=subprocess.PIPE,
+                            stderr=subprocess.DEVNULL, text=True)
+    try:
+        assert proc.stdout is not None and proc.stdout.readline().strip() == 'READY'
+        acq = EEGAcquisition(stream_name, stream_type='', adapt=True)
+        desc = acq.connect(timeout=60)
+        assert (desc.n_channels, desc.sample_rate, desc.unit) == (64, 160.0, '0')
+        assert acq.scale == 1.0
+        data = np.vstack([c.data for c in collect(acq, 2 * 160)])
+        acq.close()
+    finally:
+        proc.kill()
+        proc.wait(30)
+    raw = mne.io.read_raw_edf(path, preload=True, verbose=False).get_data().T   # volts
+    # the player loops over the file from an unknown start: find the received block in it
+    n = 32
+    starts = [k for k in range(len(raw) - n)
+              if np.allclose(raw[k:k + n, 0], data[:n, 0], rtol=1e-5, atol=1e-9)]
+    assert len(starts) == 1, f'{len(starts)} matches of the first received samples'
+    k = starts[0]
+    m = min(len(data), len(raw) - k)
+    np.testing.assert_allclose(data[:m], raw[k:k + m], rtol=1e-5, atol=1e-9)
