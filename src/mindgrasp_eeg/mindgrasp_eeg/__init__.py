@@ -13,8 +13,12 @@ Layers (ROS-free unless the module name ends in ``_node``):
 - :mod:`~mindgrasp_eeg.virtual_amp`: synthetic generator + subject + outlet, paced by a clock.
 - :mod:`~mindgrasp_eeg.player`: streams EDF/GDF/BDF/FIF/XDF files over LSL with a marker stream.
 - :mod:`~mindgrasp_eeg.export`: rosbag2 (``/eeg/raw``, prompts, targets) -> FIF/EDF.
+- :mod:`~mindgrasp_eeg.lsl_scope`: LSL discovery on this host unless ``MINDGRASP_LSL_SCOPE=network``
+  (applied when this package is imported, before liblsl reads its configuration).
 - Nodes: :mod:`~mindgrasp_eeg.acquisition_node`, :mod:`~mindgrasp_eeg.virtual_amp_node`.
 """
+
+import sys
 
 
 class EEGError(Exception):
@@ -22,3 +26,16 @@ class EEGError(Exception):
 
 
 __all__ = ['EEGError']
+
+
+def _apply_lsl_scope() -> None:
+    from .lsl_scope import apply_lsl_scope
+
+    try:
+        apply_lsl_scope()
+    except EEGError as exc:       # a bad setting keeps the safe default, and says so
+        print(f'mindgrasp_eeg: {exc} Keeping LSL on this machine.', file=sys.stderr)
+        apply_lsl_scope(scope='machine')
+
+
+_apply_lsl_scope()
