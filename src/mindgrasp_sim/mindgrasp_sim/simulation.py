@@ -28,9 +28,11 @@ sensor readings (:meth:`Simulation.render_camera`, :meth:`Simulation.joint_readi
 from __future__ import annotations
 
 import contextlib
+import ctypes
 import math
 import os
 import sys
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -67,6 +69,22 @@ SKY_RGB = (70, 80, 100)
 #: camera light: mostly ambient so the task colours stay saturated (original thresholds 0.7/0.3)
 _LIGHT = {'lightDirection': [0.4, -0.3, 1.0], 'lightAmbientCoeff': 0.55,
           'lightDiffuseCoeff': 0.5, 'lightSpecularCoeff': 0.0}
+
+
+@contextlib.contextmanager
+def _c_stdout_to_stderr() -> Iterator[None]:
+    """PyBullet's C code prints ``argv[0]=`` to stdout on every connect; send it to stderr so
+    stdout stays the caller's (e.g. a command's --json line)."""
+    libc = ctypes.CDLL(None)
+    sys.stdout.flush()
+    saved = os.dup(1)
+    try:
+        os.dup2(2, 1)
+        yield
+    finally:
+        libc.fflush(None)                # C stdio buffers go out while fd 1 is still stderr
+        os.dup2(saved, 1)
+        os.close(saved)
 
 
 @dataclass
@@ -192,8 +210,9 @@ class Simulation:
             msg = 'gui=True needs a display, but DISPLAY is not set; run with gui=False ' \
                   '(headless) or from a desktop session.'
             raise SimError(msg)
-        self._p = BulletClient(connection_mode=pb.GUI if self.gui else pb.DIRECT)
-        self._kin = BulletClient(connection_mode=pb.DIRECT)   # kinematic twin for IK / FK
+        with _c_stdout_to_stderr():
+            self._p = BulletClient(connection_mode=pb.GUI if self.gui else pb.DIRECT)
+            self._kin = BulletClient(connection_mode=pb.DIRECT)   # kinematic twin for IK / FK
         p = self._p
         p.setPhysicsEngineParameter(fixedTimeStep=self.dt, numSolverIterations=solver_iterations,
                                     deterministicOverlappingPairs=1, numSubSteps=0)
