@@ -75,7 +75,7 @@ COMMANDS: dict[str, str | dict[str, str]] = {
 
 
 def _module_doc(module_name: str) -> str:
-    """First docstring line of a command module, without importing heavy packages on --help."""
+    """Docstring of a command module, without importing heavy packages on --help."""
     try:
         spec = importlib.util.find_spec(module_name)
     except (ImportError, ValueError):
@@ -89,12 +89,18 @@ def _module_doc(module_name: str) -> str:
             doc = ast.get_docstring(ast.parse(f.read())) or ''
     except (OSError, SyntaxError):
         return ''
-    return doc.strip().splitlines()[0] if doc.strip() else ''
+    return doc.strip()
+
+
+def _summary(doc: str) -> str:
+    """The first paragraph of ``doc`` on one line (the command list's help)."""
+    return ' '.join(doc.split('\n\n')[0].split())
 
 
 def _add_command(subparsers: argparse._SubParsersAction, name: str, module_name: str) -> None:
-    parser = subparsers.add_parser(name, help=_module_doc(module_name),
-                                   description=_module_doc(module_name))
+    doc = _module_doc(module_name)
+    parser = subparsers.add_parser(name, help=_summary(doc), description=doc,
+                                   formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.set_defaults(_module=module_name)
     module = _import(module_name)
     if module is not None:
@@ -122,7 +128,7 @@ def build_parser(argv: Sequence[str]) -> argparse.ArgumentParser:
             if command == chosen:
                 _add_command(sub, command, target)
             else:
-                sub.add_parser(command, help=_module_doc(target))
+                sub.add_parser(command, help=_summary(_module_doc(target)))
             continue
         cmd_parser = sub.add_parser(command, help=f'{command} verbs: ' + ', '.join(target))
         verbs = cmd_parser.add_subparsers(dest='verb', metavar='<verb>')
@@ -130,7 +136,7 @@ def build_parser(argv: Sequence[str]) -> argparse.ArgumentParser:
             if command == chosen and len(argv) > 1 and argv[1] == verb:
                 _add_command(verbs, verb, module_name)
             else:
-                verbs.add_parser(verb, help=_module_doc(module_name))
+                verbs.add_parser(verb, help=_summary(_module_doc(module_name)))
     return parser
 
 
