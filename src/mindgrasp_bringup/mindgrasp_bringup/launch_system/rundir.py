@@ -61,9 +61,19 @@ def create_run_dir(profile: str, run_dir: str | Path | None = None,
         safe = re.sub(r'[^A-Za-z0-9_.-]+', '_', profile) or 'launch'
         base = root / f'{utc_stamp()}_{safe}'
         path, n = base, 1
-        while path.exists():
-            n += 1
-            path = base.with_name(f'{base.name}-{n}')
+        # mkdir claims the name atomically: two launches in the same second (another shell, a
+        # parallel test) get -2, -3 ... instead of sharing one directory
+        while True:
+            try:
+                root.mkdir(parents=True, exist_ok=True)
+                path.mkdir()
+                break
+            except FileExistsError:
+                n += 1
+                path = base.with_name(f'{base.name}-{n}')
+            except OSError as exc:
+                msg = f'cannot create the run directory {path} ({exc}): give a writable --run-dir.'
+                raise LaunchError(msg) from exc
     try:
         (path / 'logs').mkdir(parents=True, exist_ok=True)
     except OSError as exc:
