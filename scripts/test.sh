@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # The test command: sets up .venv if needed, then runs the whole test suite.
-# Extra arguments go to pytest (e.g. scripts/test.sh -m "not slow" -x).
+# Extra arguments go to pytest (e.g. scripts/test.sh -m "not slow" -x; -n 0 runs in one process).
+# Two pytest-xdist workers by default (MINDGRASP_TEST_WORKERS): most tests wait on other
+# processes, so two at a time use the 2 cores; each worker has its own ROS_DOMAIN_ID.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ./scripts/setup.sh
@@ -8,4 +10,4 @@ cd "$(dirname "$0")/.."
 export ROS_AUTOMATIC_DISCOVERY_RANGE=${ROS_AUTOMATIC_DISCOVERY_RANGE:-LOCALHOST}
 export ROS_DOMAIN_ID=${ROS_DOMAIN_ID:-$(( (RANDOM % 100) + 100 ))}
 export MNE_DATASETS_EEGBCI_PATH=${MNE_DATASETS_EEGBCI_PATH:-$(cd .. && pwd)/shared/data}
-exec .venv/bin/python -m pytest "$@"
+exec .venv/bin/python -m pytest -n "${MINDGRASP_TEST_WORKERS:-2}" --dist loadfile "$@"

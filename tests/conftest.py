@@ -15,9 +15,13 @@ from mindgrasp_testing import NodeProcess
 REPO = Path(__file__).resolve().parents[1]
 SHARED_DATA = REPO.parent / 'shared' / 'data'
 
-# DDS stays on this host and on a domain of its own, so parallel runs never cross-talk.
+# DDS stays on this host and on a domain of its own, so parallel runs never cross-talk; each
+# pytest-xdist worker (gw0, gw1, ...) takes the next domains after the run's.
 os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
 os.environ.setdefault('ROS_DOMAIN_ID', str(100 + os.getpid() % 100))
+if os.environ.get('PYTEST_XDIST_WORKER', '').startswith('gw'):
+    os.environ['ROS_DOMAIN_ID'] = str(
+        (int(os.environ['ROS_DOMAIN_ID']) + 1 + int(os.environ['PYTEST_XDIST_WORKER'][2:])) % 232)
 if SHARED_DATA.is_dir():
     os.environ.setdefault('MNE_DATASETS_EEGBCI_PATH', str(SHARED_DATA))
 
