@@ -164,6 +164,16 @@ def test_colcon_installs_executables_and_share_files(workspace: Path) -> None:
                               capture_output=True, text=True, timeout=120, check=False)
     assert help_run.returncode == 0, help_run.stderr
     assert 'launch' in help_run.stdout
+    # an installed node executable (ros2 run mindgrasp_fsm fsm_node --help): its docstring and
+    # the ROS arguments, without starting the node
+    node_help = subprocess.run(
+        sourced(workspace, str(install / 'mindgrasp_fsm' / 'lib' / 'mindgrasp_fsm' / 'fsm_node'),
+                '--help'), env=workspace_env(), capture_output=True, text=True, timeout=120,
+        check=False)
+    assert node_help.returncode == 0, node_help.stderr
+    assert 'six-state MIndGrasp controller' in node_help.stdout
+    assert '--ros-args' in node_help.stdout and 'param describe' in node_help.stdout
+    assert 'Grasp controller ready' not in node_help.stdout + node_help.stderr
     # the sourced workspace's copies are imported, not the source tree or an editable install
     where = subprocess.run(
         sourced(workspace, sys.executable, '-c',

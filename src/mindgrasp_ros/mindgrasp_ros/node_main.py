@@ -51,7 +51,7 @@ from mindgrasp_ros import rclpy
 from mindgrasp_ros.process import exit_if_main_program
 
 __all__ = ['EXIT_FAILED', 'EXIT_OK', 'EXIT_REFUSED', 'NodeFailure', 'declare_duration',
-           'end_after', 'error_text', 'exit_code', 'fail', 'is_done', 'run_node']
+           'end_after', 'error_text', 'exit_code', 'fail', 'help_text', 'is_done', 'run_node']
 
 EXIT_OK = 0       #: finished or stopped
 EXIT_FAILED = 1   #: failed while running
@@ -154,6 +154,27 @@ def error_text(node: Any) -> str | None:
     return None
 
 
+def _wants_help(argv: list[str]) -> bool:
+    """``-h``/``--help`` before ``--ros-args`` (after it, every word belongs to ROS)."""
+    words = argv[:argv.index('--ros-args')] if '--ros-args' in argv else argv
+    return any(w in ('-h', '--help') for w in words)
+
+
+def help_text(node_class: Callable[[], Any]) -> str:
+    """What ``<node executable> --help`` prints: the node module's docstring and the ROS
+    arguments (the node does not start)."""
+    module = sys.modules.get(getattr(node_class, '__module__', ''))
+    doc = (getattr(module, '__doc__', None) or getattr(node_class, '__doc__', None) or '').strip()
+    spec = getattr(module, '__spec__', None)          # run with -m, __name__ is '__main__'
+    name = spec.name if spec is not None else getattr(module, '__name__', 'node')
+    return (f'{doc}\n\n'
+            f'usage: python -m {name} [--ros-args [-p NAME:=VALUE] [--params-file FILE]\n'
+            '                 [-r FROM:=TO] [--log-level LEVEL]]\n'
+            '       ros2 run <package> <executable> [--ros-args ...]\n\n'
+            'Parameters with units, ranges and whether a change applies while the node runs:\n'
+            '    mindgrasp param describe /<node> <name>   (defaults: <package>/param/*.yaml)')
+
+
 def run_node(node_class: Callable[[], Any], args: list[str] | None = None, *,
              errors: tuple[type[BaseException], ...] = (), linger_sec: float = 0.0) -> int:
     """Init, construct ``node_class()``, spin until Ctrl-C or ``node.done``, clean up.
@@ -169,7 +190,12 @@ def run_node(node_class: Callable[[], Any], args: list[str] | None = None, *,
         linger_sec: after ``done`` completes, keep spinning this long (s) so reliable readers
             receive the last messages (a session's "end" prompt).
     """
-    rclpy.init(args=args if args is not None else sys.argv)
+    argv = list(args if args is not None else sys.argv)
+    if _wants_help(argv):
+        print(help_text(node_class))
+        exit_if_main_program(EXIT_OK, getattr(node_class, '__module__', ''))
+        return EXIT_OK
+    rclpy.init(args=argv)
     node = None
     label = getattr(node_class, '__name__', 'node')
     code = EXIT_OK
