@@ -91,6 +91,9 @@ def add_common_arguments(parser: argparse.ArgumentParser, trials: int) -> None:
     parser.add_argument('--trial-timeout', type=positive_float, default=600.0, metavar='S',
                         help='end a trial without a grasp after S simulated s (default 600)')
     parser.add_argument('--no-progress', action='store_true', help='no progress bar')
+    parser.add_argument('--realism', default='none',
+                        help='sensor noise and physical spread: none (default), default or a '
+                             'profile YAML path (mindgrasp_sim.realism), seeded per trial')
 
 
 def fail(command: str, text: str) -> int:

@@ -15,9 +15,6 @@ from mindgrasp_experiments.cli import add_common_arguments, run_experiment
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Arguments of ``mindgrasp experiment random-locations``."""
     add_common_arguments(parser, trials=507)
-    parser.add_argument('--realism', default='none',
-                        help='sensor noise and physical spread: none (default), default or a '
-                             'profile YAML path (mindgrasp_sim.realism), seeded per trial')
 
 
 def main(args: argparse.Namespace) -> int:

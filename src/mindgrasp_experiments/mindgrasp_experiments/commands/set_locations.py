@@ -5,6 +5,7 @@ trial, the subject drives the arm through EEG -> classifier -> controller (lock-
     mindgrasp experiment set-locations --trials 160 --subject virtual --accuracy 0.8
     mindgrasp experiment set-locations --trials 6 --subject oracle --json
     mindgrasp experiment set-locations --trials 10 --subject eegmmidb:1 --accuracy 0.9
+    mindgrasp experiment set-locations --trials 90 --subject virtual --realism default
 """
 
 from __future__ import annotations
