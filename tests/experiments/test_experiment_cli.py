@@ -41,6 +41,7 @@ def last_json(result: subprocess.CompletedProcess) -> dict:
     (['random-locations', '--stall-timeout', 'nan'], "argument --stall-timeout: 'nan' is not"),
     (['random-locations', '--launch', 'nowhere.launch.py'], 'no such launch file'),
     (['random-locations', '--realism', 'foggy'], "--realism: Unknown realism profile 'foggy'"),
+    (['set-locations', '--realism', 'foggy'], "--realism: Unknown realism profile 'foggy'"),
     (['report', 'no/such/run'], 'is not a directory'),
 ])
 def test_bad_input_is_one_clear_line_and_exit_2(args: list[str], message: str) -> None:
