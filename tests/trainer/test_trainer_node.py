@@ -230,9 +230,9 @@ def test_trainer_without_training_robot_exits_with_the_fix(ros, spawn_node):
     ('params', 'match'),
     [
         ({'turn_joint': 9}, "'turn_joint' is 9, outside the 6 joints"),
-        ({'reset_timeout': 0.0}, "'reset_timeout' must be a positive number of seconds"),
-        ({'robot_timeout': -1.0}, "'robot_timeout' must be 0 (wait forever) or a positive"),
-        ({'rate': 0.0}, "The rate 'rate' must be a positive number of Hz"),
+        ({'reset_timeout': 0.0}, "parameter 'reset_timeout': must be within [0.001, 3600.0]"),
+        ({'robot_timeout': -1.0}, "parameter 'robot_timeout': must be within [0.0, inf]"),
+        ({'rate': 0.0}, "parameter 'rate': must be within [1.0, 10000.0]"),
     ],
 )
 def test_trainer_bad_parameter(ros, spawn_node, params, match):

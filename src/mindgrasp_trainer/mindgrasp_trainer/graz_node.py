@@ -14,21 +14,70 @@ the last trial, or after ``duration`` seconds when that is > 0.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import MIPrediction, Prompt
 from mindgrasp_ros.interfaces.sensor_msgs.msg import Image
 
 from mindgrasp_ros import rclpy
 from mindgrasp_ros.node_main import run_node
+from mindgrasp_ros.params import declare_params, param
 from mindgrasp_ros.topics import BCI_PREDICTION, TRAINER_DISPLAY, TRAINER_PROMPT
-from mindgrasp_trainer.display import render_display
+from mindgrasp_trainer.display import FEEDBACK_MODES, render_display
 from mindgrasp_trainer.graz import GrazProtocol, PromptSequencer
-from mindgrasp_trainer.protocol import TrainerError
-from mindgrasp_trainer.ros_common import (
-    EegGate,
-    check_rate,
-    fixed_parameters_callback,
-    to_msg,
-)
+from mindgrasp_trainer.protocol import TrainerError, check_classes
+from mindgrasp_trainer.ros_common import EegGate, to_msg
+
+#: the GrazProtocol arguments among the parameters
+_PROTOCOL = ('n_trials', 'classes', 'seed', 'max_repeat', 'fixation', 'cue', 'imagery',
+             'rest_min', 'rest_max', 'start_delay')
+
+
+@dataclass
+class GrazParams:
+    """ROS parameters of the Graz prompter (``graz_prompter:`` in ``param/trainer.yaml``); only
+    the feedback bar's settings change while it runs, the schedule is planned at start."""
+
+    n_trials: int = param(40, 'total trials; a multiple of len(classes) gives exact balance',
+                          min=1, max=100000)
+    classes: list[int] = param([0, 1, 2, 3], 'classes to cue: 0 left hand, 1 right hand, '
+                               '2 both hands, 3 both feet')
+    seed: int = param(0, 'seed of the class order and the rest durations', min=0)
+    max_repeat: int = param(0, 'longest run of one class in a row (0 = no limit)', min=0)
+    fixation: float = param(2.0, 'fixation cross before the cue', unit='s', min=0.001,
+                            max=3600.0)
+    cue: float = param(1.25, 'arrow on screen', unit='s', min=0.001, max=3600.0)
+    imagery: float = param(2.75, 'imagery after the arrow (cue + imagery = 4 s, BCI IV 2a)',
+                           unit='s', min=0.001, max=3600.0)
+    rest_min: float = param(1.5, 'shortest inter-trial rest', unit='s', min=0.0, max=3600.0)
+    rest_max: float = param(2.5, 'longest inter-trial rest', unit='s', min=0.0, max=3600.0)
+    start_delay: float = param(5.0, 'before the first fixation: amplifier, recorder and '
+                               'subscribers come up', unit='s', min=0.0, max=3600.0)
+    duration: float = param(0.0, 'end after this long even if trials remain (0 = no limit)',
+                            unit='s', min=0.0)
+    rate: float = param(200.0, 'prompt timer (onset resolution 1 / rate)', unit='Hz', min=1.0,
+                        max=10000.0)
+    display_rate: float = param(10.0, 'frames per second on /trainer/display (0 = no display '
+                                'topic)', unit='Hz', min=0.0, max=10000.0)
+    display_width: int = param(480, 'width of the /trainer/display frames', unit='px', min=32,
+                               max=7680)
+    display_height: int = param(360, 'height of the /trainer/display frames', unit='px',
+                                min=32, max=4320)
+    feedback: str = param('move', 'when the feedback bar from /bci/prediction shows',
+                          choices=FEEDBACK_MODES, live=True)
+    max_certainty: float = param(1.0, 'certainty that fills the feedback bar', min=1e-6,
+                                 max=1e6, live=True)
+    prediction_timeout: float = param(1.0, 'hide the bar when /bci/prediction has been quiet '
+                                      'this long', unit='s', min=0.0)
+    wait_for_eeg: bool = param(False, 'start the schedule once /eeg/raw flows (sessions turn '
+                               'it on)')
+
+    def __post_init__(self) -> None:
+        check_classes(self.classes)
+        if self.rest_min > self.rest_max:
+            msg = (f"'rest_min' ({self.rest_min} s) is larger than 'rest_max' ({self.rest_max} "
+                   's); swap them or make them equal for a fixed rest.')
+            raise TrainerError(msg)
 
 
 class GrazNode(rclpy.node.Node):
@@ -36,59 +85,28 @@ class GrazNode(rclpy.node.Node):
 
     def __init__(self, **kwargs) -> None:
         super().__init__('graz_prompter', **kwargs)
-        self.declare_parameters('', [
-            ('n_trials', 40), ('classes', [0, 1, 2, 3]), ('seed', 0),
-            ('fixation', 2.0), ('cue', 1.25), ('imagery', 2.75),
-            ('rest_min', 1.5), ('rest_max', 2.5), ('max_repeat', 0),
-            ('start_delay', 5.0), ('duration', 0.0), ('rate', 200.0),
-            ('display_rate', 10.0), ('display_width', 480), ('display_height', 360),
-            ('feedback', 'move'), ('max_certainty', 1.0), ('prediction_timeout', 1.0),
-            ('wait_for_eeg', False),
-        ])  # fmt: skip
-        p = {name: self.get_parameter(name).value for name in (
-            'n_trials', 'classes', 'seed', 'fixation', 'cue', 'imagery', 'rest_min', 'rest_max',
-            'max_repeat', 'start_delay')}  # fmt: skip
-        self.duration = float(self.get_parameter('duration').value)
-        self.display = {
-            'width': int(self.get_parameter('display_width').value),
-            'height': int(self.get_parameter('display_height').value),
-            'feedback': str(self.get_parameter('feedback').value),
-            'max_certainty': float(self.get_parameter('max_certainty').value),
-        }
-        try:
-            self.protocol = GrazProtocol(**p)
-            self.sequencer = PromptSequencer(self.protocol.schedule())
-            render_display(None, **self.display)  # validates the display parameters
-            rate = check_rate('rate', self.get_parameter('rate').value)
-            display_rate = check_rate(
-                'display_rate', self.get_parameter('display_rate').value, allow_zero=True
-            )
-        except TrainerError as err:
-            self.get_logger().error(str(err))
-            raise
+        p = self.p = declare_params(self, GrazParams)
+        # a TrainerError here (no class order keeps runs to max_repeat) ends the node with exit
+        # code 2 and its one-line message (run_node)
+        self.protocol = GrazProtocol(**{name: getattr(p, name) for name in _PROTOCOL})
+        self.sequencer = PromptSequencer(self.protocol.schedule())
         self.n_trials = len(self.protocol.class_order())
         self.prediction: tuple[int, float] | None = None
         self.prediction_ns = 0  # ROS time of the latest prediction's arrival
-        timeout = float(self.get_parameter('prediction_timeout').value)
-        self.prediction_timeout_ns = int(timeout * 1e9)
         self.t0_ns: int | None = None
         self.done = rclpy.task.Future()  # result set when the session has ended
         # wait_for_eeg: the schedule starts once EEG flows (an amplifier that starts late on a
         # busy machine would otherwise miss the first trials)
-        self.eeg_gate = EegGate(self) if self.get_parameter('wait_for_eeg').value else None
+        self.eeg_gate = EegGate(self) if p.wait_for_eeg else None
 
         self.prompt_pub = self.create_publisher(Prompt, TRAINER_PROMPT.name, TRAINER_PROMPT.qos)
         self.create_subscription(MIPrediction, BCI_PREDICTION.name, self.prediction_callback,
                                  BCI_PREDICTION.qos)
-        self.create_timer(1.0 / rate, self.tick_callback)
-        if display_rate > 0:
+        self.create_timer(1.0 / p.rate, self.tick_callback)
+        if p.display_rate > 0:
             self.display_pub = self.create_publisher(Image, TRAINER_DISPLAY.name,
                                                      TRAINER_DISPLAY.qos)
-            self.create_timer(1.0 / display_rate, self.display_callback)
-        self.add_on_set_parameters_callback(fixed_parameters_callback({
-            'feedback': lambda v: self._set_display('feedback', str(v)),
-            'max_certainty': lambda v: self._set_display('max_certainty', float(v)),
-        }))  # fmt: skip
+            self.create_timer(1.0 / p.display_rate, self.display_callback)
         self.get_logger().info(
             f'Graz-BCI session: {self.n_trials} trials, classes {list(self.protocol.classes)}, '
             f'seed {self.protocol.seed}, {self.protocol.total_duration():.1f} s planned.'
@@ -97,10 +115,6 @@ class GrazNode(rclpy.node.Node):
     @property
     def finished(self) -> bool:
         return self.done.done()
-
-    def _set_display(self, key: str, value: object) -> None:
-        render_display(None, **(self.display | {key: value}))  # raises TrainerError if invalid
-        self.display[key] = value
 
     def prediction_callback(self, msg: MIPrediction) -> None:
         self.prediction = (int(msg.class_index), float(msg.certainty))
@@ -118,7 +132,7 @@ class GrazNode(rclpy.node.Node):
             self.t0_ns = now.nanoseconds
         elapsed = (now.nanoseconds - self.t0_ns) * 1e-9
         events = self.sequencer.due(elapsed)
-        if self.duration > 0 and elapsed >= self.duration and not self.sequencer.done:
+        if self.p.duration > 0 and elapsed >= self.p.duration and not self.sequencer.done:
             events.append(self.sequencer.stop(elapsed))
         for event in events:
             self.prompt_pub.publish(to_msg(event, now.to_msg()))
@@ -134,9 +148,11 @@ class GrazNode(rclpy.node.Node):
 
     def display_callback(self) -> None:
         # a classifier that went quiet shows no bar rather than a stale one
+        p = self.p  # feedback and max_certainty are live: declare_params updates them in place
         age_ns = self.get_clock().now().nanoseconds - self.prediction_ns
-        prediction = self.prediction if age_ns <= self.prediction_timeout_ns else None
-        frame = render_display(self.sequencer.current, prediction, **self.display)
+        prediction = self.prediction if age_ns <= p.prediction_timeout * 1e9 else None
+        frame = render_display(self.sequencer.current, prediction, p.display_width,
+                               p.display_height, p.feedback, p.max_certainty)
         msg = Image(
             height=frame.shape[0], width=frame.shape[1], encoding='rgb8',
             is_bigendian=0, step=frame.shape[1] * 3, data=frame.reshape(-1),

@@ -28,7 +28,7 @@ __all__ = [
 PHASES: tuple[str, ...] = ('fixation', 'cue', 'move', 'wait', 'rest', 'end')
 
 
-class TrainerError(Exception):
+class TrainerError(ValueError):
     """Bad parameter or input of a trainer protocol; the message names the value and the fix."""
 
 

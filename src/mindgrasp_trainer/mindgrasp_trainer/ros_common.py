@@ -1,19 +1,16 @@
-"""ROS plumbing shared by the trainer nodes: prompt QoS and message, rate and parameter checks.
+"""ROS plumbing shared by the prompter nodes: the EEG gate, the prompt QoS and message.
 Imports the client layer; the protocols themselves do not.
 """
 
 from __future__ import annotations
 
 from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import Prompt
-from mindgrasp_ros.interfaces.rcl_interfaces.msg import SetParametersResult
 
 from mindgrasp_ros import rclpy
-from mindgrasp_trainer.protocol import PromptEvent, TrainerError
+from mindgrasp_trainer.protocol import PromptEvent
 
 __all__ = [
     'EegGate',
-    'check_rate',
-    'fixed_parameters_callback',
     'prompt_qos',
     'to_msg',
 ]
@@ -57,42 +54,6 @@ def prompt_qos() -> rclpy.qos.QoSProfile:
     from mindgrasp_ros.topics import TRAINER_PROMPT
 
     return TRAINER_PROMPT.qos
-
-
-def check_rate(name: str, value: float, allow_zero: bool = False) -> float:
-    """Validate a timer rate parameter (Hz)."""
-    value = float(value)
-    if not (value > 0 or (allow_zero and value == 0)) or value > 10000:
-        zero = ' (0 turns it off)' if allow_zero else ''
-        msg = (
-            f"The rate '{name}' must be a positive number of Hz up to 10000{zero}; "
-            f'{value} is invalid.'
-        )
-        raise TrainerError(msg)
-    return value
-
-
-def fixed_parameters_callback(live: dict) -> object:
-    """An on-set-parameters callback: names in ``live`` map to a validator that applies the new
-    value; every other parameter is fixed for the session and the change is refused."""
-
-    def callback(params: list) -> SetParametersResult:
-        for param in params:
-            if param.name == 'use_sim_time':
-                continue
-            if param.name not in live:
-                return SetParametersResult(
-                    successful=False,
-                    reason=f"'{param.name}' is fixed once the session is planned; restart the "
-                    f'node to change it (live: {", ".join(sorted(live)) or "none"}).',
-                )
-            try:
-                live[param.name](param.value)
-            except TrainerError as err:
-                return SetParametersResult(successful=False, reason=str(err))
-        return SetParametersResult(successful=True)
-
-    return callback
 
 
 def to_msg(event: PromptEvent, stamp) -> Prompt:

@@ -18,6 +18,7 @@ import csv
 import json
 import math
 import time
+from dataclasses import dataclass
 
 import numpy as np
 from mindgrasp_ros.interfaces.geometry_msgs.msg import PoseStamped
@@ -28,6 +29,7 @@ from mindgrasp_ros.interfaces.std_msgs.msg import Float64, Float64MultiArray
 
 from mindgrasp_ros import rclpy
 from mindgrasp_ros.node_main import run_node
+from mindgrasp_ros.params import declare_params, param
 from mindgrasp_ros.topics import (
     ARM_COMMANDS,
     EE_POSE,
@@ -37,21 +39,71 @@ from mindgrasp_ros.topics import (
     TRAINER_PROMPT,
     TRAINER_ROBOT,
 )
-from mindgrasp_trainer.protocol import CLASS_NAMES, TrainerError
-from mindgrasp_trainer.ros_common import (
-    EegGate,
-    check_rate,
-    fixed_parameters_callback,
-    to_msg,
-)
-from mindgrasp_trainer.trainer import TrainerProtocol, ee_distance
+from mindgrasp_trainer.protocol import CLASS_NAMES, TrainerError, check_classes
+from mindgrasp_trainer.ros_common import EegGate, to_msg
+from mindgrasp_trainer.trainer import GRASP_OBJECT, TrainerProtocol, ee_distance
 
-_PROTOCOL_PARAMS = (
-    ('n_trials', 40), ('classes', [0, 1, 2, 3]), ('seed', 0), ('balanced', True),
-    ('move_duration', 2.0), ('wait_duration', 2.0), ('turn_speed', 0.2), ('approach_speed', 0.05),
-    ('turn_joint', 0), ('approach_joint', 1), ('n_joints', 6), ('reset_height', 0.1),
-    ('grasp_state', 5), ('settle_time', 1.0), ('start_delay', 5.0), ('duration', 0.0),
-)  # fmt: skip
+#: the TrainerProtocol arguments among the parameters
+_PROTOCOL = ('n_trials', 'classes', 'seed', 'balanced', 'move_duration', 'wait_duration',
+             'turn_speed', 'approach_speed', 'turn_joint', 'approach_joint', 'n_joints',
+             'reset_height', 'grasp_state', 'settle_time', 'start_delay', 'duration')
+
+
+@dataclass
+class TrainerParams:
+    """ROS parameters of the trainer (``trainer:`` in ``param/trainer.yaml``); only
+    ``reset_timeout`` changes while it runs, the trials are planned at start."""
+
+    n_trials: int = param(40, 'number of trials; the session ends after the last one', min=1,
+                          max=100000)
+    classes: list[int] = param([0, 1, 2, 3], 'classes to prompt: 0 left hand, 1 right hand, '
+                               '2 both hands, 3 both feet')
+    seed: int = param(0, 'seed of the class order', min=0)
+    balanced: bool = param(True, 'balanced random order; false = independent draw per trial '
+                           '(paper)')
+    move_duration: float = param(2.0, 'training robot moves (paper: 2 s)', unit='s', min=0.001,
+                                 max=3600.0)
+    wait_duration: float = param(2.0, 'then waits for the user (paper: 2 s)', unit='s', min=0.0,
+                                 max=3600.0)
+    turn_speed: float = param(0.2, "velocity of 'turn_joint' for left hand (+) / right hand (-)",
+                              unit='rad/s', min=-10.0, max=10.0)
+    approach_speed: float = param(0.05, "velocity of 'approach_joint' for both hands (+, "
+                                  'approach) / both feet (-, back away)', unit='rad/s',
+                                  min=-10.0, max=10.0)
+    turn_joint: int = param(0, 'zero-based joint turned for left/right hand (0: joint 1, base '
+                            'yaw)', min=0, max=63)
+    approach_joint: int = param(1, 'zero-based joint moved for both hands/feet (1: joint 2, '
+                                'shoulder)', min=0, max=63)
+    n_joints: int = param(6, 'length of the velocity command', min=1, max=64)
+    reset_height: float = param(0.1, 'reset when the training end-effector goes below this',
+                                unit='m', min=-10.0, max=10.0)
+    grasp_state: int = param(GRASP_OBJECT, '... or when /fsm/state enters this state '
+                             '(5 GRASP_OBJECT)', min=0, max=255)
+    settle_time: float = param(1.0, 'rest after a reset before the next trial', unit='s',
+                               min=0.0, max=3600.0)
+    start_delay: float = param(5.0, 'after the training robot is heard from, before the first '
+                               'trial', unit='s', min=0.0, max=3600.0)
+    duration: float = param(0.0, 'end after this long even if trials remain (0 = run all '
+                            'trials)', unit='s', min=0.0)
+    rate: float = param(50.0, 'command and prompt timer; the simulator stops the arm after '
+                        '0.25 s of silence', unit='Hz', min=1.0, max=10000.0)
+    robot_timeout: float = param(30.0, 'give up when the training robot is not heard from '
+                                 '(0 = wait forever)', unit='s', min=0.0)
+    reset_timeout: float = param(5.0, '/sim/reset must answer within this', unit='s',
+                                 min=0.001, max=3600.0, live=True)
+    reset_new_random_draw: bool = param(False, 'a reset draws a new scene')
+    log_file: str = param('', "per-trial CSV (distances in m); '' = log only")
+    wait_for_eeg: bool = param(False, 'start the first trial once /eeg/raw flows (sessions '
+                               'turn it on)')
+
+    def __post_init__(self) -> None:
+        check_classes(self.classes)
+        for name in ('turn_joint', 'approach_joint'):
+            index = getattr(self, name)
+            if not 0 <= index < self.n_joints:
+                msg = (f"'{name}' is {index}, outside the {self.n_joints} joints; use an index "
+                       f"from 0 to {self.n_joints - 1} (or raise 'n_joints').")
+                raise TrainerError(msg)
 
 
 def _position(msg: PoseStamped) -> np.ndarray:
@@ -64,26 +116,8 @@ class TrainerNode(rclpy.node.Node):
 
     def __init__(self, **kwargs) -> None:
         super().__init__('trainer', **kwargs)
-        self.declare_parameters('', [
-            *_PROTOCOL_PARAMS, ('rate', 50.0), ('robot_timeout', 30.0), ('reset_timeout', 5.0),
-            ('reset_new_random_draw', False), ('log_file', ''), ('wait_for_eeg', False),
-        ])  # fmt: skip
-        params = {name: self.get_parameter(name).value for name, _ in _PROTOCOL_PARAMS}
-        try:
-            self.protocol = TrainerProtocol(**params)
-            rate = check_rate('rate', self.get_parameter('rate').value)
-            self._set_reset_timeout(self.get_parameter('reset_timeout').value)
-            self.robot_timeout = float(self.get_parameter('robot_timeout').value)
-            if not (math.isfinite(self.robot_timeout) and self.robot_timeout >= 0):
-                msg = (
-                    f"'robot_timeout' must be 0 (wait forever) or a positive number of seconds; "
-                    f'{self.robot_timeout} is invalid.'
-                )
-                raise TrainerError(msg)
-        except TrainerError as err:
-            self.get_logger().error(str(err))
-            raise
-        self.log_file = str(self.get_parameter('log_file').value)
+        p = self.p = declare_params(self, TrainerParams)
+        self.protocol = TrainerProtocol(**{name: getattr(p, name) for name in _PROTOCOL})
         self.trainer_pos: np.ndarray | None = None
         self.user_pos: np.ndarray | None = None
         self.fsm_state: int | None = None
@@ -95,7 +129,7 @@ class TrainerNode(rclpy.node.Node):
         self.trainer_pose_time = math.inf  # wall time of the last training robot pose
         self.stale_warned = 0.0
         self.done = rclpy.task.Future()  # result: exit code, set when the session has ended
-        self.eeg_gate = EegGate(self) if self.get_parameter('wait_for_eeg').value else None
+        self.eeg_gate = EegGate(self) if p.wait_for_eeg else None
 
         self.prompt_pub = self.create_publisher(Prompt, TRAINER_PROMPT.name, TRAINER_PROMPT.qos)
         arm, joints, pose = (t.in_namespace(TRAINER_ROBOT)
@@ -108,10 +142,7 @@ class TrainerNode(rclpy.node.Node):
         self.create_subscription(PoseStamped, EE_POSE.name, self.user_pose_callback, EE_POSE.qos)
         self.create_subscription(FsmState, FSM_STATE.name, self.fsm_callback, FSM_STATE.qos)
         self.reset_client = self.create_client(ResetSim, '/sim/reset')
-        self.create_timer(1.0 / rate, self.tick_callback)
-        self.add_on_set_parameters_callback(fixed_parameters_callback({
-            'reset_timeout': self._set_reset_timeout,
-        }))  # fmt: skip
+        self.create_timer(1.0 / p.rate, self.tick_callback)
         self.get_logger().info(
             f'MIndGrasp Trainer: {self.protocol.n_trials} trials of '
             f'{self.protocol.move_duration} s move + {self.protocol.wait_duration} s wait, '
@@ -126,13 +157,6 @@ class TrainerNode(rclpy.node.Node):
     @property
     def exit_code(self) -> int:
         return self.done.result() if self.done.done() else 0
-
-    def _set_reset_timeout(self, value: object) -> None:
-        value = float(value)
-        if not (math.isfinite(value) and value > 0):
-            msg = f"'reset_timeout' must be a positive number of seconds; {value} is invalid."
-            raise TrainerError(msg)
-        self.reset_timeout = value
 
     # ------------------------------------------------------------------ inputs
     def joint_states_callback(self, msg: JointState) -> None:
@@ -176,7 +200,7 @@ class TrainerNode(rclpy.node.Node):
                 self._finish(1)
                 return False
             return True
-        if self.robot_timeout > 0 and time.monotonic() - self.created > self.robot_timeout:
+        if self.p.robot_timeout > 0 and time.monotonic() - self.created > self.p.robot_timeout:
             missing = [
                 topic for topic, value in (
                     ('/trainer_robot/joint_states', self.joint_count),
@@ -184,7 +208,7 @@ class TrainerNode(rclpy.node.Node):
                 ) if value is None
             ]  # fmt: skip
             self.get_logger().error(
-                f'No message on {" and ".join(missing)} within {self.robot_timeout:.1f} s: start '
+                f'No message on {" and ".join(missing)} within {self.p.robot_timeout:.1f} s: start '
                 'the simulator with the training robot (mindgrasp launch trainer) or remap the '
                 "topics; 'robot_timeout' sets the wait."
             )
@@ -253,9 +277,9 @@ class TrainerNode(rclpy.node.Node):
             self.protocol.reset_finished(t, success=False)
             return
         request = ResetSim.Request(
-            new_random_draw=bool(self.get_parameter('reset_new_random_draw').value), seed=-1
+            new_random_draw=self.p.reset_new_random_draw, seed=-1
         )
-        self.reset_deadline = time.monotonic() + self.reset_timeout
+        self.reset_deadline = time.monotonic() + self.p.reset_timeout
         self.reset_future = self.reset_client.call_async(request)
         self.reset_future.add_done_callback(self.reset_done_callback)
 
@@ -275,7 +299,7 @@ class TrainerNode(rclpy.node.Node):
     def _check_reset_timeout(self, t: float) -> None:
         if self.reset_deadline is not None and time.monotonic() > self.reset_deadline:
             self.get_logger().error(
-                f'/sim/reset did not answer within {self.reset_timeout:.1f} s; the session goes '
+                f'/sim/reset did not answer within {self.p.reset_timeout:.1f} s; the session goes '
                 "on. Check the simulator's log, or raise 'reset_timeout'."
             )
             self.reset_future = None
@@ -291,8 +315,8 @@ class TrainerNode(rclpy.node.Node):
             return
         summary = json.dumps(_rounded(self.protocol.summary()))
         self.get_logger().info(f'Trainer session summary (distances in m): {summary}')
-        if self.log_file:
-            self._write_log(self.log_file)
+        if self.p.log_file:
+            self._write_log(self.p.log_file)
 
     def _write_log(self, path: str) -> None:
         """Per-trial CSV: trial, class, onset (s), mean and final end-effector distance (m)."""
