@@ -40,10 +40,11 @@ def test_virtual_amp_publishes_eeg_on_sim_time() -> None:
 
 
 def test_virtual_amp_rejects_an_unknown_output() -> None:
-    from mindgrasp_eeg import EEGError
     from mindgrasp_eeg.virtual_amp_node import VirtualAmpNode
+    from mindgrasp_ros.params import ParameterError
 
-    with LockstepRunner() as runner, pytest.raises(EEGError, match="'output' is 'udp'; use 'lsl'"):
+    with LockstepRunner() as runner, \
+            pytest.raises(ParameterError, match="'output' is 'udp'; use one of lsl, ros"):
         runner.add(VirtualAmpNode, ros_args=['-p', 'output:=udp'])
 
 

@@ -22,28 +22,19 @@ sender on the network can stand in for it.
 from __future__ import annotations
 
 import socket
-import sys
 
 import numpy as np
 from mindgrasp_ros.interfaces.diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import EEGChunk
 
+from mindgrasp_eeg import EEGError
 from mindgrasp_eeg.acquisition import ERROR, OK, WARN, EEGAcquisition, ros_stamp_ns
-from mindgrasp_eeg.montage import NAUTILUS_32
-from mindgrasp_eeg.node_main import run_node
+from mindgrasp_eeg.params import AcquisitionParams
 from mindgrasp_eeg.ros_conversions import ns_to_time_fields
 from mindgrasp_ros import rclpy
+from mindgrasp_ros.node_main import end_after, fail, run_node
+from mindgrasp_ros.params import declare_params
 
-PARAMETERS = [
-    ('stream_name', 'MIndGrasp-VirtualAmp'), ('stream_type', ''), ('source_id', ''),
-    ('hostname', ''),
-    ('n_channels', 32), ('sample_rate', 250.0), ('channel_names', list(NAUTILUS_32)),
-    ('check_channel_names', True), ('adapt_to_stream', False), ('stream_unit', 'auto'),
-    ('chunk_period', 1.0 / 32.0), ('max_buflen', 1.0), ('resolve_timeout', 30.0),
-    ('lost_timeout', 0.5), ('nan_policy', 'replace'), ('dejitter', True), ('clocksync', True),
-    ('quality_window', 1.0), ('flat_threshold', 1e-7), ('rail_threshold', 0.1),
-    ('status_period', 1.0), ('frame_id', 'eeg'), ('duration', 0.0),
-]
 _LEVELS = {OK: DiagnosticStatus.OK, WARN: DiagnosticStatus.WARN, ERROR: DiagnosticStatus.ERROR}
 
 
@@ -52,41 +43,39 @@ class AcquisitionNode(rclpy.node.Node):
 
     def __init__(self, **kwargs) -> None:
         super().__init__('eeg_acquisition', **kwargs)
-        self.declare_parameters('', PARAMETERS)
-        p = {name: self.get_parameter(name).value for name, _ in PARAMETERS}
-        self.p = p
+        self.done = rclpy.task.Future()
+        self.params = p = declare_params(self, AcquisitionParams)
         self.acq = EEGAcquisition(
-            p['stream_name'], p['stream_type'], p['source_id'], n_channels=p['n_channels'],
-            sample_rate=p['sample_rate'],
-            channel_names=p['channel_names'] if p['check_channel_names'] else (),
-            adapt=p['adapt_to_stream'], stream_unit=p['stream_unit'], max_buflen=p['max_buflen'],
-            resolve_timeout=p['resolve_timeout'], lost_timeout=p['lost_timeout'],
-            nan_policy=p['nan_policy'], dejitter=p['dejitter'], clocksync=p['clocksync'],
-            quality_window=p['quality_window'], flat_threshold=p['flat_threshold'],
-            rail_threshold=p['rail_threshold'],
-            hostname=socket.gethostname() if p['hostname'] == 'local' else p['hostname'])
+            p.stream_name, p.stream_type, p.source_id, n_channels=p.n_channels,
+            sample_rate=p.sample_rate,
+            channel_names=p.channel_names if p.check_channel_names else (),
+            adapt=p.adapt_to_stream, stream_unit=p.stream_unit, max_buflen=p.max_buflen,
+            resolve_timeout=p.resolve_timeout, lost_timeout=p.lost_timeout,
+            nan_policy=p.nan_policy, dejitter=p.dejitter, clocksync=p.clocksync,
+            quality_window=p.quality_window, flat_threshold=p.flat_threshold,
+            rail_threshold=p.rail_threshold,
+            hostname=socket.gethostname() if p.hostname == 'local' else p.hostname)
         qos_raw = rclpy.qos.QoSProfile(depth=100,
                                        reliability=rclpy.qos.ReliabilityPolicy.BEST_EFFORT,
                                        durability=rclpy.qos.DurabilityPolicy.VOLATILE)
         self.pub_raw = self.create_publisher(EEGChunk, '/eeg/raw', qos_raw)
         self.pub_status = self.create_publisher(DiagnosticArray, '/eeg/status', 10)
-        self._wanted = (f'name {p["stream_name"]!r}, type {p["stream_type"]!r}, source_id '
-                        f'{p["source_id"]!r}, host {self.acq.hostname!r}')
+        self._wanted = (f'name {p.stream_name!r}, type {p.stream_type!r}, source_id '
+                        f'{p.source_id!r}, host {self.acq.hostname!r}')
         if not self.acq.pinned:
             self.get_logger().warning(
                 'The EEG stream is not pinned: any LSL sender with this name is accepted. Set '
                 'source_id and hostname (hostname:=local for this host) to accept only your '
                 'amplifier.')
         self.get_logger().info(f'Searching for the LSL stream ({self._wanted}) for up to '
-                               f'{p["resolve_timeout"]:g} s.')
+                               f'{p.resolve_timeout:g} s.')
         self.acq.start_search()
         self._n_warnings = 0
         self._last_level = -1
         self._last_stamp_ns = -1
-        self.create_timer(p['chunk_period'], self.poll_callback)
-        self.create_timer(p['status_period'], self.status_callback)
-        self._start_ns = self.get_clock().now().nanoseconds
-        self.done = False
+        self.create_timer(p.chunk_period, self.poll_callback)
+        self.create_timer(p.status_period, self.status_callback)
+        end_after(self, p.duration)
 
     def _connected(self) -> bool:
         """False while the search goes on; raises EEGError when it failed (ends the node)."""
@@ -100,14 +89,21 @@ class AcquisitionNode(rclpy.node.Node):
         self._n_warnings = len(self.acq.warnings)
         self.get_logger().info(f'Connected to {desc.summary()}, unit {desc.unit or "?"} '
                                f'(x{self.acq.scale:g} to volts); publishing /eeg/raw every '
-                               f'{self.p["chunk_period"] * 1e3:.1f} ms.')
+                               f'{self.params.chunk_period * 1e3:.1f} ms.')
         self.status_callback()
         return True
 
     def poll_callback(self) -> None:
-        """Pull what LSL has and publish it (once the stream is found)."""
-        self._check_duration()
-        if not self._connected():
+        """Pull what LSL has and publish it (once the stream is found); a stream not found or
+        of the wrong layout ends the node with exit code 1 and the reason."""
+        if self.done.done():
+            return
+        try:
+            connected = self._connected()
+        except EEGError as exc:
+            fail(self, str(exc))
+            return
+        if not connected:
             return
         chunks = self.acq.poll()
         if chunks:
@@ -121,7 +117,7 @@ class AcquisitionNode(rclpy.node.Node):
                                n_samples=len(chunk.data), first_sample_index=chunk.first_index,
                                unit='V', data=np.ascontiguousarray(chunk.data).ravel())
                 msg.header.stamp.sec, msg.header.stamp.nanosec = ns_to_time_fields(stamp)
-                msg.header.frame_id = self.p['frame_id']
+                msg.header.frame_id = self.params.frame_id
                 self.pub_raw.publish(msg)
         if len(self.acq.warnings) > self._n_warnings:
             for warning in self.acq.warnings[self._n_warnings:]:
@@ -129,11 +125,6 @@ class AcquisitionNode(rclpy.node.Node):
             self._n_warnings = len(self.acq.warnings)
         if self.acq.status().level != self._last_level:
             self.status_callback()
-
-    def _check_duration(self) -> None:
-        duration = self.p['duration']
-        if duration > 0 and self.get_clock().now().nanoseconds - self._start_ns > duration * 1e9:
-            self.done = True
 
     def status_callback(self) -> None:
         """Publish /eeg/status; log level changes."""
@@ -168,9 +159,12 @@ class AcquisitionNode(rclpy.node.Node):
 
 
 def main(args: list[str] | None = None) -> int:
-    """Run the node until Ctrl-C or ``duration``; exit 1 with a message on bad input."""
-    return run_node(AcquisitionNode, 'eeg_acquisition', args)
+    """Run the node until Ctrl-C or ``duration``; exit 1 when the stream is not found or has the
+    wrong layout, 2 on a bad parameter (one line each)."""
+    return run_node(AcquisitionNode, args, errors=(EEGError,))
 
 
 if __name__ == '__main__':
-    sys.exit(main())
+    from mindgrasp_ros.process import run_program
+
+    run_program(main)   # ends right after the node's cleanup: no slow interpreter teardown

@@ -18,8 +18,6 @@ marker on ``<stream_name>-markers``, as ground truth for evaluations.
 
 from __future__ import annotations
 
-import sys
-
 import numpy as np
 from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import EEGChunk, FsmState, Prompt, TaskTarget
 from mindgrasp_ros.interfaces.sensor_msgs.msg import JointState
@@ -29,30 +27,16 @@ from mindgrasp_ros.interfaces.visualization_msgs.msg import MarkerArray
 from mindgrasp_common.markers import objects_from_markers
 from mindgrasp_eeg import EEGError
 from mindgrasp_eeg.lsl import EEGOutlet, MarkerOutlet
-from mindgrasp_eeg.montage import NAUTILUS_32, class_name
-from mindgrasp_eeg.node_main import run_node
+from mindgrasp_eeg.montage import class_name
+from mindgrasp_eeg.params import VirtualAmpParams
 from mindgrasp_eeg.replay_eeg import ReplayEEG, parse_replay_source
 from mindgrasp_eeg.ros_conversions import base_yaw_from_joint_state, ns_to_time_fields, time_to_s
 from mindgrasp_eeg.subject import VirtualSubject
 from mindgrasp_eeg.synthetic import SyntheticEEG
 from mindgrasp_eeg.virtual_amp import VirtualAmplifier
 from mindgrasp_ros import rclpy
-
-PARAMETERS = [
-    ('stream_name', 'MIndGrasp-VirtualAmp'), ('stream_type', 'EEG'), ('source_id', ''),
-    ('channel_names', list(NAUTILUS_32)), ('sample_rate', 250.0), ('unit', 'microvolts'),
-    ('subject_mode', 'noise'), ('accuracy', 0.9), ('reaction_delay', 0.5), ('lapse_rate', 0.0),
-    ('active_phases', ['cue', 'move', 'wait']), ('decision_period', 0.5),
-    ('heading_tolerance', 0.1),
-    ('base_joint', ''), ('base_position', [0.0, 0.0]), ('heading_offset', 0.0),
-    ('seed', 0), ('head_seed', 0), ('background_rms', 10e-6), ('alpha_rms', 8e-6),
-    ('mu_rms', 6e-6), ('beta_rms', 3e-6), ('sensor_noise_rms', 0.5e-6), ('erd_depth', 0.5),
-    ('erd_tau', 0.3), ('blink_rate', 0.0), ('blink_amplitude', 100e-6), ('emg_rate', 0.0),
-    ('emg_rms', 20e-6), ('line_noise', 0.0), ('line_freq', 50.0),
-    ('push_period', 1.0 / 32.0), ('block', 8), ('duration', 0.0), ('output', 'lsl'),
-    ('frame_id', 'eeg'), ('eeg_source', 'synthetic'),
-]
-OUTPUTS = ('lsl', 'ros')
+from mindgrasp_ros.node_main import end_after, run_node
+from mindgrasp_ros.params import declare_params
 
 
 class VirtualAmpNode(rclpy.node.Node):
@@ -60,28 +44,29 @@ class VirtualAmpNode(rclpy.node.Node):
 
     def __init__(self, **kwargs) -> None:
         super().__init__('virtual_amp', **kwargs)
-        self.declare_parameters('', PARAMETERS)
-        p = {name: self.get_parameter(name).value for name, _ in PARAMETERS}
-        self.p = p
-        if p['output'] not in OUTPUTS:
-            msg = (f"The parameter 'output' is {p['output']!r}; use 'lsl' (an LSL stream, live "
-                   "runs) or 'ros' (/eeg/raw on the node clock, lock-step experiments).")
-            raise EEGError(msg)
-        gen = self.make_generator(p) if p['eeg_source'] != 'synthetic' else SyntheticEEG(
-            list(p['channel_names']), p['sample_rate'], seed=p['seed'], head_seed=p['head_seed'],
-            background_rms=p['background_rms'], alpha_rms=p['alpha_rms'], mu_rms=p['mu_rms'],
-            beta_rms=p['beta_rms'], sensor_noise_rms=p['sensor_noise_rms'],
-            erd_depth=p['erd_depth'], erd_tau=p['erd_tau'], blink_rate=p['blink_rate'],
-            blink_amplitude=p['blink_amplitude'], emg_rate=p['emg_rate'], emg_rms=p['emg_rms'],
-            line_noise=p['line_noise'], line_freq=p['line_freq'])
+        self.done = rclpy.task.Future()
+        self.params = p = declare_params(self, VirtualAmpParams)
+        if p.eeg_source != 'synthetic':
+            gen = self.make_generator(p.eeg_source, p.seed)
+        else:
+            gen = SyntheticEEG(
+                list(p.channel_names), p.sample_rate, seed=p.seed, head_seed=p.head_seed,
+                background_rms=p.background_rms, alpha_rms=p.alpha_rms, mu_rms=p.mu_rms,
+                beta_rms=p.beta_rms, sensor_noise_rms=p.sensor_noise_rms,
+                erd_depth=p.erd_depth, erd_tau=p.erd_tau, blink_rate=p.blink_rate,
+                blink_amplitude=p.blink_amplitude, emg_rate=p.emg_rate, emg_rms=p.emg_rms,
+                line_noise=p.line_noise, line_freq=p.line_freq)
+        # the stream's layout: the parameters', or the recordings' with eeg_source:=eegmmidb:N
+        self.channel_names = list(gen.channel_names)
+        self.sample_rate = float(gen.sample_rate)
         self.subject = VirtualSubject(
-            p['subject_mode'], accuracy=p['accuracy'], reaction_delay=p['reaction_delay'],
-            lapse_rate=p['lapse_rate'], seed=p['seed'], active_phases=p['active_phases'],
-            decision_period=p['decision_period'], heading_tolerance=p['heading_tolerance'])
+            p.subject_mode, accuracy=p.accuracy, reaction_delay=p.reaction_delay,
+            lapse_rate=p.lapse_rate, seed=p.seed, active_phases=p.active_phases,
+            decision_period=p.decision_period, heading_tolerance=p.heading_tolerance)
         latched = rclpy.qos.QoSProfile(depth=10,
                                        reliability=rclpy.qos.ReliabilityPolicy.RELIABLE,
                                        durability=rclpy.qos.DurabilityPolicy.TRANSIENT_LOCAL)
-        mode = p['subject_mode']
+        mode = p.subject_mode
         if mode == 'follow':
             self.create_subscription(Prompt, '/trainer/prompt', self.prompt_callback, latched)
         elif mode == 'pursue':
@@ -92,39 +77,35 @@ class VirtualAmpNode(rclpy.node.Node):
             self.create_subscription(FsmState, '/fsm/state', self.fsm_callback, latched)
         self.pub_intent = self.create_publisher(String, '/virtual_subject/intent', latched)
         outlet, self.markers, self.pub_raw = None, None, None
-        if p['output'] == 'ros':
+        if p.output == 'ros':
             qos_raw = rclpy.qos.QoSProfile(depth=100,
                                            reliability=rclpy.qos.ReliabilityPolicy.BEST_EFFORT,
                                            durability=rclpy.qos.DurabilityPolicy.VOLATILE)
             self.pub_raw = self.create_publisher(EEGChunk, '/eeg/raw', qos_raw)
         else:
             # the outlets last, so streaming starts soon after the stream becomes visible
-            outlet = EEGOutlet(p['stream_name'], list(p['channel_names']), p['sample_rate'],
-                               stream_type=p['stream_type'], source_id=p['source_id'],
-                               unit=p['unit'])
-            self.markers = MarkerOutlet(f'{p["stream_name"]}-markers',
-                                        f'{p["source_id"] or p["stream_name"]}-markers')
+            outlet = EEGOutlet(p.stream_name, self.channel_names, self.sample_rate,
+                               stream_type=p.stream_type, source_id=p.source_id, unit=p.unit)
+            self.markers = MarkerOutlet(f'{p.stream_name}-markers',
+                                        f'{p.source_id or p.stream_name}-markers')
         sim_time = bool(self.get_parameter('use_sim_time').value)
         self.amp = VirtualAmplifier(gen, self.subject, outlet, realtime_stamps=not sim_time,
-                                    block=p['block'], max_catch_up=1.0 if sim_time else None)
+                                    block=p.block, max_catch_up=1.0 if sim_time else None)
         self.sim_time = sim_time
         self._last_intent: object = 'unset'
-        self.create_timer(p['push_period'], self.push_callback)
-        self._start = self.now_s()
-        self.done = False
-        where = f"LSL stream '{p['stream_name']}'" if outlet is not None else '/eeg/raw'
+        self.create_timer(p.push_period, self.push_callback)
+        end_after(self, p.duration)
+        where = f"LSL stream '{p.stream_name}'" if outlet is not None else '/eeg/raw'
         self.get_logger().info(
-            f"Virtual amplifier on {where}: {len(p['channel_names'])} channels at "
-            f"{p['sample_rate']:g} Hz, subject mode {mode!r}, seed {p['seed']}, "
+            f'Virtual amplifier on {where}: {len(self.channel_names)} channels at '
+            f'{self.sample_rate:g} Hz, subject mode {mode!r}, seed {p.seed}, '
             f"paced by {'/clock' if sim_time else 'wall time'}.")
 
     @staticmethod
-    def make_generator(p: dict) -> ReplayEEG:
+    def make_generator(eeg_source: str, seed: int) -> ReplayEEG:
         """``eeg_source:=eegmmidb:<subject>``: real EEG of that subject's imagery runs (the
         channels and rate of the recordings replace channel_names and sample_rate)."""
-        gen = ReplayEEG.eegmmidb(parse_replay_source(str(p['eeg_source'])), seed=p['seed'])
-        p['channel_names'], p['sample_rate'] = list(gen.channel_names), gen.sample_rate
-        return gen
+        return ReplayEEG.eegmmidb(parse_replay_source(eeg_source), seed=seed)
 
     def now_s(self) -> float:
         """Node clock (s): wall time, or simulated time with use_sim_time."""
@@ -141,13 +122,13 @@ class VirtualAmpNode(rclpy.node.Node):
 
     def objects_callback(self, msg: MarkerArray) -> None:
         """Scene objects (world frame, base at ``base_position``)."""
-        self.subject.set_objects(objects_from_markers(msg.markers, self.p['base_position']))
+        self.subject.set_objects(objects_from_markers(msg.markers, self.params.base_position))
 
     def joints_callback(self, msg: JointState) -> None:
         """Arm heading from the base joint."""
-        yaw = base_yaw_from_joint_state(msg.name, msg.position, self.p['base_joint'])
+        yaw = base_yaw_from_joint_state(msg.name, msg.position, self.params.base_joint)
         if yaw is not None:
-            self.subject.set_base_yaw(yaw + self.p['heading_offset'])
+            self.subject.set_base_yaw(yaw + self.params.heading_offset)
 
     def fsm_callback(self, msg: FsmState) -> None:
         """Controller state and its object of interest."""
@@ -168,19 +149,17 @@ class VirtualAmpNode(rclpy.node.Node):
             if self.markers is not None:
                 self.markers.push(name)
             self.pub_intent.publish(String(data=name))
-        if self.p['duration'] > 0 and now - self._start > self.p['duration']:
-            self.done = True
 
     def publish_chunk(self, data: np.ndarray, first: int) -> None:
         """``output:=ros``: one EEGChunk of ``data`` (n_samples, n_channels; volts) whose first
         sample is sample ``first`` of the stream, stamped on the node clock."""
-        fs = float(self.p['sample_rate'])
+        fs = self.sample_rate
         stamp_ns = round((self.amp.t_start + first / fs) * 1e9)
-        msg = EEGChunk(sample_rate=fs, channel_names=list(self.p['channel_names']),
+        msg = EEGChunk(sample_rate=fs, channel_names=self.channel_names,
                        n_samples=len(data), first_sample_index=first, unit='V',
                        data=np.ascontiguousarray(data, dtype=np.float32).ravel())
         msg.header.stamp.sec, msg.header.stamp.nanosec = ns_to_time_fields(stamp_ns)
-        msg.header.frame_id = self.p['frame_id']
+        msg.header.frame_id = self.params.frame_id
         self.pub_raw.publish(msg)
 
     def destroy_node(self) -> None:
@@ -193,9 +172,11 @@ class VirtualAmpNode(rclpy.node.Node):
 
 
 def main(args: list[str] | None = None) -> int:
-    """Run until Ctrl-C or ``duration``; exit 1 with a message on bad parameters."""
-    return run_node(VirtualAmpNode, 'virtual_amp', args)
+    """Run until Ctrl-C or ``duration``; exit 2 with one line on a bad parameter."""
+    return run_node(VirtualAmpNode, args, errors=(EEGError,))
 
 
 if __name__ == '__main__':
-    sys.exit(main())
+    from mindgrasp_ros.process import run_program
+
+    run_program(main)   # ends right after the node's cleanup: no slow interpreter teardown

@@ -130,8 +130,6 @@ def fail(node: Any, reason: str) -> None:
 def is_done(node: Any) -> bool:
     """True once ``node.done`` (a Future) has completed; False for a node without one."""
     done = getattr(node, 'done', None)
-    if isinstance(done, bool):   # nodes not yet on the skeleton  # TODO(skeleton): remove
-        return done
     return bool(done is not None and done.done())
 
 
@@ -147,8 +145,6 @@ def exit_code(node: Any) -> int:
 
 def error_text(node: Any) -> str | None:
     """The failure reason of a node whose ``done`` holds an exception, else None."""
-    if isinstance(getattr(node, 'done', None), bool):   # TODO(skeleton): remove
-        return getattr(node, 'error', None)
     if is_done(node) and node.done.exception() is not None:
         return str(node.done.exception())
     return None

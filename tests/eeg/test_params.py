@@ -1,0 +1,88 @@
+"""The EEG nodes' parameters: the parameter file and the dataclasses agree; a bad value is refused
+at start with one line (exit code 2); a failure while running is exit code 1 with one line."""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+import subprocess
+import sys
+
+import pytest
+
+from mindgrasp_eeg.params import AcquisitionParams, VirtualAmpParams, default_params_path
+from mindgrasp_ros.params import ParameterError, describe, from_mapping, read_yaml_section
+
+NODES = [('eeg_acquisition', AcquisitionParams), ('virtual_amp', VirtualAmpParams)]
+
+
+@pytest.mark.parametrize(('node_name', 'cls'), NODES)
+def test_parameter_file_holds_every_parameter_with_the_defaults(node_name: str, cls: type) -> None:
+    section = read_yaml_section(default_params_path(), node_name)
+    assert set(section) == {f.name for f in dataclasses.fields(cls)}
+    assert from_mapping(cls, section) == cls()
+
+
+@pytest.mark.parametrize(('node_name', 'cls'), NODES)
+def test_every_parameter_is_described_and_read_only(node_name: str, cls: type) -> None:
+    for name, (_, desc) in describe(cls).items():
+        assert desc.description and desc.read_only, name
+
+
+@pytest.mark.parametrize(('cls', 'values', 'match'), [
+    (AcquisitionParams, {'sample_rate': -1.0}, r"'sample_rate' must be within \[0, inf\] Hz"),
+    (AcquisitionParams, {'nan_policy': 'zero'}, r"'nan_policy' is 'zero'; use one of replace"),
+    (AcquisitionParams, {'chunk_period': 0.0}, r"'chunk_period' must be within"),
+    (VirtualAmpParams, {'output': 'udp'}, r"'output' is 'udp'; use one of lsl, ros"),
+    (VirtualAmpParams, {'accuracy': 1.5}, r"'accuracy' must be within \[0, 1\]"),
+    (VirtualAmpParams, {'subject_mode': 'chase'}, r"'subject_mode' is 'chase'; use one of noise"),
+    (VirtualAmpParams, {'sample_rate': 30.0}, r"'sample_rate' must be within \[60, "),
+])
+def test_bad_values_name_the_parameter(cls: type, values: dict, match: str) -> None:
+    with pytest.raises(ParameterError, match=match):
+        from_mapping(cls, values)
+
+
+def _run(module: str, *params: str) -> subprocess.CompletedProcess:
+    args = [a for p in params for a in ('-p', p)]
+    env = {**os.environ, 'PYTHONUNBUFFERED': '1'}
+    return subprocess.run([sys.executable, '-m', module, '--ros-args', *args], env=env,
+                          capture_output=True, text=True, timeout=120, check=False)
+
+
+def _error_lines(run: subprocess.CompletedProcess) -> list[str]:
+    return [line for line in (run.stdout + run.stderr).splitlines() if 'ERROR' in line]
+
+
+@pytest.mark.parametrize(('module', 'param', 'words'), [
+    ('mindgrasp_eeg.acquisition_node', 'sample_rate:=-1',
+     ('[AcquisitionNode] ERROR:', "'sample_rate'", '-1', '[0.0, inf]')),
+    ('mindgrasp_eeg.virtual_amp_node', 'sample_rate:=-1',
+     ('[VirtualAmpNode] ERROR:', "'sample_rate'", '-1', '[60.0, 100000.0]')),
+    ('mindgrasp_eeg.virtual_amp_node', 'subject_mode:=chase',
+     ('[VirtualAmpNode] ERROR:', "'subject_mode' is 'chase'; use one of noise, follow, pursue")),
+])
+def test_a_bad_parameter_ends_the_node_process_with_exit_code_2_and_one_line(
+        module: str, param: str, words: tuple[str, ...]) -> None:
+    run = _run(module, param)
+    assert run.returncode == 2, run.stdout + run.stderr
+    assert 'Traceback' not in run.stderr
+    lines = _error_lines(run)
+    assert len(lines) == 1, run.stdout + run.stderr
+    assert lines[0].startswith(words[0]) and all(w in lines[0] for w in words[1:]), lines[0]
+
+
+def test_a_bad_stream_selector_is_refused_with_exit_code_2() -> None:
+    """A parameter the EEG package checks itself (not a range): still a refusal to start."""
+    run = _run('mindgrasp_eeg.acquisition_node', 'stream_unit:=furlongs')
+    assert run.returncode == 2, run.stdout + run.stderr
+    lines = _error_lines(run)
+    assert len(lines) == 1 and "The EEG unit 'furlongs' is unknown" in lines[0], run.stderr
+
+
+def test_a_stream_not_found_while_running_is_exit_code_1_with_the_reason(stream_name) -> None:
+    run = _run('mindgrasp_eeg.acquisition_node', f'stream_name:={stream_name}',
+               'resolve_timeout:=0.5')
+    assert run.returncode == 1, run.stdout + run.stderr
+    assert 'Traceback' not in run.stderr
+    assert f"[eeg_acquisition] ERROR: No LSL stream with name='{stream_name}'" in run.stderr
