@@ -107,7 +107,8 @@ def run_without_ros(args: argparse.Namespace) -> int:
 
 
 def main(args: argparse.Namespace) -> int:
-    """Run the node (or the ROS-free loop); 1 with a message on bad parameters."""
+    """Run the node (or the ROS-free loop); the node's exit code (2 and one line on a bad
+    parameter), or 1 with a message when the ROS-free loop cannot start."""
     try:
         if args.no_ros:
             return run_without_ros(args)
