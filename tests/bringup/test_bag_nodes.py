@@ -187,7 +187,7 @@ def test_bag_play_missing_bag_is_a_clear_error(tmp_path):
     out = subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', 'bag', 'play',
                           str(tmp_path / 'nope')], capture_output=True, text=True, env=_env(),
                          timeout=60)
-    assert out.returncode == 1
+    assert out.returncode == 2    # a bad argument: the node refuses to start
     assert 'does not exist; pass a run directory (runs/<run>) or its bag folder' in out.stderr
 
 
@@ -225,9 +225,10 @@ def test_recorder_node_full_disk_stops_recording_and_keeps_running(tmp_path):
 
 
 def test_bag_record_bad_options_are_clear_errors(tmp_path):
-    # a number out of range is an argparse error (exit 2); a regex is checked by the recorder
+    # a number out of range is an argparse error, a regex is checked by the recorder's
+    # parameters: both exit 2
     for extra, code, message in (
-            (['-e', '('], 1, 'The topic regular expression is not valid'),
+            (['-e', '('], 2, 'The topic regular expression is not valid'),
             (['--compression', 'zstd', '--max-queue-mb', '0'], 2,
              'argument --max-queue-mb: must be >= 1, got 0')):
         out = subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', 'bag', 'record',

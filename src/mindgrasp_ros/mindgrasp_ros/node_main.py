@@ -33,9 +33,14 @@ Exit codes (one convention for every node, as the launcher reports them):
   ``ParameterException`` family, :class:`~mindgrasp_ros.params.ParameterError`) or one of the
   ``errors`` the caller names (the package's own error class); one line, no traceback.
 
-A node that must do something on the way out (stop the arm, log a count) overrides
+A node that must do something on the way out (stop the arm, log a count, close a bag) overrides
 ``destroy_node()`` and calls ``super().destroy_node()``, as in rclpy; ``rclpy.ok()`` there tells
-whether it may still publish.
+whether it may still publish. The exit code is read after that cleanup: a node stopped by Ctrl-C
+whose cleanup finds a failure (the bag could not be written) calls :func:`fail` there and exits 1.
+
+A node with its own timing-critical thread (the bag player publishes on the bag's schedule) passes
+``poll_sec``: the main thread then runs the ready callbacks without waiting in the middleware and
+sleeps on ``done`` in between, so the GIL stays free for that thread.
 
 Works with the real rclpy (``MINDGRASP_RMW=rclpy``) and with our runtime: only rclpy's public API
 is used (``init``, executors, ``task.Future``, ``executors.ExternalShutdownException``).
@@ -44,6 +49,7 @@ is used (``init``, executors, ``task.Future``, ``executors.ExternalShutdownExcep
 from __future__ import annotations
 
 import sys
+import threading
 from collections.abc import Callable
 from typing import Any
 
@@ -172,7 +178,8 @@ def help_text(node_class: Callable[[], Any]) -> str:
 
 
 def run_node(node_class: Callable[[], Any], args: list[str] | None = None, *,
-             errors: tuple[type[BaseException], ...] = (), linger_sec: float = 0.0) -> int:
+             errors: tuple[type[BaseException], ...] = (), linger_sec: float = 0.0,
+             poll_sec: float = 0.0) -> int:
     """Init, construct ``node_class()``, spin until Ctrl-C or ``node.done``, clean up.
 
     Returns the exit code (see the module docstring).
@@ -185,6 +192,12 @@ def run_node(node_class: Callable[[], Any], args: list[str] | None = None, *,
             constructor raises them (exit 2, one line).
         linger_sec: after ``done`` completes, keep spinning this long (s) so reliable readers
             receive the last messages (a session's "end" prompt).
+        poll_sec: 0 (default) waits for work in the middleware, as ``rclpy.spin``. > 0 polls
+            instead: run what is ready without waiting, then sleep on ``done`` for up to
+            ``poll_sec`` s with the GIL released. For a node whose own thread keeps a schedule:
+            the main thread waiting in the middleware delayed the bag player's publications by
+            several ms (its timing needs ~1 ms); callbacks (parameter services) then run up to
+            ``poll_sec`` late.
     """
     argv = list(args if args is not None else sys.argv)
     if _wants_help(argv):
@@ -194,7 +207,6 @@ def run_node(node_class: Callable[[], Any], args: list[str] | None = None, *,
     rclpy.init(args=argv)
     node = None
     label = getattr(node_class, '__name__', 'node')
-    code = EXIT_OK
     try:
         try:
             node = node_class()
@@ -208,20 +220,35 @@ def run_node(node_class: Callable[[], Any], args: list[str] | None = None, *,
         # one executor for the node's lifetime: no add/remove per spin (rclpy.spin_once does that)
         executor = rclpy.executors.SingleThreadedExecutor()
         executor.add_node(node)
-        executor.spin_until_future_complete(done)
+        if poll_sec > 0:
+            _poll_until_done(executor, done, poll_sec)
+        else:
+            executor.spin_until_future_complete(done)
         if done.done() and linger_sec > 0 and rclpy.ok():
             executor.spin_until_future_complete(rclpy.task.Future(), timeout_sec=linger_sec)
-        code = exit_code(node)
-        reason = error_text(node)
-        if reason is not None:
-            print(f'[{label}] ERROR: {reason}', file=sys.stderr, flush=True)
     except (KeyboardInterrupt, _external_shutdown()):
-        code = EXIT_OK
+        pass   # a stop: exit 0 unless the cleanup below fails the node
     finally:
         if node is not None:
             node.destroy_node()
         rclpy.try_shutdown()
+    # read after destroy_node(): a cleanup that failed (fail(node, ...)) counts too
+    code = exit_code(node)
+    reason = error_text(node)
+    if reason is not None:
+        print(f'[{label}] ERROR: {reason}', file=sys.stderr, flush=True)
     # run as a program: end right after the cleanup (the interpreter's teardown of torch/scipy
     # took 2-5 s on a loaded machine; a node must stop within 1 s of SIGINT)
     exit_if_main_program(code, getattr(node_class, '__module__', ''))
     return code
+
+
+def _poll_until_done(executor: Any, done: Any, poll_sec: float) -> None:
+    """Run ready callbacks without waiting in the middleware; in between, sleep on ``done`` (the
+    GIL is released) for up to ``poll_sec`` s. Ends when ``done`` completes or the context shuts
+    down (``rclpy.shutdown()`` from elsewhere)."""
+    completed = threading.Event()
+    done.add_done_callback(lambda _future: completed.set())
+    while rclpy.ok() and not done.done():
+        executor.spin_once(timeout_sec=0.0)
+        completed.wait(poll_sec)

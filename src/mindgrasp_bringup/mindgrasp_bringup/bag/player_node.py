@@ -1,15 +1,20 @@
 """Player node: publishes a bag's messages with their original timing (like ``ros2 bag play``).
 
 Run: ``python -m mindgrasp_bringup.bag.player_node --ros-args -p bag:=runs/x/bag -p rate:=2.0
--p clock:=true``. Publishes the recorded CDR bytes unchanged (raw publishers) with the QoS the
-recording offered; topics whose type the client layer cannot publish are skipped and named.
+-p clock:=true`` (parameters: :class:`PlayerParams`). Publishes the recorded CDR bytes unchanged
+(raw publishers) with the QoS the recording offered; topics whose type the client layer cannot
+publish are skipped and named.
+
+The playback runs in its own thread on the bag's schedule; the node ends when it has played the
+bag (exit 0), on Ctrl-C/SIGTERM (0, within the current wait), on a bag error while playing (1),
+or refuses to start on a bad parameter or an unreadable bag (2).
 """
 
 from __future__ import annotations
 
-import signal
 import sys
 import threading
+from dataclasses import dataclass
 from typing import Any
 
 from mindgrasp_bringup.bag.errors import BagError
@@ -20,9 +25,37 @@ from mindgrasp_bringup.bag.reader import BagReader, TopicInfo
 from mindgrasp_bringup.bag.ros_glue import message_class, qos_profile
 from mindgrasp_bringup.bag.typestore import typestore
 from mindgrasp_ros import rclpy
+from mindgrasp_ros.node_main import fail, run_node
+from mindgrasp_ros.params import ParameterError, declare_params, param
 
 CLOCK_TYPE = 'rosgraph_msgs/msg/Clock'
 TIME_TYPE = 'builtin_interfaces/msg/Time'
+
+
+@dataclass
+class PlayerParams:
+    """Parameters of the player node (names as ``ros2 bag play``'s options)."""
+
+    bag: str = param('', 'run directory (runs/<run>), bag directory or .mcap/.db3 file')
+    rate: float = param(1.0, 'playback speed factor (1.0: real time; > 0)', min=0.0)
+    loop: bool = param(False, 'play again from the start when the bag ends')
+    start_offset: float = param(0.0, 'skip this long of the bag beginning', unit='s', min=0.0)
+    topics: list[str] = param([], 'play only these topics (empty: every topic)')
+    regex: str = param('', "play only the topics matching this regular expression ('': all)")
+    exclude_regex: str = param('', 'do not play the topics matching this regular expression')
+    remap: list[str] = param([], 'publish a topic under another name: /from:=/to entries')
+    clock: bool = param(False, 'publish /clock with the bag time')
+    clock_frequency: float = param(40.0, 'rate of /clock', unit='Hz', min=0.001)
+    delay: float = param(0.0, 'wait this long after creating the publishers, so subscribers '
+                         'match before the first message', unit='s', min=0.0)
+    priority: int = param(0, 'real-time (SCHED_FIFO) priority of the playback thread (0: '
+                          'normal; needs root or CAP_SYS_NICE)', min=0, max=99)
+    progress: bool = param(False, 'show a progress bar on stderr')
+
+    def __post_init__(self) -> None:
+        if not self.rate > 0:
+            msg = f"The parameter 'rate' must be > 0 (1.0 = real time); {self.rate} is invalid."
+            raise ParameterError(msg)
 
 
 class PlayerNode(rclpy.node.Node):
@@ -30,44 +63,32 @@ class PlayerNode(rclpy.node.Node):
 
     def __init__(self, **kwargs: Any) -> None:
         super().__init__('bag_player', **kwargs)
-        self.declare_parameters('', [
-            ('bag', ''), ('rate', 1.0), ('loop', False), ('start_offset', 0.0),
-            ('topics', ['']), ('regex', ''), ('exclude_regex', ''), ('remap', ['']),
-            ('clock', False), ('clock_frequency', 40.0), ('delay', 0.0), ('priority', 0),
-            ('progress', False)])
-        v = {name: self.get_parameter(name).value for name in (
-            'bag', 'rate', 'loop', 'start_offset', 'topics', 'regex', 'exclude_regex', 'remap',
-            'clock', 'clock_frequency', 'delay', 'priority', 'progress')}
-        if not v['bag']:
+        self.params = p = declare_params(self, PlayerParams)
+        self.done = rclpy.task.Future()
+        if not p.bag:
             msg = 'The parameter bag is empty; pass the bag directory with -p bag:=<path>.'
-            raise BagError(msg)
-        self.reader = BagReader(resolve_bag(v['bag'])).open()  # a run directory or its bag
+            raise ParameterError(msg)
+        self.reader = BagReader(resolve_bag(p.bag)).open()  # a run directory or its bag
         for note in self.reader.notes:
             self.get_logger().warning(note)
-        topics = [t for t in (v['topics'] or []) if t] or None
-        self.remap = parse_remaps([r for r in (v['remap'] or []) if r])
+        self.remap = parse_remaps([r for r in p.remap if r])
         self.publishers_: dict[str, Any] = {}
         self.player = Player(
-            self.reader, rate=float(v['rate']), loop=bool(v['loop']),
-            start_offset=float(v['start_offset']), topics=topics, regex=v['regex'],
-            exclude_regex=v['exclude_regex'], remap=self.remap,
-            can_publish=self._create_publisher)
+            self.reader, rate=p.rate, loop=p.loop, start_offset=p.start_offset,
+            topics=[t for t in p.topics if t] or None, regex=p.regex,
+            exclude_regex=p.exclude_regex, remap=self.remap, can_publish=self._create_publisher)
         for line in self.player.skipped_report():
             self.get_logger().warning(line)
         self.clock_publisher = None
-        self.clock_frequency = float(v['clock_frequency'])
-        if v['clock']:
+        if p.clock:
             clock_qos = rclpy.qos.QoSProfile(depth=1,
                                              reliability=rclpy.qos.ReliabilityPolicy.BEST_EFFORT)
             self.clock_publisher = self.create_publisher(
                 message_class(CLOCK_TYPE), '/clock', clock_qos, raw=True)
-        self.delay = float(v['delay'])
-        self.priority = int(v['priority'])
-        self.progress = bool(v['progress'])
         self.stats: PlayStats | None = None
-        self.error: str | None = None
         self.stop_event = threading.Event()
         self.thread = threading.Thread(target=self._play, name='bag-player', daemon=True)
+        self.thread.start()   # after ``delay`` s, so subscribers can match first
 
     def _create_publisher(self, info: TopicInfo) -> str | None:
         """Create the raw publisher of one bag topic; the reason when it cannot be played."""
@@ -86,13 +107,15 @@ class PlayerNode(rclpy.node.Node):
                                                       raw=True)
         return None
 
-    def start(self) -> None:
-        """Start playing (after ``delay`` s, so subscribers can match first)."""
-        self.thread.start()
-
     def _play(self) -> None:
-        if self.delay > 0 and self.stop_event.wait(self.delay):
-            return
+        try:
+            if not (self.params.delay > 0 and self.stop_event.wait(self.params.delay)):
+                self._play_bag()
+        finally:
+            if not self.done.done():
+                self.done.set_result(0)
+
+    def _play_bag(self) -> None:
         store = typestore()
         clock_class, time_class = store.types[CLOCK_TYPE], store.types[TIME_TYPE]
         publishers = self.publishers_   # keyed by output topic, as the player reports them
@@ -102,7 +125,7 @@ class PlayerNode(rclpy.node.Node):
         total = sum(info.message_count for info in self.reader.topics.values()
                     if self.remap.get(info.name, info.name) in publishers)
         bar = tqdm(total=None if self.player.loop else total, unit='msg', desc='bag play',
-                   disable=not self.progress, file=sys.stderr)
+                   disable=not self.params.progress, file=sys.stderr)
 
         def publish(topic: str, data: bytes) -> None:
             publishers[topic].publish(data)
@@ -120,54 +143,37 @@ class PlayerNode(rclpy.node.Node):
             self.stats = self.player.run(
                 publish,
                 publish_clock=publish_clock if self.clock_publisher is not None else None,
-                clock_hz=self.clock_frequency, stop=self.stop_event, priority=self.priority)
+                clock_hz=self.params.clock_frequency, stop=self.stop_event,
+                priority=self.params.priority)
             for note in self.stats.notes:
                 self.get_logger().warning(note)
         except BagError as exc:
-            self.error = str(exc)
-            self.get_logger().error(self.error)
+            fail(self, str(exc))
         finally:
             bar.close()
 
+    def destroy_node(self) -> None:
+        """Stop the playback (Ctrl-C, SIGTERM), log what was published, close the bag."""
+        self.stop_event.set()
+        self.thread.join(5.0)
+        if self.stats is not None:
+            total = sum(self.stats.published.values())
+            self.get_logger().info(f'Published {total} message(s) on {len(self.stats.published)} '
+                                   f'topic(s); worst lateness {self.stats.max_late_ms:.1f} ms.')
+        self.reader.close()
+        super().destroy_node()
+
 
 def main(args: list[str] | None = None) -> int:
-    """Play the bag; 0 when played to the end (or stopped), 1 on a bag error."""
+    """Play the bag; 0 when played to the end (or stopped), 1 on a bag error while playing, 2 on
+    a bad parameter or bag."""
     # The playback thread shares the GIL with the executor thread; Python's default 5 ms switch
     # interval would delay publications by up to 5 ms. 0.5 ms keeps them on time.
     sys.setswitchinterval(0.0005)
-    rclpy.init(args=args)
-    try:
-        node = PlayerNode()
-    except BagError as exc:
-        print(f'bag player: {exc}', file=sys.stderr)
-        rclpy.shutdown()
-        return 1
-    signal.signal(signal.SIGTERM, lambda *_: node.stop_event.set())
-    node.start()
-    try:
-        while rclpy.ok() and node.thread.is_alive():
-            # Short non-blocking spins: a blocking spin keeps the GIL busy enough to delay the
-            # playback thread by several ms; parameter services still answer within 50 ms.
-            rclpy.spin_once(node, timeout_sec=0.0)
-            node.thread.join(0.05)
-    except KeyboardInterrupt:
-        pass
-    finally:
-        node.stop_event.set()
-        node.thread.join(5.0)
-        stats, error = node.stats, node.error
-        if stats is not None:
-            total = sum(stats.published.values())
-            node.get_logger().info(f'Published {total} message(s) on {len(stats.published)} '
-                                   f'topic(s); worst lateness {stats.max_late_ms:.1f} ms.')
-        node.reader.close()
-        node.destroy_node()
-        if rclpy.ok():
-            rclpy.shutdown()
-    return 1 if error else 0
+    # poll_sec: a main thread waiting in the middleware keeps the GIL busy enough to delay the
+    # playback thread by several ms; polling every 50 ms still answers parameter services.
+    return run_node(PlayerNode, args, errors=(BagError,), poll_sec=0.05)
 
 
 if __name__ == '__main__':
-    from mindgrasp_ros.process import run_program
-
-    run_program(main)   # ends right after the node's cleanup: no slow interpreter teardown
+    raise SystemExit(main())

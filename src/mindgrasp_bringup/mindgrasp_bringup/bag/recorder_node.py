@@ -1,9 +1,10 @@
 """Recorder node: records all topics (or a pattern list) to a rosbag2 MCAP bag.
 
 Run: ``python -m mindgrasp_bringup.bag.recorder_node --ros-args -p output:=runs/x/bag
--p topics:="['/eeg/raw']" -p duration:=10.0``. New topics are discovered while it runs; the
-subscriptions take raw CDR bytes, and a :class:`~mindgrasp_bringup.bag.recorder.Recorder`
-writes them from its own thread, so callbacks never wait for the disk.
+-p topics:="['/eeg/raw']" -p duration:=10.0`` (parameters: :class:`RecorderParams`). New topics
+are discovered while it runs; the subscriptions take raw CDR bytes, and a
+:class:`~mindgrasp_bringup.bag.recorder.Recorder` writes them from its own thread, so callbacks
+never wait for the disk.
 
 QoS as rosbag2 does it: a topic is subscribed once it has a publisher (a topic that only has
 subscribers is not, as ``ros2 bag record`` without ``--include-unpublished-topics``), with the QoS
@@ -13,6 +14,11 @@ camera after a reliable one, a volatile publisher on a transient-local topic), t
 subscribed again with the relaxed QoS. At the end, every wanted topic that was not recorded is
 reported with the reason, in the log and in metadata.yaml ``custom_data``
 (``not_recorded:/topic``).
+
+The bag is closed in ``destroy_node()``, so Ctrl-C, SIGTERM and the end of ``duration`` all keep
+everything recorded (a SIGKILL leaves an unfinished MCAP file that ``mindgrasp bag reindex``
+recovers). Exit codes: 0 recorded, 1 recording failed (full disk; the node keeps running until
+stopped, as the error is logged at once), 2 bad parameter.
 """
 
 from __future__ import annotations
@@ -20,7 +26,9 @@ from __future__ import annotations
 import re
 import signal
 import sys
+import threading
 import time
+from dataclasses import dataclass
 from typing import Any
 
 from mindgrasp_bringup.bag.errors import BagError
@@ -29,9 +37,45 @@ from mindgrasp_bringup.bag.recorder import Recorder
 from mindgrasp_bringup.bag.ros_glue import message_class, qos_profile
 from mindgrasp_bringup.bag.writer import BagWriter
 from mindgrasp_ros import rclpy
+from mindgrasp_ros.node_main import NodeFailure, end_after, run_node
+from mindgrasp_ros.params import ParameterError, declare_params, param
 
 #: Topics of the ROS graph itself that a bag never needs.
 _ALWAYS_EXCLUDED = ('/rosout', '/parameter_events')
+
+
+@dataclass
+class RecorderParams:
+    """Parameters of the recorder node (names as ``ros2 bag record``'s options)."""
+
+    output: str = param('', "bag directory to create ('': rosbag2_<date>-<time>)")
+    topics: list[str] = param([], 'topics to record (empty: every topic, or those matching '
+                              'regex)')
+    regex: str = param('', "record the topics matching this regular expression ('': no filter)")
+    exclude_regex: str = param('', 'do not record the topics matching this regular expression')
+    max_bag_size: int = param(0, 'start a new .mcap file at this size (0: never)', unit='B',
+                              min=0)
+    max_bag_duration: float = param(0.0, 'start a new .mcap file after this long (0: never)',
+                                    unit='s', min=0.0)
+    compression: str = param('none', 'MCAP chunk compression', choices=('none', 'zstd', 'lz4'))
+    chunk_size: int = param(1 << 20, 'MCAP chunk size', unit='B', min=1)
+    flush_interval: float = param(1.0, 'longest time before written messages reach the file '
+                                  '(bounds the loss if the recorder is killed)', unit='s',
+                                  min=0.001)
+    max_queue_mb: int = param(512, 'memory for messages waiting for the disk', unit='MiB', min=1)
+    discovery_period: float = param(0.5, 'how often new topics are looked for', unit='s',
+                                    min=0.01)
+    duration: float = param(0.0, 'end after this long (0: run until stopped)', unit='s', min=0.0)
+    include_ros_topics: bool = param(False, 'record /rosout and /parameter_events too')
+
+    def __post_init__(self) -> None:
+        for name in ('regex', 'exclude_regex'):
+            try:
+                re.compile(getattr(self, name))
+            except re.error as exc:
+                msg = (f'The topic regular expression is not valid ({exc}); fix the {name} '
+                       'parameter.')
+                raise ParameterError(msg) from None
 
 
 class RecorderNode(rclpy.node.Node):
@@ -39,31 +83,16 @@ class RecorderNode(rclpy.node.Node):
 
     def __init__(self, **kwargs: Any) -> None:
         super().__init__('recorder', **kwargs)
-        self.declare_parameters('', [
-            ('output', ''), ('topics', ['']), ('regex', ''), ('exclude_regex', ''),
-            ('max_bag_size', 0), ('max_bag_duration', 0.0), ('compression', 'none'),
-            ('chunk_size', 1 << 20), ('flush_interval', 1.0), ('max_queue_mb', 512),
-            ('discovery_period', 0.5), ('duration', 0.0), ('include_ros_topics', False)])
-        value = {name: self.get_parameter(name).value for name in (
-            'output', 'topics', 'regex', 'exclude_regex', 'max_bag_size', 'max_bag_duration',
-            'compression', 'chunk_size', 'flush_interval', 'max_queue_mb', 'discovery_period',
-            'duration', 'include_ros_topics')}
-        output = value['output'] or time.strftime('rosbag2_%Y_%m_%d-%H_%M_%S')
-        self.topics = [t for t in (value['topics'] or []) if t]
-        try:
-            self.include = re.compile(value['regex']) if value['regex'] else None
-            self.exclude = re.compile(value['exclude_regex']) if value['exclude_regex'] else None
-        except re.error as exc:
-            msg = (f'The topic regular expression is not valid ({exc}); fix the regex or '
-                   'exclude_regex parameter.')
-            raise BagError(msg) from None
-        self.include_ros_topics = bool(value['include_ros_topics'])
-        writer = BagWriter(output, chunk_size=int(value['chunk_size']),
-                           compression=str(value['compression']),
-                           flush_interval=float(value['flush_interval']),
-                           max_bag_size=int(value['max_bag_size']),
-                           max_bag_duration=float(value['max_bag_duration']))
-        self.recorder = Recorder(writer, max_queue_bytes=int(value['max_queue_mb']) << 20,
+        self.params = p = declare_params(self, RecorderParams)
+        self.done = rclpy.task.Future()
+        self.topics = [t for t in p.topics if t]
+        self.include = re.compile(p.regex) if p.regex else None
+        self.exclude = re.compile(p.exclude_regex) if p.exclude_regex else None
+        writer = BagWriter(p.output or time.strftime('rosbag2_%Y_%m_%d-%H_%M_%S'),
+                           chunk_size=p.chunk_size, compression=p.compression,
+                           flush_interval=p.flush_interval, max_bag_size=p.max_bag_size,
+                           max_bag_duration=p.max_bag_duration)
+        self.recorder = Recorder(writer, max_queue_bytes=p.max_queue_mb << 20,
                                  on_error=self._on_error)
         self.recorder.start()
         self._topic_subscriptions: dict[str, Any] = {}
@@ -72,19 +101,17 @@ class RecorderNode(rclpy.node.Node):
         self._unpublished: set[str] = set()                 # seen with subscribers only
         self._refused: set[str] = set()
         self._types: dict[str, str] = {}
-        self.finished = False
         self.get_logger().info(f'Recording to {writer.path} (MCAP, compression '
                                f'{writer.compression}).')
-        self.create_timer(float(value['discovery_period']), self.discover_callback)
+        self.create_timer(p.discovery_period, self.discover_callback)
         self.create_timer(1.0, self.report_callback)
-        if value['duration'] > 0:
-            self.create_timer(float(value['duration']), self.duration_callback)
+        end_after(self, p.duration)
         self.discover_callback()
 
     def _wanted(self, topic: str) -> bool:
         if topic in self.topics:
             return True
-        if not self.include_ros_topics and topic in _ALWAYS_EXCLUDED:
+        if not self.params.include_ros_topics and topic in _ALWAYS_EXCLUDED:
             return False
         if self.exclude is not None and self.exclude.search(topic):
             return False
@@ -190,17 +217,31 @@ class RecorderNode(rclpy.node.Node):
         for line in self.recorder.reports():
             self.get_logger().warning(line)
 
-    def duration_callback(self) -> None:
-        """End after the ``duration`` parameter (s)."""
-        self.finished = True
-
     def _on_error(self, message: str) -> None:
-        # Called from the writer thread: log only; the node keeps running, subscriptions idle.
+        # Called from the writer thread: log only; the node keeps running, subscriptions idle,
+        # and ends with exit code 1 when stopped (destroy_node).
         self.get_logger().error(message)
 
-    def stop(self) -> None:
+    def destroy_node(self) -> None:
+        """Close the bag (:meth:`stop`); a recording error ends the node with exit code 1."""
+        previous = None
+        if threading.current_thread() is threading.main_thread():
+            # the launcher follows SIGINT with SIGTERM: that must not cut the bag's closing short
+            previous = signal.signal(signal.SIGTERM, signal.SIG_IGN)
+        try:
+            error = self.stop()
+        finally:
+            if previous is not None:
+                signal.signal(signal.SIGTERM, previous)
+        if error is not None and not self.done.done():
+            # logged already, when it happened: run_node prints it once more as the last line
+            self.done.set_exception(NodeFailure(error))
+        super().destroy_node()
+
+    def stop(self) -> str | None:
         """Write what is queued and close the bag; log the counters and the topics not
-        recorded (with the reason, also stored in metadata.yaml ``custom_data``)."""
+        recorded (with the reason, also stored in metadata.yaml ``custom_data``). Returns the
+        recording error (a sentence), None when everything was written."""
         for sub in self._topic_subscriptions.values():
             if sub.get_publisher_count() > 0:
                 self._matched.add(sub.topic_name)
@@ -211,7 +252,7 @@ class RecorderNode(rclpy.node.Node):
             counters = self.recorder.stop()
         except BagError as exc:
             self.get_logger().error(str(exc))
-            return
+            return str(exc)
         for line in self.recorder.reports():
             self.get_logger().warning(line)
         total = sum(c.written for c in counters.values())
@@ -222,37 +263,16 @@ class RecorderNode(rclpy.node.Node):
                                f'{len(missing)} topic(s) not recorded.')
         for topic, why in missing.items():
             self.get_logger().warning(f'Not recorded: {topic}: {why}')
-
+        return self.recorder.error
 
 def main(args: list[str] | None = None) -> int:
-    """Run the recorder until Ctrl-C, SIGTERM or its ``duration``; 1 if recording failed."""
+    """Record until Ctrl-C, SIGTERM or ``duration``; 1 if recording failed, 2 on a bad
+    parameter."""
     # The writer thread shares the GIL with the callbacks; a 1 ms switch interval (default 5 ms)
     # keeps receive timestamps, and so playback timing, within ~1 ms of the arrival.
     sys.setswitchinterval(0.001)
-    rclpy.init(args=args)
-    try:
-        node = RecorderNode()
-    except BagError as exc:
-        print(f'recorder: {exc}', file=sys.stderr)
-        rclpy.shutdown()
-        return 1
-    # The launcher stops nodes with SIGINT, then SIGTERM: both end the loop and close the bag.
-    signal.signal(signal.SIGTERM, lambda *_: setattr(node, 'finished', True))
-    try:
-        while rclpy.ok() and not node.finished:
-            rclpy.spin_once(node, timeout_sec=0.1)
-    except KeyboardInterrupt:
-        pass
-    finally:
-        node.stop()
-        error = node.recorder.error
-        node.destroy_node()
-        if rclpy.ok():
-            rclpy.shutdown()
-    return 1 if error else 0
+    return run_node(RecorderNode, args, errors=(BagError,))
 
 
 if __name__ == '__main__':
-    from mindgrasp_ros.process import run_program
-
-    run_program(main)   # ends right after the node's cleanup: no slow interpreter teardown
+    raise SystemExit(main())

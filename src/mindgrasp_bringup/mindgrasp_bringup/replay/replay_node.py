@@ -3,62 +3,67 @@
     python -m mindgrasp_bringup.replay.replay_node --ros-args -p bag:=runs/<run> \
         -p controller:=true
 
-Parameters: ``bag`` (run directory or its bag folder), ``controller`` (re-run the controller,
-open loop), ``model`` (classifier model; '' = the run's), ``output`` (report directory; '' =
-``<run>/replays/<time>``), ``progress``. The re-run nodes run lock-step on the bag's clock in
-this process (see :mod:`mindgrasp_bringup.replay.engine`); the node ends when the report is
-written, and logs the summary line.
+Parameters: :class:`ReplayParams`. The re-run nodes run lock-step on the bag's clock in this
+process (see :mod:`mindgrasp_bringup.replay.engine`); the node ends when the report is written
+(exit 0) and logs the summary line. A missing bag or one the replay cannot use ends it with exit
+code 2 and one line; Ctrl-C stops it (0).
 """
 
 from __future__ import annotations
 
-import sys
+from dataclasses import dataclass
 
 from mindgrasp_bringup.bag.errors import BagError
+from mindgrasp_bringup.bag.paths import resolve_bag
 from mindgrasp_bringup.replay import ReplayConfig, run_replay, summary_line
 from mindgrasp_ros import rclpy
+from mindgrasp_ros.node_main import EXIT_OK, EXIT_REFUSED, run_node
+from mindgrasp_ros.params import ParameterError, declare_params, param
 
-PARAMETERS = [('bag', ''), ('controller', False), ('model', ''), ('output', ''),
-              ('progress', True)]
+
+@dataclass
+class ReplayParams:
+    """Parameters of the replay node (the arguments of ``mindgrasp launch replay``)."""
+
+    bag: str = param('', 'the run directory (runs/<run>) or its bag folder (runs/<run>/bag)')
+    controller: bool = param(False, 're-run the controller too (open loop)')
+    model: str = param('', "classifier model (.json); '': the one the run used")
+    output: str = param('', "report directory; '': <run>/replays/<time>")
+    progress: bool = param(True, 'show a progress bar on stderr')
 
 
 class ReplayNode(rclpy.node.Node):
-    """Holds the replay's parameters; :meth:`run` replays and writes the report."""
+    """Replays once (from a one-shot timer, so Ctrl-C stops it) and ends with the report."""
 
     def __init__(self, **kwargs: object) -> None:
         super().__init__('replay', **kwargs)
-        self.declare_parameters('', PARAMETERS)
-        self.p = {name: self.get_parameter(name).value for name, _ in PARAMETERS}
+        self.params = declare_params(self, ReplayParams)
+        self.done = rclpy.task.Future()
+        if not self.params.bag:
+            raise ParameterError('No bag given: mindgrasp launch replay bag:=runs/<run>.')
+        resolve_bag(self.params.bag)   # a missing bag refuses to start (BagError, exit 2)
+        self.timer = self.create_timer(0.0, self.replay_callback)
 
-    def run(self) -> int:
-        """Replay; 0 when the report is written, 2 on a bad bag argument."""
-        if not self.p['bag']:
-            self.get_logger().error('No bag given: mindgrasp launch replay bag:=runs/<run>.')
-            return 2
-        cfg = ReplayConfig(self.p['bag'], controller=bool(self.p['controller']),
-                           model=str(self.p['model']), output=self.p['output'] or None,
-                           progress=bool(self.p['progress']))
+    def replay_callback(self) -> None:
+        """Replay and write the report; a bag the replay cannot use ends the node with exit 2."""
+        self.timer.cancel()
+        p = self.params
+        cfg = ReplayConfig(p.bag, controller=p.controller, model=p.model,
+                           output=p.output or None, progress=p.progress)
         try:
             result = run_replay(cfg)
-        except BagError as exc:
+        except BagError as exc:   # bad input found while reading the run: as a bad argument
             self.get_logger().error(str(exc))
-            return 2
+            self.done.set_result(EXIT_REFUSED)
+            return
         self.get_logger().info(summary_line(result))
-        return 0
+        self.done.set_result(EXIT_OK)
 
 
 def main(args: list[str] | None = None) -> int:
-    """Replay once and end."""
-    rclpy.init(args=args)
-    node = ReplayNode()
-    try:
-        return node.run()
-    except KeyboardInterrupt:
-        return 130
-    finally:
-        node.destroy_node()
-        rclpy.try_shutdown()
+    """Replay once and end: 0 with the report written, 2 on a bad bag or parameter."""
+    return run_node(ReplayNode, args, errors=(BagError,))
 
 
 if __name__ == '__main__':
-    sys.exit(main())
+    raise SystemExit(main())
