@@ -27,7 +27,7 @@ PARAMS = {'mindgrasp_bringup.bag.recorder_node': RecorderParams,
 
 @pytest.mark.parametrize('cls', PARAMS.values(), ids=lambda c: c.__name__)
 def test_every_parameter_is_described_and_read_only(cls) -> None:
-    for name, (default, desc) in describe(cls).items():
+    for name, (_default, desc) in describe(cls).items():
         assert desc.description and desc.read_only, name
     assert from_mapping(cls, {}) == cls()     # the defaults pass their own checks
 

@@ -48,6 +48,7 @@ CASES = [
     ('graz session running', 'mindgrasp_trainer.graz_node', {'n_trials': 40},
      'Graz-BCI session'),
     ('recorder recording', 'mindgrasp_bringup.bag.recorder_node', {}, 'Recording to'),
+    ('player waiting for the next message', 'mindgrasp_bringup.bag.player_node', {}, 'Playing'),
 ]
 
 
@@ -65,6 +66,16 @@ def stop_time(proc, sig: int = signal.SIGINT) -> float:
 def start(spawn_node, tmp_path, module: str, params: dict, ready: str):
     if module.endswith('recorder_node'):
         params = {'output': str(tmp_path / 'bag'), 'topics': '[/chatter]', **params}
+    if module.endswith('player_node'):   # two messages 10 min apart: it waits for the second
+        from conftest_bag import STRING, string
+
+        from mindgrasp_bringup.bag import BagWriter
+
+        with BagWriter(tmp_path / 'bag') as writer:
+            writer.add_topic(f'/{STREAM}/chatter', STRING)
+            for k, stamp in enumerate((1, 600 * 10**9)):
+                writer.write(f'/{STREAM}/chatter', stamp, string(f'message {k}'))
+        params = {'bag': str(tmp_path / 'bag'), **params}
     proc = spawn_node(module, **params)
     assert proc.wait_for_output(ready, 120.0), proc.output()
     return proc

@@ -86,6 +86,8 @@ class PlayerNode(rclpy.node.Node):
             self.clock_publisher = self.create_publisher(
                 message_class(CLOCK_TYPE), '/clock', clock_qos, raw=True)
         self.stats: PlayStats | None = None
+        self.get_logger().info(f'Playing {self.reader.path} ({len(self.publishers_)} topic(s), '
+                               f'rate {p.rate:g}).')
         self.stop_event = threading.Event()
         self.thread = threading.Thread(target=self._play, name='bag-player', daemon=True)
         self.thread.start()   # after ``delay`` s, so subscribers can match first
