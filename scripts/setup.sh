@@ -18,7 +18,8 @@ fi
 .venv/bin/python -m pip install --quiet --upgrade pip
 # torch first and pinned: an unpinned torch pulls GBs of CUDA packages.
 .venv/bin/python -m pip install --quiet -c constraints.txt "torch==2.13.0"
-.venv/bin/python -m pip install --quiet -c constraints.txt -e ".[test]"
+# test + cluster: the suite runs the Ray test too
+.venv/bin/python -m pip install --quiet -c constraints.txt -e ".[test,cluster]"
 # Xvfb: the participant display's window tests run under a private X server. Installed when
 # missing and apt-get can (root); otherwise those tests are skipped with the reason.
 if ! command -v Xvfb >/dev/null 2>&1; then

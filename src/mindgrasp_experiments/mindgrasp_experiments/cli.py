@@ -91,6 +91,10 @@ def add_common_arguments(parser: argparse.ArgumentParser, trials: int) -> None:
     parser.add_argument('--trial-timeout', type=positive_float, default=600.0, metavar='S',
                         help='end a trial without a grasp after S simulated s (default 600)')
     parser.add_argument('--no-progress', action='store_true', help='no progress bar')
+    parser.add_argument('--ray', metavar='ADDRESS', default=None,
+                        help='run the trials as Ray tasks (pip install -e ".[cluster]"): auto '
+                             '(the Ray instance of this machine, or a new local one) or '
+                             'HOST:PORT of a cluster\'s head node; same records as --workers')
     parser.add_argument('--realism', default='none',
                         help='sensor noise and physical spread: none (default), default or a '
                              'profile YAML path (mindgrasp_sim.realism), seeded per trial')
@@ -121,6 +125,14 @@ def check(args: argparse.Namespace, command: str) -> str | None:
         return f'--trial-timeout must be > 0 s, got {args.trial_timeout}.'
     if args.launch is not None and not Path(args.launch).is_file():
         return f'--launch {args.launch}: no such launch file; give a *.launch.py path.'
+    if getattr(args, 'ray', None) is not None:
+        from mindgrasp_experiments import ExperimentError
+        from mindgrasp_experiments.workers import check_ray_address
+
+        try:
+            check_ray_address(args.ray)
+        except ExperimentError as exc:
+            return str(exc)
     realism = getattr(args, 'realism', None)
     if realism is not None:
         from mindgrasp_sim.errors import SimError
@@ -182,7 +194,7 @@ def run_experiment(args: argparse.Namespace, protocol: str, command: str) -> int
                desc=f'{protocol} ({subject})', dynamic_ncols=True)
     try:
         for run in run_trials(components, trials, seed=args.seed, workers=args.workers,
-                              step_s=args.step):
+                              step_s=args.step, ray=args.ray):
             runs.append(run)
             done = [r.record for r in runs]
             write_records(done, out)      # on disk as they finish: nothing is lost on a crash
@@ -206,7 +218,7 @@ def run_experiment(args: argparse.Namespace, protocol: str, command: str) -> int
     info = {
         'command': ' '.join(['mindgrasp', 'experiment', command, *sys.argv[3:]]),
         'protocol': protocol, 'subject': subject, 'seed': args.seed,
-        'accuracy': getattr(args, 'accuracy', None), 'workers': args.workers,
+        'accuracy': getattr(args, 'accuracy', None), 'workers': args.workers, 'ray': args.ray,
         'realism': getattr(args, 'realism', None),
         'trials_requested': args.trials, 'interrupted': interrupted,
         'launch_overlay': args.launch, 'step_s': args.step,

@@ -119,7 +119,7 @@ def main(args: argparse.Namespace) -> int:
                 wall_p = time.perf_counter()
                 try:
                     for run in run_trials(comps, trials, seed=args.seed, workers=args.workers,
-                                          step_s=args.step):
+                                          step_s=args.step, ray=args.ray):
                         runs.append(run)
                         write_records([r.record for r in runs], point_dir)
                         bar.update(1)
@@ -153,7 +153,7 @@ def main(args: argparse.Namespace) -> int:
     run_info = {'command': ' '.join(['mindgrasp', 'experiment', COMMAND, *sys.argv[3:]]),
                 'subject': args.subject, 'seed': args.seed, 'trials': args.trials,
                 'accuracies': accuracies, 'params': {f'{n}.{p}': v for n, p, v in params},
-                'workers': args.workers, 'step_s': args.step, 'wall_s': wall,
+                'workers': args.workers, 'ray': args.ray, 'step_s': args.step, 'wall_s': wall,
                 'sim_s': sim_total, 'interrupted': interrupted}
     doc = write_sweep(out, points, varied, run_info)
     print(f'Accuracy sweep: {len(points)} point(s) x {args.trials} trials in {out} '
