@@ -5,6 +5,7 @@ time goes per node (wall s in each node's callbacks) and per function (``--profi
     python benchmarks/experiment.py --subject oracle --trials 3
     python benchmarks/experiment.py --protocol random_locations --subject autonomous
     python benchmarks/experiment.py --profile 25            # + the 25 costliest functions
+    python benchmarks/experiment.py --sweep --trials 8      # trials/min: 1, 2 workers, Ray
 
 The trials run in this process, one after the other (``--workers`` of the CLI multiplies the
 real-time factor by up to the number of free cores). The machine's load counts: the CPU figure
@@ -34,6 +35,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument('--step', type=float, default=0.02)
     parser.add_argument('--profile', type=int, default=0, metavar='N',
                         help='profile with cProfile and print the N costliest functions')
+    parser.add_argument('--sweep', action='store_true',
+                        help='trials per minute with 1 and 2 worker processes and with Ray '
+                             '(--ray auto; needs the cluster extra), and the ratio to 1 worker')
     args = parser.parse_args(argv)
 
     from mindgrasp_experiments.cli import noise_model_path
@@ -45,6 +49,8 @@ def main(argv: list[str] | None = None) -> int:
         launch_args['model'] = noise_model_path(Path(tempfile.mkdtemp()))
     comps = lockstep_components('experiment', launch_args, Path(tempfile.mkdtemp()) / 'params',
                                 log=lambda _text: None)
+    if args.sweep:
+        return sweep_speed(comps, args)
     prof = cProfile.Profile() if args.profile else None
     runs = []
     wall0 = time.perf_counter()
@@ -77,6 +83,36 @@ def main(argv: list[str] | None = None) -> int:
     if prof is not None:
         print()
         pstats.Stats(prof, stream=sys.stdout).sort_stats('tottime').print_stats(args.profile)
+    return 0
+
+
+def sweep_speed(comps: list, args: argparse.Namespace) -> int:
+    """Trials per minute of the same trials with 1 and 2 workers and on Ray (this machine)."""
+    import importlib.util
+    import json
+
+    from mindgrasp_experiments.workers import run_trials
+
+    ways: list[tuple[str, dict]] = [('1 worker', {'workers': 1}), ('2 workers', {'workers': 2})]
+    if importlib.util.find_spec('ray') is not None:
+        ways.append(('ray auto', {'ray': 'auto'}))
+    else:
+        print('Ray is not installed (pip install -e ".[cluster]"): its row is left out')
+    trials = list(range(1, args.trials + 1))
+    figures: dict[str, float] = {}
+    records: dict[str, list] = {}
+    for name, how in ways:
+        wall0 = time.perf_counter()
+        runs = list(run_trials(comps, trials, seed=args.seed, step_s=args.step, **how))
+        wall = time.perf_counter() - wall0
+        figures[name] = 60.0 * len(runs) / wall
+        records[name] = sorted((r.record for r in runs), key=lambda rec: rec.trial)
+        ratio = figures[name] / figures['1 worker']
+        same = records[name] == records['1 worker']
+        print(f'{name:10s} {len(runs)} trials in {wall:6.1f} s: {figures[name]:5.2f} trials/min, '
+              f'{ratio:4.2f}x one worker; records {"identical" if same else "DIFFER"}',
+              flush=True)
+    print(json.dumps({'trials': len(trials), 'trials_per_min': figures}))
     return 0
 
 
