@@ -108,7 +108,7 @@ def sweep_speed(comps: list, args: argparse.Namespace) -> int:
         figures[name] = 60.0 * len(runs) / wall
         records[name] = sorted((r.record for r in runs), key=lambda rec: rec.trial)
         ratio = figures[name] / figures['1 worker']
-        same = records[name] == records['1 worker']
+        same = str(records[name]) == str(records['1 worker'])    # NaN == NaN as text
         print(f'{name:10s} {len(runs)} trials in {wall:6.1f} s: {figures[name]:5.2f} trials/min, '
               f'{ratio:4.2f}x one worker; records {"identical" if same else "DIFFER"}',
               flush=True)
