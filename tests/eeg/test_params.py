@@ -86,3 +86,23 @@ def test_a_stream_not_found_while_running_is_exit_code_1_with_the_reason(stream_
     assert run.returncode == 1, run.stdout + run.stderr
     assert 'Traceback' not in run.stderr
     assert f"[eeg_acquisition] ERROR: No LSL stream with name='{stream_name}'" in run.stderr
+
+
+def test_a_running_virtual_amp_shows_its_descriptors_and_refuses_a_change() -> None:
+    """In a node (lock-step, in this process): the declared ranges and units are the
+    ParameterDescriptors; a change while it runs is refused with the reason."""
+    from mindgrasp_eeg.virtual_amp_node import VirtualAmpNode
+    from mindgrasp_ros import rclpy
+    from mindgrasp_ros.composition import LockstepRunner
+
+    with LockstepRunner(start_time_s=1.0) as runner:
+        node = runner.add(VirtualAmpNode, ros_args=['-p', 'output:=ros', '-p', 'accuracy:=0.7'])
+        assert node.params.accuracy == 0.7
+        desc = node.describe_parameter('sample_rate')
+        assert desc.read_only and '[Hz]' in desc.description
+        assert desc.floating_point_range[0].from_value == 60.0
+        assert 'one of: noise, follow, pursue' in \
+            node.describe_parameter('subject_mode').additional_constraints
+        result = node.set_parameters([rclpy.parameter.Parameter('accuracy', value=0.5)])[0]
+        assert not result.successful and 'read-only' in result.reason
+        assert node.params.accuracy == 0.7
