@@ -194,10 +194,10 @@ def run_node(node_class: Callable[[], Any], args: list[str] | None = None, *,
             receive the last messages (a session's "end" prompt).
         poll_sec: 0 (default) waits for work in the middleware, as ``rclpy.spin``. > 0 polls
             instead: run what is ready without waiting, then sleep on ``done`` for up to
-            ``poll_sec`` s with the GIL released. For a node whose own thread keeps a schedule:
-            the main thread waiting in the middleware delayed the bag player's publications by
-            several ms (its timing needs ~1 ms); callbacks (parameter services) then run up to
-            ``poll_sec`` late.
+            ``poll_sec`` s with the GIL released. For a node whose own thread keeps a schedule
+            (the bag player: its private loop did this because a blocking spin had delayed
+            publications by several ms; ``benchmarks/player.py`` compares the two modes);
+            callbacks (parameter services) then run up to ``poll_sec`` late.
     """
     argv = list(args if args is not None else sys.argv)
     if _wants_help(argv):

@@ -172,8 +172,9 @@ def main(args: list[str] | None = None) -> int:
     # The playback thread shares the GIL with the executor thread; Python's default 5 ms switch
     # interval would delay publications by up to 5 ms. 0.5 ms keeps them on time.
     sys.setswitchinterval(0.0005)
-    # poll_sec: a main thread waiting in the middleware keeps the GIL busy enough to delay the
-    # playback thread by several ms; polling every 50 ms still answers parameter services.
+    # poll_sec: a main thread waiting in the middleware was found to delay the playback thread by
+    # several ms; polling every 50 ms still answers parameter services (benchmarks/player.py
+    # compares both: at load 9 on 2 cores the two were within noise of each other).
     return run_node(PlayerNode, args, errors=(BagError,), poll_sec=0.05)
 
 
