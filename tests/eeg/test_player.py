@@ -39,7 +39,7 @@ def open_inlet(name: str) -> pylsl.StreamInlet:
     found = pylsl.resolve_byprop('name', name, timeout=60)   # a busy host starts it slowly
     assert found, f'stream {name} not found'
     inlet = pylsl.StreamInlet(found[0], processing_flags=pylsl.proc_clocksync)
-    inlet.open_stream(timeout=5)
+    inlet.open_stream(timeout=30)
     return inlet
 
 

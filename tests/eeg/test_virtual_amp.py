@@ -53,11 +53,11 @@ def test_cli_without_ros_streams_labelled_eeg(stream_name) -> None:
                              '--no-ros', '--cues', '1', '--name', stream_name],
                             stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
     try:
-        found = pylsl.resolve_byprop('name', stream_name, timeout=15)
-        mk = pylsl.resolve_byprop('name', f'{stream_name}-markers', timeout=15)
+        found = pylsl.resolve_byprop('name', stream_name, timeout=60)
+        mk = pylsl.resolve_byprop('name', f'{stream_name}-markers', timeout=60)
         assert found and mk
         eeg, markers = pylsl.StreamInlet(found[0]), pylsl.StreamInlet(mk[0])
-        info = eeg.info(timeout=5)
+        info = eeg.info(timeout=30)
         ch = info.desc().child('channels').child('channel')
         labels, units = [], set()
         while not ch.empty():

@@ -39,7 +39,7 @@ def test_pubsub_qos_matching(rclpy_ctx, spawn_node, writer_reliable, reader_reli
                         f'reliable:={str(writer_reliable).lower()}')
     node, got = _listener(rclpy_ctx, '/chatter', reliable=reader_reliable)
     if delivers:
-        assert spin_until(node, lambda: len(got) >= 10, timeout=20), talker.output()
+        assert spin_until(node, lambda: len(got) >= 10, timeout=60), talker.output()
         numbers = [int(s.split()[1]) for s in got]
         assert numbers == sorted(numbers)
         if writer_reliable and reader_reliable:
@@ -55,7 +55,7 @@ def test_transient_local_late_joiner(rclpy_ctx, spawn_node):
     assert peer.wait_for_output('ready')
     time.sleep(0.5)  # the messages were published before we exist
     node, got = _listener(rclpy_ctx, '/latched', transient=True)
-    assert spin_until(node, lambda: len(got) >= 2, timeout=15), peer.output()
+    assert spin_until(node, lambda: len(got) >= 2, timeout=60), peer.output()
     spin_until(node, lambda: False, timeout=0.5)
     assert got == ['latched 1', 'latched 2']  # depth 2 keeps the last two
 
@@ -64,9 +64,9 @@ def test_remapping_and_node_name_from_command_line(rclpy_ctx, spawn_node):
     spawn_node(PEER, 'talker', '--ros-args', '-r', 'chatter:=/remapped/chat',
                '-r', '__node:=renamed', '-r', '__ns:=/lab')
     node, got = _listener(rclpy_ctx, '/remapped/chat')
-    assert spin_until(node, lambda: len(got) >= 3, timeout=20)
+    assert spin_until(node, lambda: len(got) >= 3, timeout=60)
     assert spin_until(node, lambda: ('renamed', '/lab') in node.get_node_names_and_namespaces(),
-                      timeout=10)
+                      timeout=60)
     infos = node.get_publishers_info_by_topic('/remapped/chat')
     assert [(i.node_name, i.node_namespace) for i in infos] == [('renamed', '/lab')]
     assert infos[0].topic_type == 'std_msgs/msg/String'
@@ -87,10 +87,10 @@ def test_services_and_parameters_across_processes(rclpy_ctx, spawn_node, tmp_pat
     rclpy = rclpy_ctx
     node = rclpy.node.Node('test_client')
     get = node.create_client(GetParameters, '/peer_params/get_parameters')
-    assert get.wait_for_service(timeout_sec=20)
+    assert get.wait_for_service(timeout_sec=60)
     future = get.call_async(GetParameters.Request(names=['gain', 'name', 'nested.level',
                                                          'channels']))
-    rclpy.spin_until_future_complete(node, future, timeout_sec=10)
+    rclpy.spin_until_future_complete(node, future, timeout_sec=60)
     values = future.result().values
     assert values[0].double_value == 4.0  # -p wins over the file
     assert values[1].string_value == 'from_wildcard'
@@ -98,26 +98,26 @@ def test_services_and_parameters_across_processes(rclpy_ctx, spawn_node, tmp_pat
     assert list(values[3].string_array_value) == ['C3', 'Cz', 'C4']
 
     set_ = node.create_client(SetParameters, '/peer_params/set_parameters')
-    assert set_.wait_for_service(timeout_sec=10)
+    assert set_.wait_for_service(timeout_sec=60)
     future = set_.call_async(SetParameters.Request(parameters=[
         Parameter(name='gain', value=ParameterValue(type=3, double_value=7.0)),
         Parameter(name='gain', value=ParameterValue(type=4, string_value='oops'))]))
-    rclpy.spin_until_future_complete(node, future, timeout_sec=10)
+    rclpy.spin_until_future_complete(node, future, timeout_sec=60)
     ok, wrong_type = future.result().results
     assert ok.successful
     assert not wrong_type.successful and 'expected DOUBLE' in wrong_type.reason
 
     toggle = node.create_client(SetBool, '/toggle')
-    assert toggle.wait_for_service(timeout_sec=10)
+    assert toggle.wait_for_service(timeout_sec=60)
     future = toggle.call_async(SetBool.Request(data=True))
-    rclpy.spin_until_future_complete(node, future, timeout_sec=10)
+    rclpy.spin_until_future_complete(node, future, timeout_sec=60)
     assert future.result().message == 'on=True gain=7.0'
 
 
 def test_ros_discovery_info_lists_nodes_and_endpoints(rclpy_ctx, spawn_node):
     spawn_node(PEER, 'echo')
     node = rclpy_ctx.node.Node('observer')
-    assert spin_until(node, lambda: 'peer_echo' in node.get_node_names(), timeout=15)
+    assert spin_until(node, lambda: 'peer_echo' in node.get_node_names(), timeout=60)
     assert 'observer' in node.get_node_names()
     graph = node.context.graph
 
@@ -127,7 +127,7 @@ def test_ros_discovery_info_lists_nodes_and_endpoints(rclpy_ctx, spawn_node):
                 and ('/chatter', 'std_msgs/msg/String') in ep.get('subscribers', [])
                 and len(ep.get('services', [])) >= 6)
 
-    assert spin_until(node, complete, timeout=15)
+    assert spin_until(node, complete, timeout=60)
     endpoints = graph.node_endpoints('peer_echo', '/')
     assert ('/chatter', 'std_msgs/msg/String') in endpoints['subscribers']
     assert ('/rosout', 'rcl_interfaces/msg/Log') in endpoints['publishers']

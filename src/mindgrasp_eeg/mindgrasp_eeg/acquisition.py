@@ -50,11 +50,11 @@ from pylsl.util import LostError
 from . import EEGError
 from .lsl import (
     StreamDescription,
+    StreamFinder,
     check_stream,
     not_found_error,
     open_inlet,
     resolve_stream,
-    stream_predicate,
     unit_scale,
 )
 from .quality import QualityMonitor
@@ -211,37 +211,34 @@ class EEGAcquisition:
         return self._search is not None
 
     def start_search(self, timeout: float | None = None) -> None:
-        """Look for the stream in a background thread, in slices of 0.5 s, so the caller never
-        blocks (an executor keeps serving signals, timers and status). :meth:`finish_search`
-        collects the outcome."""
+        """Look for the stream in a background thread (liblsl's continuous resolver, polled
+        every 0.1 s), so the caller never blocks (an executor keeps serving signals, timers and
+        status). :meth:`finish_search` collects the outcome."""
         timeout = self.resolve_timeout if timeout is None else timeout
-        stream_predicate(*self.selector, self.hostname)          # bad selectors fail here, at once
-        if not any(self.selector):
-            resolve_stream(*self.selector, timeout=0.0)     # raises: no selector given
+        finder = StreamFinder(*self.selector, self.hostname)   # bad selectors fail here, at once
         outcome: dict[str, object] = {}
 
         def run() -> None:
             deadline = time.monotonic() + timeout
-            while not self._stop.is_set():
-                remaining = deadline - time.monotonic()
-                try:
-                    info = resolve_stream(*self.selector, timeout=max(0.05, min(0.5, remaining)),
-                                          list_visible=False, hostname=self.hostname)
-                    outcome['found'] = open_inlet(info, max_buflen=self.max_buflen,
-                                                  dejitter=self.dejitter,
-                                                  clocksync=self._clocksync_for(info))
-                    return
-                except EEGError as exc:
-                    if time.monotonic() < deadline:
-                        continue
-                    outcome['error'] = not_found_error(
-                        stream_predicate(*self.selector, self.hostname), timeout) \
-                        if str(exc).startswith('No LSL stream with') else exc
-                    return
-                except Exception as exc:  # reported by finish_search
-                    outcome['error'] = EEGError(f'Opening the LSL stream failed: '
-                                                f'{type(exc).__name__}: {exc}')
-                    return
+            try:
+                while not self._stop.is_set():
+                    info = finder.newest()
+                    if info is not None:
+                        outcome['found'] = open_inlet(info, max_buflen=self.max_buflen,
+                                                      dejitter=self.dejitter,
+                                                      clocksync=self._clocksync_for(info))
+                        return
+                    if time.monotonic() >= deadline:
+                        outcome['error'] = not_found_error(finder.pred, timeout)
+                        return
+                    self._stop.wait(0.1)
+            except EEGError as exc:
+                outcome['error'] = exc
+            except Exception as exc:  # reported by finish_search
+                outcome['error'] = EEGError(f'Opening the LSL stream failed: '
+                                            f'{type(exc).__name__}: {exc}')
+            finally:
+                finder.close()
 
         thread = threading.Thread(target=run, name='eeg-search', daemon=True)
         self._search = (thread, outcome)
@@ -302,8 +299,8 @@ class EEGAcquisition:
 
     def close(self) -> None:
         """Stop searching and reconnecting and close the inlet. The threads end by themselves
-        within 0.5 s (their resolve slice); waiting for them here would only delay a node's
-        stop, so they get 0.1 s (they are daemon threads)."""
+        within 0.1 s (their poll period; opening an inlet may take longer); waiting for them
+        here would only delay a node's stop, so they get 0.1 s (they are daemon threads)."""
         self._stop.set()
         for thread in (self._reconnect_thread, self._search and self._search[0]):
             if thread is not None:
@@ -316,11 +313,21 @@ class EEGAcquisition:
         if self._reconnect_thread is not None and self._reconnect_thread.is_alive():
             return
 
+        finder = StreamFinder(*self.selector, self.hostname)
+
         def run() -> None:
+            try:
+                reconnect()
+            finally:
+                finder.close()
+
+        def reconnect() -> None:
             while not self._stop.is_set():
                 try:
-                    info = resolve_stream(*self.selector, timeout=0.5, list_visible=False,
-                                          hostname=self.hostname)
+                    info = finder.newest()
+                    if info is None:
+                        self._stop.wait(0.1)
+                        continue
                     if info.uid() == lost_uid and pylsl.local_clock() - self._last_data_at < 2.0:
                         # the lost outlet may still be listed for a moment; give it time
                         self._stop.wait(0.1)
@@ -331,6 +338,7 @@ class EEGAcquisition:
                 except EEGError as exc:
                     with self._lock:
                         self._reconnect_error = str(exc).split(' Visible streams')[0]
+                    self._stop.wait(0.1)
                     continue
                 except Exception as exc:  # keep trying, report it
                     with self._lock:

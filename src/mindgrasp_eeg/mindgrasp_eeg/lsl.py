@@ -154,6 +154,33 @@ def resolve_stream(name: str = '', stream_type: str = '', source_id: str = '',
     return max(found, key=lambda i: i.created_at())
 
 
+class StreamFinder:
+    """Streams matching a selector, found in the background by liblsl's continuous resolver.
+
+    :meth:`newest` never blocks, and a slow answer is not lost: a search in short one-shot
+    resolves restarted its query every slice, and on a loaded machine (or with the discovery
+    on this host only, where answers take 0.5-1 s) no slice lasted long enough to get one.
+    """
+
+    def __init__(self, name: str = '', stream_type: str = '', source_id: str = '',
+                 hostname: str = '') -> None:
+        self.pred = stream_predicate(name, stream_type, source_id, hostname)
+        if not self.pred:
+            msg = ('No LSL stream selector given: set at least one of eeg_stream (name), '
+                   'stream_type or source_id.')
+            raise EEGError(msg)
+        self._resolver = pylsl.ContinuousResolver(pred=self.pred, forget_after=2.0)
+
+    def newest(self, exclude_uids: Sequence[str] = ()) -> pylsl.StreamInfo | None:
+        """The most recently created matching stream seen so far, or None."""
+        found = [i for i in self._resolver.results() if i.uid() not in exclude_uids]
+        return max(found, key=lambda i: i.created_at()) if found else None
+
+    def close(self) -> None:
+        """Stop the background search."""
+        self._resolver = None
+
+
 def open_inlet(info: pylsl.StreamInfo, *, max_buflen: float = 1.0, dejitter: bool = True,
                clocksync: bool = True, timeout: float = 5.0) -> tuple[pylsl.StreamInlet,
                                                                       StreamDescription]:

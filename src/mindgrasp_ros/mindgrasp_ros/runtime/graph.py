@@ -18,7 +18,8 @@ from cyclonedds.builtin import (
     BuiltinTopicDcpsPublication,
     BuiltinTopicDcpsSubscription,
 )
-from cyclonedds.core import InstanceState, Policy
+from cyclonedds.core import InstanceState, Policy, Qos, ReadCondition, SampleState, ViewState
+from cyclonedds.util import duration
 
 from mindgrasp_ros.runtime.dds import (
     DdsParticipant,
@@ -82,6 +83,10 @@ def _qos_from_dds(qos: Any) -> QoSProfile:
     return profile
 
 
+#: most endpoints one graph query reads (a ROS graph of a few hundred nodes)
+_MAX_ENDPOINTS = 8192
+
+
 def _duration(ns: int) -> Duration:
     return Duration(nanoseconds=0 if ns >= 2**62 else ns)
 
@@ -102,8 +107,21 @@ class GraphCache:
     def __init__(self, dds: DdsParticipant) -> None:
         self._dds = dds
         self._lock = threading.Lock()
-        self._pub_reader = BuiltinDataReader(dds.participant, BuiltinTopicDcpsPublication)
-        self._sub_reader = BuiltinDataReader(dds.participant, BuiltinTopicDcpsSubscription)
+        # The endpoints are *read* (not taken) through an alive-only condition, and Cyclone
+        # purges disposed ones itself. Taking every sample, as before, also took the disposals
+        # of leaving endpoints, whose data fields cyclonedds-python still converts: under load
+        # that failed now and then ("Callfunc endpoint constructor errored"), every sample of
+        # the take was lost, and the caller (a recorder listing topics at start) crashed.
+        purge = Qos(Policy.ReaderDataLifecycle(
+            autopurge_nowriter_samples_delay=duration(seconds=1),
+            autopurge_disposed_samples_delay=duration(seconds=1)))
+        self._pub_reader = BuiltinDataReader(dds.participant, BuiltinTopicDcpsPublication,
+                                             qos=purge)
+        self._sub_reader = BuiltinDataReader(dds.participant, BuiltinTopicDcpsSubscription,
+                                             qos=purge)
+        alive = ViewState.Any | SampleState.Any | InstanceState.Alive
+        self._alive = {id(r): ReadCondition(r, alive) for r in (self._pub_reader,
+                                                                  self._sub_reader)}
         self._info_reader = dds.create_reader(
             'ros_discovery_info', 'rmw_dds_common/msg/ParticipantEntitiesInfo',
             QoSProfile(history=HistoryPolicy.KEEP_ALL, durability=DurabilityPolicy.TRANSIENT_LOCAL))
@@ -121,19 +139,13 @@ class GraphCache:
 
     def _update(self) -> None:
         with self._lock:
+            endpoints: dict[bytes, tuple[str, Any]] = {}
             for kind, reader in (('publisher', self._pub_reader),
                                  ('subscription', self._sub_reader)):
-                while True:
-                    samples = reader.take(N=512)
-                    if not samples:
-                        break
-                    for s in samples:
-                        alive = s.sample_info.instance_state == InstanceState.Alive
-                        key = s.key.bytes
-                        if alive and s.topic_name:
-                            self._endpoints[key] = (kind, s)
-                        else:
-                            self._endpoints.pop(key, None)
+                for s in reader.read(N=_MAX_ENDPOINTS, condition=self._alive[id(reader)]):
+                    if s.topic_name:
+                        endpoints[s.key.bytes] = (kind, s)
+            self._endpoints = endpoints
             for data, _info in self._info_reader.take(1024):
                 try:
                     msg = deserialize(data, 'rmw_dds_common/msg/ParticipantEntitiesInfo')
