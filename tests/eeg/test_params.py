@@ -3,24 +3,19 @@ at start with one line (exit code 2); a failure while running is exit code 1 wit
 
 from __future__ import annotations
 
-import dataclasses
 import os
 import subprocess
 import sys
 
 import pytest
 
-from mindgrasp_eeg.params import AcquisitionParams, VirtualAmpParams, default_params_path
-from mindgrasp_ros.params import ParameterError, describe, from_mapping, read_yaml_section
+from mindgrasp_eeg.params import AcquisitionParams, VirtualAmpParams
+from mindgrasp_ros.params import ParameterError, describe, from_mapping
 
 NODES = [('eeg_acquisition', AcquisitionParams), ('virtual_amp', VirtualAmpParams)]
 
 
-@pytest.mark.parametrize(('node_name', 'cls'), NODES)
-def test_parameter_file_holds_every_parameter_with_the_defaults(node_name: str, cls: type) -> None:
-    section = read_yaml_section(default_params_path(), node_name)
-    assert set(section) == {f.name for f in dataclasses.fields(cls)}
-    assert from_mapping(cls, section) == cls()
+# the parameter file against the defaults: tests/ros/test_node_params.py, with every node
 
 
 @pytest.mark.parametrize(('node_name', 'cls'), NODES)

@@ -20,6 +20,12 @@ NODES = [
     ('classifier', 'mindgrasp_classifier.classifier_node', 'ClassifierParams',
      'mindgrasp_classifier', 'classifier.yaml'),
     ('sim', 'mindgrasp_sim.sim_node', 'SimParams', 'mindgrasp_sim', 'sim.yaml'),
+    ('graz_prompter', 'mindgrasp_trainer.graz_node', 'GrazParams', 'mindgrasp_trainer',
+     'trainer.yaml'),
+    ('trainer', 'mindgrasp_trainer.trainer_node', 'TrainerParams', 'mindgrasp_trainer',
+     'trainer.yaml'),
+    ('eeg_acquisition', 'mindgrasp_eeg.params', 'AcquisitionParams', 'mindgrasp_eeg', 'eeg.yaml'),
+    ('virtual_amp', 'mindgrasp_eeg.params', 'VirtualAmpParams', 'mindgrasp_eeg', 'eeg.yaml'),
 ]
 IDS = [n[0] for n in NODES]
 

@@ -99,7 +99,8 @@ class VirtualAmpParams:
                             'first)')
     base_position: list[float] = param([0.0, 0.0], 'pursue: arm base in the /sim/objects frame',
                                        unit='m')
-    heading_offset: float = param(0.0, 'pursue: arm heading at base_joint = 0', unit='rad')
+    heading_offset: float = param(0.0, 'pursue: arm heading at base_joint = 0', unit='rad',
+                                  min=-6.3, max=6.3)
     seed: int = param(0, 'seed of the EEG time series and the subject decisions', min=0)
     head_seed: int = param(0, 'seed of the head model (keep it for one virtual subject)', min=0)
     background_rms: float = param(10e-6, '1/f background', unit='V', min=0.0)
