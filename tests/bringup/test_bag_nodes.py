@@ -137,7 +137,9 @@ def test_bag_info_cli_prints_counts_rates_and_types(recorded):
     eeg_line = next(line for line in out.stdout.splitlines() if f'{prefix}/eeg ' in line)
     assert EEG in eeg_line and f'Count: {N_EEG:>7}' in eeg_line
     rate = float(eeg_line.split('Rate:')[1].split('Hz')[0])
-    assert 8.0 < rate < 12.0                    # published at 10 Hz
+    # published at 10 Hz; under load the timer fires late and then catches up, so the rate from
+    # the first and last stamps of a short recording drifts: a loose bound, the count is exact
+    assert 5.0 < rate < 20.0
     info = yaml.safe_load(subprocess.run(
         [sys.executable, '-m', 'mindgrasp_bringup', 'bag', 'info', str(bag), '--yaml'],
         capture_output=True, text=True, env=_env(), timeout=60).stdout)

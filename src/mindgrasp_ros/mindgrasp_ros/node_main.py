@@ -134,14 +134,18 @@ def fail(node: Any, reason: str) -> None:
 
 
 def is_done(node: Any) -> bool:
-    """True once ``node.done`` (a Future) has completed; False for a node without one."""
+    """True once ``node.done`` (a Future) has completed; False for a node without one. A user's
+    own node in a composed launch may keep a plain ``bool`` ``done`` (as rclpy demos do); that
+    counts as well."""
     done = getattr(node, 'done', None)
-    return bool(done is not None and done.done())
+    if isinstance(done, bool):
+        return done
+    return bool(done is not None and callable(getattr(done, 'done', None)) and done.done())
 
 
 def exit_code(node: Any) -> int:
     """The exit code a completed ``node.done`` stands for (0 while it runs)."""
-    if not is_done(node):
+    if not is_done(node) or isinstance(node.done, bool):
         return EXIT_OK
     if node.done.exception() is not None:
         return EXIT_FAILED
@@ -151,9 +155,13 @@ def exit_code(node: Any) -> int:
 
 def error_text(node: Any) -> str | None:
     """The failure reason of a node whose ``done`` holds an exception, else None."""
-    if is_done(node) and node.done.exception() is not None:
+    if is_done(node) and not isinstance(node.done, bool) and node.done.exception() is not None:
         return str(node.done.exception())
     return None
+
+
+#: longest single wait of a node's executor (s): how soon a signal is handled
+_SIGNAL_CHECK_SEC = 0.1
 
 
 def _wants_help(argv: list[str]) -> bool:
@@ -223,7 +231,11 @@ def run_node(node_class: Callable[[], Any], args: list[str] | None = None, *,
         if poll_sec > 0:
             _poll_until_done(executor, done, poll_sec)
         else:
-            executor.spin_until_future_complete(done)
+            # waits of at most _SIGNAL_CHECK_SEC: Python runs the SIGINT handler only between
+            # C calls, and a wait with nothing to wake it (a recorder whose publishers went
+            # quiet) blocked Ctrl-C for good
+            while not done.done() and rclpy.ok():
+                executor.spin_until_future_complete(done, timeout_sec=_SIGNAL_CHECK_SEC)
         if done.done() and linger_sec > 0 and rclpy.ok():
             executor.spin_until_future_complete(rclpy.task.Future(), timeout_sec=linger_sec)
     except (KeyboardInterrupt, _external_shutdown()):

@@ -9,6 +9,7 @@ list`` and ``ros2 topic info -v`` use, so the answers agree with the ROS 2 tools
 from __future__ import annotations
 
 import threading
+import uuid
 from collections import defaultdict
 from dataclasses import dataclass
 from typing import Any
@@ -18,6 +19,7 @@ from cyclonedds.builtin import (
     BuiltinTopicDcpsPublication,
     BuiltinTopicDcpsSubscription,
 )
+from cyclonedds.builtin_types import DcpsEndpoint
 from cyclonedds.core import InstanceState, Policy, Qos, ReadCondition, SampleState, ViewState
 from cyclonedds.util import duration
 
@@ -83,6 +85,21 @@ def _qos_from_dds(qos: Any) -> QoSProfile:
     return profile
 
 
+def _endpoint_without_type_id(keybytes: bytes, participant_keybytes: bytes, handle: int,
+                              topic_name: str | None, type_name: str | None, qos: Any,
+                              sample_info: Any, _type_id: bytes | None = None) -> DcpsEndpoint:
+    """cyclonedds' ``endpoint_constructor`` without decoding the XTypes type identifier.
+
+    The graph never uses it, and cyclonedds' ``TypeIdentifier.deserialize`` of some endpoints'
+    bytes looped for ever (a recorder listing topics hung on SIGINT; found with a faulthandler
+    dump) or raised ("Callfunc endpoint constructor errored", failing the whole read).
+    """
+    endpoint = DcpsEndpoint(uuid.UUID(bytes=keybytes), uuid.UUID(bytes=participant_keybytes),
+                            handle, topic_name, type_name, qos, None)
+    endpoint.sample_info = sample_info
+    return endpoint
+
+
 #: most endpoints one graph query reads (a ROS graph of a few hundred nodes)
 _MAX_ENDPOINTS = 8192
 
@@ -108,10 +125,8 @@ class GraphCache:
         self._dds = dds
         self._lock = threading.Lock()
         # The endpoints are *read* (not taken) through an alive-only condition, and Cyclone
-        # purges disposed ones itself. Taking every sample, as before, also took the disposals
-        # of leaving endpoints, whose data fields cyclonedds-python still converts: under load
-        # that failed now and then ("Callfunc endpoint constructor errored"), every sample of
-        # the take was lost, and the caller (a recorder listing topics at start) crashed.
+        # purges disposed ones itself: a failed read loses nothing, a failed take lost every
+        # sample it took, disposals included.
         purge = Qos(Policy.ReaderDataLifecycle(
             autopurge_nowriter_samples_delay=duration(seconds=1),
             autopurge_disposed_samples_delay=duration(seconds=1)))
@@ -119,6 +134,8 @@ class GraphCache:
                                              qos=purge)
         self._sub_reader = BuiltinDataReader(dds.participant, BuiltinTopicDcpsSubscription,
                                              qos=purge)
+        for reader in (self._pub_reader, self._sub_reader):
+            reader._constructor = _endpoint_without_type_id
         alive = ViewState.Any | SampleState.Any | InstanceState.Alive
         self._alive = {id(r): ReadCondition(r, alive) for r in (self._pub_reader,
                                                                   self._sub_reader)}
@@ -140,12 +157,17 @@ class GraphCache:
     def _update(self) -> None:
         with self._lock:
             endpoints: dict[bytes, tuple[str, Any]] = {}
-            for kind, reader in (('publisher', self._pub_reader),
-                                 ('subscription', self._sub_reader)):
-                for s in reader.read(N=_MAX_ENDPOINTS, condition=self._alive[id(reader)]):
-                    if s.topic_name:
-                        endpoints[s.key.bytes] = (kind, s)
-            self._endpoints = endpoints
+            try:
+                for kind, reader in (('publisher', self._pub_reader),
+                                     ('subscription', self._sub_reader)):
+                    for s in reader.read(N=_MAX_ENDPOINTS, condition=self._alive[id(reader)]):
+                        if s.topic_name:
+                            endpoints[s.key.bytes] = (kind, s)
+                self._endpoints = endpoints
+            except Exception:
+                # should cyclonedds-python still fail a read, read() took nothing: the next
+                # query sees every endpoint again; keep the last complete view meanwhile
+                pass
             for data, _info in self._info_reader.take(1024):
                 try:
                     msg = deserialize(data, 'rmw_dds_common/msg/ParticipantEntitiesInfo')
