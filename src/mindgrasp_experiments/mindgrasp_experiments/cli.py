@@ -93,7 +93,7 @@ def add_common_arguments(parser: argparse.ArgumentParser, trials: int) -> None:
     parser.add_argument('--no-progress', action='store_true', help='no progress bar')
     parser.add_argument('--ray', metavar='ADDRESS', default=None,
                         help='run the trials as Ray tasks (pip install -e ".[cluster]"): auto '
-                             '(the Ray instance of this machine, or a new local one) or '
+                             '(a local Ray instance of this run) or '
                              'HOST:PORT of a cluster\'s head node; same records as --workers')
     parser.add_argument('--realism', default='none',
                         help='sensor noise and physical spread: none (default), default or a '

@@ -3,8 +3,8 @@
 Each trial runs in its own fresh lock-step graph (:func:`~mindgrasp_experiments.engine.run_trial`)
 seeded from ``(seed, trial)``, so a trial's record is the same whichever process runs it. With
 ``workers > 1`` trials are handed out one at a time to ``workers`` spawned processes (each builds
-the node graph's imports once). With ``ray`` (``auto``: the Ray instance running on this machine,
-or a new local one; ``HOST:PORT`` or ``ray://HOST:PORT``: a cluster) every trial is a Ray task
+the node graph's imports once). With ``ray`` (``auto``: a new local Ray instance of this
+process; ``HOST:PORT`` or ``ray://HOST:PORT``: a cluster) every trial is a Ray task
 (optional extra ``cluster``); the driver gathers the records as they finish.
 """
 
@@ -44,8 +44,8 @@ def check_ray_address(address: str) -> None:
         return
     host, _, port = address.removeprefix('ray://').rpartition(':')
     if not host or not port.isdigit():
-        msg = (f'--ray {address!r} is not a Ray address; give auto (this machine), HOST:PORT of '
-               f'the head node (ray start --head) or ray://HOST:PORT (Ray client).')
+        msg = (f'--ray {address!r} is not a Ray address; give auto (a local instance), '
+               f'HOST:PORT of the head node (ray start --head) or ray://HOST:PORT (Ray client).')
         raise ExperimentError(msg)
     try:
         socket.create_connection((host, int(port)), timeout=RAY_CONNECT_TIMEOUT).close()
@@ -68,10 +68,9 @@ def _ray_trials(components: Sequence[LockstepComponent], trials: Sequence[int], 
         if address != 'auto':
             ray.init(address=address, **options)
         else:
-            try:                                   # the Ray instance of this machine, if any
-                ray.init(address='auto', **options)
-            except ConnectionError:                # else a new one, on loopback only
-                ray.init(_node_ip_address='127.0.0.1', **options)
+            # a Ray instance of our own on this machine (address 'local'), on loopback; joining
+            # whatever instance runs here could hand our trials to another user's workers
+            ray.init(address='local', _node_ip_address='127.0.0.1', **options)
         atexit.register(ray.shutdown)
     task = ray.remote(run_trial).options(num_cpus=1, max_retries=0)
     pending = [task.remote(list(components), trial, seed=seed, step_s=step_s,
