@@ -235,7 +235,7 @@ def run_node(node_class: Callable[[], Any], args: list[str] | None = None, *,
             # C calls, and a wait with nothing to wake it (a recorder whose publishers went
             # quiet) blocked Ctrl-C for good
             while not done.done() and rclpy.ok():
-                executor.spin_until_future_complete(done, timeout_sec=_SIGNAL_CHECK_SEC)
+                executor.spin_once(timeout_sec=_SIGNAL_CHECK_SEC)
         if done.done() and linger_sec > 0 and rclpy.ok():
             executor.spin_until_future_complete(rclpy.task.Future(), timeout_sec=linger_sec)
     except (KeyboardInterrupt, _external_shutdown()):

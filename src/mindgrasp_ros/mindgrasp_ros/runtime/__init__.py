@@ -51,9 +51,17 @@ def init(*, args: list[str] | None = None, context: Context | None = None,
 
 
 def _install_sigterm_handler() -> None:
-    """SIGTERM behaves like Ctrl-C (KeyboardInterrupt), so nodes clean up the same way."""
+    """SIGTERM behaves like Ctrl-C (KeyboardInterrupt), so nodes clean up the same way.
+
+    SIGINT is handled too, as rclpy installs its handler whatever it inherited: a process
+    started in the background of a script (or by a test runner's worker) inherits SIGINT
+    *ignored*, and Python keeps it so; such a node then ignored the launcher's SIGINT until it
+    was killed, and its bag was not closed.
+    """
     if threading.current_thread() is not threading.main_thread():
         return
+    if signal.getsignal(signal.SIGINT) in (signal.SIG_IGN, signal.SIG_DFL, None):
+        signal.signal(signal.SIGINT, signal.default_int_handler)
     if signal.getsignal(signal.SIGTERM) in (signal.SIG_DFL, None):
         signal.signal(signal.SIGTERM, lambda *_: signal.default_int_handler(signal.SIGINT, None))
 
