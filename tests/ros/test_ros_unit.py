@@ -360,3 +360,23 @@ def test_spin_once_waits_for_its_timeout_when_idle(rclpy_ctx):
         rclpy_ctx.spin_once(node, timeout_sec=0.1)
         calls += 1
     assert calls <= 15  # ~10 at 0.1 s each; a busy loop makes thousands
+
+
+def test_a_ctrl_c_during_a_graph_query_is_not_lost(rclpy_ctx):
+    """cyclonedds' C layer calls the endpoint constructor per sample and turns what it raises
+    into a plain error: a KeyboardInterrupt landing there must still reach the node's loop."""
+    from mindgrasp_ros.interfaces.std_msgs.msg import String
+
+    node = rclpy_ctx.node.Node('graph_interrupt')
+    node.create_publisher(String, '/graph_interrupt', 10)
+    assert spin_until(node, lambda: '/graph_interrupt' in dict(node.get_topic_names_and_types()),
+                      timeout=60)
+    graph = node.context.graph
+
+    def interrupted(*_args):
+        raise KeyboardInterrupt
+
+    graph._pub_reader._constructor = graph._guarded(interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        node.get_topic_names_and_types()
+    node.destroy_node()

@@ -5,8 +5,9 @@ How LSL time maps to ROS time
 Pulled LSL timestamps ``t_lsl`` (s) are in this host's ``pylsl.local_clock()`` domain after clock
 synchronisation and dejitter (see :mod:`mindgrasp_eeg.lsl`); a sender on the same host shares that
 clock, so clock synchronisation is skipped for it (its estimate would only add jitter). At each
-pull the node reads both clocks back to back, ``lsl_now = local_clock()`` and ``ros_now`` (the
-node clock: system time, or ``/clock`` with ``use_sim_time``), and stamps a sample with ::
+pull the node reads both clocks at one moment (:func:`read_clocks`), ``lsl_now = local_clock()`` and
+``ros_now`` (the node clock: system time, or ``/clock`` with ``use_sim_time``), and stamps a sample
+with ::
 
     stamp_ros = ros_now - (lsl_now - t_lsl)
 
@@ -40,7 +41,7 @@ import math
 import socket
 import threading
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -70,6 +71,23 @@ def ros_stamp_ns(t_lsl: float, lsl_now: float, ros_now_ns: int) -> int:
     return int(ros_now_ns - round((lsl_now - t_lsl) * 1e9))
 
 
+def read_clocks(ros_now_ns: Callable[[], int], tries: int = 3) -> tuple[float, int]:
+    """``(lsl_now, ros_now_ns)`` read at one moment: the LSL clock on either side of the ROS
+    clock, the tightest bracket of a few tries. A process preempted between two plain reads
+    (a loaded machine) would shift every stamp of the chunk by the preemption."""
+    best: tuple[float, float, int] | None = None
+    for _ in range(tries):
+        before = pylsl.local_clock()
+        ros = ros_now_ns()
+        after = pylsl.local_clock()
+        if best is None or after - before < best[0]:
+            best = (after - before, (before + after) / 2, ros)
+        if after - before < 1e-4:
+            break
+    assert best is not None
+    return best[1], best[2]
+
+
 @dataclass
 class Chunk:
     """Consecutive samples without gaps.
@@ -77,13 +95,11 @@ class Chunk:
     data : ndarray, shape (n_samples, n_channels), float32, volts
     timestamps : ndarray, shape (n_samples,), LSL seconds (receiver clock)
     first_index : running index of ``data[0]`` since the first sample of the session
-    lsl_now : ``pylsl.local_clock()`` read when these samples were pulled (s)
     """
 
     data: np.ndarray
     timestamps: np.ndarray
     first_index: int
-    lsl_now: float
 
 
 @dataclass
@@ -414,9 +430,9 @@ class EEGAcquisition:
         self._last_data_at = now
         self._got_data = True
         return self._process(np.asarray(raw, dtype=np.float64) * self.scale,
-                             np.asarray(ts, dtype=np.float64), now)
+                             np.asarray(ts, dtype=np.float64))
 
-    def _process(self, data: np.ndarray, ts: np.ndarray, now: float) -> list[Chunk]:
+    def _process(self, data: np.ndarray, ts: np.ndarray) -> list[Chunk]:
         assert self.desc is not None and self.quality is not None
         fs = self.desc.sample_rate
         # order: keep samples strictly after the running maximum
@@ -458,7 +474,7 @@ class EEGAcquisition:
         data, ts, index = data[keep], ts[keep], index[keep]
         # split where the index jumps
         cuts = np.flatnonzero(np.diff(index) != 1) + 1
-        return [Chunk(d.astype(np.float32), t, int(i[0]), now)
+        return [Chunk(d.astype(np.float32), t, int(i[0]))
                 for d, t, i in zip(np.split(data, cuts), np.split(ts, cuts),
                                    np.split(index, cuts), strict=True) if len(i)]
 

@@ -28,7 +28,7 @@ from mindgrasp_ros.interfaces.diagnostic_msgs.msg import DiagnosticArray, Diagno
 from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import EEGChunk
 
 from mindgrasp_eeg import EEGError
-from mindgrasp_eeg.acquisition import ERROR, OK, WARN, EEGAcquisition, ros_stamp_ns
+from mindgrasp_eeg.acquisition import ERROR, OK, WARN, EEGAcquisition, read_clocks, ros_stamp_ns
 from mindgrasp_eeg.params import AcquisitionParams
 from mindgrasp_eeg.ros_conversions import ns_to_time_fields
 from mindgrasp_ros import rclpy
@@ -107,10 +107,10 @@ class AcquisitionNode(rclpy.node.Node):
             return
         chunks = self.acq.poll()
         if chunks:
-            ros_now = self.get_clock().now().nanoseconds
+            lsl_now, ros_now = read_clocks(lambda: self.get_clock().now().nanoseconds)
             desc = self.acq.desc
             for chunk in chunks:
-                stamp = ros_stamp_ns(float(chunk.timestamps[0]), chunk.lsl_now, ros_now)
+                stamp = ros_stamp_ns(float(chunk.timestamps[0]), lsl_now, ros_now)
                 stamp = max(stamp, self._last_stamp_ns + 1)   # never backwards
                 self._last_stamp_ns = stamp
                 msg = EEGChunk(sample_rate=desc.sample_rate, channel_names=list(desc.channel_names),

@@ -368,3 +368,8 @@ class DdsParticipant:
         with self._lock:
             self.participant.__del__()
             self._topics.clear()
+            # explicit too: a Domain left to the GC (e.g. kept by a reference cycle) makes the
+            # next rclpy.init() in this process fail with PRECONDITION_NOT_MET
+            if self._domain is not None:
+                self._domain.__del__()
+                self._domain = None

@@ -134,8 +134,13 @@ class GraphCache:
                                              qos=purge)
         self._sub_reader = BuiltinDataReader(dds.participant, BuiltinTopicDcpsSubscription,
                                              qos=purge)
+        # cyclonedds' C layer calls these Python functions per sample and turns any exception
+        # raised in them into "Callfunc ... errored": a Ctrl-C (KeyboardInterrupt) landing there
+        # was lost that way, and the node kept running. They keep it for _update to re-raise.
+        self._interrupt: BaseException | None = None
         for reader in (self._pub_reader, self._sub_reader):
-            reader._constructor = _endpoint_without_type_id
+            reader._constructor = self._guarded(_endpoint_without_type_id)
+            reader._cqos_conv = self._guarded(reader._cqos_conv)
         alive = ViewState.Any | SampleState.Any | InstanceState.Alive
         self._alive = {id(r): ReadCondition(r, alive) for r in (self._pub_reader,
                                                                   self._sub_reader)}
@@ -145,6 +150,15 @@ class GraphCache:
         self._endpoints: dict[bytes, tuple[str, Any]] = {}  # gid -> (kind, DcpsEndpoint)
         #: participant gid -> [(namespace, name, reader gids, writer gids)]
         self._participants: dict[bytes, list[tuple[str, str, set[bytes], set[bytes]]]] = {}
+
+    def _guarded(self, function: Any) -> Any:
+        def call(*args: Any) -> Any:
+            try:
+                return function(*args)
+            except BaseException as exc:   # kept, and re-raised by _update after the read
+                self._interrupt = exc
+                return None
+        return call
 
     def close(self) -> None:
         try:
@@ -157,17 +171,16 @@ class GraphCache:
     def _update(self) -> None:
         with self._lock:
             endpoints: dict[bytes, tuple[str, Any]] = {}
-            try:
-                for kind, reader in (('publisher', self._pub_reader),
-                                     ('subscription', self._sub_reader)):
-                    for s in reader.read(N=_MAX_ENDPOINTS, condition=self._alive[id(reader)]):
-                        if s.topic_name:
-                            endpoints[s.key.bytes] = (kind, s)
-                self._endpoints = endpoints
-            except Exception:
-                # should cyclonedds-python still fail a read, read() took nothing: the next
-                # query sees every endpoint again; keep the last complete view meanwhile
-                pass
+            for kind, reader in (('publisher', self._pub_reader),
+                                 ('subscription', self._sub_reader)):
+                samples = reader.read(N=_MAX_ENDPOINTS, condition=self._alive[id(reader)])
+                if self._interrupt is not None:
+                    interrupt, self._interrupt = self._interrupt, None
+                    raise interrupt
+                for s in samples:
+                    if s is not None and s.topic_name:
+                        endpoints[s.key.bytes] = (kind, s)
+            self._endpoints = endpoints
             for data, _info in self._info_reader.take(1024):
                 try:
                     msg = deserialize(data, 'rmw_dds_common/msg/ParticipantEntitiesInfo')
