@@ -15,13 +15,36 @@ from mindgrasp_testing import NodeProcess
 REPO = Path(__file__).resolve().parents[1]
 SHARED_DATA = REPO.parent / 'shared' / 'data'
 
-# DDS stays on this host and on a domain of its own, so parallel runs never cross-talk; each
-# pytest-xdist worker (gw0, gw1, ...) takes the next domains after the run's.
+# DDS stays on this host and on a domain of its own: each pytest process (the xdist workers
+# gw0, gw1, ...) claims a domain no other test process on this host holds, so suites run side
+# by side never cross-talk (a sim of one suite answering another's test).
 os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
-os.environ.setdefault('ROS_DOMAIN_ID', str(100 + os.getpid() % 100))
-if os.environ.get('PYTEST_XDIST_WORKER', '').startswith('gw'):
-    os.environ['ROS_DOMAIN_ID'] = str(
-        (int(os.environ['ROS_DOMAIN_ID']) + 1 + int(os.environ['PYTEST_XDIST_WORKER'][2:])) % 232)
+_DOMAIN_LOCK = None
+
+
+def _claim_domain() -> int:
+    """A ROS domain id held by an exclusive lock on ``<tmp>/mindgrasp-test-domain-<id>.lock``
+    for the life of this process (the OS drops the lock when it ends, however it ends)."""
+    global _DOMAIN_LOCK
+    import fcntl
+    import tempfile
+
+    for i in range(231):
+        domain = 1 + (os.getpid() + i) % 231
+        path = Path(tempfile.gettempdir()) / f'mindgrasp-test-domain-{domain}.lock'
+        lock = path.open('w')  # held open, not closed on return: it keeps the claim
+        try:
+            fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            lock.close()
+            continue
+        _DOMAIN_LOCK = lock
+        return domain
+    raise RuntimeError('All 231 ROS domain ids are held by test processes on this host.')
+
+
+if 'ROS_DOMAIN_ID' not in os.environ or os.environ.get('PYTEST_XDIST_WORKER'):
+    os.environ['ROS_DOMAIN_ID'] = str(_claim_domain())
 if SHARED_DATA.is_dir():
     os.environ.setdefault('MNE_DATASETS_EEGBCI_PATH', str(SHARED_DATA))
 
