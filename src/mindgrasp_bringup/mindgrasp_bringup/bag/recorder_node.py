@@ -265,6 +265,7 @@ class RecorderNode(rclpy.node.Node):
             self.get_logger().warning(f'Not recorded: {topic}: {why}')
         return self.recorder.error
 
+
 def main(args: list[str] | None = None) -> int:
     """Record until Ctrl-C, SIGTERM or ``duration``; 1 if recording failed, 2 on a bad
     parameter."""
@@ -275,4 +276,6 @@ def main(args: list[str] | None = None) -> int:
 
 
 if __name__ == '__main__':
-    raise SystemExit(main())
+    from mindgrasp_ros.process import run_program
+
+    run_program(main)   # ends right after the node's cleanup: no slow interpreter teardown

@@ -66,4 +66,6 @@ def main(args: list[str] | None = None) -> int:
 
 
 if __name__ == '__main__':
-    raise SystemExit(main())
+    from mindgrasp_ros.process import run_program
+
+    run_program(main)   # ends right after the node's cleanup: no slow interpreter teardown
