@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import dataclasses
 import os
-import subprocess
 import sys
 import tempfile
 import threading
@@ -28,44 +27,7 @@ from mindgrasp_classifier.data import Recording
 from mindgrasp_classifier.errors import ClassifierError
 from mindgrasp_classifier.model import MiModel
 from mindgrasp_classifier.training import score_predictions
-
-
-class _Proc:
-    """A node process with its output in a log file."""
-
-    def __init__(self, args: list[str], log: Path) -> None:
-        self.log_path = log
-        self._log = log.open('wb')
-        env = dict(os.environ, PYTHONUNBUFFERED='1')
-        self.proc = subprocess.Popen([sys.executable, '-u', *args], stdout=self._log,
-                                     stderr=subprocess.STDOUT, env=env, start_new_session=True)
-
-    def output(self) -> str:
-        self._log.flush()
-        return self.log_path.read_text(errors='replace')
-
-    def wait_for(self, text: str, timeout: float) -> bool:
-        end = time.monotonic() + timeout
-        while time.monotonic() < end:
-            if text in self.output():
-                return True
-            if self.proc.poll() is not None:
-                break
-            time.sleep(0.05)
-        return text in self.output()
-
-    def stop(self) -> None:
-        import signal
-
-        for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGKILL):
-            if self.proc.poll() is not None:
-                break
-            self.proc.send_signal(sig)
-            try:
-                self.proc.wait(5)
-            except subprocess.TimeoutExpired:
-                continue
-        self._log.close()
+from mindgrasp_ros.node_process import NodeProcess
 
 
 def _stamp(msg: Any) -> float:
@@ -92,7 +54,7 @@ def stream_live(model_path: str, rec: Recording, workdir: Path,
     data = np.where(np.isfinite(rec.data), rec.data, 0.0)   # the player streams numbers only
     player = DatasetPlayer(dataclasses.replace(rec, data=data, annotations=[]),
                            name, block=max(1, round(rec.rate / 64)))
-    procs: list[_Proc] = []
+    procs: list[NodeProcess] = []
     rclpy.init(args=[])
     try:
         node = rclpy.node.Node(f'classifier_live_eval_{uuid.uuid4().hex[:6]}')
@@ -109,21 +71,25 @@ def stream_live(model_path: str, rec: Recording, workdir: Path,
         node.create_subscription(
             MIPrediction, '/bci/prediction',
             lambda m: preds.append((_stamp(m), np.asarray(m.distances, dtype=float))), 100)
-        acq = _Proc(['-m', 'mindgrasp_eeg.acquisition_node', '--ros-args',
-                     '-r', f'__node:=eeg_acquisition_{name[-8:]}',
-                     '-p', f'stream_name:={name}', '-p', f'n_channels:={len(rec.channels)}',
-                     '-p', f'sample_rate:={rec.rate}', '-p', 'check_channel_names:=false',
-                     '-p', 'adapt_to_stream:=true', '-p', 'resolve_timeout:=30.0'],
-                    workdir / 'acquisition.log')
+        env = dict(os.environ, PYTHONUNBUFFERED='1')
+        acq = NodeProcess(
+            'mindgrasp_eeg.acquisition_node',
+            ['--ros-args', '-r', f'__node:=eeg_acquisition_{name[-8:]}',
+             '-p', f'stream_name:={name}', '-p', f'n_channels:={len(rec.channels)}',
+             '-p', f'sample_rate:={rec.rate}', '-p', 'check_channel_names:=false',
+             '-p', 'adapt_to_stream:=true', '-p', 'resolve_timeout:=30.0'],
+            env, workdir / 'acquisition.log')
         procs.append(acq)
-        if not acq.wait_for('Connected to', 60):
+        if not acq.wait_for_output('Connected to', 60):
             msg = f'The acquisition node did not connect to the player:\n{acq.output()[-2000:]}'
             raise ClassifierError(msg)
-        clf = _Proc(['-m', 'mindgrasp_classifier.classifier_node', '--ros-args',
-                     '-r', f'__node:=classifier_{name[-8:]}', '-p', f'model:={model_path}',
-                     '-p', 'classes:=[]'], workdir / 'classifier.log')
+        clf = NodeProcess(
+            'mindgrasp_classifier.classifier_node',
+            ['--ros-args', '-r', f'__node:=classifier_{name[-8:]}', '-p', f'model:={model_path}',
+             '-p', 'classes:=[]'],
+            env, workdir / 'classifier.log')
         procs.append(clf)
-        if not clf.wait_for('Loaded', 60):
+        if not clf.wait_for_output('Loaded', 60):
             msg = f'The classifier node did not start:\n{clf.output()[-2000:]}'
             raise ClassifierError(msg)
         pub_ready = time.monotonic() + 30
@@ -149,7 +115,7 @@ def stream_live(model_path: str, rec: Recording, workdir: Path,
                     chunks[-1][1] + chunks[-1][2] >= n_expected and \
                     preds and preds[-1][0] >= chunks[-1][0]:
                 break
-            if clf.proc.poll() is not None:
+            if clf.poll() is not None:
                 msg = f'The classifier node stopped:\n{clf.output()[-2000:]}'
                 raise ClassifierError(msg)
         bar.close()
