@@ -82,7 +82,7 @@ def run_dir(tmp_path: Path) -> tuple[Path, np.ndarray]:
 def test_session_from_bag(run_dir) -> None:
     path, data = run_dir
     s = read_session(path)
-    assert s.sample_rate == FS and s.channel_names == NAMES and s.start_ns == T0_NS
+    assert s.rate == FS and s.channels == NAMES and s.start_ns == T0_NS
     assert s.data.shape == (1000, 3) and s.n_missing == 50
     np.testing.assert_allclose(s.data[:400], data[:400].astype(np.float32))
     assert ('BAD_gap' in [a[2] for a in s.annotations])
@@ -142,3 +142,17 @@ def test_cli(run_dir) -> None:
                           timeout=120)
     assert proc.returncode == 0, proc.stderr
     assert '1000 samples x 3 channels at 250 Hz' in proc.stdout and out.is_file()
+
+
+def test_the_classifier_reads_the_same_recording(run_dir) -> None:
+    """The exporter and the classifier's trainer read a run into one type, with the same samples,
+    gaps and start time."""
+    from mindgrasp_classifier.data import load_bag
+
+    path, _data = run_dir
+    exported, trained = read_session(path), load_bag(path)
+    assert exported.channels == trained.channels and exported.rate == trained.rate
+    assert exported.first_sample_index == trained.first_sample_index
+    np.testing.assert_array_equal(exported.data, trained.data)     # NaN in the same gap
+    assert exported.n_missing == trained.n_missing == 50
+    assert abs(exported.start_ns - trained.start_ns) < 1e9 / FS

@@ -32,8 +32,8 @@ def test_launch_eeg_records_a_played_dataset(tmp_path: Path, stream_name: str) -
     assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
     assert 'adopting the stream' in run.stdout + run.stderr  # 64 ch @ 160 Hz, not 32 @ 250
     session = read_session(tmp_path / 'run')
-    assert session.sample_rate == 160.0 and len(session.channel_names) == 64
-    assert session.channel_names[:3] == ['FC5', 'FC3', 'FC1']
+    assert session.rate == 160.0 and len(session.channels) == 64
+    assert session.channels[:3] == ['FC5', 'FC3', 'FC1']
     assert len(session.data) > 3 * 160 and session.n_missing == 0
     rec = load_recording(path)
     k0 = int(np.argmin(np.abs(rec.data[:20000] - session.data[0]).sum(axis=1)))

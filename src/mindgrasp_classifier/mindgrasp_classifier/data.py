@@ -267,7 +267,8 @@ def load_bag(path: str | Path, eeg_topic: str = '/eeg/raw',
             events.append((onset, k))
     return Recording(data=data, rate=rate, channels=channels,
                      events=np.array(events, dtype=int).reshape(-1, 2), source=str(bag_dir),
-                     first_sample_index=base, n_aborted=n_aborted)
+                     first_sample_index=base, n_aborted=n_aborted,
+                     start_ns=round((offset + base / rate) * 1e9))
 
 
 def _find_bag_dir(path: Path) -> Path:

@@ -192,6 +192,8 @@ class Recording:
         Stream index of ``data[0]`` (0 for files).
     n_aborted : int
         Cued trials left out of ``events`` because they were cut short (recorded runs).
+    start_ns : int
+        ROS time of ``data[0]`` (ns) for recorded runs; 0 when unknown (files).
     """
 
     data: np.ndarray
@@ -202,8 +204,14 @@ class Recording:
     source: str = ''
     first_sample_index: int = 0
     n_aborted: int = 0
+    start_ns: int = 0
 
     @property
     def duration(self) -> float:
         """Length (s)."""
         return len(self.data) / self.rate
+
+    @property
+    def n_missing(self) -> int:
+        """Samples (rows) with a NaN: lost by the acquisition, or not finite in the file."""
+        return int(np.isnan(self.data).any(axis=1).sum())

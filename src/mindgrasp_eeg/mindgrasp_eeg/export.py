@@ -28,35 +28,16 @@ Units: EEGChunk data are volts; MNE keeps volts (FIF float32; EDF scales to 16-b
 from __future__ import annotations
 
 import datetime as dt
-from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+
+from mindgrasp_common.types import Recording
 
 from . import EEGError
 from .montage import class_name
 
 FORMATS = ('fif', 'edf')
-
-
-@dataclass
-class Session:
-    """EEG of one recording.
-
-    data : ndarray, shape (n_samples, n_channels), float64, volts (zeros in gaps)
-    sample_rate : Hz
-    channel_names : n_channels labels
-    start_ns : ROS time of sample 0 (ns)
-    annotations : (onset s, duration s, description)
-    n_missing : samples not received (in gaps)
-    """
-
-    data: np.ndarray
-    sample_rate: float
-    channel_names: list[str]
-    start_ns: int
-    annotations: list[tuple[float, float, str]] = field(default_factory=list)
-    n_missing: int = 0
 
 
 def find_bag(path: str | Path) -> Path:
@@ -84,8 +65,9 @@ def _stamp_ns(header: object) -> int:
     return int(header.stamp.sec) * 1_000_000_000 + int(header.stamp.nanosec)
 
 
-def read_session(path: str | Path, eeg_topic: str = '/eeg/raw') -> Session:
-    """Read EEG and annotation topics of a run directory or bag.
+def read_session(path: str | Path, eeg_topic: str = '/eeg/raw') -> Recording:
+    """Read EEG and annotation topics of a run directory or bag: a :class:`Recording` (volts, NaN
+    where samples were lost, ``start_ns`` the ROS time of sample 0) with the annotations above.
 
     Raises
     ------
@@ -159,7 +141,7 @@ def read_session(path: str | Path, eeg_topic: str = '/eeg/raw') -> Session:
     chunks.sort(key=lambda c: c[0])
     i0 = chunks[0][0]
     n_total = chunks[-1][0] + len(chunks[-1][2]) - i0
-    data = np.zeros((n_total, len(names)))
+    data = np.full((n_total, len(names)), np.nan)
     have = np.zeros(n_total, dtype=bool)
     for first, _stamp, block in chunks:
         data[first - i0:first - i0 + len(block)] = block
@@ -181,21 +163,23 @@ def read_session(path: str | Path, eeg_topic: str = '/eeg/raw') -> Session:
         ann.append((a / fs, (b - a) / fs, 'BAD_gap'))
     if skipped:
         ann.append((0.0, 0.0, f'note/{skipped} chunks with another channel layout skipped'))
-    return Session(data, fs, list(names), start_ns, sorted(ann), int((~have).sum()))
+    return Recording(data, fs, list(names), annotations=sorted(ann), source=str(bag),
+                     first_sample_index=i0, start_ns=start_ns)
 
 
-def to_raw(session: Session):
-    """An ``mne.io.RawArray`` (volts, EEG channels) with annotations and measurement date."""
+def to_raw(recording: Recording):
+    """An ``mne.io.RawArray`` (volts, EEG channels; lost samples as zeros, under their
+    ``BAD_gap`` annotations) with annotations and measurement date."""
     import mne
 
-    info = mne.create_info(session.channel_names, session.sample_rate, 'eeg')
-    raw = mne.io.RawArray(session.data.T, info, verbose='error')
-    raw.set_meas_date(dt.datetime.fromtimestamp(session.start_ns * 1e-9, tz=dt.timezone.utc))
+    info = mne.create_info(recording.channels, recording.rate, 'eeg')
+    raw = mne.io.RawArray(np.nan_to_num(recording.data, nan=0.0).T, info, verbose='error')
+    raw.set_meas_date(dt.datetime.fromtimestamp(recording.start_ns * 1e-9, tz=dt.timezone.utc))
     # electrode positions for topographies and source analysis; channels outside 10-20 keep none
     raw.set_montage(mne.channels.make_standard_montage('standard_1020'), on_missing='ignore',
                     match_case=False, verbose='error')
-    if session.annotations:
-        onset, duration, desc = zip(*session.annotations, strict=True)
+    if recording.annotations:
+        onset, duration, desc = zip(*recording.annotations, strict=True)
         raw.set_annotations(mne.Annotations(onset, duration, desc,
                                             orig_time=raw.info['meas_date']))
     return raw
@@ -210,14 +194,14 @@ def export_session(path: str | Path, output: str | Path | None = None, fmt: str 
     if fmt not in FORMATS:
         msg = f'The export format must be one of {FORMATS}; {fmt!r} is not supported.'
         raise EEGError(msg)
-    session = read_session(path, eeg_topic)
+    recording = read_session(path, eeg_topic)
     bag = find_bag(path)
     base = bag.parent if bag.name == 'bag' else bag
     out = Path(output) if output else base / ('eeg_raw.fif' if fmt == 'fif' else 'eeg.edf')
     if out.exists() and not overwrite:
         msg = f'{str(out)!r} exists already; pass --overwrite or another --output.'
         raise EEGError(msg)
-    raw = to_raw(session)
+    raw = to_raw(recording)
     if fmt == 'fif':
         raw.save(out, overwrite=True, verbose='error')
     else:

@@ -29,14 +29,14 @@ def main(args: argparse.Namespace) -> int:
     from .export import export_session, read_session
 
     try:
-        session = read_session(args.path, args.eeg_topic)
+        recording = read_session(args.path, args.eeg_topic)
         out = export_session(args.path, args.output, args.format, args.eeg_topic,
                              overwrite=args.overwrite)
     except EEGError as exc:
         print(f'mindgrasp export eeg: {exc}', file=sys.stderr)
         return 1
-    n_ann = sum(1 for a in session.annotations if not a[2].startswith('BAD_'))
-    print(f'Wrote {out}: {len(session.data)} samples x {len(session.channel_names)} channels at '
-          f'{session.sample_rate:g} Hz ({len(session.data) / session.sample_rate:.1f} s), '
-          f'{n_ann} annotations, {session.n_missing} missing samples.')
+    n_ann = sum(1 for a in recording.annotations if not a[2].startswith('BAD_'))
+    print(f'Wrote {out}: {len(recording.data)} samples x {len(recording.channels)} channels at '
+          f'{recording.rate:g} Hz ({recording.duration:.1f} s), {n_ann} annotations, '
+          f'{recording.n_missing} missing samples.')
     return 0
