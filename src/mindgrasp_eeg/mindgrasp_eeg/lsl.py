@@ -285,11 +285,12 @@ class EEGOutlet:
         self.info = info
         self._outlet = pylsl.StreamOutlet(info, chunk_size=chunk_size, max_buffered=30)
 
-    def push_volts(self, data: np.ndarray, timestamp: float = 0.0) -> None:
+    def push_volts(self, data: np.ndarray, timestamp: float | np.ndarray = 0.0) -> None:
         """Push samples given in volts, shape (n_samples, n_channels).
 
-        ``timestamp`` (LSL s) is that of the LAST sample (0: now); earlier samples are placed
-        back at the nominal rate, as LSL does.
+        ``timestamp`` (LSL s): a float is that of the LAST sample (0: now), earlier samples are
+        placed back at the nominal rate, as LSL does; an array, shape (n_samples,), gives each
+        sample's own (a playback faster than the nominal rate).
         """
         data = np.asarray(data)
         if data.ndim != 2 or data.shape[1] != self.n_channels:
@@ -297,8 +298,9 @@ class EEGOutlet:
                    f'{data.shape}.')
             raise EEGError(msg)
         if len(data):
+            stamps = timestamp if np.isscalar(timestamp) else [float(t) for t in timestamp]
             self._outlet.push_chunk(np.ascontiguousarray(data / self.scale, dtype=np.float32),
-                                    timestamp)
+                                    stamps)
 
     def have_consumers(self) -> bool:
         """True when at least one inlet is connected."""

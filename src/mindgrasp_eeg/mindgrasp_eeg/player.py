@@ -211,8 +211,10 @@ class DatasetPlayer:
             pos = k % n_total
             n = min(self.block, due - k, n_total - pos)
             self._push_markers(k, k + n)
+            # each sample its own stamp: LSL would space them at the nominal rate (the file's),
+            # not at the playback's
             self.outlet.push_volts(self.rec.data[pos:pos + n],
-                                   self._t0 + (k + n - 1) / (fs * self.rate))
+                                   self._t0 + np.arange(k, k + n) / (fs * self.rate))
             self.n_pushed += n
             pushed += n
         return pushed
