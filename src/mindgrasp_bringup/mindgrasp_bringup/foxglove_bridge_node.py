@@ -30,7 +30,7 @@ from mindgrasp_bringup.bag.qos import adapted_qos, qos_to_dict, resubscribe_qos
 from mindgrasp_bringup.bag.ros_glue import message_class, qos_profile
 from mindgrasp_bringup.live_view import DEFAULT_PORT, FoxgloveServer, LiveViewError
 from mindgrasp_ros import rclpy
-from mindgrasp_ros.node_main import run_node
+from mindgrasp_ros.node_main import end_after, run_node
 from mindgrasp_ros.params import ParameterError, declare_params, param
 from mindgrasp_ros.typesupport import message_definition
 
@@ -93,8 +93,7 @@ class FoxgloveBridgeNode(rclpy.node.Node):
                                '(Open connection > Foxglove WebSocket).')
         self.create_timer(self.params.discovery_period, self.discover_callback)
         self.create_timer(0.05, self.clients_callback)
-        if self.params.duration > 0:
-            self.create_timer(self.params.duration, self.duration_callback)
+        end_after(self, self.params.duration)
         self.discover_callback()
 
     def _wanted(self, topic: str) -> bool:
@@ -153,9 +152,6 @@ class FoxgloveBridgeNode(rclpy.node.Node):
 
         self._subscriptions[topic] = self.create_subscription(
             message_class(self._types[topic]), topic, forward, qos_profile(rclpy, qos), raw=True)
-
-    def duration_callback(self) -> None:
-        self.done.set_result(0)
 
     def destroy_node(self) -> None:
         sent = sum(t.messages for t in self.server.topics.values())
