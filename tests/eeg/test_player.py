@@ -59,7 +59,7 @@ def test_eegmmidb_playback_rate_and_marker_alignment(stream_name) -> None:
             if len(t):
                 data.append(d)
                 ts.append(t)
-                arrival.append((time.monotonic(), len(t)))
+                arrival.append(pylsl.local_clock() - t[-1])    # how late its last sample is
             m, mt = markers.pull_chunk(timeout=0.0)
             mk += [(row[0], stamp) for row, stamp in zip(m, mt, strict=True)]
             time.sleep(0.01)
@@ -70,12 +70,14 @@ def test_eegmmidb_playback_rate_and_marker_alignment(stream_name) -> None:
     # the samples are the file's, in order: locate the first one in the file
     k0 = int(np.argmin(np.abs(rec.data[:2000] - data[0]).sum(axis=1)))
     np.testing.assert_allclose(data, rec.data[k0:k0 + len(data)], atol=1e-9)
-    # effective rate from arrival times (wall clock) within 1 %
-    t_arr = np.array([a for a, _ in arrival])
-    counts = np.cumsum([n for _, n in arrival])
-    warm = t_arr > t_arr[0] + 1.0
-    rate = (counts[warm][-1] - counts[warm][0]) / (t_arr[warm][-1] - t_arr[warm][0])
-    assert rate == pytest.approx(FS, rel=0.01)
+    # real time: samples stamped 1 / FS apart arrive when their time has come, never before,
+    # and not later and later (a pace below FS); medians, so a stall of this reader (a loaded
+    # host) does not count as the player's
+    np.testing.assert_allclose(np.diff(ts), 1 / FS, atol=1e-4)
+    lag = np.array(arrival)
+    assert lag.min() > -0.005, lag.min()
+    quarter = max(1, len(lag) // 4)
+    assert abs(np.median(lag[-quarter:]) - np.median(lag[:quarter])) < 0.05, lag
     # markers: each one within 10 ms of the timestamp of its annotation's sample
     assert mk, 'no marker arrived'
     onsets = {round(o * FS): desc for o, _d, desc in rec.annotations}
