@@ -34,6 +34,7 @@ from mindgrasp_eeg.ros_conversions import ns_to_time_fields
 from mindgrasp_ros import rclpy
 from mindgrasp_ros.node_main import end_after, fail, run_node
 from mindgrasp_ros.params import declare_params
+from mindgrasp_ros.topics import EEG_RAW, EEG_STATUS
 
 _LEVELS = {OK: DiagnosticStatus.OK, WARN: DiagnosticStatus.WARN, ERROR: DiagnosticStatus.ERROR}
 
@@ -55,11 +56,8 @@ class AcquisitionNode(rclpy.node.Node):
             quality_window=p.quality_window, flat_threshold=p.flat_threshold,
             rail_threshold=p.rail_threshold,
             hostname=socket.gethostname() if p.hostname == 'local' else p.hostname)
-        qos_raw = rclpy.qos.QoSProfile(depth=100,
-                                       reliability=rclpy.qos.ReliabilityPolicy.BEST_EFFORT,
-                                       durability=rclpy.qos.DurabilityPolicy.VOLATILE)
-        self.pub_raw = self.create_publisher(EEGChunk, '/eeg/raw', qos_raw)
-        self.pub_status = self.create_publisher(DiagnosticArray, '/eeg/status', 10)
+        self.pub_raw = self.create_publisher(EEGChunk, EEG_RAW.name, EEG_RAW.qos)
+        self.pub_status = self.create_publisher(DiagnosticArray, EEG_STATUS.name, EEG_STATUS.qos)
         self._wanted = (f'name {p.stream_name!r}, type {p.stream_type!r}, source_id '
                         f'{p.source_id!r}, host {self.acq.hostname!r}')
         if not self.acq.pinned:

@@ -33,6 +33,14 @@ from pathlib import Path
 import numpy as np
 
 from mindgrasp_common.types import Recording
+from mindgrasp_ros.topics import (
+    EEG_RAW,
+    FSM_STATE,
+    TASK_RESULT,
+    TASK_TARGET,
+    TRAINER_PROMPT,
+    VIRTUAL_SUBJECT_INTENT,
+)
 
 from . import EEGError
 from .montage import class_name
@@ -65,7 +73,7 @@ def _stamp_ns(header: object) -> int:
     return int(header.stamp.sec) * 1_000_000_000 + int(header.stamp.nanosec)
 
 
-def read_session(path: str | Path, eeg_topic: str = '/eeg/raw') -> Recording:
+def read_session(path: str | Path, eeg_topic: str = EEG_RAW.name) -> Recording:
     """Read EEG and annotation topics of a run directory or bag: a :class:`Recording` (volts, NaN
     where samples were lost, ``start_ns`` the ROS time of sample 0) with the annotations above.
 
@@ -86,8 +94,8 @@ def read_session(path: str | Path, eeg_topic: str = '/eeg/raw') -> Recording:
     skipped = 0
     try:
         with Reader(bag) as reader:
-            wanted = {eeg_topic, '/trainer/prompt', '/task/target', '/virtual_subject/intent',
-                      '/task/result', '/fsm/state'}
+            wanted = {eeg_topic, TRAINER_PROMPT.name, TASK_TARGET.name,
+                      VIRTUAL_SUBJECT_INTENT.name, TASK_RESULT.name, FSM_STATE.name}
             conns = [c for c in reader.connections if c.topic in wanted]
             for conn, t_log, raw in reader.messages(connections=conns):
                 msg = store.deserialize_cdr(raw, conn.msgtype)
@@ -100,18 +108,18 @@ def read_session(path: str | Path, eeg_topic: str = '/eeg/raw') -> Recording:
                     data = np.asarray(msg.data, dtype=np.float64).reshape(
                         int(msg.n_samples), len(this[1]))
                     chunks.append((int(msg.first_sample_index), _stamp_ns(msg.header), data))
-                elif conn.topic == '/trainer/prompt':
+                elif conn.topic == TRAINER_PROMPT.name:
                     events.append((_stamp_ns(msg.header), float(msg.duration),
                                    f'prompt/{msg.phase}/{class_name(int(msg.class_index))}'))
-                elif conn.topic == '/task/target':
+                elif conn.topic == TASK_TARGET.name:
                     targets.append((_stamp_ns(msg.header) or t_log,
                                     f'target/{msg.colour} {msg.shape}'))
-                elif conn.topic == '/task/result':
+                elif conn.topic == TASK_RESULT.name:
                     end = _stamp_ns(msg.header) or t_log
                     outcome = 'success' if msg.success else 'failure'
                     events.append((end - round(float(msg.duration) * 1e9), float(msg.duration),
                                    f'result/{outcome}/{msg.desired_object}'))
-                elif conn.topic == '/fsm/state':
+                elif conn.topic == FSM_STATE.name:
                     states.append((_stamp_ns(msg.header) or t_log,
                                    f'state/{int(msg.state)} {msg.state_name}'))
                 else:
@@ -186,7 +194,7 @@ def to_raw(recording: Recording):
 
 
 def export_session(path: str | Path, output: str | Path | None = None, fmt: str = 'fif',
-                   eeg_topic: str = '/eeg/raw', overwrite: bool = False) -> Path:
+                   eeg_topic: str = EEG_RAW.name, overwrite: bool = False) -> Path:
     """Write the EEG of a run directory or bag as FIF or EDF; returns the file written.
 
     The default output is ``<run dir>/eeg_raw.fif`` (or ``eeg.edf``) next to the bag.

@@ -11,6 +11,8 @@ from __future__ import annotations
 import argparse
 import sys
 
+from mindgrasp_ros.topics import EEG_RAW
+
 from . import EEGError
 
 
@@ -20,7 +22,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--format', choices=['fif', 'edf'], default='fif', help='output format')
     parser.add_argument('-o', '--output', default=None,
                         help='output file (default: eeg_raw.fif / eeg.edf in the run directory)')
-    parser.add_argument('--eeg-topic', default='/eeg/raw', help='topic of the EEGChunk messages')
+    parser.add_argument('--eeg-topic', default=EEG_RAW.name, help='topic of the EEGChunk messages')
     parser.add_argument('--overwrite', action='store_true', help='replace an existing file')
 
 

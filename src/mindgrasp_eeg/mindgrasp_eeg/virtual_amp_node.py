@@ -37,6 +37,15 @@ from mindgrasp_eeg.virtual_amp import VirtualAmplifier
 from mindgrasp_ros import rclpy
 from mindgrasp_ros.node_main import end_after, run_node
 from mindgrasp_ros.params import declare_params
+from mindgrasp_ros.topics import (
+    EEG_RAW,
+    FSM_STATE,
+    JOINT_STATES,
+    SIM_OBJECTS,
+    TASK_TARGET,
+    TRAINER_PROMPT,
+    VIRTUAL_SUBJECT_INTENT,
+)
 
 
 class VirtualAmpNode(rclpy.node.Node):
@@ -63,25 +72,25 @@ class VirtualAmpNode(rclpy.node.Node):
             p.subject_mode, accuracy=p.accuracy, reaction_delay=p.reaction_delay,
             lapse_rate=p.lapse_rate, seed=p.seed, active_phases=p.active_phases,
             decision_period=p.decision_period, heading_tolerance=p.heading_tolerance)
+        # depth 10, not the table's 1: the subscriptions' queues and the intent's late-joiner
+        # history stay as they were (the table's LATCHED is depth 1)
         latched = rclpy.qos.QoSProfile(depth=10,
                                        reliability=rclpy.qos.ReliabilityPolicy.RELIABLE,
                                        durability=rclpy.qos.DurabilityPolicy.TRANSIENT_LOCAL)
         mode = p.subject_mode
         if mode == 'follow':
-            self.create_subscription(Prompt, '/trainer/prompt', self.prompt_callback, latched)
+            self.create_subscription(Prompt, TRAINER_PROMPT.name, self.prompt_callback, latched)
         elif mode == 'pursue':
-            self.create_subscription(TaskTarget, '/task/target', self.target_callback, latched)
-            self.create_subscription(MarkerArray, '/sim/objects', self.objects_callback, latched)
-            self.create_subscription(JointState, '/joint_states', self.joints_callback,
+            self.create_subscription(TaskTarget, TASK_TARGET.name, self.target_callback, latched)
+            self.create_subscription(MarkerArray, SIM_OBJECTS.name, self.objects_callback,
+                                     latched)
+            self.create_subscription(JointState, JOINT_STATES.name, self.joints_callback,
                                      rclpy.qos.qos_profile_sensor_data)
-            self.create_subscription(FsmState, '/fsm/state', self.fsm_callback, latched)
-        self.pub_intent = self.create_publisher(String, '/virtual_subject/intent', latched)
+            self.create_subscription(FsmState, FSM_STATE.name, self.fsm_callback, latched)
+        self.pub_intent = self.create_publisher(String, VIRTUAL_SUBJECT_INTENT.name, latched)
         outlet, self.markers, self.pub_raw = None, None, None
         if p.output == 'ros':
-            qos_raw = rclpy.qos.QoSProfile(depth=100,
-                                           reliability=rclpy.qos.ReliabilityPolicy.BEST_EFFORT,
-                                           durability=rclpy.qos.DurabilityPolicy.VOLATILE)
-            self.pub_raw = self.create_publisher(EEGChunk, '/eeg/raw', qos_raw)
+            self.pub_raw = self.create_publisher(EEGChunk, EEG_RAW.name, EEG_RAW.qos)
         else:
             # the outlets last, so streaming starts soon after the stream becomes visible
             outlet = EEGOutlet(p.stream_name, self.channel_names, self.sample_rate,
