@@ -7,6 +7,7 @@ import json
 from typing import Any
 
 from mindgrasp_classifier.data import Recording, load_inputs
+from mindgrasp_ros.topics import EEG_RAW, TRAINER_PROMPT, VIRTUAL_SUBJECT_INTENT
 
 
 def add_data_arguments(parser: argparse.ArgumentParser) -> None:
@@ -24,14 +25,14 @@ def add_data_arguments(parser: argparse.ArgumentParser) -> None:
                    help='EEGMMIDB runs for --eegbci (default 4 6 8 10)')
     g.add_argument('--event-map', metavar='MAP',
                    help='annotation to class for other files, e.g. T1=left_hand,T2=right_hand')
-    g.add_argument('--eeg-topic', default='/eeg/raw', help='EEG topic in bags (default /eeg/raw)')
-    g.add_argument('--prompt-topic', default='/trainer/prompt',
+    g.add_argument('--eeg-topic', default=EEG_RAW.name, help='EEG topic in bags (default /eeg/raw)')
+    g.add_argument('--prompt-topic', default=TRAINER_PROMPT.name,
                    help='prompt topic in bags (default /trainer/prompt)')
     g.add_argument('--labels', choices=('prompt', 'intent'), default='prompt',
                    help='labels of bag runs: the trainer/Graz prompts (prompt, default), or the '
                         "virtual subject's intent for demo and experiment runs (intent, from "
                         '--intent-topic; epochs [tmin, tmax] tile each intent)')
-    g.add_argument('--intent-topic', default='/virtual_subject/intent',
+    g.add_argument('--intent-topic', default=VIRTUAL_SUBJECT_INTENT.name,
                    help='intent topic in bags for --labels intent (default '
                         '/virtual_subject/intent)')
     g.add_argument('--keep-aborted', action='store_true',

@@ -19,6 +19,7 @@ from mindgrasp_classifier.errors import ClassifierError
 from mindgrasp_classifier.model import CLASS_NAMES, class_index
 from mindgrasp_common.mi import NO_CLASS
 from mindgrasp_common.types import Recording
+from mindgrasp_ros.topics import EEG_RAW, TRAINER_PROMPT, VIRTUAL_SUBJECT_INTENT
 
 #: EEGMMIDB run -> {annotation: MIndGrasp class} (../shared/data/EEGMMIDB-README.md).
 EEGMMIDB_RUNS: dict[int, dict[str, int]] = {
@@ -161,9 +162,9 @@ def intent_events(changes: Sequence[tuple[float, str]], end: float, tmin: float,
     return events
 
 
-def load_bag(path: str | Path, eeg_topic: str = '/eeg/raw',
-             prompt_topic: str = '/trainer/prompt', *, labels: str = 'prompt',
-             keep_aborted: bool = False, intent_topic: str = '/virtual_subject/intent',
+def load_bag(path: str | Path, eeg_topic: str = EEG_RAW.name,
+             prompt_topic: str = TRAINER_PROMPT.name, *, labels: str = 'prompt',
+             keep_aborted: bool = False, intent_topic: str = VIRTUAL_SUBJECT_INTENT.name,
              tmin: float = 0.5, tmax: float = 2.5) -> Recording:
     """Load a recorded run (rosbag2 folder) with EEG chunks and its labels.
 
@@ -289,9 +290,9 @@ def _find_bag_dir(path: Path) -> Path:
 
 def load_inputs(edf: Iterable[str] = (), bags: Iterable[str] = (), event_map: str | None = None,
                 eegbci_subject: int | None = None, eegbci_runs: Sequence[int] = (),
-                eeg_topic: str = '/eeg/raw',
-                prompt_topic: str = '/trainer/prompt', *, labels: str = 'prompt',
-                keep_aborted: bool = False, intent_topic: str = '/virtual_subject/intent',
+                eeg_topic: str = EEG_RAW.name,
+                prompt_topic: str = TRAINER_PROMPT.name, *, labels: str = 'prompt',
+                keep_aborted: bool = False, intent_topic: str = VIRTUAL_SUBJECT_INTENT.name,
                 tmin: float = 0.5, tmax: float = 2.5) -> list[Recording]:
     """Load every input named on a command line; raises if none is given."""
     emap = parse_event_map(event_map) if event_map else None

@@ -28,6 +28,7 @@ from mindgrasp_classifier.errors import ClassifierError
 from mindgrasp_classifier.model import MiModel
 from mindgrasp_classifier.training import score_predictions
 from mindgrasp_ros.node_process import NodeProcess
+from mindgrasp_ros.topics import BCI_PREDICTION, EEG_RAW
 
 
 def _stamp(msg: Any) -> float:
@@ -62,14 +63,12 @@ def stream_live(model_path: str, rec: Recording, workdir: Path,
         executor.add_node(node)
         chunks: list[tuple[float, int, int]] = []
         preds: list[tuple[float, np.ndarray]] = []
-        sensor = rclpy.qos.QoSProfile(depth=100,
-                                      reliability=rclpy.qos.ReliabilityPolicy.BEST_EFFORT)
         node.create_subscription(
-            EEGChunk, '/eeg/raw',
+            EEGChunk, EEG_RAW.name,
             lambda m: chunks.append((_stamp(m), int(m.first_sample_index), int(m.n_samples))),
-            sensor)
-        node.create_subscription(
-            MIPrediction, '/bci/prediction',
+            EEG_RAW.qos)
+        node.create_subscription(     # depth 100 (the table's is 10): no prediction dropped
+            MIPrediction, BCI_PREDICTION.name,
             lambda m: preds.append((_stamp(m), np.asarray(m.distances, dtype=float))), 100)
         env = dict(os.environ, PYTHONUNBUFFERED='1')
         acq = NodeProcess(
@@ -94,7 +93,7 @@ def stream_live(model_path: str, rec: Recording, workdir: Path,
             raise ClassifierError(msg)
         pub_ready = time.monotonic() + 30
         while time.monotonic() < pub_ready and not (
-                node.count_publishers('/bci/prediction') and node.count_publishers('/eeg/raw')):
+                node.count_publishers(BCI_PREDICTION.name) and node.count_publishers(EEG_RAW.name)):
             executor.spin_once(timeout_sec=0.05)
         time.sleep(1.0)                              # let discovery settle on both sides
         thread = threading.Thread(target=player.run, kwargs={'period': 0.005}, daemon=True)
