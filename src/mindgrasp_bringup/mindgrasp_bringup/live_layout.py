@@ -15,6 +15,17 @@ import sys
 from pathlib import Path
 
 from mindgrasp_common.resources import resource_path
+from mindgrasp_ros.topics import (
+    BCI_PREDICTION,
+    COLOR_IMAGE,
+    EEG_RAW,
+    FSM_STATE,
+    ROBOT_DESCRIPTION,
+    SIM_OBJECTS,
+    TF,
+    TF_STATIC,
+    VISION_OVERLAY,
+)
 
 __all__ = ['LAYOUT_FILE', 'TOPICS', 'build_layout']
 
@@ -22,8 +33,8 @@ __all__ = ['LAYOUT_FILE', 'TOPICS', 'build_layout']
 LAYOUT_FILE = resource_path('mindgrasp_bringup', 'foxglove') / 'mindgrasp_live.json'
 
 #: topics the layout shows (each published by the demo)
-TOPICS = ('/vision/overlay', '/camera/color/image_raw', '/robot_description', '/tf',
-          '/tf_static', '/sim/objects', '/eeg/raw', '/bci/prediction', '/fsm/state')
+TOPICS = tuple(t.name for t in (VISION_OVERLAY, COLOR_IMAGE, ROBOT_DESCRIPTION, TF, TF_STATIC,
+                                 SIM_OBJECTS, EEG_RAW, BCI_PREDICTION, FSM_STATE))
 
 
 def build_layout() -> str:
@@ -31,27 +42,27 @@ def build_layout() -> str:
     import foxglove.layouts as fl
 
     camera = fl.ImagePanel(title='Eye-in-hand camera + overlay', config=fl.ImageConfig(
-        image_mode=fl.ImageModeConfig(image_topic='/vision/overlay')))
+        image_mode=fl.ImageModeConfig(image_topic=VISION_OVERLAY.name)))
     scene = fl.ThreeDeePanel(title='Arm and objects (TF, URDF)', config=fl.ThreeDeeConfig(
         follow_tf='base_link', fixed_frame='world',
         layers={'urdf': fl.BaseRendererUrdfLayerSettings(
             layer_id='foxglove.Urdf', instance_id='urdf', label='MIndGrasp arm',
-            source_type='topic', topic='/robot_description', control_mode='transforms')},
-        topics={'/sim/objects': fl.BaseRendererRosMarkerTopicSettings(visible=True)}))
+            source_type='topic', topic=ROBOT_DESCRIPTION.name, control_mode='transforms')},
+        topics={SIM_OBJECTS.name: fl.BaseRendererRosMarkerTopicSettings(visible=True)}))
     eeg = fl.PlotPanel(title='EEG (V, first sample of each chunk)', config=fl.PlotConfig(
-        paths=[fl.PlotSeries(value=f'/eeg/raw.data[{i}]', label=f'channel {i + 1}',
+        paths=[fl.PlotSeries(value=f'{EEG_RAW.name}.data[{i}]', label=f'channel {i + 1}',
                              timestamp_method='headerStamp') for i in range(3)],
         time_window_mode='sliding', following_view_width=10.0, show_legend=True))
     prediction = fl.PlotPanel(title='Prediction certainty and class', config=fl.PlotConfig(
-        paths=[fl.PlotSeries(value='/bci/prediction.certainty', label='certainty',
+        paths=[fl.PlotSeries(value=f'{BCI_PREDICTION.name}.certainty', label='certainty',
                              timestamp_method='headerStamp'),
-               fl.PlotSeries(value='/bci/prediction.class_index', label='class (0 L, 1 R, '
+               fl.PlotSeries(value=f'{BCI_PREDICTION.name}.class_index', label='class (0 L, 1 R, '
                              '2 both hands, 3 feet)', timestamp_method='headerStamp',
                              line_interpolation='step')],
         time_window_mode='sliding', following_view_width=30.0, show_legend=True))
     state = fl.StateTransitionsPanel(title='Controller state', config=fl.StateTransitionsConfig(
-        paths=[fl.StateTransitionsSeries(value='/fsm/state.state_name', label='state'),
-               fl.StateTransitionsSeries(value='/fsm/state.object_of_interest',
+        paths=[fl.StateTransitionsSeries(value=f'{FSM_STATE.name}.state_name', label='state'),
+               fl.StateTransitionsSeries(value=f'{FSM_STATE.name}.object_of_interest',
                                          label='object of interest')],
         time_window_mode='sliding', x_axis_range=60.0))
     left = fl.SplitContainer(direction='column', items=[

@@ -27,6 +27,7 @@ from mindgrasp_bringup.bag.typestore import typestore
 from mindgrasp_ros import rclpy
 from mindgrasp_ros.node_main import fail, run_node
 from mindgrasp_ros.params import ParameterError, declare_params, param
+from mindgrasp_ros.topics import CLOCK
 
 CLOCK_TYPE = 'rosgraph_msgs/msg/Clock'
 TIME_TYPE = 'builtin_interfaces/msg/Time'
@@ -81,10 +82,8 @@ class PlayerNode(rclpy.node.Node):
             self.get_logger().warning(line)
         self.clock_publisher = None
         if p.clock:
-            clock_qos = rclpy.qos.QoSProfile(depth=1,
-                                             reliability=rclpy.qos.ReliabilityPolicy.BEST_EFFORT)
             self.clock_publisher = self.create_publisher(
-                message_class(CLOCK_TYPE), '/clock', clock_qos, raw=True)
+                message_class(CLOCK_TYPE), CLOCK.name, CLOCK.qos, raw=True)
         self.stats: PlayStats | None = None
         self.get_logger().info(f'Playing {self.reader.path} ({len(self.publishers_)} topic(s), '
                                f'rate {p.rate:g}).')

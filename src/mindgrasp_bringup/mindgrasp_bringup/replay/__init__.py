@@ -5,6 +5,8 @@ Entry points: ``mindgrasp replay RUN`` (:mod:`mindgrasp_bringup.commands.replay`
 ``mindgrasp launch replay bag:=RUN`` (:mod:`.replay_node`).
 """
 
+from mindgrasp_ros.topics import BCI_PREDICTION, FSM_STATE
+
 from .engine import ReplayConfig, ReplayResult, replay
 from .report import compare, write_report
 
@@ -23,10 +25,10 @@ def run_replay(cfg: ReplayConfig) -> ReplayResult:
 def summary_line(result: ReplayResult) -> str:
     """One line: agreement per topic and where the report is."""
     s = result.summary
-    pred = s['topics']['/bci/prediction']
+    pred = s['topics'][BCI_PREDICTION.name]
     parts = [f'predictions {pred["agree"]}/{pred["comparable"]} agree '
              f'({100 * (pred["agreement"] or 0):.1f} %)']
-    state = s['topics'].get('/fsm/state')
+    state = s['topics'].get(FSM_STATE.name)
     if state is not None:
         parts.append(f'controller states {100 * (state["agreement"] or 0):.1f} % (open loop)')
     return f'Replayed {", ".join(result.nodes)}: ' + '; '.join(parts) + \

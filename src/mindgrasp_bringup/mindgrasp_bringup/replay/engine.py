@@ -35,6 +35,7 @@ from mindgrasp_bringup.bag.reader import BagReader
 from mindgrasp_bringup.bag.ros_glue import qos_profile
 from mindgrasp_bringup.bag.typestore import typestore as default_typestore
 from mindgrasp_bringup.bag.writer import BagWriter
+from mindgrasp_ros.topics import BCI_PREDICTION, BCI_STATUS, CLOCK, EEG_RAW, FSM_STATE
 
 __all__ = ['COMPARED_TOPICS', 'NODES', 'ReplayConfig', 'ReplayResult', 'replay']
 
@@ -42,13 +43,12 @@ __all__ = ['COMPARED_TOPICS', 'NODES', 'ReplayConfig', 'ReplayResult', 'replay']
 NODES = {'classifier': ('mindgrasp_classifier.classifier_node', 'classifier'),
          'controller': ('mindgrasp_fsm.fsm_node', 'fsm')}
 #: outputs compared recorded vs replayed: topic -> type
-COMPARED_TOPICS = {'/bci/prediction': 'mindgrasp_msgs/msg/MIPrediction',
-                   '/fsm/state': 'mindgrasp_msgs/msg/FsmState'}
-EEG_TOPIC = '/eeg/raw'
-EEG_TYPE = 'mindgrasp_msgs/msg/EEGChunk'
-STATUS_TOPIC = '/bci/status'
+COMPARED_TOPICS = {BCI_PREDICTION.name: BCI_PREDICTION.type, FSM_STATE.name: FSM_STATE.type}
+EEG_TOPIC = EEG_RAW.name
+EEG_TYPE = EEG_RAW.type
+STATUS_TOPIC = BCI_STATUS.name
 #: never fed from the bag: the runner owns /clock; graph topics
-_NOT_FED = ('/clock', '/parameter_events', '/rosout')
+_NOT_FED = (CLOCK.name, '/parameter_events', '/rosout')
 
 
 @dataclass

@@ -27,6 +27,7 @@ from typing import Any
 import numpy as np
 
 from mindgrasp_bringup.replay.engine import ReplayResult
+from mindgrasp_ros.topics import BCI_PREDICTION, FSM_STATE
 
 __all__ = ['compare', 'write_report']
 
@@ -84,8 +85,8 @@ def compare(result: ReplayResult, store: Any) -> dict[str, Any]:
         'open_loop': 'controller' in result.nodes, 'fed': result.fed,
         'skipped_eeg_chunks': result.skipped_eeg_chunks, 'topics': {}, 'notes': result.notes,
     }
-    rec = _predictions(result.recorded.get('/bci/prediction', []), store)
-    rep = _predictions(result.replayed.get('/bci/prediction', []), store)
+    rec = _predictions(result.recorded.get(BCI_PREDICTION.name, []), store)
+    rep = _predictions(result.replayed.get(BCI_PREDICTION.name, []), store)
     lo, hi = result.first_fed_eeg_ns, result.last_fed_eeg_ns
     tol = 5_000_000  # ns: about a sample at 250 Hz
     comparable = sorted(s for s, p in rec.items() if lo is not None and hi is not None
@@ -109,12 +110,12 @@ def compare(result: ReplayResult, store: Any) -> dict[str, Any]:
                 f'{rep[first_div].class_index} replayed')
         pred['first_divergence'] = {'time_s': (first_div - t0) / 1e9, 'stamp_ns': first_div,
                                     'what': what}
-    summary['topics']['/bci/prediction'] = pred
+    summary['topics'][BCI_PREDICTION.name] = pred
     summary['prediction_agreement'] = pred['agreement'] if comparable else 0.0
     summary['_predictions'] = (rec, rep, comparable)
-    if '/fsm/state' in result.replayed:
-        rs = _states(result.recorded.get('/fsm/state', []), store)
-        ps = _states(result.replayed['/fsm/state'], store)
+    if FSM_STATE.name in result.replayed:
+        rs = _states(result.recorded.get(FSM_STATE.name, []), store)
+        ps = _states(result.replayed[FSM_STATE.name], store)
         grid = np.arange(t0, result.end_ns + 1, round(STATE_GRID_S * 1e9), dtype=np.int64)
         a, b = _state_at(rs, grid), _state_at(ps, grid)
         both = (a > 0) & (b > 0)
@@ -130,7 +131,7 @@ def compare(result: ReplayResult, store: Any) -> dict[str, Any]:
             state['first_divergence'] = {
                 'time_s': (int(grid[i]) - t0) / 1e9,
                 'what': f'state {a[i]} recorded, {b[i]} replayed'}
-        summary['topics']['/fsm/state'] = state
+        summary['topics'][FSM_STATE.name] = state
         summary['state_agreement'] = state['agreement']
         summary['_states'] = (grid, a, b)
     return summary
@@ -181,7 +182,7 @@ def write_report(result: ReplayResult, store: Any) -> dict[str, Any]:
 
 
 def _markdown(s: dict[str, Any]) -> str:
-    pred = s['topics']['/bci/prediction']
+    pred = s['topics'][BCI_PREDICTION.name]
     lines = [
         '# Replay report', '',
         f'- Run: `{s["run_dir"] or s["bag"]}`',
@@ -196,7 +197,7 @@ def _markdown(s: dict[str, Any]) -> str:
     lines.append(f'| /bci/prediction | {pred["recorded"]} | {pred["replayed"]} | '
                  f'{pred["comparable"]} | {_fmt(pred["agreement"])} | '
                  + (f'{div["time_s"]:.3f} s: {div["what"]}' if div else 'none') + ' |')
-    state = s['topics'].get('/fsm/state')
+    state = s['topics'].get(FSM_STATE.name)
     if state is not None:
         div = state['first_divergence']
         lines.append(f'| /fsm/state (open loop) | {state["recorded_messages"]} msgs | '
@@ -241,9 +242,9 @@ def _plot(path: Path, rec: dict, rep: dict, states: Any, summary: dict[str, Any]
             ax.plot(t, c + offset, marker, ms=3, ls='none', label=label)
     ax.set_yticks(range(4), ['left hand', 'right hand', 'both hands', 'both feet'])
     ax.set_title(f'/bci/prediction: agreement '
-                 f'{_fmt(summary["topics"]["/bci/prediction"]["agreement"])}')
+                 f'{_fmt(summary["topics"][BCI_PREDICTION.name]["agreement"])}')
     ax.legend(loc='upper right', fontsize=8)
-    div = summary['topics']['/bci/prediction']['first_divergence']
+    div = summary['topics'][BCI_PREDICTION.name]['first_divergence']
     if div:
         ax.axvline(div['time_s'], color='r', ls='--', lw=1)
     if states is not None:
@@ -254,9 +255,9 @@ def _plot(path: Path, rec: dict, rep: dict, states: Any, summary: dict[str, Any]
         ax.step(t, b, where='post', ls='--', label='replayed (open loop)')
         ax.set_yticks(range(1, 7), ['search', 'center', 'approach', 'final', 'grasp', 'return'])
         ax.set_title(f'/fsm/state: agreement '
-                     f'{_fmt(summary["topics"]["/fsm/state"]["agreement"])} (open loop)')
+                     f'{_fmt(summary["topics"][FSM_STATE.name]["agreement"])} (open loop)')
         ax.legend(loc='upper right', fontsize=8)
-        div = summary['topics']['/fsm/state']['first_divergence']
+        div = summary['topics'][FSM_STATE.name]['first_divergence']
         if div:
             ax.axvline(div['time_s'], color='r', ls='--', lw=1)
     axes[-1][0].set_xlabel('time since the bag start (s)')
