@@ -10,6 +10,7 @@ import math
 import cv2
 import numpy as np
 
+from mindgrasp_ros.topics import COLOR_IMAGE, DEPTH_IMAGE
 from mindgrasp_vision._checks import VisionError
 from mindgrasp_vision.detector import Detection
 
@@ -31,7 +32,7 @@ def _rows(msg: object, channels: int, itemsize: int, topic: str) -> np.ndarray:
     return data[:step * h].reshape(h, step)[:, :row]
 
 
-def rgb_from_image(msg: object, topic: str = '/camera/color/image_raw') -> np.ndarray:
+def rgb_from_image(msg: object, topic: str = COLOR_IMAGE.name) -> np.ndarray:
     """Colour image, shape (height, width, 3) uint8 RGB, from an ``rgb8`` or ``bgr8`` Image."""
     enc = str(msg.encoding).lower()
     if enc not in ('rgb8', 'bgr8'):
@@ -45,7 +46,7 @@ def rgb_from_image(msg: object, topic: str = '/camera/color/image_raw') -> np.nd
     return np.ascontiguousarray(rgb)
 
 
-def depth_from_image(msg: object, topic: str = '/camera/depth/image_raw') -> np.ndarray:
+def depth_from_image(msg: object, topic: str = DEPTH_IMAGE.name) -> np.ndarray:
     """Depth image, shape (height, width) float32 m, from a ``32FC1`` or ``16UC1`` (mm) Image."""
     enc = str(msg.encoding).upper()
     h, w = int(msg.height), int(msg.width)

@@ -97,7 +97,7 @@ class VisionNode(rclpy.node.Node):
         self._last_image = self._now()
         try:
             rgb = rgb_from_image(msg)
-            self._check_size(rgb.shape[1], rgb.shape[0], '/camera/color/image_raw')
+            self._check_size(rgb.shape[1], rgb.shape[0], COLOR_IMAGE.name)
         except VisionError as exc:
             self.get_logger().error(str(exc), throttle_duration_sec=5.0)
             return
@@ -111,7 +111,7 @@ class VisionNode(rclpy.node.Node):
     def depth_callback(self, msg: Image) -> None:
         try:
             depth = depth_from_image(msg)
-            self._check_size(depth.shape[1], depth.shape[0], '/camera/depth/image_raw')
+            self._check_size(depth.shape[1], depth.shape[0], DEPTH_IMAGE.name)
         except VisionError as exc:
             self.get_logger().error(str(exc), throttle_duration_sec=5.0)
             return
