@@ -28,6 +28,14 @@ from mindgrasp_eeg.subject import VirtualSubject
 from mindgrasp_ros import rclpy
 from mindgrasp_ros.node_main import end_after, run_node
 from mindgrasp_ros.params import declare_params, param
+from mindgrasp_ros.topics import (
+    BCI_PREDICTION,
+    FSM_STATE,
+    JOINT_STATES,
+    SIM_OBJECTS,
+    TASK_TARGET,
+    VIRTUAL_SUBJECT_INTENT,
+)
 
 
 @dataclass
@@ -58,16 +66,17 @@ class OracleSubjectNode(rclpy.node.Node):
                                       reaction_delay=p['reaction_delay'], seed=p['seed'],
                                       decision_period=p['decision_period'],
                                       heading_tolerance=p['heading_tolerance'])
+        # depth 10, not the table's LATCHED (depth 1): queues and the intent's history as before
         latched = rclpy.qos.QoSProfile(depth=10,
                                        reliability=rclpy.qos.ReliabilityPolicy.RELIABLE,
                                        durability=rclpy.qos.DurabilityPolicy.TRANSIENT_LOCAL)
-        self.create_subscription(TaskTarget, '/task/target', self.target_callback, latched)
-        self.create_subscription(MarkerArray, '/sim/objects', self.objects_callback, latched)
-        self.create_subscription(JointState, '/joint_states', self.joints_callback,
+        self.create_subscription(TaskTarget, TASK_TARGET.name, self.target_callback, latched)
+        self.create_subscription(MarkerArray, SIM_OBJECTS.name, self.objects_callback, latched)
+        self.create_subscription(JointState, JOINT_STATES.name, self.joints_callback,
                                  rclpy.qos.qos_profile_sensor_data)
-        self.create_subscription(FsmState, '/fsm/state', self.fsm_callback, latched)
-        self.pub = self.create_publisher(MIPrediction, '/bci/prediction', 10)
-        self.pub_intent = self.create_publisher(String, '/virtual_subject/intent', latched)
+        self.create_subscription(FsmState, FSM_STATE.name, self.fsm_callback, latched)
+        self.pub = self.create_publisher(MIPrediction, BCI_PREDICTION.name, BCI_PREDICTION.qos)
+        self.pub_intent = self.create_publisher(String, VIRTUAL_SUBJECT_INTENT.name, latched)
         self._last_intent: object = 'unset'
         self.create_timer(p['period'], self.predict_callback)
         end_after(self, p['duration'])

@@ -47,9 +47,20 @@ from mindgrasp_experiments.summary import summarise
 from mindgrasp_ros import rclpy
 from mindgrasp_ros.node_main import fail, run_node
 from mindgrasp_ros.params import declare_params, param
+from mindgrasp_ros.topics import (
+    BCI_PREDICTION,
+    EE_POSE,
+    EEG_RAW,
+    FSM_STATE,
+    SIM_OBJECTS,
+    TASK_RESULT,
+    TASK_TARGET,
+    VIRTUAL_SUBJECT_INTENT,
+    VISION_DETECTIONS,
+)
 
 #: topics the trial manager can wait for before a trial (any message counts)
-WAITABLE = ('/eeg/raw', '/bci/prediction', '/vision/detections')
+WAITABLE = (EEG_RAW.name, BCI_PREDICTION.name, VISION_DETECTIONS.name)
 
 
 @dataclass
@@ -101,22 +112,24 @@ class TrialManagerNode(rclpy.node.Node):
             str(Path(os.environ['MINDGRASP_RUN_DIR']) / 'trials')
             if os.environ.get('MINDGRASP_RUN_DIR') else '')
         self.records_dir = Path(records_dir) if records_dir else None
-        latched = rclpy.qos.QoSProfile(depth=1,
-                                       durability=rclpy.qos.DurabilityPolicy.TRANSIENT_LOCAL)
-        self.target_pub = self.create_publisher(TaskTarget, '/task/target', latched)
-        self.create_subscription(MarkerArray, '/sim/objects', self.objects_callback, latched)
-        self.create_subscription(GraspResult, '/task/result', self.result_callback, 10)
-        self.create_subscription(FsmState, '/fsm/state', self.fsm_callback, latched)
-        self.create_subscription(MIPrediction, '/bci/prediction', self.prediction_callback, 10)
-        self.create_subscription(String, '/virtual_subject/intent', self.intent_callback,
+        self.target_pub = self.create_publisher(TaskTarget, TASK_TARGET.name, TASK_TARGET.qos)
+        self.create_subscription(MarkerArray, SIM_OBJECTS.name, self.objects_callback,
+                                 SIM_OBJECTS.qos)
+        self.create_subscription(GraspResult, TASK_RESULT.name, self.result_callback,
+                                 TASK_RESULT.qos)
+        self.create_subscription(FsmState, FSM_STATE.name, self.fsm_callback, FSM_STATE.qos)
+        self.create_subscription(MIPrediction, BCI_PREDICTION.name, self.prediction_callback,
+                                 BCI_PREDICTION.qos)
+        # depth 10, not the table's 1: the subscription's queue stays as it was
+        self.create_subscription(String, VIRTUAL_SUBJECT_INTENT.name, self.intent_callback,
                                  rclpy.qos.QoSProfile(
                                      depth=10,
                                      durability=rclpy.qos.DurabilityPolicy.TRANSIENT_LOCAL))
-        self.create_subscription(PoseStamped, '/ee_pose', self.ee_callback, 10)
+        self.create_subscription(PoseStamped, EE_POSE.name, self.ee_callback, EE_POSE.qos)
         # readiness: any message type will do; the last arrival time of each topic is kept
         self.last_seen: dict[str, float] = {}
         for topic in p['wait_for']:
-            if topic and topic != '/bci/prediction':
+            if topic and topic != BCI_PREDICTION.name:
                 self._watch(topic)
         self.reset_client = self.create_client(ResetSim, '/sim/reset')
         self.load_client = self.create_client(LoadScene, '/sim/load_scene')
@@ -144,8 +157,9 @@ class TrialManagerNode(rclpy.node.Node):
     def _watch(self, topic: str) -> None:
         from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import DetectionArray, EEGChunk
 
-        kinds = {'/eeg/raw': (EEGChunk, rclpy.qos.qos_profile_sensor_data),
-                 '/vision/detections': (DetectionArray, 10)}
+        # /eeg/raw: sensor-data QoS (depth 5), not the table's depth 100: only arrivals count
+        kinds = {EEG_RAW.name: (EEGChunk, rclpy.qos.qos_profile_sensor_data),
+                 VISION_DETECTIONS.name: (DetectionArray, VISION_DETECTIONS.qos)}
         kind, qos = kinds[topic]
         self.create_subscription(kind, topic, lambda _m, t=topic: self._seen(t), qos)
 
@@ -168,7 +182,7 @@ class TrialManagerNode(rclpy.node.Node):
             self.tracker.on_state(int(msg.state), msg.object_of_interest, self.now_s())
 
     def prediction_callback(self, msg: MIPrediction) -> None:
-        self._seen('/bci/prediction')
+        self._seen(BCI_PREDICTION.name)
         if self.phase == 'trial':
             self.tracker.on_prediction(int(msg.class_index), float(msg.certainty), self.now_s())
 
@@ -257,7 +271,7 @@ class TrialManagerNode(rclpy.node.Node):
         missing = [t for t in self.p['wait_for']
                    if t and now - self.last_seen.get(t, -math.inf) > 1.0]
         if self.scene == {}:
-            missing.insert(0, '/sim/objects')
+            missing.insert(0, SIM_OBJECTS.name)
         if missing:
             waited = now - self.phase_since
             text = ', '.join(missing)

@@ -166,8 +166,11 @@ class LockstepRunner:
                                 start_parameter_services=False, enable_rosout=False)
         self._clock_cls = get_message_class('rosgraph_msgs/msg/Clock')
         from mindgrasp_ros.runtime.qos import qos_profile_clock
+        from mindgrasp_ros.topics import CLOCK
 
-        self._clock_pub = self._clock_node.create_publisher(self._clock_cls, '/clock',
+        # the runtime's own profile (the same as CLOCK's): CLOCK.qos would build the real
+        # rclpy's QoSProfile under MINDGRASP_RMW=rclpy, and these nodes are the runtime's
+        self._clock_pub = self._clock_node.create_publisher(self._clock_cls, CLOCK.name,
                                                             qos_profile_clock)
         self.nodes: list[Any] = []
         #: wall seconds spent in each node's callbacks (by node name), and in collecting work
