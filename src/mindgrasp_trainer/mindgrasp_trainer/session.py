@@ -45,6 +45,7 @@ from typing import Any
 import yaml
 
 from mindgrasp_common.resources import resource_path
+from mindgrasp_ros.topics import DISPLAY_FLIP, TASK_RESULT, TASK_TARGET, TRAINER_PROMPT
 from mindgrasp_trainer.protocol import TrainerError
 
 __all__ = ['PLAN_DIR', 'Phase', 'Plan', 'Session', 'SessionError', 'calibration_plan',
@@ -58,7 +59,7 @@ PHASE_KEYS = {'name', 'kind', 'trials', 'feedback', 'train', 'duration', 'args',
 PLAN_KEYS = {'name', 'description', 'training', 'phases'}
 TRAINING_KEYS = {'min_trials', 'cv', 'pipeline', 'tmin', 'tmax', 'seed', 'labels'}
 #: where training labels come from: the prompters' stamps, or when the display drew them
-LABEL_TOPICS = {'prompt': '/trainer/prompt', 'display': '/display/flip'}
+LABEL_TOPICS = {'prompt': TRAINER_PROMPT.name, 'display': DISPLAY_FLIP.name}
 
 
 class SessionError(TrainerError):
@@ -523,8 +524,8 @@ def _grasp_results(bag: Path) -> list[dict[str, Any]]:
     store = typestore()
     trials: dict[int, dict[str, Any]] = {}
     with BagReader(bag) as reader:
-        for topic, _, data in reader.messages(['/task/target', '/task/result']):
-            if topic == '/task/target':
+        for topic, _, data in reader.messages([TASK_TARGET.name, TASK_RESULT.name]):
+            if topic == TASK_TARGET.name:
                 m = store.deserialize_cdr(data, 'mindgrasp_msgs/msg/TaskTarget')
                 trials.setdefault(int(m.trial), {
                     'trial': int(m.trial), 'desired': f'{m.colour} {m.shape}'.strip(),
