@@ -3,6 +3,8 @@ parameters, sim time, composition and lock-step, malformed samples, error messag
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 import pytest
 from rosbags.typesys import Stores, get_typestore
@@ -377,6 +379,10 @@ def test_a_ctrl_c_during_a_graph_query_is_not_lost(rclpy_ctx):
         raise KeyboardInterrupt
 
     graph._pub_reader._constructor = graph._guarded(interrupted)
+    node.create_publisher(String, '/graph_interrupt_2', 10)   # new: the next read decodes it
+    deadline = time.monotonic() + 60
     with pytest.raises(KeyboardInterrupt):
-        node.get_topic_names_and_types()
+        while time.monotonic() < deadline:
+            node.get_topic_names_and_types()
+            time.sleep(0.05)
     node.destroy_node()
