@@ -3,9 +3,13 @@ real launch that records the simulator's topics."""
 
 from __future__ import annotations
 
+import os
+import time
+
 import pytest
 
 from mindgrasp_bringup.launch_system import LaunchService
+from mindgrasp_ros.node_process import NodeProcess
 
 
 def sim_process(*args: str):
@@ -34,12 +38,28 @@ def test_sim_profile_arguments():
 
 @pytest.mark.slow
 def test_sim_launch_runs_and_records(tmp_path):
+    """A real launch, stopped with Ctrl-C once the recorder has subscribed to the simulator's
+    topics (however long a loaded host takes to start the simulator: a fixed duration:=6 ended
+    one launch before the simulator had imported PyBullet)."""
     run_dir = tmp_path / 'run'
-    service = LaunchService('sim', ['duration:=6', 'time_mode:=fast'], run_dir=run_dir)
-    assert service.run() == 0
+    topics = ('/joint_states', '/camera/color/image_raw', '/camera/depth/image_raw',
+              '/camera/color/camera_info', '/ee_pose', '/sim/objects', '/clock')
+    launch = NodeProcess('mindgrasp_bringup', ['launch', 'sim', 'time_mode:=fast', '--run-dir',
+                                               str(run_dir)],
+                         dict(os.environ), tmp_path / 'launch.log')
+    try:
+        log = run_dir / 'logs' / 'recorder.log'
+        deadline = time.monotonic() + 120
+        while time.monotonic() < deadline and launch.poll() is None and not (
+                log.is_file() and all(f'Subscribed to {t} ' in log.read_text() for t in topics)):
+            time.sleep(0.2)
+        subscribed = log.read_text() if log.is_file() else ''
+    finally:
+        code = launch.stop(timeout=30)
+    assert all(f'Subscribed to {t} ' in subscribed for t in topics), launch.output()
+    assert code == 0, launch.output()
     metadata = (run_dir / 'bag' / 'metadata.yaml').read_text()
-    for topic in ('/joint_states', '/camera/color/image_raw', '/camera/depth/image_raw',
-                  '/camera/color/camera_info', '/ee_pose', '/sim/objects', '/clock'):
+    for topic in topics:
         assert f'name: {topic}\n' in metadata, topic
 
 
