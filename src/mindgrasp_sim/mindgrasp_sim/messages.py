@@ -102,9 +102,11 @@ def object_markers(hdr: Header, objects: list[SceneObject]) -> MarkerArray:
     return MarkerArray(markers=markers)
 
 
-def grasp_result(hdr: Header, event: TaskEvent, desired_object: str = '') -> GraspResult:
-    """GraspResult of a task event (durations in s, heights in m)."""
-    return GraspResult(header=hdr, trial=event.trial, desired_object=desired_object,
+def grasp_result(hdr: Header, event: TaskEvent, desired_object: str = '',
+                 task_trial: int = 0) -> GraspResult:
+    """GraspResult of a task event (durations in s, heights in m); ``trial`` is the task's trial
+    (``/task/target``) when one is set (> 0), else the simulator's count of resets."""
+    return GraspResult(header=hdr, trial=task_trial or event.trial, desired_object=desired_object,
                        grasped_object=event.grasped_object, success=event.success,
                        duration=float(event.duration), lift_height=float(event.lift_height),
                        reason=event.reason)

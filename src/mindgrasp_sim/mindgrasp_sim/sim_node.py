@@ -216,6 +216,7 @@ class SimNode(rclpy.node.Node):
         self.monitor = TaskMonitor(success_height=float(p['success_height']))
         self.monitor.new_trial(0.0)
         self.desired = ''
+        self.task_trial = 0       # /task/target's trial: the number /task/result reports
         self.total_steps = 0
         self.js_every = self.sim.physics_hz / float(p['joint_state_rate'])
         # /tf at most at tf_publish_frequency, as robot_state_publisher's publish_frequency
@@ -407,6 +408,7 @@ class SimNode(rclpy.node.Node):
 
     def target_callback(self, msg: TaskTarget) -> None:
         self.desired = f'{msg.colour} {msg.shape}'.strip()
+        self.task_trial = int(msg.trial)
 
     # ------------------------------------------------------------------ services
     def _after_reset(self) -> None:
@@ -536,10 +538,11 @@ class SimNode(rclpy.node.Node):
         """Publish /task/result on a lift or a drop; report new arm collisions."""
         event = self.monitor.update(self.sim)
         if event is not None:
-            self.result_pub.publish(msgs.grasp_result(self._header(self.p['frame_id']), event,
-                                                      self.desired))
+            result = msgs.grasp_result(self._header(self.p['frame_id']), event, self.desired,
+                                       self.task_trial)
+            self.result_pub.publish(result)
             self.get_logger().info(
-                f'Trial {event.trial}: {event.grasped_object} {event.reason} '
+                f'Trial {result.trial}: {event.grasped_object} {event.reason} '
                 f'(lift {event.lift_height:.3f} m, {event.duration:.1f} s).')
         if self.total_steps % (self.task_every * 4) == 0:
             collisions = self.sim.collisions()
