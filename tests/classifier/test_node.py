@@ -183,7 +183,7 @@ def test_node_adapts_class_means_from_prompts(spawn_node, source, model_path, rc
         return 0
 
     assert source.spin(60.0, until=lambda: updates() >= 10), (updates(), proc.output())
-    assert 'adaptation supervised' in proc.output()
+    assert proc.wait_for_output('adaptation supervised', 60), proc.output()
 
 
 def test_node_stops_when_the_stream_layout_changes(spawn_node, source, model_path):

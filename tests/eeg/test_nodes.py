@@ -128,7 +128,7 @@ def test_loss_reported_and_reconnected(spawn_node, listener, stream_name) -> Non
     assert listener.spin(60, lambda: level_of(listener.status[-1]) == 0)
     values = dict((kv.key, kv.value) for kv in listener.status[-1].status[0].values)
     assert int(values['reconnects']) >= 1 and int(values['dropped']) > 0
-    assert 'is lost' in acq.output()
+    assert acq.wait_for_output('is lost', 60), acq.output()
 
 
 def test_acquisition_node_rejects_wrong_layout(spawn_node, stream_name, lsl_source) -> None:
@@ -247,7 +247,7 @@ def test_acquisition_searches_without_blocking_and_reports_it(spawn_node, listen
                    and stream_name in s.status[0].message for s in listener.status)
 
     assert listener.spin(60, searching), acq.output()
-    assert 'is not pinned' in acq.output()              # any sender with this name is taken
+    assert acq.wait_for_output('is not pinned', 60)      # any sender with this name is taken
     spawn_node('mindgrasp_eeg.virtual_amp_node', stream_name=stream_name)
     assert listener.spin(60, lambda: len(listener.chunks) > 10), acq.output()
     assert listener.spin(60, lambda: level_of(listener.status[-1]) == 0)

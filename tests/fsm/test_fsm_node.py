@@ -93,7 +93,9 @@ def test_fsm_node_turns_on_left_hand_and_stops_when_predictions_end(rclpy_ctx, s
     assert all(np.all(c == 0) for c in commands[n:])
     assert spin_until(node, lambda: not states[-1].stopped, 60.0), proc.output()
     assert spin_until(node, lambda: abs(commands[-1][0] - 0.4) < 1e-9, 60.0)
-    assert 'fresh decision after the prediction loss: left hand' in proc.output()
+    # its log line and the command are written in one tick, in no fixed order: wait for it
+    assert proc.wait_for_output('fresh decision after the prediction loss: left hand', 60), \
+        proc.output()
     node.destroy_node()
     assert proc.stop() in (0, -2, 130), proc.output()
 

@@ -84,7 +84,7 @@ def test_param_describe_set_live_and_read_only(spawn_node, rclpy_ctx):
     # a valid live change takes effect: the total grows by the new gain per tick
     out = _cli('param', 'set', '/skeleton_ticker', 'gain', '0')
     assert out.returncode == 0 and 'Set parameter successful' in out.stdout, out.stderr
-    assert 'Parameter change applied: gain=0.0' in proc.output()
+    assert proc.wait_for_output('Parameter change applied: gain=0.0', 60), proc.output()
     node = rclpy_ctx.node.Node('skeleton_probe')
     from mindgrasp_ros.interfaces.rcl_interfaces.msg import Log
 

@@ -160,7 +160,8 @@ def test_bad_images_are_reported_by_name(rclpy_ctx, spawn_node, sim, view):
     # a depth image of another size: reported, colour detection goes on without depth
     small = np.ascontiguousarray(depth[::2, ::2])
     assert cam.stream(rgb, small, k, lambda: len(cam.detections) >= 2)
-    assert 'The depth image is 64x64 px but the colour image is 128x128 px' in proc.output()
+    assert proc.wait_for_output('The depth image is 64x64 px but the colour image is 128x128 px',
+                                60), proc.output()
     assert [d.colour for d in cam.detections[-1].detections] == ['blue']
     # without usable depth the distance comes from the known object size (0.05 m), as the
     # paper did
