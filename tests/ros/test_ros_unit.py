@@ -365,9 +365,14 @@ def test_spin_once_waits_for_its_timeout_when_idle(rclpy_ctx):
 
 
 def test_a_ctrl_c_during_a_graph_query_is_not_lost(rclpy_ctx):
-    """cyclonedds' C layer calls the endpoint constructor per sample and turns what it raises
-    into a plain error: a KeyboardInterrupt landing there must still reach the node's loop."""
+    """cyclonedds' C layer calls Python per sample during a graph read and turns what it raises
+    into a plain error: a Ctrl-C arriving then must still reach the node's loop."""
+    import os
+    import signal
+
     from mindgrasp_ros.interfaces.std_msgs.msg import String
+
+    from mindgrasp_ros.runtime.graph import _endpoint_without_type_id
 
     node = rclpy_ctx.node.Node('graph_interrupt')
     node.create_publisher(String, '/graph_interrupt', 10)
@@ -375,10 +380,11 @@ def test_a_ctrl_c_during_a_graph_query_is_not_lost(rclpy_ctx):
                       timeout=60)
     graph = node.context.graph
 
-    def interrupted(*_args):
-        raise KeyboardInterrupt
+    def interrupted(*args):
+        os.kill(os.getpid(), signal.SIGINT)            # Ctrl-C while C reads an endpoint
+        return _endpoint_without_type_id(*args)
 
-    graph._pub_reader._constructor = graph._guarded(interrupted)
+    graph._pub_reader._constructor = interrupted
     node.create_publisher(String, '/graph_interrupt_2', 10)   # new: the next read decodes it
     deadline = time.monotonic() + 60
     with pytest.raises(KeyboardInterrupt):

@@ -8,11 +8,14 @@ list`` and ``ros2 topic info -v`` use, so the answers agree with the ROS 2 tools
 
 from __future__ import annotations
 
+import contextlib
 import math
+import signal
 import threading
 import time
 import uuid
 from collections import defaultdict
+from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import Any
 
@@ -108,6 +111,35 @@ _MAX_ENDPOINTS = 8192
 _PURGE_SEC = 10.0
 
 
+@contextlib.contextmanager
+def _signals_deferred() -> Iterator[None]:
+    """SIGINT and SIGTERM arriving inside the block are handled right after it.
+
+    cyclonedds' read calls Python per sample (the endpoint, its QoS, its sample info) from C and
+    turns an exception raised there into "Callfunc ... errored" or "Sampleinfo errored": a
+    Ctrl-C (KeyboardInterrupt) landing in a graph query was lost that way, or ended the node
+    with exit code 1. Only the main thread receives signals; elsewhere this does nothing.
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    caught: list[int] = []
+    signals = (signal.SIGINT, signal.SIGTERM)
+    previous = {s: signal.signal(s, lambda number, _frame: caught.append(number))
+                for s in signals}
+    try:
+        yield
+    finally:
+        for number, handler in previous.items():
+            signal.signal(number, handler)
+        for number in caught[:1]:          # the old handler, as if it had come now
+            handler = previous[number]
+            if callable(handler):
+                handler(number, None)
+            elif handler == signal.SIG_DFL:
+                signal.raise_signal(number)
+
+
 def _duration(ns: int) -> Duration:
     return Duration(nanoseconds=0 if ns >= 2**62 else ns)
 
@@ -141,14 +173,9 @@ class GraphCache:
                                              qos=purge)
         self._sub_reader = BuiltinDataReader(dds.participant, BuiltinTopicDcpsSubscription,
                                              qos=purge)
-        # cyclonedds' C layer calls these Python functions per sample and turns any exception
-        # raised in them into "Callfunc ... errored": a Ctrl-C (KeyboardInterrupt) landing there
-        # was lost that way, and the node kept running. They keep it for _read to re-raise.
-        self._interrupt: BaseException | None = None
         readers = (self._pub_reader, self._sub_reader)
         for reader in readers:
-            reader._constructor = self._guarded(_endpoint_without_type_id)
-            reader._cqos_conv = self._guarded(reader._cqos_conv)
+            reader._constructor = _endpoint_without_type_id
         alive = ViewState.Any | SampleState.Any | InstanceState.Alive
         new = ViewState.Any | SampleState.NotRead | InstanceState.Any
         self._alive = {id(r): ReadCondition(r, alive) for r in readers}
@@ -161,15 +188,6 @@ class GraphCache:
         #: participant gid -> [(namespace, name, reader gids, writer gids)]
         self._participants: dict[bytes, list[tuple[str, str, set[bytes], set[bytes]]]] = {}
 
-    def _guarded(self, function: Any) -> Any:
-        def call(*args: Any) -> Any:
-            try:
-                return function(*args)
-            except BaseException as exc:   # kept, and re-raised by _update after the read
-                self._interrupt = exc
-                return None
-        return call
-
     def close(self) -> None:
         try:
             self._dds.delete_reader(self._info_reader)
@@ -179,10 +197,8 @@ class GraphCache:
             pass
 
     def _read(self, reader: BuiltinDataReader, condition: ReadCondition) -> list[Any]:
-        samples = reader.read(N=_MAX_ENDPOINTS, condition=condition)
-        if self._interrupt is not None:
-            interrupt, self._interrupt = self._interrupt, None
-            raise interrupt
+        with _signals_deferred():
+            samples = reader.read(N=_MAX_ENDPOINTS, condition=condition)
         return [s for s in samples if s is not None]
 
     def _update(self) -> None:
