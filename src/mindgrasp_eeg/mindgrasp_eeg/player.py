@@ -211,10 +211,14 @@ class DatasetPlayer:
             pos = k % n_total
             n = min(self.block, due - k, n_total - pos)
             self._push_markers(k, k + n)
-            # each sample its own stamp: LSL would space them at the nominal rate (the file's),
-            # not at the playback's
-            self.outlet.push_volts(self.rec.data[pos:pos + n],
-                                   self._t0 + np.arange(k, k + n) / (fs * self.rate))
+            # at rate 1 LSL places a block's earlier samples back at the nominal rate from the
+            # last one's stamp; at another rate each sample needs its own (LSL would space them
+            # at the file's rate, not the playback's)
+            if self.rate == 1.0:
+                stamps = self._t0 + (k + n - 1) / fs
+            else:
+                stamps = self._t0 + np.arange(k, k + n) / (fs * self.rate)
+            self.outlet.push_volts(self.rec.data[pos:pos + n], stamps)
             self.n_pushed += n
             pushed += n
         return pushed
