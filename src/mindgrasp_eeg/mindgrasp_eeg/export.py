@@ -193,19 +193,20 @@ def to_raw(recording: Recording):
     return raw
 
 
-def export_session(path: str | Path, output: str | Path | None = None, fmt: str = 'fif',
-                   eeg_topic: str = EEG_RAW.name, overwrite: bool = False) -> Path:
-    """Write the EEG of a run directory or bag as FIF or EDF; returns the file written.
+def default_output(path: str | Path, fmt: str) -> Path:
+    """``<run dir>/eeg_raw.fif`` (or ``eeg.edf``), next to the bag of ``path``."""
+    bag = find_bag(path)
+    base = bag.parent if bag.name == 'bag' else bag
+    return base / ('eeg_raw.fif' if fmt == 'fif' else 'eeg.edf')
 
-    The default output is ``<run dir>/eeg_raw.fif`` (or ``eeg.edf``) next to the bag.
-    """
+
+def write_recording(recording: Recording, out: str | Path, fmt: str = 'fif',
+                    overwrite: bool = False) -> Path:
+    """Write ``recording`` (as :func:`read_session` returns it) as FIF or EDF to ``out``."""
     if fmt not in FORMATS:
         msg = f'The export format must be one of {FORMATS}; {fmt!r} is not supported.'
         raise EEGError(msg)
-    recording = read_session(path, eeg_topic)
-    bag = find_bag(path)
-    base = bag.parent if bag.name == 'bag' else bag
-    out = Path(output) if output else base / ('eeg_raw.fif' if fmt == 'fif' else 'eeg.edf')
+    out = Path(out)
     if out.exists() and not overwrite:
         msg = f'{str(out)!r} exists already; pass --overwrite or another --output.'
         raise EEGError(msg)
@@ -217,3 +218,16 @@ def export_session(path: str | Path, output: str | Path | None = None, fmt: str 
 
         mne.export.export_raw(out, raw, fmt='edf', overwrite=True, verbose='error')
     return out
+
+
+def export_session(path: str | Path, output: str | Path | None = None, fmt: str = 'fif',
+                   eeg_topic: str = EEG_RAW.name, overwrite: bool = False) -> Path:
+    """Write the EEG of a run directory or bag as FIF or EDF; returns the file written.
+
+    The default output is ``<run dir>/eeg_raw.fif`` (or ``eeg.edf``) next to the bag.
+    """
+    if fmt not in FORMATS:
+        msg = f'The export format must be one of {FORMATS}; {fmt!r} is not supported.'
+        raise EEGError(msg)
+    recording = read_session(path, eeg_topic)
+    return write_recording(recording, output or default_output(path, fmt), fmt, overwrite)

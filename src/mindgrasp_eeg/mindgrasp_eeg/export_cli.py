@@ -28,12 +28,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def main(args: argparse.Namespace) -> int:
     """Export; 0 on success, 1 with a message on bad input."""
-    from .export import export_session, read_session
+    from .export import default_output, read_session, write_recording
 
     try:
-        recording = read_session(args.path, args.eeg_topic)
-        out = export_session(args.path, args.output, args.format, args.eeg_topic,
-                             overwrite=args.overwrite)
+        recording = read_session(args.path, args.eeg_topic)   # the bag is read once
+        out = write_recording(recording, args.output or default_output(args.path, args.format),
+                              args.format, overwrite=args.overwrite)
     except EEGError as exc:
         print(f'mindgrasp export eeg: {exc}', file=sys.stderr)
         return 1
