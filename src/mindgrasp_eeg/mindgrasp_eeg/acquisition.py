@@ -325,7 +325,7 @@ class EEGAcquisition:
             self._inlet.close_stream()
             self._inlet = None
 
-    def _start_reconnect(self, lost_uid: str) -> None:
+    def _start_reconnect(self, lost_uid: str, closed: bool = False) -> None:
         if self._reconnect_thread is not None and self._reconnect_thread.is_alive():
             return
 
@@ -340,7 +340,9 @@ class EEGAcquisition:
         def reconnect() -> None:
             while not self._stop.is_set():
                 try:
-                    info = finder.newest()
+                    # a closed outlet never sends again, but the resolver may still list it for
+                    # a while: a new stream (a restarted amplifier) has a new uid
+                    info = finder.newest(exclude_uids=(lost_uid,) if closed else ())
                     if info is None:
                         self._stop.wait(0.1)
                         continue
@@ -368,7 +370,9 @@ class EEGAcquisition:
         self._reconnect_thread = threading.Thread(target=run, name='eeg-reconnect', daemon=True)
         self._reconnect_thread.start()
 
-    def _mark_lost(self) -> None:
+    def _mark_lost(self, closed: bool = False) -> None:
+        """The stream is lost; ``closed``: its sender closed the connection (its outlet is
+        gone, not just quiet), so only another stream can take its place."""
         if not self.lost:
             self.lost = True
             self.counters['losses'] += 1
@@ -376,7 +380,7 @@ class EEGAcquisition:
             with contextlib.suppress(Exception):   # closing a dead inlet may fail
                 self._inlet.close_stream()
             self._inlet = None
-        self._start_reconnect(self.desc.uid if self.desc else '')
+        self._start_reconnect(self.desc.uid if self.desc else '', closed)
 
     def _take_pending(self) -> None:
         with self._lock:
@@ -415,7 +419,7 @@ class EEGAcquisition:
             raw, ts = self._inlet.pull_chunk(timeout=0.0, max_samples=4096, as_numpy=True)
         except LostError:
             self._lost_reason = 'the sender closed the connection'
-            self._mark_lost()
+            self._mark_lost(closed=True)
             return []
         now = pylsl.local_clock()
         if len(ts) == 0:
