@@ -26,8 +26,8 @@ def test_demo_runs_headless_ends_cleanly_and_records_the_session(tmp_path: Path)
     run_dir = tmp_path / 'run'
     stream = f'mg-demo-test-{uuid.uuid4().hex[:8]}'  # LSL names are host-wide
     # generous stop timeout: this machine may be loaded by other test runs
-    # one trial: the virtual subject (pursue) must drive the arm to grasp the red cube; the
-    # trial manager then ends the launch (duration is only a safety net)
+    # one trial: the virtual subject (pursue) drives the arm to grasp the red cube; the trial
+    # manager then ends the launch (duration is only a safety net)
     # the live view on a free port: several test runs share this host. The trial manager waits
     # until EEG, classifier and vision publish (a minute on a loaded machine) before the trial
     result = run_launch('demo', 'duration:=400', f'eeg_stream:={stream}', 'trials:=1',
@@ -40,14 +40,24 @@ def test_demo_runs_headless_ends_cleanly_and_records_the_session(tmp_path: Path)
         'recorder', 'trial_manager', 'sim', 'virtual_amp', 'eeg_acquisition', 'classifier',
         'vision', 'fsm', 'foxglove_bridge'}
     log = (run_dir / 'logs' / 'trial_manager.log').read_text()
-    assert 'Trial 1 (red cube): correct object grasped' in log, log[-2000:]
     # the live trial manager writes the same records as the lock-step experiments
     from mindgrasp_experiments.records import TrialRecord, read_records
 
     (record,) = read_records(run_dir / 'trials')
-    assert isinstance(record, TrialRecord) and record.correct_and_successful
+    assert isinstance(record, TrialRecord) and record.desired == 'red cube', record
     assert (run_dir / 'trials' / 'records.csv').read_text().splitlines()[0].split(',') == \
         TrialRecord.columns()
+    # the live BCI loop chose an object and the controller went for it (state 5, grasp). Which
+    # object, and whether the lift holds, depend on the subject (accuracy 0.9), the live decoder
+    # and the wall-clock timing of nine processes on a possibly loaded host, so they are not this
+    # test's condition: the record must say what happened, as the log does. The desired object
+    # grasped through the same nodes is asserted where time is deterministic, in lock-step
+    # (tests/experiments/test_experiment_cli.py: the virtual subject at accuracy 1 through the
+    # decoder, and the oracle subject).
+    assert '5' in record.states.split('-') and record.chosen, (record, log[-2000:])
+    verdict = ('correct object grasped' if record.correct_and_successful else
+               f'grasped the {record.grasped}' if record.success else f'failed ({record.failure}')
+    assert f'Trial 1 (red cube): {verdict}' in log, (record, log[-2000:])
     for label in ('sim', 'eeg_acquisition', 'classifier', 'vision', 'fsm'):
         assert (run_dir / 'logs' / f'{label}.log').stat().st_size > 0, label
     from mindgrasp_bringup.bag.reader import BagReader
