@@ -796,19 +796,22 @@ class Simulation:
         rgb[ground] = np.asarray(GROUND_RGBA[:3]) * 255 * 0.85
         rgb[empty & ~ground] = SKY_RGB
 
-    def _hide_other_robots(self, robot: str) -> list[int]:
+    def _hide_other_robots(self, robot: str) -> list[tuple[int, tuple, tuple]]:
         # the trainer's ghost arm is seen by people, not by the user's camera: park it below
         # the ground while rendering (it collides with nothing, so physics is unaffected)
         hidden = []
         for name, r in self._robots.items():
             if name != robot and name == 'trainer':
+                # PyBullet's base pose is the base's inertial frame, not its URDF link frame:
+                # put back exactly what was read (restoring [0, 0, 0] sank the ghost 5 cm)
+                pos, orn = self._p.getBasePositionAndOrientation(r.body)
                 self._p.resetBasePositionAndOrientation(r.body, [0, 0, -5.0], [0, 0, 0, 1])
-                hidden.append(r.body)
+                hidden.append((r.body, pos, orn))
         return hidden
 
-    def _unhide(self, hidden: list[int]) -> None:
-        for body in hidden:
-            self._p.resetBasePositionAndOrientation(body, [0, 0, 0], [0, 0, 0, 1])
+    def _unhide(self, hidden: list[tuple[int, tuple, tuple]]) -> None:
+        for body, pos, orn in hidden:
+            self._p.resetBasePositionAndOrientation(body, pos, orn)
 
     # ------------------------------------------------------------------ kinematics
     def _kin_set(self, q: np.ndarray) -> None:
