@@ -392,3 +392,61 @@ def test_a_ctrl_c_during_a_graph_query_is_not_lost(rclpy_ctx):
             node.get_topic_names_and_types()
             time.sleep(0.05)
     node.destroy_node()
+
+
+_TAKE_INTERRUPTED = '''
+import os, signal, sys, time
+import cyclonedds.internal as ci
+from mindgrasp_ros import rclpy
+from mindgrasp_ros.interfaces.std_msgs.msg import String
+
+rclpy.init()
+node = rclpy.create_node('take_interrupt')
+got = []
+node.create_subscription(String, '/take_interrupt', got.append, 10)
+deadline = time.monotonic() + 120
+while not got and time.monotonic() < deadline:
+    rclpy.spin_once(node, timeout_sec=0.1)
+print('received', len(got), flush=True)
+original = ci.SampleInfo.__init__
+
+def interrupted(self, *args, **kwargs):      # Ctrl-C while C builds a sample's info
+    ci.SampleInfo.__init__ = original
+    os.kill(os.getpid(), signal.SIGINT)
+    original(self, *args, **kwargs)
+
+ci.SampleInfo.__init__ = interrupted
+try:
+    while time.monotonic() < deadline:
+        rclpy.spin_once(node, timeout_sec=0.1)
+except KeyboardInterrupt:
+    print('KeyboardInterrupt', flush=True)
+    sys.exit(0)
+sys.exit(3)
+'''
+
+
+def test_a_ctrl_c_during_a_take_is_a_keyboard_interrupt(rclpy_ctx):
+    """cyclonedds' take builds each sample's info in Python from C: a Ctrl-C landing there made
+    ``ddspy_take`` crash the process (an experiment stopped with Ctrl-C lost its report). It
+    must reach the program as a KeyboardInterrupt. In a child process: a crash must not take the
+    test runner with it; the publisher is here, as take only runs for another process's data."""
+    import subprocess
+    import sys
+
+    from mindgrasp_ros.interfaces.std_msgs.msg import String
+
+    node = rclpy_ctx.node.Node('take_interrupt_publisher')
+    pub = node.create_publisher(String, '/take_interrupt', 10)
+    child = subprocess.Popen([sys.executable, '-c', _TAKE_INTERRUPTED], stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 180
+    while child.poll() is None and time.monotonic() < deadline:
+        pub.publish(String(data='x'))
+        time.sleep(0.05)
+    if child.poll() is None:
+        child.kill()
+    out, err = child.communicate(timeout=60)
+    node.destroy_node()
+    assert child.returncode == 0 and 'KeyboardInterrupt' in out, \
+        (child.returncode, out, err[-2000:])

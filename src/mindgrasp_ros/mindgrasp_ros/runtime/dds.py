@@ -39,6 +39,7 @@ from mindgrasp_ros.runtime.qos import (
     QoSProfile,
     ReliabilityPolicy,
 )
+from mindgrasp_ros.runtime.signal_guard import DDS_CALL
 from mindgrasp_ros.typesupport import rihs01, typestore
 
 __all__ = ['DdsParticipant', 'dds_type_name', 'ros_type_name_from_dds']
@@ -245,7 +246,8 @@ class DdsReader:
 
     def take(self, n: int = 64) -> list[tuple[bytes, Any]]:
         """Up to n valid samples as (CDR bytes incl. header, SampleInfo)."""
-        ret = ddspy_take(self.reader._ref, _ANY_STATE, n)
+        with DDS_CALL:      # it builds each SampleInfo in Python, from C
+            ret = ddspy_take(self.reader._ref, _ANY_STATE, n)
         if isinstance(ret, int):
             msg = f'DDS take failed with code {ret}.'
             raise DdsError(msg)

@@ -8,14 +8,11 @@ list`` and ``ros2 topic info -v`` use, so the answers agree with the ROS 2 tools
 
 from __future__ import annotations
 
-import contextlib
 import math
-import signal
 import threading
 import time
 import uuid
 from collections import defaultdict
-from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import Any
 
@@ -41,6 +38,7 @@ from mindgrasp_ros.runtime.qos import (
     QoSProfile,
     ReliabilityPolicy,
 )
+from mindgrasp_ros.runtime.signal_guard import DDS_CALL
 from mindgrasp_ros.typesupport import deserialize
 
 __all__ = ['GraphCache', 'TopicEndpointInfo']
@@ -111,35 +109,6 @@ _MAX_ENDPOINTS = 8192
 _PURGE_SEC = 10.0
 
 
-@contextlib.contextmanager
-def _signals_deferred() -> Iterator[None]:
-    """SIGINT and SIGTERM arriving inside the block are handled right after it.
-
-    cyclonedds' read calls Python per sample (the endpoint, its QoS, its sample info) from C and
-    turns an exception raised there into "Callfunc ... errored" or "Sampleinfo errored": a
-    Ctrl-C (KeyboardInterrupt) landing in a graph query was lost that way, or ended the node
-    with exit code 1. Only the main thread receives signals; elsewhere this does nothing.
-    """
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    caught: list[int] = []
-    signals = (signal.SIGINT, signal.SIGTERM)
-    previous = {s: signal.signal(s, lambda number, _frame: caught.append(number))
-                for s in signals}
-    try:
-        yield
-    finally:
-        for number, handler in previous.items():
-            signal.signal(number, handler)
-        for number in caught[:1]:          # the old handler, as if it had come now
-            handler = previous[number]
-            if callable(handler):
-                handler(number, None)
-            elif handler == signal.SIG_DFL:
-                signal.raise_signal(number)
-
-
 def _duration(ns: int) -> Duration:
     return Duration(nanoseconds=0 if ns >= 2**62 else ns)
 
@@ -197,7 +166,7 @@ class GraphCache:
             pass
 
     def _read(self, reader: BuiltinDataReader, condition: ReadCondition) -> list[Any]:
-        with _signals_deferred():
+        with DDS_CALL:
             samples = reader.read(N=_MAX_ENDPOINTS, condition=condition)
         return [s for s in samples if s is not None]
 
