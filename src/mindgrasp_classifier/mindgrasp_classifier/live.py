@@ -11,7 +11,6 @@ evaluation. Use a ``ROS_DOMAIN_ID`` of your own: the nodes run on the current on
 from __future__ import annotations
 
 import dataclasses
-import os
 import sys
 import tempfile
 import threading
@@ -70,14 +69,13 @@ def stream_live(model_path: str, rec: Recording, workdir: Path,
         node.create_subscription(     # depth 100 (the table's is 10): no prediction dropped
             MIPrediction, BCI_PREDICTION.name,
             lambda m: preds.append((_stamp(m), np.asarray(m.distances, dtype=float))), 100)
-        env = dict(os.environ, PYTHONUNBUFFERED='1')
         acq = NodeProcess(
             'mindgrasp_eeg.acquisition_node',
             ['--ros-args', '-r', f'__node:=eeg_acquisition_{name[-8:]}',
              '-p', f'stream_name:={name}', '-p', f'n_channels:={len(rec.channels)}',
              '-p', f'sample_rate:={rec.rate}', '-p', 'check_channel_names:=false',
              '-p', 'adapt_to_stream:=true', '-p', 'resolve_timeout:=30.0'],
-            env, workdir / 'acquisition.log')
+            None, workdir / 'acquisition.log')
         procs.append(acq)
         if not acq.wait_for_output('Connected to', 60):
             msg = f'The acquisition node did not connect to the player:\n{acq.output()[-2000:]}'
@@ -86,7 +84,7 @@ def stream_live(model_path: str, rec: Recording, workdir: Path,
             'mindgrasp_classifier.classifier_node',
             ['--ros-args', '-r', f'__node:=classifier_{name[-8:]}', '-p', f'model:={model_path}',
              '-p', 'classes:=[]'],
-            env, workdir / 'classifier.log')
+            None, workdir / 'classifier.log')
         procs.append(clf)
         if not clf.wait_for_output('Loaded', 60):
             msg = f'The classifier node did not start:\n{clf.output()[-2000:]}'

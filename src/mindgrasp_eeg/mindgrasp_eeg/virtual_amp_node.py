@@ -41,6 +41,7 @@ from mindgrasp_ros.topics import (
     EEG_RAW,
     FSM_STATE,
     JOINT_STATES,
+    LATCHED_QUEUE,
     SIM_OBJECTS,
     TASK_TARGET,
     TRAINER_PROMPT,
@@ -72,11 +73,7 @@ class VirtualAmpNode(rclpy.node.Node):
             p.subject_mode, accuracy=p.accuracy, reaction_delay=p.reaction_delay,
             lapse_rate=p.lapse_rate, seed=p.seed, active_phases=p.active_phases,
             decision_period=p.decision_period, heading_tolerance=p.heading_tolerance)
-        # depth 10, not the table's 1: the subscriptions' queues and the intent's late-joiner
-        # history stay as they were (the table's LATCHED is depth 1)
-        latched = rclpy.qos.QoSProfile(depth=10,
-                                       reliability=rclpy.qos.ReliabilityPolicy.RELIABLE,
-                                       durability=rclpy.qos.DurabilityPolicy.TRANSIENT_LOCAL)
+        latched = LATCHED_QUEUE.profile()
         mode = p.subject_mode
         if mode == 'follow':
             self.create_subscription(Prompt, TRAINER_PROMPT.name, self.prompt_callback, latched)

@@ -32,6 +32,7 @@ from mindgrasp_ros.topics import (
     BCI_PREDICTION,
     FSM_STATE,
     JOINT_STATES,
+    LATCHED_QUEUE,
     SIM_OBJECTS,
     TASK_TARGET,
     VIRTUAL_SUBJECT_INTENT,
@@ -66,10 +67,7 @@ class OracleSubjectNode(rclpy.node.Node):
                                       reaction_delay=p['reaction_delay'], seed=p['seed'],
                                       decision_period=p['decision_period'],
                                       heading_tolerance=p['heading_tolerance'])
-        # depth 10, not the table's LATCHED (depth 1): queues and the intent's history as before
-        latched = rclpy.qos.QoSProfile(depth=10,
-                                       reliability=rclpy.qos.ReliabilityPolicy.RELIABLE,
-                                       durability=rclpy.qos.DurabilityPolicy.TRANSIENT_LOCAL)
+        latched = LATCHED_QUEUE.profile()
         self.create_subscription(TaskTarget, TASK_TARGET.name, self.target_callback, latched)
         self.create_subscription(MarkerArray, SIM_OBJECTS.name, self.objects_callback, latched)
         self.create_subscription(JointState, JOINT_STATES.name, self.joints_callback,

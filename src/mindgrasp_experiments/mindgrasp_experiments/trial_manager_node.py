@@ -52,6 +52,7 @@ from mindgrasp_ros.topics import (
     EE_POSE,
     EEG_RAW,
     FSM_STATE,
+    LATCHED_QUEUE,
     SIM_OBJECTS,
     TASK_RESULT,
     TASK_TARGET,
@@ -120,11 +121,8 @@ class TrialManagerNode(rclpy.node.Node):
         self.create_subscription(FsmState, FSM_STATE.name, self.fsm_callback, FSM_STATE.qos)
         self.create_subscription(MIPrediction, BCI_PREDICTION.name, self.prediction_callback,
                                  BCI_PREDICTION.qos)
-        # depth 10, not the table's 1: the subscription's queue stays as it was
         self.create_subscription(String, VIRTUAL_SUBJECT_INTENT.name, self.intent_callback,
-                                 rclpy.qos.QoSProfile(
-                                     depth=10,
-                                     durability=rclpy.qos.DurabilityPolicy.TRANSIENT_LOCAL))
+                                 LATCHED_QUEUE.profile())
         self.create_subscription(PoseStamped, EE_POSE.name, self.ee_callback, EE_POSE.qos)
         # readiness: any message type will do; the last arrival time of each topic is kept
         self.last_seen: dict[str, float] = {}

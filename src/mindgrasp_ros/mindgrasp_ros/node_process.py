@@ -15,13 +15,14 @@ __all__ = ['NodeProcess']
 
 class NodeProcess:
     """``python -m module [args]`` (or ``python script.py [args]``) in a new session, stdout and
-    stderr in ``log``.
+    stderr in ``log``; ``env`` None: this process's environment.
 
     Stopped as the launcher stops a node: SIGINT, then SIGTERM, then SIGKILL, each given
     ``timeout`` seconds.
     """
 
-    def __init__(self, module: str, args: list[str], env: dict[str, str], log: Path) -> None:
+    def __init__(self, module: str, args: list[str], env: dict[str, str] | None,
+                 log: Path) -> None:
         self.module = module
         self.log_path = log
         self._log = log.open('wb')

@@ -22,7 +22,7 @@ import dataclasses
 import importlib
 from typing import Any
 
-__all__ = ['TOPICS', 'Qos', 'Topic', 'markdown_table', 'topic']
+__all__ = ['LATCHED_QUEUE', 'TOPICS', 'Qos', 'Topic', 'markdown_table', 'topic']
 
 
 @dataclasses.dataclass(frozen=True)
@@ -53,6 +53,9 @@ class Qos:
 
 RELIABLE = Qos()
 LATCHED = Qos(durability='transient_local', depth=1)
+#: a latched topic read or written with a queue of 10: a subscriber keeps the late-joiner sample
+#: and what follows it; the virtual subjects' intent keeps its last 10 for a late recorder
+LATCHED_QUEUE = Qos(durability='transient_local', depth=10)
 SENSOR = Qos(reliability='best_effort', depth=5)      # rclpy's qos_profile_sensor_data
 
 
