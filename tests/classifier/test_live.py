@@ -11,6 +11,7 @@ import sys
 import numpy as np
 import pytest
 
+from mindgrasp_classifier.live import _map_predictions
 from mindgrasp_classifier.training import TrainingConfig, train
 
 from .classifier_synth import make_recording
@@ -43,3 +44,15 @@ def test_live_agrees_with_offline(tmp_path):
     assert summary.startswith('Evaluated 4 trial(s) of 1 recording(s): accuracy ')
     assert f"{100 * live['accuracy']:.1f} % live ({live['n_predictions']} predictions)." \
         in summary
+
+
+def test_predictions_map_to_recording_samples_when_the_start_was_missed():
+    # the acquisition node heard the stream from recording sample 60 on and numbered it 0
+    rate, start = 250.0, 1000.0                       # ROS time of recording sample 0
+    chunks = [(start + (60 + k) / rate, k, 8) for k in range(0, 800, 8)]
+    preds = [(start + (60 + 255) / rate, np.zeros(2)), (start + (60 + 271) / rate, np.ones(2))]
+    ends, dists = _map_predictions(chunks, preds, rate, start)
+    assert ends.tolist() == [315, 331] and dists.shape == (2, 2)
+    ends, _ = _map_predictions([(start + k / rate, k, 8) for k in range(0, 800, 8)],
+                               [(start + 255 / rate, np.zeros(2))], rate, start)
+    assert ends.tolist() == [255]

@@ -47,6 +47,7 @@ def stream_live(model_path: str, rec: Recording, workdir: Path,
     """
     from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import EEGChunk, MIPrediction
 
+    from mindgrasp_eeg.acquisition import read_clocks
     from mindgrasp_eeg.player import DatasetPlayer
     from mindgrasp_ros import rclpy
 
@@ -69,6 +70,17 @@ def stream_live(model_path: str, rec: Recording, workdir: Path,
         node.create_subscription(     # depth 100 (the table's is 10): no prediction dropped
             MIPrediction, BCI_PREDICTION.name,
             lambda m: preds.append((_stamp(m), np.asarray(m.distances, dtype=float))), 100)
+        # the classifier first: the stream must not sit idle while it loads (an acquisition
+        # node that hears nothing for 5 s reconnects, and would miss the first samples)
+        clf = NodeProcess(
+            'mindgrasp_classifier.classifier_node',
+            ['--ros-args', '-r', f'__node:=classifier_{name[-8:]}', '-p', f'model:={model_path}',
+             '-p', 'classes:=[]'],
+            None, workdir / 'classifier.log')
+        procs.append(clf)
+        if not clf.wait_for_output('Loaded', 60):
+            msg = f'The classifier node did not start:\n{clf.output()[-2000:]}'
+            raise ClassifierError(msg)
         acq = NodeProcess(
             'mindgrasp_eeg.acquisition_node',
             ['--ros-args', '-r', f'__node:=eeg_acquisition_{name[-8:]}',
@@ -79,15 +91,6 @@ def stream_live(model_path: str, rec: Recording, workdir: Path,
         procs.append(acq)
         if not acq.wait_for_output('Connected to', 60):
             msg = f'The acquisition node did not connect to the player:\n{acq.output()[-2000:]}'
-            raise ClassifierError(msg)
-        clf = NodeProcess(
-            'mindgrasp_classifier.classifier_node',
-            ['--ros-args', '-r', f'__node:=classifier_{name[-8:]}', '-p', f'model:={model_path}',
-             '-p', 'classes:=[]'],
-            None, workdir / 'classifier.log')
-        procs.append(clf)
-        if not clf.wait_for_output('Loaded', 60):
-            msg = f'The classifier node did not start:\n{clf.output()[-2000:]}'
             raise ClassifierError(msg)
         pub_ready = time.monotonic() + 30
         while time.monotonic() < pub_ready and not (
@@ -118,31 +121,42 @@ def stream_live(model_path: str, rec: Recording, workdir: Path,
         bar.close()
         for _ in range(20):
             executor.spin_once(timeout_sec=0.02)
+        lsl_now, ros_now_ns = read_clocks(lambda: node.get_clock().now().nanoseconds)
         node.destroy_node()
     finally:
         player.close()
         for p in reversed(procs):
             p.stop()
         rclpy.try_shutdown()
-    return _map_predictions(chunks, preds, rec.rate)
+    start = None if player.start_time is None else \
+        player.start_time + (ros_now_ns * 1e-9 - lsl_now)
+    return _map_predictions(chunks, preds, rec.rate, start)
 
 
 def _map_predictions(chunks: list[tuple[float, int, int]], preds: list[tuple[float, np.ndarray]],
-                     rate: float) -> tuple[np.ndarray, np.ndarray]:
-    """Sample index of each prediction: stamp = chunk stamp + (index - first) / rate."""
-    if not chunks or not preds:
+                     rate: float, start: float | None) -> tuple[np.ndarray, np.ndarray]:
+    """Recording sample index of each prediction's last sample.
+
+    The acquisition node numbers samples from the first one it received, so its index is the
+    recording's only when nothing was missed at the start. ``start`` (ROS time, s, of the
+    recording's sample 0, from the player's clock) gives each chunk its recording index; the
+    difference is the shift. Within the stream: stamp = chunk stamp + (index - first) / rate.
+    """
+    if not chunks or not preds or start is None:
         msg = ('No EEG chunks or predictions arrived; check that DDS works on this ROS_DOMAIN_ID '
                'and look at the node logs.')
         raise ClassifierError(msg)
     chunks = sorted(chunks)
     stamps = np.array([c[0] for c in chunks])
+    firsts = np.array([c[1] for c in chunks])
+    shift = int(np.median(np.round((stamps - start) * rate) - firsts))
     ends, dists = [], []
     for t, d in preds:
         i = int(np.searchsorted(stamps, t + 0.5 / rate, side='right')) - 1
         if i < 0:
             continue
         s, first, _n = chunks[i]
-        ends.append(first + round((t - s) * rate))
+        ends.append(first + shift + round((t - s) * rate))
         dists.append(d)
     return np.array(ends, dtype=int), np.array(dists)
 

@@ -192,6 +192,12 @@ class DatasetPlayer:
         self._ann_next = 0
 
     @property
+    def start_time(self) -> float | None:
+        """LSL time (s, this host's ``local_clock()``) of the file's sample 0; None before the
+        first :meth:`step`."""
+        return self._t0
+
+    @property
     def finished(self) -> bool:
         """True when a non-looping playback has pushed everything."""
         return not self.loop and self.n_pushed >= len(self.rec.data)
