@@ -167,10 +167,13 @@ def test_ctrl_c_writes_the_finished_trials(tmp_path: Path) -> None:
 
     out = tmp_path / 'stopped'
     env = dict(os.environ)
+    # started as a script's background job is: with SIGINT ignored (inherited), which the
+    # command must not keep (it ran all 50 trials through the Ctrl-C)
     proc = subprocess.Popen([sys.executable, '-m', 'mindgrasp_bringup', 'experiment',
                              'random-locations', '--trials', '50', '--trial-timeout', '3',
                              '--out', str(out), '--no-progress'],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_IGN))
     # records.csv is rewritten after every finished trial: stop once it holds one
     deadline = time.monotonic() + 900
     csv = out / 'records.csv'

@@ -15,6 +15,8 @@ import importlib.util
 import sys
 from collections.abc import Sequence
 
+from mindgrasp_ros.process import handle_stop_signals
+
 #: command -> module, or command -> {verb: module}
 COMMANDS: dict[str, str | dict[str, str]] = {
     'launch': 'mindgrasp_bringup.commands.launch',
@@ -149,6 +151,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     if module_name is None:
         parser.print_help()
         return 0 if not argv else 2
+    handle_stop_signals()    # Ctrl-C and SIGTERM stop every command, even one run in the background
     module = _import(module_name)
     if module is None:
         print(f'mindgrasp: the command module {module_name!r} is not installed.', file=sys.stderr)

@@ -16,12 +16,33 @@ from __future__ import annotations
 
 import logging
 import os
+import signal
 import sys
+import threading
 import traceback
 from collections.abc import Callable
 from pathlib import Path
 
-__all__ = ['exit_if_main_program', 'exit_process', 'is_main_program', 'run_program']
+__all__ = ['exit_if_main_program', 'exit_process', 'handle_stop_signals', 'is_main_program',
+           'run_program']
+
+
+def handle_stop_signals() -> None:
+    """Ctrl-C (SIGINT) and SIGTERM raise KeyboardInterrupt in the main thread, whatever this
+    process inherited, so a program stopped either way cleans up the same way.
+
+    A process started in the background of a script (or by a test runner's worker) inherits
+    SIGINT *ignored*, and Python keeps it so: such a node ignored the launcher's SIGINT until it
+    was killed (its bag not closed), and an experiment ran all its trials through a Ctrl-C.
+    rclpy too installs its handler whatever was inherited. Handlers the program installed
+    itself are kept; nothing happens outside the main thread.
+    """
+    if threading.current_thread() is not threading.main_thread():
+        return
+    if signal.getsignal(signal.SIGINT) in (signal.SIG_IGN, signal.SIG_DFL, None):
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+    if signal.getsignal(signal.SIGTERM) in (signal.SIG_DFL, None):
+        signal.signal(signal.SIGTERM, lambda *_: signal.default_int_handler(signal.SIGINT, None))
 
 
 def is_main_program(module: str) -> bool:

@@ -8,10 +8,10 @@ submodules mirror ``rclpy.node``, ``rclpy.qos``, ``rclpy.executors``, ``rclpy.pa
 
 from __future__ import annotations
 
-import signal
 import threading
 from typing import Any
 
+from mindgrasp_ros.process import handle_stop_signals
 from mindgrasp_ros.runtime import (
     callback_groups,
     clock,
@@ -47,23 +47,7 @@ def init(*, args: list[str] | None = None, context: Context | None = None,
     the DDS domain (``ROS_DOMAIN_ID`` unless ``domain_id`` is given)."""
     ctx = context or _default_context
     ctx.init(args, domain_id=domain_id)
-    _install_sigterm_handler()
-
-
-def _install_sigterm_handler() -> None:
-    """SIGTERM behaves like Ctrl-C (KeyboardInterrupt), so nodes clean up the same way.
-
-    SIGINT is handled too, as rclpy installs its handler whatever it inherited: a process
-    started in the background of a script (or by a test runner's worker) inherits SIGINT
-    *ignored*, and Python keeps it so; such a node then ignored the launcher's SIGINT until it
-    was killed, and its bag was not closed.
-    """
-    if threading.current_thread() is not threading.main_thread():
-        return
-    if signal.getsignal(signal.SIGINT) in (signal.SIG_IGN, signal.SIG_DFL, None):
-        signal.signal(signal.SIGINT, signal.default_int_handler)
-    if signal.getsignal(signal.SIGTERM) in (signal.SIG_DFL, None):
-        signal.signal(signal.SIGTERM, lambda *_: signal.default_int_handler(signal.SIGINT, None))
+    handle_stop_signals()      # as rclpy: whatever the process inherited
 
 
 def ok(*, context: Context | None = None) -> bool:
