@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import sys
 import threading
+import traceback
 from dataclasses import dataclass
 from typing import Any
 
@@ -85,6 +86,7 @@ class PlayerNode(rclpy.node.Node):
             self.clock_publisher = self.create_publisher(
                 message_class(CLOCK_TYPE), CLOCK.name, CLOCK.qos, raw=True)
         self.stats: PlayStats | None = None
+        self._prepare_publishing()
         self.get_logger().info(f'Playing {self.reader.path} ({len(self.publishers_)} topic(s), '
                                f'rate {p.rate:g}).')
         self.stop_event = threading.Event()
@@ -116,13 +118,15 @@ class PlayerNode(rclpy.node.Node):
             if not self.done.done():
                 self.done.set_result(0)
 
-    def _play_bag(self) -> None:
+    def _prepare_publishing(self) -> None:
+        """Everything the playback thread needs before its first wait (the type store, the
+        progress bar, a first serialisation), done before the node says it plays: a thread busy
+        with it would answer a stop only after it (seconds on a loaded machine)."""
+        from tqdm import tqdm
+
         store = typestore()
         clock_class, time_class = store.types[CLOCK_TYPE], store.types[TIME_TYPE]
         publishers = self.publishers_   # keyed by output topic, as the player reports them
-
-        from tqdm import tqdm
-
         total = sum(info.message_count for info in self.reader.topics.values()
                     if self.remap.get(info.name, info.name) in publishers)
         bar = tqdm(total=None if self.player.loop else total, unit='msg', desc='bag play',
@@ -140,10 +144,13 @@ class PlayerNode(rclpy.node.Node):
 
         # rosbags builds a type's serializer on its first use (several ms): not on the schedule
         store.serialize_cdr(clock_class(clock=time_class(sec=0, nanosec=0)), CLOCK_TYPE)
+        self._bar, self._publish = bar, publish
+        self._publish_clock = publish_clock if self.clock_publisher is not None else None
+
+    def _play_bag(self) -> None:
         try:
             self.stats = self.player.run(
-                publish,
-                publish_clock=publish_clock if self.clock_publisher is not None else None,
+                self._publish, publish_clock=self._publish_clock,
                 clock_hz=self.params.clock_frequency, stop=self.stop_event,
                 priority=self.params.priority)
             for note in self.stats.notes:
@@ -151,12 +158,17 @@ class PlayerNode(rclpy.node.Node):
         except BagError as exc:
             fail(self, str(exc))
         finally:
-            bar.close()
+            self._bar.close()
 
     def destroy_node(self) -> None:
         """Stop the playback (Ctrl-C, SIGTERM), log what was published, close the bag."""
         self.stop_event.set()
         self.thread.join(5.0)
+        if self.thread.is_alive():    # say where it hangs: a stop must take one wait (50 ms)
+            frame = sys._current_frames().get(self.thread.ident)
+            where = ''.join(traceback.format_stack(frame)[-4:]) if frame else '?'
+            self.get_logger().error(f'The playback thread did not stop within 5 s; it is at:\n'
+                                    f'{where}')
         if self.stats is not None:
             total = sum(self.stats.published.values())
             self.get_logger().info(f'Published {total} message(s) on {len(self.stats.published)} '
