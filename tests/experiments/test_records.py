@@ -63,6 +63,23 @@ def test_wrong_object_lifted_and_no_grasp() -> None:
         TrialTracker().finish(1.0)
 
 
+def test_a_drop_does_not_end_the_trial_and_is_named() -> None:
+    tracker = TrialTracker()
+    tracker.start(1, 'red sphere', 0, t=0.0)
+    tracker.on_result('red sphere', False, 10.0, lift_height=0.157)   # slipped out
+    tracker.on_result('red sphere', True, 18.0, lift_height=0.25)     # the retry lifted it
+    tracker.on_result('red sphere', False, 19.0, lift_height=0.25)    # after the lift: ignored
+    rec = tracker.finish(20.0)
+    assert rec.success and rec.failure == '' and rec.time_to_grasp_s == 18.0
+    assert rec.lift_height == 0.25
+    tracker.start(2, 'red sphere', 0, t=0.0)
+    tracker.on_result('red sphere', False, 10.0, lift_height=0.157)
+    rec = tracker.finish(30.0, 'no_grasp', 'the grasp attempt ended without a lift')
+    assert not rec.success and rec.failure == 'dropped' and rec.grasped == 'red sphere'
+    assert rec.reason == ('the red sphere was dropped after a lift to 0.157 m (success: above '
+                          '0.22 m)')
+
+
 def test_records_round_trip_csv_and_parquet(tmp_path) -> None:
     tracker = TrialTracker('set_locations', 'noise')
     records = [_trial(tracker, 2, 'red cube', 'red cube', 'red cube', True),

@@ -29,7 +29,7 @@ __all__ = ['FAILURES', 'SUCCESS_HEIGHT', 'TrialRecord', 'TrialTracker', 'read_re
            'write_records']
 
 #: why a trial ended without a grasp result ('' = it ended normally)
-FAILURES = ('', 'no_grasp', 'timeout', 'stalled', 'node_error', 'interrupted')
+FAILURES = ('', 'no_grasp', 'dropped', 'timeout', 'stalled', 'node_error', 'interrupted')
 
 #: classes as the virtual subject's intent names them (mindgrasp_eeg.montage.class_name)
 _INTENT_CLASSES = {'left_hand': 0, 'right_hand': 1, 'both_hands': 2, 'both_feet': 3}
@@ -50,7 +50,7 @@ class TrialRecord:
     desired_y: float = math.nan
     chosen: str = ''                 # the controller's object of interest when it began to
                                      # grasp: colour + shape CNN, as the paper names it
-    grasped: str = ''                # ground truth: the object lifted or dropped ('' = none)
+    grasped: str = ''                # ground truth: the object lifted (or last dropped; '' none)
     success: bool = False            # an object was lifted above SUCCESS_HEIGHT
     correct_choice: bool = False     # the object gone for is the desired one
     correct_and_successful: bool = False
@@ -175,9 +175,10 @@ class TrialTracker:
 
     def on_result(self, grasped: str, success: bool, t: float,
                   lift_height: float = math.nan) -> None:
-        """``/task/result``: the first lift (or drop) of the trial."""
+        """``/task/result``: a lift above the success height, or a drop. A drop does not end the
+        trial (the controller may grasp again); the first lift counts."""
         rec = self.record
-        if rec is None or rec.grasped:
+        if rec is None or rec.success:
             return
         rec.grasped, rec.success, rec.lift_height = grasped, bool(success), float(lift_height)
         if success:
@@ -204,7 +205,11 @@ class TrialTracker:
         gone_for = rec.grasped or rec.chosen
         rec.correct_choice = bool(gone_for) and gone_for == rec.desired
         rec.correct_and_successful = rec.success and rec.grasped == rec.desired
-        if not failure and not rec.grasped:
+        if rec.grasped and not rec.success and failure in ('', 'no_grasp'):
+            failure = 'dropped'
+            reason = (f'the {rec.grasped} was dropped after a lift to {rec.lift_height:.3f} m '
+                      f'(success: above {SUCCESS_HEIGHT:.2f} m)')
+        elif not failure and not rec.grasped:
             failure = 'no_grasp'
         rec.failure = failure
         rec.reason = reason or ('object lifted above '

@@ -169,10 +169,18 @@ class TrialManagerNode(rclpy.node.Node):
                       for o in objects_from_markers(msg.markers)}
 
     def result_callback(self, msg: GraspResult) -> None:
-        if self.phase == 'trial' and self.result is None:
+        """A lift ends the trial; a drop is noted and the trial goes on (the controller grasps
+        again after a slip, ``grasp_retries``), until a lift, the controller gives up, or a
+        timeout."""
+        if self.phase != 'trial' or self.result is not None:
+            return
+        self.tracker.on_result(msg.grasped_object, bool(msg.success), self.now_s(),
+                               float(msg.lift_height))
+        if msg.success:
             self.result = msg
-            self.tracker.on_result(msg.grasped_object, bool(msg.success), self.now_s(),
-                                   float(msg.lift_height))
+        else:
+            self.get_logger().info(f'Trial {self.trial}: the {msg.grasped_object} was dropped '
+                                   f'(lift to {msg.lift_height:.3f} m); the trial goes on.')
 
     def fsm_callback(self, msg: FsmState) -> None:
         self.fsm_state = int(msg.state)
