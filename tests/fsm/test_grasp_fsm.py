@@ -571,6 +571,26 @@ def test_object_lost_in_the_lift_unloads_the_fingers(params: FsmParams) -> None:
     assert entered and 'slipped after the lift' in entered[0].reason
 
 
+def test_an_object_carried_by_two_fingers_after_the_lift_is_held(params: FsmParams) -> None:
+    """Three fingers must close on the object; after the lift two that still carry it are a
+    hold (a sphere off-centre in the hand), one is a slip."""
+    two = GripperState(opening=0.5, force=2.6, stamp=0.0, contact=True, fingers_in_contact=2,
+                       efforts=(1.35, 1.21, 0.07))
+    one = GripperState(opening=0.5, force=1.4, stamp=0.0, contact=True, fingers_in_contact=1,
+                       efforts=(1.35, 0.1, 0.07))
+    for after_lift, outcome in ((two, 'holding'), (one, None)):
+        fsm = _grasp_fsm(params)
+        q = _grasp_pose()
+        outs, q, t = _drive(fsm, q, SQUEEZING, 1.2)
+        assert outs[-1].phase == 'lift'
+        outs, _, _ = _drive(fsm, q, after_lift, 6.0, t0=t)
+        if outcome:
+            assert fsm.outcome == outcome
+        else:
+            entered = [o for o in outs if o.state == State.FINAL_APPROACH]
+            assert entered and '1 finger(s) push on something' in entered[0].reason
+
+
 def test_contact_flags_are_used_without_efforts_or_when_asked(params: FsmParams) -> None:
     from mindgrasp_fsm.grasp_policy import fingers_loaded
 

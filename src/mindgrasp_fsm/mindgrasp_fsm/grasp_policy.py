@@ -19,7 +19,8 @@ measurement instead:
 7. ``check_contact``: every finger must push on something (finger effort; a real hand's contact
    sensor cannot tell the object from the table) and the hand must not be fully closed.
 8. ``lift`` + ``check_lift``: lift and check the finger efforts and opening again (an object
-   that slipped out unloads the fingers); a slip or a miss opens the hand,
+   that slipped out unloads the fingers; ``min_fingers_holding`` still carry it); a slip or a
+   miss opens the hand,
    backs off and retries once (``grasp_retries``), from a new measurement.
 
 All motions are joint velocities (rad/s), within joint limits and velocity limits.
@@ -362,7 +363,11 @@ class GraspPolicy:
         closure = min((1.0 - gripper.opening) + p.grip_squeeze, p.gripper_closed_position)
         self._gripper = GripperCommand(closure, self._gripper.max_force)
 
-    def _holding(self, gripper: GripperState | None) -> tuple[bool, str]:
+    def _holding(self, gripper: GripperState | None,
+                 min_fingers: int | None = None) -> tuple[bool, str]:
+        """Whether the hand holds something: ``min_fingers`` (default
+        ``min_fingers_in_contact``) fingers loaded, and why."""
+        wanted = self.params.min_fingers_in_contact if min_fingers is None else min_fingers
         if gripper is None:
             return True, 'no gripper feedback: grasp not verified'
         if gripper.opening <= self.params.closed_empty_opening:
@@ -371,9 +376,9 @@ class GraspPolicy:
         if loaded is not None:
             # effort sensing: what a real hand knows (contact flags cannot tell the table apart)
             efforts = ', '.join(f'{abs(e):.2f}' for e in gripper.efforts or ())
-            if loaded < self.params.min_fingers_in_contact:
+            if loaded < wanted:
                 return False, (f'{loaded} finger(s) push on something (efforts {efforts} N m), '
-                               f'{self.params.min_fingers_in_contact} wanted for a firm grasp')
+                               f'{wanted} wanted')
             return True, f'{loaded} fingers loaded (efforts {efforts} N m, opening ' \
                          f'{gripper.opening:.2f})'
         touching = (gripper.contact if gripper.contact is not None
@@ -381,9 +386,8 @@ class GraspPolicy:
         if not touching:
             return False, f'no finger contact (force {gripper.force:.1f} N)'
         n = gripper.fingers_in_contact
-        if n is not None and n < self.params.min_fingers_in_contact:
-            return False, (f'only {n} finger(s) touch the object, '
-                           f'{self.params.min_fingers_in_contact} wanted for a firm grasp')
+        if n is not None and n < wanted:
+            return False, f'only {n} finger(s) touch the object, {wanted} wanted'
         fingers = '' if n is None else f'{n} fingers, '
         return True, f'finger contact ({fingers}opening {gripper.opening:.2f})'
 
@@ -453,7 +457,7 @@ class GraspPolicy:
         if self.phase == 'check_lift':
             if t - self._t0 < p.lift_check_time:
                 return PolicyStep(self._zeros(), self._gripper, self.phase)
-            ok, why = self._holding(gripper)
+            ok, why = self._holding(gripper, p.min_fingers_holding)
             if not ok:
                 return self._fail(t, q, f'slipped after the lift: {why}', can_retry)
             self.phase = 'hold'

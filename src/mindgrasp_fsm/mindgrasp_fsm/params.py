@@ -236,6 +236,10 @@ class FsmParams:
                                      min=0.0, max=500.0, live=True)
     min_fingers_in_contact: int = param(3, 'fingers that must touch for a firm grasp (contact '
                                         'sensing)', min=1, max=10, live=True)
+    # once lifted, what carries the object is what counts: a sphere off-centre in the hand (a
+    # camera a few mm off its calibration) rides on two fingers; opening on it dropped it
+    min_fingers_holding: int = param(2, 'loaded fingers after the lift for the object to count '
+                                     'as held (fewer: it slipped)', min=1, max=10, live=True)
     # a finger closing freely needs < 0.1 N m, one squeezing an object its limit of 1.2-2.4 N m.
     # A real hand cannot tell the object from the table by contact, so the grasp check counts
     # loaded fingers; 0 uses the contact flags instead (a simulator's "touches an object")
