@@ -30,3 +30,18 @@ def spin_until(ros) -> Callable[..., bool]:
     """``spin_until(node, condition, timeout)``: spin until ``condition()`` holds or ``timeout`` s
     pass; returns the condition."""
     return lambda node, condition, timeout: _spin_until(node, condition, timeout)
+
+
+@pytest.fixture
+def make_node(ros) -> Iterator[Callable[[str], object]]:
+    """``make_node(name)``: a node in the test process, destroyed at teardown even when the test
+    fails (a leftover node, say a stand-in's /sim/reset service, would answer the next test)."""
+    nodes = []
+
+    def make(name: str) -> object:
+        nodes.append(ros.node.Node(name))
+        return nodes[-1]
+
+    yield make
+    for node in nodes:
+        node.destroy_node()

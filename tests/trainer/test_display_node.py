@@ -50,12 +50,12 @@ def xvfb(tmp_path):
     proc.wait(10)
 
 
-def test_graz_cues_are_drawn_stamped_and_saved(ros, spawn_node, spin_until, tmp_path):
+def test_graz_cues_are_drawn_stamped_and_saved(ros, make_node, spawn_node, spin_until, tmp_path):
     from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import MIPrediction, Prompt
 
     from mindgrasp_trainer.ros_common import prompt_qos
 
-    node = ros.node.Node('display_graz_observer')
+    node = make_node('display_graz_observer')
     prompts, flips = [], []
     node.create_subscription(Prompt, '/trainer/prompt', prompts.append, prompt_qos())
     node.create_subscription(Prompt, '/display/flip', flips.append, 50)
@@ -91,12 +91,13 @@ def test_graz_cues_are_drawn_stamped_and_saved(ros, spawn_node, spin_until, tmp_
     assert len(xs) > 100 and np.median(xs) > 320
 
 
-def test_trainer_phase_in_a_window_under_xvfb_shows_both_robots(ros, spawn_node, spin_until,
-                                                                tmp_path, xvfb, monkeypatch):
+def test_trainer_phase_in_a_window_under_xvfb_shows_both_robots(
+    ros, make_node, spawn_node, spin_until, tmp_path, xvfb, monkeypatch,
+):
     from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import Prompt
 
     monkeypatch.setenv('DISPLAY', xvfb)
-    node = ros.node.Node('display_trainer_observer')
+    node = make_node('display_trainer_observer')
     flips = []
     node.create_subscription(Prompt, '/display/flip', flips.append, 50)
     png = tmp_path / 'png'
@@ -119,11 +120,13 @@ def test_trainer_phase_in_a_window_under_xvfb_shows_both_robots(ros, spawn_node,
     assert np.count_nonzero(np.all(scene < 60, axis=2)) > 300
 
 
-def test_test_phase_shows_the_camera_with_the_green_box_and_the_target(ros, spawn_node, spin_until):
+def test_test_phase_shows_the_camera_with_the_green_box_and_the_target(
+    ros, make_node, spawn_node, spin_until,
+):
     from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import TaskTarget
     from mindgrasp_ros.interfaces.sensor_msgs.msg import Image
 
-    node = ros.node.Node('display_test_observer')
+    node = make_node('display_test_observer')
     frames = []
     node.create_subscription(Image, '/display/image', frames.append,
                              ros.qos.qos_profile_sensor_data)

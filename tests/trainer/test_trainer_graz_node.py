@@ -29,10 +29,10 @@ def stamp_s(msg) -> float:
     return msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
 
 
-def test_prompts_arrive_in_order_with_the_schedule_timing(ros, spawn_node, spin_until):
+def test_prompts_arrive_in_order_with_the_schedule_timing(ros, make_node, spawn_node, spin_until):
     from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import Prompt
 
-    node = ros.node.Node('graz_listener')
+    node = make_node('graz_listener')
     got = []  # (message, receive time in ROS seconds)
     node.create_subscription(
         Prompt, '/trainer/prompt',
@@ -66,15 +66,15 @@ def test_prompts_arrive_in_order_with_the_schedule_timing(ros, spawn_node, spin_
     # each prompt reached the other process after it was stamped
     delays = np.array([t for _, t in got]) - stamps
     assert (delays > -0.01).all(), delays
-    node.destroy_node()
 
 
-def test_late_joiner_gets_the_last_prompt_and_the_display_shows_the_arrow(ros, spawn_node,
-                                                                         spin_until):
+def test_late_joiner_gets_the_last_prompt_and_the_display_shows_the_arrow(
+    ros, make_node, spawn_node, spin_until,
+):
     from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import Prompt
     from mindgrasp_ros.interfaces.sensor_msgs.msg import Image
 
-    node = ros.node.Node('graz_late_joiner')
+    node = make_node('graz_late_joiner')
     early, late, frames = [], [], []
     node.create_subscription(Prompt, '/trainer/prompt', early.append, prompt_qos(ros))
     node.create_subscription(Image, '/trainer/display', frames.append,
@@ -107,13 +107,12 @@ def test_late_joiner_gets_the_last_prompt_and_the_display_shows_the_arrow(ros, s
     dx, dy = DIRECTIONS[cue.class_index]
     centre = np.array([xs.mean() - 80, ys.mean() - 60])
     assert np.dot(centre, [dx, dy]) > 5
-    node.destroy_node()
 
 
-def test_duration_ends_the_session(ros, spawn_node, spin_until):
+def test_duration_ends_the_session(ros, make_node, spawn_node, spin_until):
     from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import Prompt
 
-    node = ros.node.Node('graz_duration_listener')
+    node = make_node('graz_duration_listener')
     got = []
     node.create_subscription(Prompt, '/trainer/prompt', got.append, prompt_qos(ros))
     t0 = time.monotonic()
@@ -122,7 +121,6 @@ def test_duration_ends_the_session(ros, spawn_node, spin_until):
     assert proc.wait(300) == 0
     assert time.monotonic() - t0 < 300     # 400 trials would take 640 s
     assert spin_until(node, lambda: got and got[-1].phase == 'end', 60.0)
-    node.destroy_node()
 
 
 @pytest.mark.parametrize(
@@ -140,14 +138,16 @@ def test_bad_parameters_end_the_node_with_the_reason(ros, spawn_node, params, ma
     assert match in out, out
 
 
-def test_live_display_parameters_and_fixed_protocol_parameters(ros, spawn_node, spin_until):
+def test_live_display_parameters_and_fixed_protocol_parameters(
+    ros, make_node, spawn_node, spin_until,
+):
     from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import MIPrediction, Prompt
     from mindgrasp_ros.interfaces.rcl_interfaces.srv import SetParameters
     from mindgrasp_ros.interfaces.sensor_msgs.msg import Image
 
     from mindgrasp_trainer.display import BAR_COLOUR
 
-    node = ros.node.Node('graz_param_client')
+    node = make_node('graz_param_client')
     frames = []
     node.create_subscription(Image, '/trainer/display', frames.append,
                              ros.qos.qos_profile_sensor_data)  # fmt: skip
@@ -200,4 +200,3 @@ def test_live_display_parameters_and_fixed_protocol_parameters(ros, spawn_node, 
     fixed = set_param('n_trials', 8)
     assert not fixed.successful
     assert "'n_trials' is read-only" in fixed.reason, fixed.reason
-    node.destroy_node()

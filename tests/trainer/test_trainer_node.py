@@ -57,7 +57,7 @@ class StandInRobot:
         self.node, self.q, self.v = node, HOME.copy(), np.zeros(6)
         self.t_last = time.monotonic()
         self.resets: list[tuple[float, float]] = []  # (time, z when called)
-        self.commands = 0
+        self.command_log: list[tuple[float, ...]] = []
         self.fsm = 1
         self.js_pub = node.create_publisher(JointState, '/trainer_robot/joint_states', 10)
         self.pose_pub = node.create_publisher(PoseStamped, '/trainer_robot/ee_pose', 10)
@@ -83,7 +83,7 @@ class StandInRobot:
 
     def command_callback(self, msg) -> None:
         self.v = np.asarray(msg.data, float)
-        self.commands += 1
+        self.command_log.append(tuple(msg.data))
 
     def reset_callback(self, request, response):
         self.resets.append((time.monotonic(), float(self.ee()[2])))
@@ -110,11 +110,13 @@ class StandInRobot:
         self.fsm_pub.publish(self.FsmState(state=self.fsm))
 
 
-def test_trainer_prompts_moves_resets_and_measures(ros, spawn_node, spin_until, tmp_path):
+def test_trainer_prompts_moves_resets_and_measures(
+    ros, make_node, spawn_node, spin_until, tmp_path,
+):
     from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import Prompt
     from mindgrasp_ros.interfaces.std_msgs.msg import Float64
 
-    node = ros.node.Node('trainer_stand_in')
+    node = make_node('trainer_stand_in')
     robot = StandInRobot(ros, node)
     prompts, distances = [], []  # prompts with the stand-in's joint positions on arrival
     tl = ros.qos.QoSProfile(
@@ -164,15 +166,18 @@ def test_trainer_prompts_moves_resets_and_measures(ros, spawn_node, spin_until, 
     assert 'Resetting both robots: training end-effector at' in out
     assert "Resetting both robots: user's robot entered the grasp state" in out
 
-    # motion: over each uninterrupted move phase, the commanded joint moved the class's way
+    # motion: the commands, in the order the stand-in received them, are one run of the class's
+    # velocity per trial, ended by stops (wait, reset); each uninterrupted move lasts 0.6 s of
+    # commands at 50 Hz. Judged on the command stream alone: where the stand-in's clock or the
+    # prompts' arrival fall against it depends on the load, not on the trainer.
     proto = TrainerProtocol(**{k: v for k, v in PARAMS.items() if k != 'rate'})
-    for (a, qa), (b, qb) in itertools.pairwise(prompts):
-        if a.phase == 'move' and b.phase == 'wait':
-            dq = qb - qa
-            expected = proto.velocity(a.class_index) * 0.6
-            np.testing.assert_allclose(dq, expected, atol=0.1, err_msg=f'trial {a.trial}')
-        if a.phase == 'wait' and b.phase == 'move':
-            np.testing.assert_allclose(qb - qa, 0.0, atol=0.06, err_msg=f'trial {a.trial} wait')
+    runs = [(np.array(v), len(list(g))) for v, g in itertools.groupby(robot.command_log)]
+    moving = [(v, n) for v, n in runs if np.any(v)]
+    assert len(moving) == 8, [(v.tolist(), n) for v, n in runs]
+    for trial, ((v, n), k) in enumerate(zip(moving, order, strict=True), start=1):
+        np.testing.assert_allclose(v, proto.velocity(int(k)), err_msg=f'trial {trial}')
+        if trial not in {t for t, _ in resets}:
+            assert 0.5 * 30 <= n <= 1.5 * 30, f'trial {trial}: {n} move commands'
 
     # the published metric is the distance between the two end-effectors
     assert len(distances) > 100
@@ -187,14 +192,15 @@ def test_trainer_prompts_moves_resets_and_measures(ros, spawn_node, spin_until, 
     assert [r['class_name'] for r in rows] == [m.class_name for m in moves]
     assert [int(r['trial']) for r in rows if r['aborted']] == [trial for trial, _ in resets]
     assert all(float(r['mean_ee_distance_m']) >= 0 for r in rows)
-    assert robot.commands > 100
-    node.destroy_node()
+    assert len(robot.command_log) > 100
 
 
-def test_missing_reset_service_is_reported_and_the_session_goes_on(ros, spawn_node, spin_until):
+def test_missing_reset_service_is_reported_and_the_session_goes_on(
+    ros, make_node, spawn_node, spin_until,
+):
     from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import Prompt
 
-    node = ros.node.Node('trainer_stand_in_no_reset')
+    node = make_node('trainer_stand_in_no_reset')
     StandInRobot(ros, node, reset_service=False)
     prompts = []
     tl = ros.qos.QoSProfile(
@@ -214,7 +220,6 @@ def test_missing_reset_service_is_reported_and_the_session_goes_on(ros, spawn_no
     assert [(m.phase, m.trial) for m in prompts if m.trial > 0] == [
         ('move', 1), ('rest', 1), ('move', 2), ('rest', 2), ('end', 2)
     ]
-    node.destroy_node()
 
 
 def test_trainer_without_training_robot_exits_with_the_fix(ros, spawn_node):

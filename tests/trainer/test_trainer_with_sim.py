@@ -10,12 +10,12 @@ import pytest
 pytestmark = pytest.mark.slow
 
 
-def test_trainer_drives_the_simulated_training_robot(ros, spawn_node, spin_until):
+def test_trainer_drives_the_simulated_training_robot(ros, make_node, spawn_node, spin_until):
     from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import Prompt
     from mindgrasp_ros.interfaces.sensor_msgs.msg import JointState
     from mindgrasp_ros.interfaces.std_msgs.msg import Float64
 
-    node = ros.node.Node('trainer_sim_observer')
+    node = make_node('trainer_sim_observer')
     joints: list[np.ndarray] = []      # joint positions (rad) in order of arrival
     prompts, distances = [], []        # (prompt, joint states received before it)
     tl = ros.qos.QoSProfile(
@@ -75,4 +75,3 @@ def test_trainer_drives_the_simulated_training_robot(ros, spawn_node, spin_until
     # distance: 0 at home (the robots coincide: during the 3 s settle after the reset, long after
     # this observer matched the trainer's publisher), growing as the training robot moves
     assert distances and min(distances) < 0.01 and max(distances) > 0.1
-    node.destroy_node()
