@@ -29,11 +29,17 @@ def test_demo_runs_headless_ends_cleanly_and_records_the_session(tmp_path: Path)
     # one trial: the virtual subject (pursue) drives the arm to grasp the red cube; the trial
     # manager then ends the launch (duration is only a safety net)
     # the live view on a free port: several test runs share this host. The trial manager waits
-    # until EEG, classifier and vision publish (a minute on a loaded machine) before the trial
-    result = run_launch('demo', 'duration:=400', f'eeg_stream:={stream}', 'trials:=1',
+    # until EEG, classifier and vision publish (a minute on a loaded machine) before the trial.
+    # The trial itself takes ~30 s idle; on a host loaded by other suites the live loop (nine
+    # processes in wall-clock time) can need several times that, so the test gives the trial
+    # 300 s instead of the demo's 120 s: a deadline for the condition, not a measure of speed
+    params = tmp_path / 'test_params.yaml'
+    params.write_text(yaml.safe_dump({'trial_manager': {'ros__parameters': {
+        'trial_timeout': 300.0}}}), encoding='utf-8')
+    result = run_launch('demo', 'duration:=500', f'eeg_stream:={stream}', 'trials:=1',
                         'live_view_port:=0',
                         "targets:=red cube", '--sigint-timeout', '20', '--run-dir', str(run_dir),
-                        timeout=900)
+                        timeout=900, MINDGRASP_PARAMS_FILES=str(params))
     assert result.returncode == 0, result.stderr[-4000:]
     summary = yaml.safe_load((run_dir / 'summary.yaml').read_text())
     assert {p['label'] for p in summary['processes']} == {
@@ -66,5 +72,9 @@ def test_demo_runs_headless_ends_cleanly_and_records_the_session(tmp_path: Path)
         reader.open()
         counts = {name: info.message_count for name, info in reader.topics.items()}
     for topic in ('/eeg/raw', '/joint_states', '/camera/color/image_raw', '/task/target',
-                  '/bci/prediction', '/vision/detections', '/fsm/state', '/task/result'):
+                  '/bci/prediction', '/vision/detections', '/fsm/state'):
         assert counts.get(topic, 0) > 0, (topic, counts)
+    # the simulator publishes a result when an object was lifted or dropped; a grasp that slips
+    # before the lift (possible on a loaded host, 'no_grasp') publishes none
+    if record.grasped:
+        assert counts.get('/task/result', 0) > 0, (record, counts)

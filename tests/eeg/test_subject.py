@@ -107,6 +107,12 @@ def test_pursue_class_like_a_competent_user() -> None:
     assert pursue_class(ahead, 0.0, 2, 'red cube') is None     # centring is autonomous
     assert pursue_class(ahead, 0.0, 4) is None
     assert pursue_class(None, 0.0, 1) is None
+    # the arm held still (after a prediction loss it waits for a fresh command): go on
+    assert pursue_class(ahead, 0.0, 4, stopped=True) == 2
+    assert pursue_class(ahead, 0.0, 2, 'red cube', stopped=True) == 2
+    assert pursue_class(ahead, 0.0, 2, 'blue cylinder', stopped=True) == 3
+    assert pursue_class(left, 0.0, 1, stopped=True) == 0
+    assert pursue_class(None, 0.0, 4, stopped=True) is None
     # angles wrap: target at +170 deg seen from -170 deg is 20 deg to the right
     back = SceneObject(3, 'red', 'sphere',
                        (math.cos(math.radians(170)), math.sin(math.radians(170)), 0.0))

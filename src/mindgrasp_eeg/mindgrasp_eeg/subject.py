@@ -60,7 +60,8 @@ def same_object(seen: str, wanted: str) -> bool:
 
 
 def pursue_class(target: SceneObject | None, base_yaw: float, fsm_state: int,
-                 object_of_interest: str = '', *, heading_tolerance: float = 0.1) -> int | None:
+                 object_of_interest: str = '', *, heading_tolerance: float = 0.1,
+                 stopped: bool = False) -> int | None:
     """What a competent user imagines to reach ``target`` (pure function).
 
     Parameters
@@ -78,6 +79,10 @@ def pursue_class(target: SceneObject | None, base_yaw: float, fsm_state: int,
         ``"<colour> <shape>"`` the controller is working on, empty when none.
     heading_tolerance : float
         Heading error (rad) under which the user considers the target centred.
+    stopped : bool
+        ``FsmState.stopped``: the controller holds the arm still. After a prediction loss it
+        waits for a fresh command (one class held, ``resume_after_stale``), so a user who would
+        rest in an autonomous state imagines both hands ("go on") until the arm moves again.
 
     Returns
     -------
@@ -86,12 +91,14 @@ def pursue_class(target: SceneObject | None, base_yaw: float, fsm_state: int,
         approach), 3 both feet (back away from a wrong object), None (rest: the controller is
         autonomous or there is nothing to do).
     """
-    if target is None or fsm_state in (State.FINAL_APPROACH, State.GRASP_OBJECT,
-                                        State.RETURN_TO_START):
+    if target is None:
         return None
+    go_on = BOTH_HANDS if stopped else None  # both hands: what the autonomous states ignore
+    if fsm_state in (State.FINAL_APPROACH, State.GRASP_OBJECT, State.RETURN_TO_START):
+        return go_on
     wrong = bool(object_of_interest) and not same_object(object_of_interest, target.label)
     if fsm_state == State.CENTER_OBJECT:
-        return BOTH_FEET if wrong else None
+        return BOTH_FEET if wrong else go_on
     if fsm_state == State.INITIAL_APPROACH:
         # the controller keeps the object centred itself: push on to it, or back off a wrong one
         return BOTH_FEET if wrong else BOTH_HANDS
@@ -155,6 +162,7 @@ class VirtualSubject:
         self.target_id, self.target_colour, self.target_shape = -1, '', ''
         self._target_changed = False
         self.base_yaw, self.fsm_state, self.object_of_interest = 0.0, 0, ''
+        self.fsm_stopped = False
         #: (time, asked class or None, imagined class or None) for every decision taken
         self.decisions: list[tuple[float, int | None, int | None]] = []
 
@@ -190,15 +198,16 @@ class VirtualSubject:
         """Arm heading (rad), from ``/joint_states``."""
         self.base_yaw = float(yaw)
 
-    def set_fsm(self, state: int, object_of_interest: str = '') -> None:
-        """Controller state (``/fsm/state``)."""
+    def set_fsm(self, state: int, object_of_interest: str = '', stopped: bool = False) -> None:
+        """Controller state (``/fsm/state``): its number, object of interest and stop flag."""
         self.fsm_state, self.object_of_interest = int(state), object_of_interest
+        self.fsm_stopped = bool(stopped)
 
     def competent_class(self) -> int | None:
         """What a competent user would imagine now (pursue mode inputs, no errors)."""
         target = find_target(self.objects, self.target_id, self.target_colour, self.target_shape)
         return pursue_class(target, self.base_yaw, self.fsm_state, self.object_of_interest,
-                            heading_tolerance=self.heading_tolerance)
+                            heading_tolerance=self.heading_tolerance, stopped=self.fsm_stopped)
 
     # -- output --------------------------------------------------------------------------------
     def intent(self, t: float) -> int | None:

@@ -138,7 +138,7 @@ class VirtualAmpNode(rclpy.node.Node):
 
     def fsm_callback(self, msg: FsmState) -> None:
         """Controller state and its object of interest."""
-        self.subject.set_fsm(int(msg.state), msg.object_of_interest)
+        self.subject.set_fsm(int(msg.state), msg.object_of_interest, msg.stopped)
 
     def push_callback(self) -> None:
         """Generate and push every sample due by now; report imagery changes."""

@@ -94,7 +94,7 @@ class OracleSubjectNode(rclpy.node.Node):
             self.subject.set_base_yaw(yaw)
 
     def fsm_callback(self, msg: FsmState) -> None:
-        self.subject.set_fsm(int(msg.state), msg.object_of_interest)
+        self.subject.set_fsm(int(msg.state), msg.object_of_interest, msg.stopped)
 
     def predict_callback(self) -> None:
         now = self.now_s()
