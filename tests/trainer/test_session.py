@@ -119,6 +119,35 @@ def test_virtual_session_runs_every_phase_retrains_and_resumes(tmp_path):
     assert (folder / 'report.yaml').is_file()
 
 
+@pytest.mark.timeout(900)   # two lock-step launches of ~45 simulated s each, and training
+def test_calibrate_runs_in_lockstep_end_to_end(tmp_path):
+    """``session calibrate``: each phase is a lock-step launch (simulated time) that records a
+    bag like a live run; the model is trained from the first bag and scored on the held-out one."""
+    import json
+
+    from mindgrasp_bringup.bag import BagReader
+
+    res = subprocess.run(
+        [sys.executable, '-m', 'mindgrasp_bringup', 'session', 'calibrate', '--subject', 'V1',
+         '--session', 's1', '--virtual-accuracy', '0.9', '--trials-per-class', '3', '--json'],
+        cwd=tmp_path, capture_output=True, text=True, timeout=800)
+    assert res.returncode == 0, res.stdout[-3000:] + res.stderr[-3000:]
+    assert res.stdout.count('lock-step: simulated') == 2                 # both phases
+    result = json.loads(res.stdout.strip().splitlines()[-1])
+    assert result['heldout_trials'] == 12 and result['virtual_accuracy'] == 0.9
+    # chance is 25 %; the virtual subject imagines the prompted class 90 % of the time
+    assert result['cv_accuracy'] > 0.5 and result['heldout_accuracy'] > 0.5
+    assert Path(result['model_path']).is_file() and result['wall_time_s'] > 0
+    folder = tmp_path / 'subjects' / 'V1' / 's1'
+    for run in ('01_graz', '02_heldout'):
+        with BagReader(folder / run / 'bag') as reader:
+            topics = set(reader.topics)
+            start, end = reader.start_ns, reader.end_ns
+        assert {'/eeg/raw', '/trainer/prompt'} <= topics
+        assert 0 < start < end < 120e9      # simulated time: the ~45 s run from 0
+    assert not list(folder.glob('*/display'))                    # no participant screen
+
+
 def test_calibration_plan_sets_trials_per_class_and_adds_a_heldout_run():
     from mindgrasp_trainer.session import calibration_plan
 

@@ -27,6 +27,12 @@ The subject folder::
 
 An interrupted phase is moved aside (``01_graz.interrupted-1``) and run again on resume; finished
 phases are kept. No ROS imports: each phase runs ``mindgrasp launch`` as a child process.
+
+With the virtual subject and no display (``mindgrasp session calibrate``, or ``session run --amp
+virtual --display off``) nothing waits on the wall clock, so each phase runs ``mindgrasp launch
+--lockstep``: the same nodes and recorder composed on simulated time, as fast as the machine
+allows; a phase's ``duration`` then counts simulated seconds. A real amplifier or a display keeps
+real time.
 """
 
 from __future__ import annotations
@@ -340,11 +346,20 @@ class Session:
         out(report)
         return 0
 
+    @property
+    def lockstep(self) -> bool:
+        """True when the phases run in lock-step: the virtual subject and no display, so
+        nothing ties the session to the wall clock (an LSL amplifier streams in real time, and
+        a person looks at the display)."""
+        return (self.launch_args.get('amp', 'virtual') == 'virtual'
+                and self.launch_args.get('display', 'off') == 'off')
+
     def _launch(self, phase: Phase, run_dir: Path, model: str, index: int,
                 certainty_scale: float = 0.0) -> int:
         args = {**self.launch_args}
         args.update(trials=str(phase.trials))
         display = args.get('display', 'off')
+        lockstep = self.lockstep
         if display != 'off':
             args.update(display_png_dir=str(run_dir / 'display'),
                         display_label=f'{phase.name} ({phase.kind})')
@@ -377,6 +392,9 @@ class Session:
         if certainty_scale > 0:
             params.setdefault('participant_display', {}).setdefault('max_certainty',
                                                                     round(certainty_scale, 4))
+        if lockstep:
+            # nobody can look at the prompter's own screen: no frames to render and record
+            params.setdefault('graz_prompter', {}).setdefault('display_rate', 0.0)
         if display == 'headless':  # frames for the record, not for a person: 10 Hz is plenty
             params.setdefault('participant_display', {}).setdefault('rate', 10.0)
         # the first trial starts once EEG flows (the amplifier may start late on a busy machine)
@@ -391,6 +409,7 @@ class Session:
                                              params.items()}, sort_keys=False), encoding='utf-8')
             env['MINDGRASP_PARAMS_FILES'] = str(pfile)
         cmd = [sys.executable, '-m', 'mindgrasp_bringup', 'launch', phase.profile,
+               *(['--lockstep'] if lockstep else []),
                '--run-dir', str(run_dir), *(f'{k}:={v}' for k, v in args.items())]
         return subprocess.call(cmd, env=env)
 

@@ -42,7 +42,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--eeg-stream', default=None, help='LSL stream name of the amplifier')
     parser.add_argument('--display', choices=['off', 'window', 'fullscreen', 'headless'],
                         default=None, help="the participant's screen (default: window with "
-                                           '--amp lsl, else headless)')
+                                           '--amp lsl, off for calibrate, else headless); the '
+                                           'virtual subject with off runs in lock-step')
     parser.add_argument('--seed', type=non_negative_int, default=None,
                         help='seed of every phase (0)')
     if getattr(parser, 'prog', '').endswith('calibrate'):
@@ -112,9 +113,12 @@ def main(args: argparse.Namespace) -> int:
                        "(check it with: mindgrasp launch eeg eeg_stream:=NAME).")
                 raise SessionError(msg)
             # the virtual amplifier's LSL stream is host-wide: a name of its own per session;
-            # a person (a real amplifier) looks at a window, the virtual subject needs none
+            # a person (a real amplifier) looks at a window; session run draws the virtual
+            # subject's screen headless for the record; calibrate draws none, so its phases run
+            # in lock-step (simulated time, as fast as the machine allows)
             stream = f'MIndGrasp-{args.subject}-{os.getpid()}'
-            display = 'window' if args.amp == 'lsl' else 'headless'
+            display = ('window' if args.amp == 'lsl' else
+                       'off' if verb == 'calibrate' else 'headless')
             session = Session(root, args.subject, name,
                               {'display': display, 'seed': '0', 'eeg_stream': stream,
                                **_launch_args(args)})

@@ -10,6 +10,8 @@ and ``/trainer/ee_distance`` (std_msgs/Float64, m). Subscribes ``/trainer_robot/
 ``/trainer_robot/ee_pose``, ``/ee_pose`` and ``/fsm/state``; calls ``/sim/reset``
 (mindgrasp_msgs/ResetSim) when the training end-effector goes below ``reset_height`` or the
 user's controller enters the grasp state. Ends by itself after ``n_trials`` or ``duration`` s.
+Every time it keeps (delays, ``robot_timeout``, ``reset_timeout``) is on the node's clock: the
+wall clock in a live run, simulated time in lock-step (``mindgrasp launch trainer --lockstep``).
 """
 
 from __future__ import annotations
@@ -17,7 +19,6 @@ from __future__ import annotations
 import csv
 import json
 import math
-import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -123,11 +124,12 @@ class TrainerNode(rclpy.node.Node):
         self.fsm_state: int | None = None
         self.grasp_latch = False
         self.joint_count: int | None = None
-        self.reset_deadline: float | None = None  # wall time by which /sim/reset must answer
+        # times below are the node's clock in s (wall time live, simulated time in lock-step)
+        self.reset_deadline: float | None = None  # by when /sim/reset must answer
         self.reset_future = None
-        self.created = time.monotonic()
-        self.trainer_pose_time = math.inf  # wall time of the last training robot pose
-        self.stale_warned = 0.0
+        self.created: float | None = None  # first tick with a clock (sim time may start late)
+        self.trainer_pose_time = math.inf  # arrival of the last training robot pose
+        self.stale_warned = -math.inf
         self.done = rclpy.task.Future()  # result: exit code, set when the session has ended
         self.eeg_gate = EegGate(self) if p.wait_for_eeg else None
 
@@ -164,7 +166,7 @@ class TrainerNode(rclpy.node.Node):
 
     def trainer_pose_callback(self, msg: PoseStamped) -> None:
         self.trainer_pos = _position(msg)
-        self.trainer_pose_time = time.monotonic()
+        self.trainer_pose_time = self._now()
 
     def user_pose_callback(self, msg: PoseStamped) -> None:
         self.user_pos = _position(msg)
@@ -186,8 +188,11 @@ class TrainerNode(rclpy.node.Node):
     def _now(self) -> float:
         return self.get_clock().now().nanoseconds * 1e-9
 
-    def _ready(self) -> bool:
-        """True once the training robot is heard from; ends the node if it never is."""
+    def _ready(self, t: float) -> bool:
+        """True once the training robot is heard from; ends the node if it never is within
+        ``robot_timeout`` of the first tick (``t``: the node's clock, s)."""
+        if self.created is None:
+            self.created = t
         if self.joint_count is not None and self.trainer_pos is not None:
             if self.eeg_gate is not None and not self.eeg_gate.ready():
                 return False
@@ -200,7 +205,7 @@ class TrainerNode(rclpy.node.Node):
                 self._finish(1)
                 return False
             return True
-        if self.p.robot_timeout > 0 and time.monotonic() - self.created > self.p.robot_timeout:
+        if self.p.robot_timeout > 0 and t - self.created > self.p.robot_timeout:
             missing = [
                 topic for topic, value in (
                     ('/trainer_robot/joint_states', self.joint_count),
@@ -223,7 +228,7 @@ class TrainerNode(rclpy.node.Node):
             return
         t = now.nanoseconds * 1e-9
         if self.protocol.state == 'idle':
-            if not self._ready():
+            if not self._ready(t):
                 return
             events = self.protocol.start(t)
             step = self.protocol.update(t, self.trainer_pos[2], self._fsm_for_tick())
@@ -232,7 +237,7 @@ class TrainerNode(rclpy.node.Node):
             z = self.trainer_pos[2] if self.trainer_pos is not None else None
             step = self.protocol.update(t, z, self._fsm_for_tick())
         self._check_reset_timeout(t)
-        self._check_stale_pose()
+        self._check_stale_pose(t)
         if self.trainer_pos is not None and self.user_pos is not None:
             d = ee_distance(self.trainer_pos, self.user_pos)
             self.protocol.record_distance(d)
@@ -256,9 +261,9 @@ class TrainerNode(rclpy.node.Node):
         if step.done:
             self._finish(0)
 
-    def _check_stale_pose(self) -> None:
-        """Warn (every 5 s at most) when the training robot's pose stops arriving."""
-        now = time.monotonic()
+    def _check_stale_pose(self, now: float) -> None:
+        """Warn (every 5 s at most) when the training robot's pose stops arriving (``now``: the
+        node's clock, s)."""
         age = now - self.trainer_pose_time
         if self.protocol.state in ('move', 'wait') and age > 1.0 and now - self.stale_warned > 5:
             self.stale_warned = now
@@ -279,7 +284,7 @@ class TrainerNode(rclpy.node.Node):
         request = ResetSim.Request(
             new_random_draw=self.p.reset_new_random_draw, seed=-1
         )
-        self.reset_deadline = time.monotonic() + self.p.reset_timeout
+        self.reset_deadline = t + self.p.reset_timeout
         self.reset_future = self.reset_client.call_async(request)
         self.reset_future.add_done_callback(self.reset_done_callback)
 
@@ -297,7 +302,7 @@ class TrainerNode(rclpy.node.Node):
         self.protocol.reset_finished(self._now(), success=bool(response.success))
 
     def _check_reset_timeout(self, t: float) -> None:
-        if self.reset_deadline is not None and time.monotonic() > self.reset_deadline:
+        if self.reset_deadline is not None and t > self.reset_deadline:
             self.get_logger().error(
                 f'/sim/reset did not answer within {self.p.reset_timeout:.1f} s; the session goes '
                 "on. Check the simulator's log, or raise 'reset_timeout'."

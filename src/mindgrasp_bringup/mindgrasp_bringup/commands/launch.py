@@ -101,7 +101,8 @@ def _run_lockstep(args: argparse.Namespace, service: LaunchService,
     run_dir = rundir.create_run_dir(service.name, args.run_dir, service.runs_root)
     given = dict(a.split(':=', 1) for a in launch_arguments)
     duration = float(given.pop('duration', 0) or 0)
-    components = lockstep_components(service.launch_file, given, run_dir / 'params', log=print)
+    components = lockstep_components(service.launch_file, given, run_dir / 'params', log=print,
+                                     bag=run_dir / 'bag')
     print(f'lock-step: composing {len(components)} node(s) on simulated time: '
           + ', '.join(c.label for c in components) + f'; run directory {run_dir}', flush=True)
     import os

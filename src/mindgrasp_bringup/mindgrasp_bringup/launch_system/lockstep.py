@@ -4,7 +4,10 @@
 optional overlay launch file whose nodes replace same-named ones) into the nodes to compose, as
 ``mindgrasp launch`` would start them, with the lock-step substitutions of
 :data:`LOCKSTEP_NODES`: LSL runs on wall time, so the virtual amplifier publishes ``/eeg/raw``
-itself (``output:=ros``) and the LSL acquisition node is left out; the recorder is left out.
+itself (``output:=ros``) and the LSL acquisition node is left out. With a ``bag`` directory the
+launch's recorder is composed too (the same node, topics and arguments as in a live run; it
+discovers the topics from the in-process graph and stamps messages with simulated time);
+without one (the experiments, which write records) the launch runs with ``record:=false``.
 :func:`run_lockstep` steps them with :class:`mindgrasp_ros.composition.LockstepRunner` until a
 node is done. The experiments (:mod:`mindgrasp_experiments.engine`) build on these.
 """
@@ -28,9 +31,14 @@ __all__ = ['LOCKSTEP_NODES', 'LockstepComponent', 'lockstep_components', 'run_lo
 LOCKSTEP_NODES: dict[str, str | dict[str, Any]] = {
     'mindgrasp_eeg.acquisition_node': 'LSL runs on wall time; the virtual amplifier publishes '
                                       '/eeg/raw itself in lock-step',
-    'mindgrasp_bringup.bag.recorder_node': 'lock-step runs write records, not bags',
+    # the runner's own /clock is not a topic of the launch (a live run has none)
+    'mindgrasp_bringup.bag.recorder_node': {'exclude_regex': '^/clock$'},
     'mindgrasp_eeg.virtual_amp_node': {'output': 'ros'},
 }
+
+#: the recorder's node module (its ``output`` is the bag directory)
+RECORDER_MODULE = 'mindgrasp_bringup.bag.recorder_node'
+
 
 @dataclass
 class LockstepComponent:
@@ -44,18 +52,21 @@ class LockstepComponent:
 
 def lockstep_components(launch: str | Path, arguments: Sequence[str] | Mapping[str, Any],
                         params_dir: Path, *, overlay: str | Path | None = None,
-                        log: Any = None) -> list[LockstepComponent]:
+                        log: Any = None, bag: Path | None = None) -> list[LockstepComponent]:
     """The nodes of ``launch`` (a profile or a launch file) to compose in lock-step.
 
     ``overlay``: a user's launch file whose nodes replace the profile's nodes of the same name
-    (another classifier, another controller) or are added. Parameter files of every node are
-    written to ``params_dir``. Raises :class:`LaunchError` naming the problem and the fix.
+    (another classifier, another controller) or are added. ``bag``: the directory the launch's
+    recorder writes (as ``<run dir>/bag`` of a live run; the launch's ``record:=false`` still
+    leaves it out); None runs without the recorder. Parameter files of every node are written to
+    ``params_dir``. Raises :class:`LaunchError` naming the problem and the fix.
     """
     from mindgrasp_bringup.launch_system import LaunchError, LaunchService
 
     args = dict(arguments) if isinstance(arguments, Mapping) else \
         dict(a.split(':=', 1) for a in arguments)
-    args['record'] = 'false'
+    if bag is None:
+        args['record'] = 'false'
     processes = list(LaunchService(launch, args).plan().processes)
     if overlay is not None:
         user = LaunchService(overlay)
@@ -83,6 +94,8 @@ def lockstep_components(launch: str | Path, arguments: Sequence[str] | Mapping[s
         params = dict(spec.parameters)
         if isinstance(rule, dict):
             params.update(rule)
+        if spec.module == RECORDER_MODULE and bag is not None:
+            params['output'] = str(bag)
         path = params_dir / f'{spec.label}.yaml'
         rundir.write_yaml(path, ros_params.dump_parameters({'/**': params}),
                           header=f'parameters of {spec.label} (lock-step)')
@@ -110,6 +123,20 @@ def set_log_level(level: str) -> None:
     set_logger_level('', level)
 
 
+def _exit_code_text(node: Any) -> str | None:
+    """'ended with exit code N' for a node that ended with a non-zero code (``done`` holds the
+    code its process would exit with, e.g. a prompter that gave up), else None."""
+    from mindgrasp_ros.node_main import is_done
+
+    done = getattr(node, 'done', None)
+    if not is_done(node) or isinstance(done, bool) or done.exception() is not None:
+        return None
+    code = done.result()
+    if isinstance(code, int) and not isinstance(code, bool) and code != 0:
+        return f'ended with exit code {code}'
+    return None
+
+
 def run_lockstep(components: Sequence[LockstepComponent], *, step_s: float = 0.02,
                  duration_s: float = 0.0, log: Any = print) -> int:
     """``mindgrasp launch <profile> --lockstep``: compose every node, step until a node is done
@@ -126,7 +153,8 @@ def run_lockstep(components: Sequence[LockstepComponent], *, step_s: float = 0.0
         end = runner.time_s + duration_s if duration_s > 0 else math.inf
         while runner.time_s < end and not any(is_done(n) for n in nodes):
             runner.step(step_s)
-        errors = [(n.get_name(), error_text(n)) for n in nodes if error_text(n)]
+        errors = [(n.get_name(), error_text(n) or _exit_code_text(n)) for n in nodes
+                  if error_text(n) or _exit_code_text(n)]
         for name, error in errors:
             log(f'[{name}] ERROR: {error}')
         code = 1 if errors else 0

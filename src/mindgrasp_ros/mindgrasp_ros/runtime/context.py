@@ -22,6 +22,7 @@ if TYPE_CHECKING:
     from mindgrasp_ros.runtime.dds import DdsParticipant, DdsWriter
     from mindgrasp_ros.runtime.entities import Publisher, Subscription, _Delivery
     from mindgrasp_ros.runtime.graph import GraphCache
+    from mindgrasp_ros.runtime.intra_graph import IntraGraph
     from mindgrasp_ros.runtime.node import Node
 
 __all__ = ['Context']
@@ -81,6 +82,10 @@ class IntraProcess:
             return
         for sub in list(subs):
             if self._compatible(pub, sub):
+                if sub.raw:
+                    # serialised now (once per publish, shared by every raw receiver), so the
+                    # bytes are the message as published even if the publisher reuses the object
+                    delivery.raw()
                 sub._enqueue(delivery)
 
     def count_subscriptions(self, topic: str) -> int:
@@ -112,7 +117,7 @@ class Context:
         self.intra = IntraProcess()
         self.nodes: list[Node] = []
         self._discovery_writer: DdsWriter | None = None
-        self._graph: GraphCache | None = None
+        self._graph: GraphCache | IntraGraph | None = None
         self.domain_id = 0
 
     def init(self, args: list[str] | None = None, *, domain_id: int | None = None,
@@ -223,13 +228,21 @@ class Context:
             self._discovery_writer.write(serialize(msg))
 
     @property
-    def graph(self) -> GraphCache:
-        """Graph introspection of the domain (created on first use)."""
+    def graph(self) -> GraphCache | IntraGraph:
+        """Graph introspection (created on first use): of the domain through DDS discovery, or,
+        in a DDS-less context, of this context's own nodes (:mod:`.intra_graph`)."""
         with self._lock:
             if self._graph is None:
-                from mindgrasp_ros.runtime.graph import GraphCache
+                if self.transport == 'intra':
+                    if not self._ok:
+                        raise NotInitializedException()
+                    from mindgrasp_ros.runtime.intra_graph import IntraGraph
 
-                self._graph = GraphCache(self.require_dds('Graph introspection'))
+                    self._graph = IntraGraph(self)
+                else:
+                    from mindgrasp_ros.runtime.graph import GraphCache
+
+                    self._graph = GraphCache(self.require_dds('Graph introspection'))
             return self._graph
 
     @property

@@ -13,7 +13,6 @@ import threading
 import time
 import uuid
 from collections import defaultdict
-from dataclasses import dataclass
 from typing import Any
 
 from cyclonedds.builtin import (
@@ -31,6 +30,7 @@ from mindgrasp_ros.runtime.dds import (
     ros_type_name_from_dds,
 )
 from mindgrasp_ros.runtime.duration import Duration
+from mindgrasp_ros.runtime.endpoint_info import TopicEndpointInfo
 from mindgrasp_ros.runtime.qos import (
     DurabilityPolicy,
     HistoryPolicy,
@@ -42,19 +42,6 @@ from mindgrasp_ros.runtime.signal_guard import DDS_CALL
 from mindgrasp_ros.typesupport import deserialize
 
 __all__ = ['GraphCache', 'TopicEndpointInfo']
-
-
-@dataclass
-class TopicEndpointInfo:
-    """One publisher or subscription of a topic (``rclpy.topic_endpoint_info``)."""
-
-    node_name: str
-    node_namespace: str
-    topic_type: str
-    endpoint_type: str  # 'PUBLISHER' | 'SUBSCRIPTION'
-    endpoint_gid: bytes
-    qos_profile: QoSProfile
-    topic_type_hash: str = ''
 
 
 def _qos_from_dds(qos: Any) -> QoSProfile:
