@@ -124,5 +124,6 @@ class VirtualAmpParams:
     output: str = param('lsl', "lsl (an LSL stream, live runs) or ros (/eeg/raw on the node "
                         'clock, lock-step experiments)', choices=OUTPUTS)
     frame_id: str = param('eeg', 'frame_id of /eeg/raw (output ros)')
-    eeg_source: str = param('synthetic', 'synthetic (head model) | eegmmidb:<subject> (real '
-                            'imagery epochs)')
+    eeg_source: str = param('synthetic', 'synthetic (head model) | eegmmidb:<subject> | '
+                            'path/to/subject.yaml (real imagery epochs of a replay subject, '
+                            'mindgrasp_eeg.subject_file)')

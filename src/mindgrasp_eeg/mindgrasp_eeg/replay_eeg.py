@@ -13,11 +13,12 @@ class are played in a seeded random order, cycling when all were played.
 Each epoch has its per-channel mean removed, so the joins carry no DC steps (the recordings'
 offsets differ from epoch to epoch; the decoder band-passes anyway).
 
-EEGMMIDB (``eegmmidb:<subject>``): imagery runs 4, 8, 12 (T1 left fist -> left hand, T2 right fist
--> right hand) and 6, 10, 14 (T1 both fists -> both hands, T2 both feet -> both feet), T0 rest.
-The loop plays :data:`EEGMMIDB_PLAY_RUNS`; the classifier is calibrated on
-:data:`EEGMMIDB_CALIBRATION_RUNS` of the same subject, never on epochs played in the loop.
-Files come through MNE's EEGMMIDB loader (``MNE_DATASETS_EEGBCI_PATH``, else it downloads).
+Which recordings are played, and how their annotations map to classes, comes from a replay subject
+description (:mod:`mindgrasp_eeg.subject_file`: ``eegmmidb:<n>`` or a subject file):
+:meth:`ReplayEEG.from_source` plays its ``play`` set; the classifier is calibrated on its
+``calibration`` set, never on the epochs played in the loop. An epoch is an annotation's duration,
+or for markers without one (XDF string markers, many GDF cues) the time up to the next annotation
+or the end of the file, at most :data:`MAX_EPOCH_S` (:func:`segments`).
 
     >>> import numpy as np
     >>> epochs = {None: [np.zeros((10, 2))], 0: [np.ones((4, 2))]}
@@ -28,6 +29,7 @@ Files come through MNE's EEGMMIDB loader (``MNE_DATASETS_EEGBCI_PATH``, else it 
 
 from __future__ import annotations
 
+import bisect
 from collections.abc import Mapping, Sequence
 
 import numpy as np
@@ -35,70 +37,51 @@ import numpy as np
 from mindgrasp_common.types import Recording
 
 from . import EEGError
+from .subject_file import SubjectFiles, replay_subject
 
-__all__ = ['EEGMMIDB_CALIBRATION_RUNS', 'EEGMMIDB_EVENTS', 'EEGMMIDB_PLAY_RUNS', 'MIN_EPOCHS',
-           'ReplayEEG', 'eegmmidb_runs', 'epochs_of', 'parse_replay_source']
+__all__ = ['MAX_EPOCH_S', 'MIN_EPOCHS', 'ReplayEEG', 'epochs_of', 'segments']
 
-#: EEGMMIDB imagery run -> {annotation: MIndGrasp class}; T0 is rest in every run
-EEGMMIDB_EVENTS: dict[int, dict[str, int]] = {
-    **{r: {'T1': 0, 'T2': 1} for r in (4, 8, 12)},      # left fist, right fist
-    **{r: {'T1': 2, 'T2': 3} for r in (6, 10, 14)},     # both fists, both feet
-}
-#: runs the classifier is calibrated on / runs played in the loop (disjoint)
-EEGMMIDB_CALIBRATION_RUNS = (4, 6)
-EEGMMIDB_PLAY_RUNS = (8, 10)
 #: fewest recorded epochs of each class (and of rest) a replay subject needs
 MIN_EPOCHS = 3
-REST = 'T0'
+#: longest epoch cut from a marker without duration (s): up to the next annotation, at most this
+MAX_EPOCH_S = 4.0
+#: shortest epoch kept (s): shorter ones are fragments at the end of a recording
+MIN_EPOCH_S = 1.0
 
 
-def parse_replay_source(text: str) -> int:
-    """``'eegmmidb:1'`` -> subject 1 (raises :class:`EEGError` naming the form)."""
-    kind, _, subject = text.partition(':')
-    if kind.lower() != 'eegmmidb' or not subject.strip().lstrip('Ss').isdigit():
-        msg = (f'{text!r} is not a replay subject; write eegmmidb:<subject>, e.g. eegmmidb:1 '
-               '(EEGMMIDB subjects 1-109).')
-        raise EEGError(msg)
-    number = int(subject.strip().lstrip('Ss'))
-    if not 1 <= number <= 109:
-        msg = f'{text!r}: EEGMMIDB has subjects 1-109; write e.g. eegmmidb:1.'
-        raise EEGError(msg)
-    return number
+def segments(recording: Recording,
+             events: Mapping[str, int | None]) -> list[tuple[int, int, int | None]]:
+    """The labelled epochs of ``recording``: ``(first sample, end sample, class)`` per annotation
+    in ``events`` (annotation -> class 0..3, None = rest), in the order of the annotations.
+
+    An epoch lasts the annotation's duration; an annotation without one (a marker) lasts until
+    the next annotation of any kind or the end of the data, at most :data:`MAX_EPOCH_S`. Epochs
+    shorter than :data:`MIN_EPOCH_S` (a fragment at the end of a run) are left out.
+    """
+    fs, n = recording.rate, len(recording.data)
+    onsets = sorted(onset for onset, _d, _l in recording.annotations)
+    out: list[tuple[int, int, int | None]] = []
+    for onset, duration, label in recording.annotations:
+        if label not in events:
+            continue
+        if duration > 0:
+            end = onset + duration
+        else:
+            later = onsets[bisect.bisect_right(onsets, onset):]
+            end = min(later[0] if later else n / fs, onset + MAX_EPOCH_S)
+        k0, k1 = round(onset * fs), min(n, round(end * fs))
+        if k1 - k0 >= MIN_EPOCH_S * fs:
+            out.append((k0, k1, events[label]))
+    return out
 
 
-def eegmmidb_runs(subject: int, runs: Sequence[int]) -> list[Recording]:
-    """The recordings of EEGMMIDB ``subject``'s ``runs`` (volts, standard 10-10 names, with
-    their annotations), through MNE's loader."""
-    from .player import expand_sources, load_recording
-
-    try:
-        paths = expand_sources([f"eegbci:{subject}:{','.join(str(r) for r in runs)}"])
-    except EEGError:
-        raise
-    except Exception as exc:    # download or file errors from MNE/pooch
-        msg = (f'MNE could not provide EEGMMIDB subject {subject} runs {list(runs)} '
-               f'({type(exc).__name__}: {exc}); set MNE_DATASETS_EEGBCI_PATH to a folder that '
-               'holds them, or allow the download.')
-        raise EEGError(msg) from None
-    return [load_recording(p) for p in paths]
-
-
-def epochs_of(recording: Recording, events: Mapping[str, int]) -> dict[int | None, list]:
-    """Epochs of ``recording`` by class (``None``: rest), from its annotations.
+def epochs_of(recording: Recording,
+              events: Mapping[str, int | None]) -> dict[int | None, list[np.ndarray]]:
+    """Epochs of ``recording`` by class (``None``: rest), cut by :func:`segments`.
 
     Returns ``{class or None: [ndarray (n_samples, n_channels), volts, mean removed]}``."""
-    out: dict[int | None, list] = {}
-    for onset, duration, label in recording.annotations:
-        if label == REST:
-            cls = None
-        elif label in events:
-            cls = events[label]
-        else:
-            continue
-        k0 = round(onset * recording.rate)
-        k1 = min(len(recording.data), round((onset + duration) * recording.rate))
-        if k1 - k0 < recording.rate:       # shorter than 1 s: a fragment at the end of the run
-            continue
+    out: dict[int | None, list[np.ndarray]] = {}
+    for k0, k1, cls in segments(recording, events):
         seg = np.asarray(recording.data[k0:k1], dtype=float)
         out.setdefault(cls, []).append(seg - seg.mean(axis=0))
     return out
@@ -118,16 +101,17 @@ class ReplayEEG:
 
     def __init__(self, epochs: Mapping[int | None, Sequence[np.ndarray]], sample_rate: float,
                  channel_names: Sequence[str], *, seed: int = 0,
-                 min_epochs: int = 1) -> None:
+                 min_epochs: int = 1, source: str = '') -> None:
         self.sample_rate = float(sample_rate)
         self.channel_names = list(channel_names)
+        where = f' {source}' if source else ''
         for cls in (None, 0, 1, 2, 3):
             have = len(epochs.get(cls, ()))
             if have < min_epochs:
                 name = 'rest' if cls is None else f'class {cls}'
-                msg = (f'The replay subject has {have} recorded epoch(s) of {name}, fewer than '
-                       f'{min_epochs}; give runs with more trials of every class (EEGMMIDB '
-                       f'imagery runs {sorted(EEGMMIDB_EVENTS)}).')
+                msg = (f'The replay subject{where} has {have} recorded epoch(s) of {name}, fewer '
+                       f'than {min_epochs}; give recordings with more trials of every class '
+                       '(and their annotations in the event map).')
                 raise EEGError(msg)
         self.epochs = {cls: [np.asarray(e, dtype=float) for e in eps]
                        for cls, eps in epochs.items()}
@@ -140,22 +124,23 @@ class ReplayEEG:
         self.n_played = {cls: 0 for cls in self.epochs}    # epochs started, per class
 
     @classmethod
-    def eegmmidb(cls, subject: int, runs: Sequence[int] = EEGMMIDB_PLAY_RUNS, *,
-                 seed: int = 0) -> ReplayEEG:
-        """EEGMMIDB ``subject``'s imagery ``runs`` (disjoint from the calibration runs)."""
-        bad = [r for r in runs if r not in EEGMMIDB_EVENTS]
-        if bad:
-            msg = (f'EEGMMIDB runs {bad} are not imagery runs; use runs of 4, 8, 12 (left/right '
-                   'fist) and 6, 10, 14 (both fists/feet).')
-            raise EEGError(msg)
-        epochs: dict[int | None, list] = {}
-        channels: list[str] | None = None
-        rate = 0.0
-        for run, rec in zip(runs, eegmmidb_runs(subject, runs), strict=True):
-            channels, rate = channels or rec.channels, rec.rate
-            for c, eps in epochs_of(rec, EEGMMIDB_EVENTS[run]).items():
+    def from_subject(cls, subject: SubjectFiles, *, seed: int = 0,
+                     recordings: Sequence[Recording] | None = None) -> ReplayEEG:
+        """The ``play`` recordings of a replay subject (``recordings``: those files, already
+        loaded by ``subject.recordings('play')``); needs :data:`MIN_EPOCHS` of each class and
+        of rest."""
+        recs = subject.recordings('play') if recordings is None else recordings
+        epochs: dict[int | None, list[np.ndarray]] = {}
+        for f, rec in zip(subject.play, recs, strict=True):
+            for c, eps in epochs_of(rec, f.events).items():
                 epochs.setdefault(c, []).extend(eps)
-        return cls(epochs, rate, channels or [], seed=seed, min_epochs=MIN_EPOCHS)
+        return cls(epochs, recs[0].rate, recs[0].channels, seed=seed, min_epochs=MIN_EPOCHS,
+                   source=subject.source)
+
+    @classmethod
+    def from_source(cls, source: str, *, seed: int = 0) -> ReplayEEG:
+        """``eegmmidb:<n>`` or a subject file's path (:func:`~.subject_file.replay_subject`)."""
+        return cls.from_subject(replay_subject(source), seed=seed)
 
     @property
     def n_channels(self) -> int:

@@ -29,7 +29,7 @@ from mindgrasp_eeg import EEGError
 from mindgrasp_eeg.lsl import EEGOutlet, MarkerOutlet
 from mindgrasp_eeg.montage import class_name
 from mindgrasp_eeg.params import VirtualAmpParams
-from mindgrasp_eeg.replay_eeg import ReplayEEG, parse_replay_source
+from mindgrasp_eeg.replay_eeg import ReplayEEG
 from mindgrasp_eeg.ros_conversions import base_yaw_from_joint_state, ns_to_time_fields, time_to_s
 from mindgrasp_eeg.subject import VirtualSubject
 from mindgrasp_eeg.synthetic import SyntheticEEG
@@ -66,7 +66,7 @@ class VirtualAmpNode(rclpy.node.Node):
                 erd_depth=p.erd_depth, erd_tau=p.erd_tau, blink_rate=p.blink_rate,
                 blink_amplitude=p.blink_amplitude, emg_rate=p.emg_rate, emg_rms=p.emg_rms,
                 line_noise=p.line_noise, line_freq=p.line_freq)
-        # the stream's layout: the parameters', or the recordings' with eeg_source:=eegmmidb:N
+        # the stream's layout: the parameters', or the recordings' with a replay eeg_source
         self.channel_names = list(gen.channel_names)
         self.sample_rate = float(gen.sample_rate)
         self.subject = VirtualSubject(
@@ -109,9 +109,10 @@ class VirtualAmpNode(rclpy.node.Node):
 
     @staticmethod
     def make_generator(eeg_source: str, seed: int) -> ReplayEEG:
-        """``eeg_source:=eegmmidb:<subject>``: real EEG of that subject's imagery runs (the
-        channels and rate of the recordings replace channel_names and sample_rate)."""
-        return ReplayEEG.eegmmidb(parse_replay_source(eeg_source), seed=seed)
+        """``eeg_source:=eegmmidb:<subject>`` or ``eeg_source:=path/to/subject.yaml``: real EEG of
+        that replay subject's play recordings (their channels and rate replace channel_names and
+        sample_rate; :mod:`mindgrasp_eeg.subject_file`)."""
+        return ReplayEEG.from_source(eeg_source, seed=seed)
 
     def now_s(self) -> float:
         """Node clock (s): wall time, or simulated time with use_sim_time."""

@@ -38,30 +38,34 @@ def noise_model_path(fallback_dir: Path) -> str:
 
 def subject_launch_args(subject: str, out: Path) -> dict[str, str]:
     """The experiment profile's launch arguments for ``subject``: a replay subject
-    (``eegmmidb:<n>``) is the pursuing virtual subject streaming that subject's real EEG, decoded
-    by a model calibrated on its other runs; the noise subject gets the noise-trained model."""
+    (``eegmmidb:<n>`` or a subject file) is the pursuing virtual subject streaming that subject's
+    real EEG, decoded by a model calibrated on its calibration recordings; the noise subject gets
+    the noise-trained model."""
     from mindgrasp_experiments.subjects import is_replay, replay_model
 
     if is_replay(subject):
-        from mindgrasp_eeg.replay_eeg import parse_replay_source
+        from mindgrasp_eeg.subject_file import replay_subject
 
-        number = parse_replay_source(subject)
-        print(f'Calibrating the classifier on EEGMMIDB S{number:03d} (once) ...', file=sys.stderr)
-        model = replay_model(subject, out / f'eegmmidb_s{number:03d}_classifier')
-        return {'subject': 'virtual', 'eeg_source': f'eegmmidb:{number}', 'model': str(model)}
+        files = replay_subject(subject)
+        print(f'Calibrating the classifier on {files.name} (once) ...', file=sys.stderr)
+        model = replay_model(files, out)
+        return {'subject': 'virtual', 'eeg_source': files.source, 'model': str(model)}
     if subject == 'noise':
         return {'subject': 'noise', 'model': noise_model_path(out)}
     return {'subject': subject}
 
 
 def subject_type(text: str) -> str:
-    """argparse type of --subject: noise, virtual, oracle or eegmmidb:<subject>."""
+    """argparse type of --subject: noise, virtual, oracle, eegmmidb:<subject> or a subject file
+    (``*.yaml``, checked when the experiment starts)."""
     import argparse
 
-    if text in ('noise', 'virtual', 'oracle') or text.lower().startswith('eegmmidb:'):
+    from mindgrasp_experiments.subjects import is_replay
+
+    if text in ('noise', 'virtual', 'oracle') or is_replay(text):
         return text
-    msg = (f'unknown subject {text!r}; use noise, virtual, oracle or eegmmidb:<subject> (real '
-           'EEG of an EEGMMIDB subject, e.g. eegmmidb:1)')
+    msg = (f'unknown subject {text!r}; use noise, virtual, oracle, eegmmidb:<subject> (real '
+           'EEG of an EEGMMIDB subject, e.g. eegmmidb:1) or a replay subject file (.yaml)')
     raise argparse.ArgumentTypeError(msg)
 
 

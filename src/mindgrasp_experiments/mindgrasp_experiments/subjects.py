@@ -11,18 +11,24 @@
     No EEG: the subject's intended class is the prediction (``oracle_subject_node``).
 ``autonomous``
     No BCI (random locations).
-``eegmmidb:<subject>``
+``eegmmidb:<subject>`` or ``path/to/subject.yaml``
     The replay subject: the virtual subject pursues the target as ``virtual`` does, but the EEG it
-    streams is real (EEGMMIDB imagery epochs of the intended class, stitched with rest;
-    :class:`mindgrasp_eeg.replay_eeg.ReplayEEG`), decoded by a classifier that
-    :func:`replay_model` calibrates on other runs of the same subject.
+    streams is real (imagery epochs of the intended class from the subject's play recordings,
+    stitched with rest; :class:`mindgrasp_eeg.replay_eeg.ReplayEEG`), decoded by a classifier that
+    :func:`replay_model` calibrates on the subject's calibration recordings. EEGMMIDB subjects are
+    built in; a subject file names any recordings (:mod:`mindgrasp_eeg.subject_file`).
 """
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from mindgrasp_eeg.subject_file import SubjectFiles
 
 __all__ = ['SUBJECTS', 'is_replay', 'noise_model', 'replay_model']
 
@@ -30,29 +36,63 @@ SUBJECTS = ('noise', 'virtual', 'oracle', 'autonomous')
 
 
 def is_replay(subject: str) -> bool:
-    """A replay subject (``eegmmidb:<subject>``)?"""
-    return subject.lower().startswith('eegmmidb:')
+    """A replay subject (``eegmmidb:<subject>`` or a subject file ``*.yaml``)?"""
+    from mindgrasp_eeg.subject_file import is_replay_source
+
+    return is_replay_source(subject)
 
 
-def replay_model(source: str, path: str | Path) -> Path:
-    """Calibrate (once) an MDM for the replay subject ``source`` (``eegmmidb:<n>``) on its
-    calibration runs (:data:`~mindgrasp_eeg.replay_eeg.EEGMMIDB_CALIBRATION_RUNS`, never the runs
-    played in the loop) and save it as ``path`` (.json + .npz); returns the .json path."""
-    from mindgrasp_classifier.data import eegbci_files, load_edf
+def replay_model(subject: str | SubjectFiles, directory: str | Path) -> Path:
+    """Calibrate (once) an MDM for a replay subject (``eegmmidb:<n>``, a subject file's path or
+    its :class:`~mindgrasp_eeg.subject_file.SubjectFiles`) on its calibration recordings, never
+    the ones played in the loop, and save it in ``directory`` as
+    ``<name>_classifier_<digest>.json`` (+ .npz); returns the .json path.
+
+    The digest (12 hex digits of :meth:`SubjectFiles.calibration_digest`) changes with the
+    calibration files, their event maps and the channel selection, so a cached model is reused
+    only for the same calibration. The whole subject is checked first (both sets loadable, one
+    channel layout and rate, enough epochs of every class and of rest to play), so its problems
+    surface here as one :class:`~mindgrasp_eeg.EEGError` line, before any node starts.
+    """
+    from mindgrasp_classifier.errors import ClassifierError
     from mindgrasp_classifier.training import TrainingConfig, train
-    from mindgrasp_eeg.replay_eeg import EEGMMIDB_CALIBRATION_RUNS, parse_replay_source
+    from mindgrasp_common.mi import CLASS_NAMES
+    from mindgrasp_eeg import EEGError
+    from mindgrasp_eeg.replay_eeg import ReplayEEG, segments
+    from mindgrasp_eeg.subject_file import check_layout, replay_subject
 
-    subject = parse_replay_source(source)
-    path = Path(path).with_suffix('')
-    json_path = path.with_suffix('.json')
+    files = replay_subject(subject) if isinstance(subject, str) else subject
+    json_path = Path(directory) / f'{files.name}_classifier_{files.calibration_digest()[:12]}.json'
     if json_path.exists():
         return json_path
-    recordings = [load_edf(f) for f in eegbci_files(subject, EEGMMIDB_CALIBRATION_RUNS)]
-    model, _report = train(recordings, TrainingConfig(pipeline='mdm', channels='motor'))
-    model.provenance['generator'] = (f'mindgrasp_experiments.subjects.replay_model({source}): '
-                                     f'EEGMMIDB runs {list(EEGMMIDB_CALIBRATION_RUNS)}')
-    path.parent.mkdir(parents=True, exist_ok=True)
-    return Path(model.save(path))
+    calibration, play = files.recordings('calibration'), files.recordings('play')
+    check_layout([*calibration, *play], files.source)
+    ReplayEEG.from_subject(files, recordings=play)          # enough epochs to play?
+    labelled = []
+    for f, rec in zip(files.calibration, calibration, strict=True):
+        events = [(k0, cls) for k0, _k1, cls in segments(rec, f.events) if cls is not None]
+        labelled.append(replace(rec, events=np.array(events, dtype=int).reshape(-1, 2)))
+    cfg = TrainingConfig(pipeline='mdm', channels=files.channels if isinstance(files.channels, str)
+                         else list(files.channels))
+    counts = {name: sum(int((r.events[:, 1] == c).sum()) for r in labelled)
+              for c, name in enumerate(CLASS_NAMES)}
+    few = {name: n for name, n in counts.items() if n < cfg.min_trials}
+    if few:
+        msg = (f'The replay subject {files.source} has too few calibration epochs: {few} (at '
+               f'least {cfg.min_trials} of every class are needed); give calibration recordings '
+               'with more trials of every class (and their annotations in the event map).')
+        raise EEGError(msg)
+    try:
+        model, _report = train(labelled, cfg)
+    except ClassifierError as exc:      # e.g. too few motor channels: name the subject file key
+        msg = (f'Cannot calibrate the replay subject {files.source}: {exc} (in a subject file: '
+               'the channels: key).')
+        raise EEGError(msg) from None
+    model.provenance['generator'] = (
+        f'mindgrasp_experiments.subjects.replay_model({files.source}): calibration '
+        f'{[f.entry for f in files.calibration]}')
+    json_path.parent.mkdir(parents=True, exist_ok=True)
+    return Path(model.save(json_path.with_suffix('')))
 
 
 def noise_model(path: str | Path, *, trials_per_class: int = 20, seed: int = 100,

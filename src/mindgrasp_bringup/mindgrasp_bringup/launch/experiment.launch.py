@@ -70,9 +70,10 @@ def generate_launch_description() -> LaunchDescription:
                         description='virtual subject: probability (0-1) that a decision '
                                     'is the right class'),
         DeclareLaunchArgument('eeg_source', default_value='synthetic',
-                              description='EEG of the virtual subject: synthetic (head model) '
-                                          'or eegmmidb:<subject> (real imagery epochs of the '
-                                          'intended class; give the calibrated model:=)'),
+                              description='EEG of the virtual subject: synthetic (head model), '
+                                          'eegmmidb:<subject> or path/to/subject.yaml (a replay '
+                                          'subject: real imagery epochs of the intended class; '
+                                          'give the calibrated model:=)'),
         number_argument('trials', default_value='3', minimum=0,
                         description='trials before the launch ends (0: until Ctrl-C)'),
         number_argument('first_trial', default_value='1', minimum=1,

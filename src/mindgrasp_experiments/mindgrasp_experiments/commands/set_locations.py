@@ -23,8 +23,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--subject', type=subject_type, default='virtual',
                         help='noise (unworn cap, classifier trained on noise), virtual (the '
                              'virtual subject pursues the target at --accuracy), oracle (its '
-                             'intent is the prediction) or eegmmidb:<subject> (it pursues the '
-                             'target with real EEG of that EEGMMIDB subject); default virtual')
+                             'intent is the prediction), eegmmidb:<subject> or a replay subject '
+                             'file (.yaml; it pursues the target with real EEG of that EEGMMIDB '
+                             'subject or of the file\'s recordings); default virtual')
     parser.add_argument('--accuracy', type=probability, default=0.8,
                         help='virtual subject: probability of imagining the right class '
                              '(default 0.8)')

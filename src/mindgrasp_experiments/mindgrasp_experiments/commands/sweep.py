@@ -30,8 +30,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help='virtual subject accuracies within (0, 1], comma-separated '
                              '(default 0.3,0.4,0.55,0.7,0.85,1.0)')
     parser.add_argument('--subject', type=subject_type, default='virtual',
-                        help='virtual (synthetic EEG, default) or eegmmidb:<subject> (the same '
-                             'pursuing subject streaming real EEG of that EEGMMIDB subject)')
+                        help='virtual (synthetic EEG, default), eegmmidb:<subject> or a replay '
+                             'subject file (.yaml): the same pursuing subject streaming real '
+                             'EEG of that EEGMMIDB subject or of the file\'s recordings')
     parser.add_argument('--param', action='append', default=[], metavar='NODE.PARAM=V1,V2,...',
                         help='also vary a parameter of a node (names as in the profile\'s '
                              'parameter files), e.g. fsm.certainty_threshold=0.3,0.5,0.7; '
@@ -49,6 +50,7 @@ def main(args: argparse.Namespace) -> int:
     from mindgrasp_experiments.engine import lockstep_components
     from mindgrasp_experiments.records import write_records
     from mindgrasp_experiments.report import write_run
+    from mindgrasp_experiments.subjects import is_replay
     from mindgrasp_experiments.sweep import (
         apply_params,
         check_params,
@@ -74,9 +76,10 @@ def main(args: argparse.Namespace) -> int:
         out = create_run_dir('sweep', args.out)
     except LaunchError as exc:
         return fail(COMMAND, str(exc))
-    if args.subject not in ('virtual',) and not args.subject.lower().startswith('eegmmidb:'):
+    if args.subject != 'virtual' and not is_replay(args.subject):
         return fail(COMMAND, f'--subject {args.subject}: a sweep varies the accuracy of a '
-                             'pursuing subject; use virtual or eegmmidb:<subject>.')
+                             'pursuing subject; use virtual, eegmmidb:<subject> or a subject '
+                             'file (.yaml).')
     try:
         subject_args = subject_launch_args(args.subject, out)
     except (ExperimentError, EEGError) as exc:
