@@ -56,6 +56,8 @@ def _error_lines(run: subprocess.CompletedProcess) -> list[str]:
      ('[VirtualAmpNode] ERROR:', "'sample_rate'", '-1', '[60.0, 100000.0]')),
     ('mindgrasp_eeg.virtual_amp_node', 'subject_mode:=chase',
      ('[VirtualAmpNode] ERROR:', "'subject_mode' is 'chase'; use one of noise, follow, pursue")),
+    ('mindgrasp_eeg.virtual_amp_node', 'eeg_source:=missing/subject.yaml',
+     ('[VirtualAmpNode] ERROR:', "The subject file '", "missing/subject.yaml' does not exist")),
 ])
 def test_a_bad_parameter_ends_the_node_process_with_exit_code_2_and_one_line(
         module: str, param: str, words: tuple[str, ...]) -> None:

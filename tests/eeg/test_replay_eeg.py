@@ -8,20 +8,20 @@ import numpy as np
 import pytest
 
 from mindgrasp_eeg import EEGError
-from mindgrasp_eeg.replay_eeg import (
+from mindgrasp_eeg.replay_eeg import MIN_EPOCHS, ReplayEEG
+from mindgrasp_eeg.subject_file import (
     EEGMMIDB_CALIBRATION_RUNS,
     EEGMMIDB_PLAY_RUNS,
-    MIN_EPOCHS,
-    ReplayEEG,
     parse_replay_source,
 )
 
 from .test_nodes import Listener, _prompt
+from .test_subject_file import EXAMPLE
 
 
 @pytest.fixture(scope='module')
 def replay() -> ReplayEEG:
-    return ReplayEEG.eegmmidb(1, seed=0)
+    return ReplayEEG.from_source('eegmmidb:1', seed=0)
 
 
 def test_calibration_and_played_runs_are_disjoint() -> None:
@@ -40,7 +40,7 @@ def test_every_class_and_rest_have_real_epochs(replay: ReplayEEG) -> None:
 
 
 def test_an_intent_streams_whole_epochs_of_its_class_and_a_change_starts_a_new_one() -> None:
-    gen = ReplayEEG.eegmmidb(1, seed=3)
+    gen = ReplayEEG.from_source('eegmmidb:1', seed=3)
     first = gen.generate(100, 2)                  # in 16-sample blocks, as the amplifier asks
     first = np.vstack([first, *(gen.generate(16, 2) for _ in range(20))])
     matches = [e for e in gen.epochs[2] if np.array_equal(e[:len(first)], first)]
@@ -56,7 +56,7 @@ def test_an_intent_streams_whole_epochs_of_its_class_and_a_change_starts_a_new_o
 
 
 def test_same_seed_same_stream() -> None:
-    a, b = ReplayEEG.eegmmidb(1, seed=5), ReplayEEG.eegmmidb(1, seed=5)
+    a, b = (ReplayEEG.from_source('eegmmidb:1', seed=5) for _ in range(2))
     for cls in (0, None, 1, 1, 3):
         assert np.array_equal(a.generate(300, cls), b.generate(300, cls))
 
@@ -73,18 +73,18 @@ def test_too_few_epochs_of_a_class_is_named(replay: ReplayEEG) -> None:
     epochs = {cls: eps[:1] if cls == 3 else eps for cls, eps in replay.epochs.items()}
     with pytest.raises(EEGError, match=r'1 recorded epoch\(s\) of class 3, fewer than 3'):
         ReplayEEG(epochs, 160.0, replay.channel_names, min_epochs=MIN_EPOCHS)
-    with pytest.raises(EEGError, match='not imagery runs'):
-        ReplayEEG.eegmmidb(1, runs=(3, 8))
 
 
-def test_virtual_amp_node_streams_the_replay_over_dds(spawn_node, rclpy_ctx,
-                                                      replay: ReplayEEG) -> None:
-    """The virtual amplifier node (output:=ros) with eeg_source:=eegmmidb:1 streams the
-    recordings' channels at their rate, and the follow subject's prompted intent."""
+@pytest.mark.parametrize('source', ['eegmmidb:1', str(EXAMPLE)], ids=['eegmmidb', 'subject_file'])
+def test_virtual_amp_node_streams_the_replay_over_dds(spawn_node, rclpy_ctx, replay: ReplayEEG,
+                                                      source: str) -> None:
+    """The virtual amplifier node (output:=ros) with eeg_source:=eegmmidb:1 or the same subject
+    as a subject file streams the recordings' channels at their rate, and the follow subject's
+    prompted intent."""
     listener = Listener(rclpy_ctx)
     try:
         spawn_node('mindgrasp_eeg.virtual_amp_node', '--ros-args', '-p', 'output:=ros', '-p',
-                   'eeg_source:=eegmmidb:1', '-p', 'subject_mode:=follow', '-p', 'accuracy:=1.0',
+                   f'eeg_source:={source}', '-p', 'subject_mode:=follow', '-p', 'accuracy:=1.0',
                    '-p', 'reaction_delay:=0.0')
         assert listener.spin(90, lambda: len(listener.chunks) > 5)
         listener.prompt_pub.publish(_prompt(listener))

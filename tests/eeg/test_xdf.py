@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import struct
 from pathlib import Path
 
 import numpy as np
@@ -10,44 +9,7 @@ import pytest
 
 from mindgrasp_eeg import EEGError
 from mindgrasp_eeg.player import load_recording
-
-
-def _chunk(tag: int, content: bytes) -> bytes:
-    body = struct.pack('<H', tag) + content
-    return struct.pack('<BI', 4, len(body)) + body
-
-
-def _varlen(n: int) -> bytes:
-    return struct.pack('<BI', 4, n)
-
-
-def write_xdf(path: Path, eeg_uv: np.ndarray, fs: float, t0: float,
-              markers: list[tuple[float, str]], names: list[str], unit: str = 'microvolts') -> None:
-    """XDF 1.0: file header, an EEG stream (float32) and a string marker stream."""
-    chans = ''.join(f'<channel><label>{n}</label><unit>{unit}</unit><type>EEG</type></channel>'
-                    for n in names)
-    eeg_hdr = (f'<?xml version="1.0"?><info><name>amp</name><type>EEG</type>'
-               f'<channel_count>{len(names)}</channel_count><nominal_srate>{fs}</nominal_srate>'
-               f'<channel_format>float32</channel_format><created_at>0</created_at>'
-               f'<desc><channels>{chans}</channels></desc></info>')
-    mk_hdr = ('<?xml version="1.0"?><info><name>amp-markers</name><type>Markers</type>'
-              '<channel_count>1</channel_count><nominal_srate>0</nominal_srate>'
-              '<channel_format>string</channel_format><created_at>0</created_at></info>')
-    out = b'XDF:' + _chunk(1, b'<?xml version="1.0"?><info><version>1.0</version></info>')
-    out += _chunk(2, struct.pack('<I', 1) + eeg_hdr.encode())
-    out += _chunk(2, struct.pack('<I', 2) + mk_hdr.encode())
-    samples = b''.join(struct.pack('<Bd', 8, t0 + k / fs) + row.astype('<f4').tobytes()
-                       for k, row in enumerate(eeg_uv))
-    out += _chunk(3, struct.pack('<I', 1) + _varlen(len(eeg_uv)) + samples)
-    mk = b''.join(struct.pack('<Bd', 8, t) + _varlen(len(s)) + s.encode() for t, s in markers)
-    out += _chunk(3, struct.pack('<I', 2) + _varlen(len(markers)) + mk)
-    for sid, first, last, n in ((1, t0, t0 + (len(eeg_uv) - 1) / fs, len(eeg_uv)),
-                                (2, markers[0][0], markers[-1][0], len(markers))):
-        footer = (f'<?xml version="1.0"?><info><first_timestamp>{first}</first_timestamp>'
-                  f'<last_timestamp>{last}</last_timestamp><sample_count>{n}</sample_count>'
-                  f'</info>')
-        out += _chunk(6, struct.pack('<I', sid) + footer.encode())
-    path.write_bytes(out)
+from mindgrasp_testing import write_xdf
 
 
 def test_xdf_recording_in_volts_with_markers(tmp_path: Path) -> None:
