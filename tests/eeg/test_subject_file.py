@@ -64,12 +64,12 @@ play:
 def test_markers_without_duration_last_until_the_next_annotation_at_most_4_s() -> None:
     fs = 100.0
     rec = Recording(data=np.zeros((round(20 * fs), 2)), rate=fs, channels=['C3', 'C4'],
-                    annotations=[(1.0, 0.0, 'L'), (3.0, 0.0, 'R'), (9.0, 0.0, 'end'),
-                                 (10.0, 6.0, 'L'), (16.0, 0.0, 'rest'), (17.5, 0.0, 'R'),
-                                 (19.6, 0.0, 'L')])
+                    annotations=[(-0.5, 0.0, 'R'), (1.0, 0.0, 'L'), (3.0, 0.0, 'R'),
+                                 (9.0, 0.0, 'end'), (10.0, 6.0, 'L'), (16.0, 0.0, 'rest'),
+                                 (17.5, 0.0, 'R'), (19.6, 0.0, 'L')])
     events = {'L': 0, 'R': 1, 'rest': None}
     assert MAX_EPOCH_S == 4.0
-    assert segments(rec, events) == [
+    assert segments(rec, events) == [    # 'R' at -0.5 s: before the first sample
         (100, 300, 0),       # to the next marker (2 s)
         (300, 700, 1),       # capped at 4 s before 'end' at 9 s
         (1000, 1600, 0),     # an annotation with a duration keeps it (6 s)

@@ -70,31 +70,42 @@ def test_recordings_without_motor_channels_need_the_channels_key(tmp_path: Path)
     assert model['channels'] == list(names)
 
 
+def run_one_trial(subject: str, out: Path) -> list[str]:
+    """``mindgrasp experiment set-locations --subject <subject>``: one trial cut at 12 simulated s
+    through the experiment's real nodes (lock-step, in a subprocess), checked; returns the file
+    names the classifier was calibrated on."""
+    result = mindgrasp('experiment', 'set-locations', '--subject', subject, '--accuracy', '1.0',
+                       '--trials', '1', '--seed', '2', '--trial-timeout', '12', '--out',
+                       str(out), '--json', '--no-progress')
+    assert result.returncode == 0, result.stderr[-3000:]
+    s = json.loads(result.stdout.strip().splitlines()[-1])
+    assert s['trials'] == 1 and s['node_errors'] == 0
+    assert subject in (out / 'params' / 'virtual_amp.yaml').read_text()     # eeg_source
+    (record,) = read_records(out)
+    assert record.decoder_windows > 0 and 0.0 <= record.decoder_accuracy <= 1.0
+    (model,) = out.glob('*_classifier_*.json')
+    return [Path(p).name for p in json.loads(model.read_text())['provenance']['sources']]
+
+
+@pytest.mark.timeout(1800)   # calibration and one whole trial through the real nodes
+def test_the_replay_subject_drives_the_experiment_with_real_eeg(tmp_path: Path) -> None:
+    """--subject eegmmidb:1: real S001 imagery epochs in the loop, decoded by a model calibrated
+    on runs 4 and 6 (never the played runs 8 and 10)."""
+    assert run_one_trial('eegmmidb:1', tmp_path / 'replay') == ['S001R04.edf', 'S001R06.edf']
+
+
 @pytest.mark.slow
 @pytest.mark.timeout(1800)   # calibration and one short trial through the real nodes
 def test_a_subject_file_with_an_xdf_recording_drives_the_experiment(tmp_path: Path) -> None:
     """--subject subject.yaml: calibration on S001 runs 4 and 6 (EDF through MNE's loader), play
-    of run 8 written as XDF with string markers (no durations) and run 10; one trial cut at 12
-    simulated s, in the experiment's real nodes (lock-step, subprocess)."""
+    of run 8 written as XDF with string markers (no durations) and run 10."""
     edf = load_recording(expand_sources(['eegbci:1:8'])[0])
     write_recording_xdf(tmp_path / 'S001R08.xdf', edf.data, edf.rate, edf.channels,
                         [(onset, label) for onset, _duration, label in edf.annotations])
-    subject = tmp_path / 'S001.yaml'
+    subject = tmp_path.resolve() / 'S001.yaml'
     hands_feet = '{T0: rest, T1: both_hands, T2: both_feet}'
     subject.write_text(f"""events: {{T0: rest, T1: left_hand, T2: right_hand}}
 calibration: [eegbci:1:4, {{file: 'eegbci:1:6', events: {hands_feet}}}]
 play: [S001R08.xdf, {{file: 'eegbci:1:10', events: {hands_feet}}}]
 """)
-    out = tmp_path / 'run'
-    result = mindgrasp('experiment', 'set-locations', '--subject', str(subject), '--accuracy',
-                       '1.0', '--trials', '1', '--seed', '2', '--trial-timeout', '12', '--out',
-                       str(out), '--json', '--no-progress')
-    assert result.returncode == 0, result.stderr[-3000:]
-    s = json.loads(result.stdout.strip().splitlines()[-1])
-    assert s['trials'] == 1 and s['node_errors'] == 0
-    (model,) = out.glob('S001_classifier_*.json')
-    sources = json.loads(model.read_text())['provenance']['sources']
-    assert [Path(p).name for p in sources] == ['S001R04.edf', 'S001R06.edf']
-    assert str(subject) in (out / 'params' / 'virtual_amp.yaml').read_text()
-    (record,) = read_records(out)
-    assert record.decoder_windows > 0 and 0.0 <= record.decoder_accuracy <= 1.0
+    assert run_one_trial(str(subject), tmp_path / 'run') == ['S001R04.edf', 'S001R06.edf']

@@ -164,23 +164,3 @@ def test_bad_subject_is_one_clear_line_and_exit_2(tmp_path: Path, command: str, 
     assert result.returncode == 2, result.stderr[-2000:]
     lines = [ln for ln in result.stderr.strip().splitlines() if not ln.startswith('Calibrating')]
     assert len(lines) == 1 and re.search(message, lines[0]), result.stderr
-
-
-@pytest.mark.timeout(1800)   # calibration and one whole trial through the real nodes
-def test_the_replay_subject_drives_the_experiment_with_real_eeg(tmp_path: Path) -> None:
-    """--subject eegmmidb:1: real S001 imagery epochs in the loop, decoded by a model calibrated
-    on runs 4 and 6 (never the played runs 8 and 10); one trial cut at 12 simulated s."""
-    out = tmp_path / 'replay'
-    result = mindgrasp('experiment', 'set-locations', '--subject', 'eegmmidb:1', '--accuracy',
-                       '1.0', '--trials', '1', '--seed', '2', '--trial-timeout', '12', '--out',
-                       str(out), '--json', '--no-progress')
-    assert result.returncode == 0, result.stderr[-3000:]
-    s = json.loads(result.stdout.strip().splitlines()[-1])
-    assert s['trials'] == 1 and s['node_errors'] == 0
-    (model_path,) = out.glob('eegmmidb_s001_classifier_*.json')
-    generator = json.loads(model_path.read_text())['provenance']['generator']
-    assert "['eegbci:1:4', 'eegbci:1:6']" in generator
-    params = (out / 'params' / 'virtual_amp.yaml').read_text()
-    assert 'eegmmidb:1' in params
-    (record,) = read_records(out)
-    assert record.decoder_windows > 0 and 0.0 <= record.decoder_accuracy <= 1.0

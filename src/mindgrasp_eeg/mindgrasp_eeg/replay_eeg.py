@@ -56,7 +56,8 @@ def segments(recording: Recording,
 
     An epoch lasts the annotation's duration; an annotation without one (a marker) lasts until
     the next annotation of any kind or the end of the data, at most :data:`MAX_EPOCH_S`. Epochs
-    shorter than :data:`MIN_EPOCH_S` (a fragment at the end of a run) are left out.
+    shorter than :data:`MIN_EPOCH_S` (a fragment at the end of a run) and epochs starting before
+    the first sample are left out.
     """
     fs, n = recording.rate, len(recording.data)
     onsets = sorted(onset for onset, _d, _l in recording.annotations)
@@ -70,7 +71,7 @@ def segments(recording: Recording,
             later = onsets[bisect.bisect_right(onsets, onset):]
             end = min(later[0] if later else n / fs, onset + MAX_EPOCH_S)
         k0, k1 = round(onset * fs), min(n, round(end * fs))
-        if k1 - k0 >= MIN_EPOCH_S * fs:
+        if k0 >= 0 and k1 - k0 >= MIN_EPOCH_S * fs:    # (a marker before the first sample: out)
             out.append((k0, k1, events[label]))
     return out
 

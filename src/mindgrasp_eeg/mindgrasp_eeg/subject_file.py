@@ -211,7 +211,7 @@ def _eegbci_paths(reference: str) -> list[Path]:
     from .player import expand_sources
 
     try:
-        return [Path(p) for p in expand_sources([reference])]
+        return [Path(p).resolve() for p in expand_sources([reference])]
     except EEGError:
         raise
     except Exception as exc:    # download or file errors from MNE/pooch
