@@ -12,6 +12,9 @@ Layers (ROS-free unless the module name ends in ``_node``):
 - :mod:`~mindgrasp_eeg.acquisition`: the acquisition core used by the acquisition node.
 - :mod:`~mindgrasp_eeg.virtual_amp`: synthetic generator + subject + outlet, paced by a clock.
 - :mod:`~mindgrasp_eeg.player`: streams EDF/GDF/BDF/FIF/XDF files over LSL with a marker stream.
+- :mod:`~mindgrasp_eeg.subject_file`: replay subjects (``eegmmidb:<n>`` or a YAML subject file):
+  calibration and play recordings with their event maps.
+- :mod:`~mindgrasp_eeg.replay_eeg`: the replay subject's generator (real epochs by intent).
 - :mod:`~mindgrasp_eeg.export`: rosbag2 (``/eeg/raw``, prompts, targets) -> FIF/EDF.
 - :mod:`~mindgrasp_eeg.lsl_scope`: LSL discovery on this host unless ``MINDGRASP_LSL_SCOPE=network``
   (applied when this package is imported, before liblsl reads its configuration).
