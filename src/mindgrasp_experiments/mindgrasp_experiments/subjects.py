@@ -68,6 +68,8 @@ def replay_model(subject: str | SubjectFiles, directory: str | Path) -> Path:
     calibration, play = files.recordings('calibration'), files.recordings('play')
     check_layout([*calibration, *play], files.source)
     ReplayEEG.from_subject(files, recordings=play)          # enough epochs to play?
+    # cues: the onsets of the class epochs (rest left out); training windows lie 0.5-2.5 s after
+    # each (TrainingConfig tmin/tmax), as for every model
     labelled = []
     for f, rec in zip(files.calibration, calibration, strict=True):
         events = [(k0, cls) for k0, _k1, cls in segments(rec, f.events) if cls is not None]
