@@ -205,7 +205,12 @@ class SyntheticEEG:
                                                                  output='sos'))
                           for band, lohi in _BANDS_HZ.items()}
         self._src_bands = [band for _e, _d, band in SOURCES.values()]
-        self._src_zi = [np.zeros((self._band_sos[b].shape[0], 2)) for b in self._src_bands]
+        # the sources of one band go through one sosfilt call (columns are filtered
+        # independently, so this is the same signal as one call per source, for half the calls)
+        self._band_cols = {band: np.array([i for i, b in enumerate(self._src_bands) if b == band])
+                           for band in dict.fromkeys(self._src_bands)}
+        self._band_zi = {band: np.zeros((self._band_sos[band].shape[0], 2, len(cols)))
+                         for band, cols in self._band_cols.items()}
         rms = {'alpha': alpha_rms, 'mu': mu_rms, 'beta': beta_rms}
         self._src_rms = np.array([rms[b] for b in self._src_bands])
         self._src_area = [name.split('_', 1)[1] for name in SOURCES]
@@ -258,9 +263,9 @@ class SyntheticEEG:
         gains = target + (self._gain - target) * decay          # (n, n_src)
         self._gain = gains[-1].copy()
         sources = np.empty((n, len(SOURCES)))
-        for i, band in enumerate(self._src_bands):
-            sources[:, i], self._src_zi[i] = signal.sosfilt(
-                self._band_sos[band], src_white[:, i], zi=self._src_zi[i])
+        for band, cols in self._band_cols.items():
+            sources[:, cols], self._band_zi[band] = signal.sosfilt(
+                self._band_sos[band], src_white[:, cols], axis=0, zi=self._band_zi[band])
         data += (sources * gains * self._src_rms) @ self.head.mixing.T
         data += self.sensor_noise_rms * noise[:, -self.n_channels:]
         self._add_artefacts(data)
