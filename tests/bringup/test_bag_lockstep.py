@@ -56,6 +56,23 @@ def test_intra_graph_and_raw_subscriptions_in_lockstep() -> None:
     assert got == [serialize(String(data='first'), 'std_msgs/msg/String')]
 
 
+def test_lockstep_components_compose_the_launchs_recorder(tmp_path: Path) -> None:
+    """The recorder of a live launch (same topics argument), writing the given bag; none without
+    a bag (the experiments) or with record:=false."""
+    from mindgrasp_bringup.launch_system.lockstep import RECORDER_MODULE, lockstep_components
+
+    def recorders(args: dict, bag: Path | None) -> list:
+        comps = lockstep_components('graz', args, tmp_path / 'params', bag=bag)
+        return [c for c in comps if c.module == RECORDER_MODULE]
+
+    (rec,) = recorders({'record_topics': '/eeg/raw /trainer/prompt'}, tmp_path / 'bag')
+    assert rec.parameters['output'] == str(tmp_path / 'bag')
+    assert rec.parameters['topics'] == ['/eeg/raw', '/trainer/prompt']
+    assert rec.parameters['exclude_regex'] == '^/clock$'
+    assert recorders({}, None) == []
+    assert recorders({'record': 'false'}, tmp_path / 'bag') == []
+
+
 def launch_graz(run_dir: Path, params_file: Path) -> subprocess.CompletedProcess:
     env = dict(os.environ, MINDGRASP_PARAMS_FILES=str(params_file))
     return subprocess.run(
