@@ -113,3 +113,27 @@ def test_lockstep_launch_records_a_bag_on_sim_time(tmp_path: Path) -> None:
         round(e.onset - schedule[0].onset, 2) for e in schedule]
     # the same seed: the same messages at the same simulated times
     assert recorded[0] == recorded[1]
+
+
+@pytest.mark.slow
+@pytest.mark.timeout(900)
+def test_trainer_profile_in_lockstep_records_its_session(tmp_path: Path) -> None:
+    """The Trainer profile (simulator with the training robot, EEG, classifier, vision,
+    controller, trainer) composed on simulated time: the trainer ends the launch, and the bag has
+    what training reads (EEG and prompts) and the robots' poses."""
+    from mindgrasp_ros.typesupport import typestore
+
+    run_dir = tmp_path / 'run'
+    result = subprocess.run(
+        [sys.executable, '-m', 'mindgrasp_bringup', 'launch', 'trainer', 'trials:=2', 'seed:=1',
+         '--lockstep', '--run-dir', str(run_dir)],
+        capture_output=True, text=True, timeout=800, check=False)
+    assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
+    store = typestore()
+    with BagReader(run_dir / 'bag') as reader:
+        assert {'/eeg/raw', '/bci/prediction', '/trainer_robot/ee_pose', '/ee_pose'} <= set(
+            reader.topics)
+        phases = [store.deserialize_cdr(data, 'mindgrasp_msgs/msg/Prompt').phase
+                  for _topic, _t, data in reader.messages(['/trainer/prompt'])]
+        assert reader.end_ns < 300e9          # simulated time from 0
+    assert phases.count('move') == 2 and phases[-1] == 'end'
