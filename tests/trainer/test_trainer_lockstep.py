@@ -121,3 +121,45 @@ def test_trainer_and_simulator_in_lockstep_are_deterministic():
     b_prompts, b_summary = run_trainer_with_sim()
     assert a_prompts == b_prompts
     assert a_summary == b_summary
+
+
+def test_display_in_lockstep_draws_every_prompt_on_sim_time(tmp_path):
+    """The headless participant display composed with the Graz prompter on simulated time: each
+    prompt phase is drawn in the step it arrives (flip stamp = prompt stamp), with one PNG each,
+    and PNGs at ``png_rate`` count simulated seconds."""
+    from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import Prompt
+
+    from mindgrasp_ros import composition, rclpy
+    from mindgrasp_trainer.display_node import DisplayNode
+    from mindgrasp_trainer.graz_node import GrazNode
+
+    flips = []
+
+    class Listener(rclpy.node.Node):
+        def __init__(self) -> None:
+            super().__init__('flip_listener')
+            self.create_subscription(Prompt, '/display/flip', flips.append, 50)
+
+    png = tmp_path / 'png'
+    runner = composition.LockstepRunner(start_time_s=100.0)
+    runner.add(Listener)
+    runner.add(DisplayNode, ros_args=['-p', 'headless:=true', '-p', f'png_dir:={png}',
+                                      '-p', 'rate:=10.0', '-p', 'png_rate:=0.5',
+                                      '-p', 'width:=400', '-p', 'height:=240'])
+    args = [a for k, v in FAST.items() for a in ('-p', f'{k}:={v}')]
+    graz = runner.add(GrazNode, ros_args=[*args, '-p', 'display_rate:=0.0'])
+    while not graz.finished and runner.time_s < 160.0:
+        runner.step(STEP)
+    for _ in range(round(10.0 / STEP)):  # 10 simulated s without prompts
+        runner.step(STEP)
+    runner.close()
+    assert graz.finished
+    expected = GrazProtocol(**FAST).schedule()
+    assert [(f.trial, f.phase) for f in flips] == [(e.trial, e.phase) for e in expected]
+    for f, e in zip(flips, expected, strict=True):  # drawn in the step the prompt came
+        assert f.header.stamp.sec + 1e-9 * f.header.stamp.nanosec >= 100.0 + e.onset
+    numbers = {int(p.stem.split('_')[1]): p.name for p in png.glob('*.png')}
+    tagged = [n for n, name in numbers.items() if '_graz_' in name]
+    assert len(tagged) == len(expected)                  # one PNG per drawn prompt phase
+    # then png_rate 0.5 Hz of simulated time: a frame every 2 simulated s
+    assert len([n for n in numbers if n > max(tagged)]) in (4, 5, 6)

@@ -42,7 +42,6 @@ from __future__ import annotations
 
 import math
 import sys
-import time
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -233,7 +232,8 @@ class DisplayNode(rclpy.node.Node):
                     f'{1e3 * late:.1f} ms after its prompt (limit '
                     f'{1e3 * float(self.p.late_threshold):.0f} ms); /display/flip has the drawn '
                     'time.')
-        now = time.monotonic()
+        # the PNG and image rates count on the node clock (simulated time in lock-step)
+        now = flip.nanoseconds * 1e-9
         image_rate = float(self.p.image_rate)
         if self.p.headless and image_rate > 0 and now - self.last_image >= 1 / image_rate:
             self.last_image = now
@@ -257,9 +257,12 @@ class DisplayNode(rclpy.node.Node):
             self.png_dir = None
 
     def check_frame_times(self) -> None:
-        """Warn, with the measured frame times, when frames come slower than ``rate``."""
+        """Warn, with the measured frame times, when frames come slower than ``rate``.
+
+        Frame times are wall time (the screen's); on simulated time (lock-step) frames follow
+        the simulated clock, so their wall-time gaps say nothing about the screen: no check."""
         ns, self.frame_ns = self.frame_ns, self.frame_ns[-1:]
-        if len(ns) < 3:
+        if len(ns) < 3 or self.get_parameter('use_sim_time').value:
             return
         dt = np.diff(np.asarray(ns)) * 1e-6  # ms
         p95 = float(np.percentile(dt, 95))
