@@ -48,7 +48,8 @@ TRIAL_MANAGER = 'mindgrasp_experiments.trial_manager_node'
 def lockstep_components(launch: str | Path, arguments: Sequence[str] | Mapping[str, Any],
                         params_dir: Path, *, overlay: str | Path | None = None,
                         log: Any = None) -> list[LockstepComponent]:
-    """:func:`mindgrasp_bringup.launch_system.lockstep.lockstep_components`, raising
+    """:func:`mindgrasp_bringup.launch_system.lockstep.lockstep_components` without the
+    recorder (an experiment writes records, not a bag per trial), raising
     :class:`ExperimentError` with the launcher's message."""
     try:
         return _lockstep_components(launch, arguments, params_dir, overlay=overlay, log=log)
