@@ -106,6 +106,10 @@ def lockstep_components(launch: str | Path, arguments: Sequence[str] | Mapping[s
         cmd = spec.command(path)
         ros_args = cmd[cmd.index('--ros-args') + 1:]
         out.append(LockstepComponent(spec.label, spec.module, ros_args, params))
+    # The recorder is composed last: its first discovery, when it is constructed, sees every
+    # node's topics, so the bag starts at the first step (a live recorder, started first, finds
+    # the other processes as they come up, seconds before they publish).
+    out.sort(key=lambda c: c.module == RECORDER_MODULE)
     return out
 
 
