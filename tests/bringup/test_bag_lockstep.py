@@ -73,6 +73,19 @@ def test_lockstep_components_compose_the_launchs_recorder(tmp_path: Path) -> Non
     assert recorders({'record': 'false'}, tmp_path / 'bag') == []
 
 
+def test_lockstep_refuses_an_lsl_amplifier_with_one_line(tmp_path: Path) -> None:
+    result = subprocess.run(
+        [sys.executable, '-m', 'mindgrasp_bringup', 'launch', 'graz', 'amp:=lsl',
+         'eeg_stream:=MyAmp', '--lockstep', '--run-dir', str(tmp_path / 'run')],
+        capture_output=True, text=True, timeout=300, check=False)
+    assert result.returncode == 2
+    assert result.stderr.strip().splitlines() == [
+        'mindgrasp launch: error: lock-step cannot take EEG from an LSL amplifier (amp:=lsl): '
+        'LSL runs on wall time. Use amp:=virtual (the virtual amplifier publishes /eeg/raw on '
+        'simulated time), or launch without --lockstep.']
+    assert not (tmp_path / 'run').exists()       # refused before anything is created
+
+
 def launch_graz(run_dir: Path, params_file: Path) -> subprocess.CompletedProcess:
     env = dict(os.environ, MINDGRASP_PARAMS_FILES=str(params_file))
     return subprocess.run(

@@ -95,9 +95,14 @@ def _run_lockstep(args: argparse.Namespace, service: LaunchService,
     """``--lockstep``: every node composed on simulated time (mindgrasp_experiments.engine);
     ``duration:=S`` counts simulated seconds. Returns 1 when a node failed."""
     from mindgrasp_bringup.launch_system import rundir
-    from mindgrasp_bringup.launch_system.lockstep import lockstep_components, run_lockstep
+    from mindgrasp_bringup.launch_system.lockstep import (
+        check_eeg_source,
+        lockstep_components,
+        run_lockstep,
+    )
 
-    service.plan()    # argument problems are reported before anything is created
+    # argument problems are reported before anything is created
+    check_eeg_source(service.plan().processes)
     run_dir = rundir.create_run_dir(service.name, args.run_dir, service.runs_root)
     given = dict(a.split(':=', 1) for a in launch_arguments)
     duration = float(given.pop('duration', 0) or 0)

@@ -24,8 +24,8 @@ from typing import Any
 from mindgrasp_bringup.launch_system import params as ros_params
 from mindgrasp_bringup.launch_system import rundir
 
-__all__ = ['LOCKSTEP_NODES', 'LockstepComponent', 'lockstep_components', 'run_lockstep',
-           'set_log_level']
+__all__ = ['LOCKSTEP_NODES', 'RECORDER_MODULE', 'LockstepComponent', 'check_eeg_source',
+           'lockstep_components', 'run_lockstep', 'set_log_level']
 
 #: node module -> None (left out in lock-step, with the reason) or parameters set in lock-step
 LOCKSTEP_NODES: dict[str, str | dict[str, Any]] = {
@@ -38,6 +38,8 @@ LOCKSTEP_NODES: dict[str, str | dict[str, Any]] = {
 
 #: the recorder's node module (its ``output`` is the bag directory)
 RECORDER_MODULE = 'mindgrasp_bringup.bag.recorder_node'
+#: the LSL acquisition node, and the node that replaces it in lock-step
+_ACQUISITION, _VIRTUAL_AMP = 'mindgrasp_eeg.acquisition_node', 'mindgrasp_eeg.virtual_amp_node'
 
 
 @dataclass
@@ -75,6 +77,7 @@ def lockstep_components(launch: str | Path, arguments: Sequence[str] | Mapping[s
         extra = user.plan().processes
         names = {p.label for p in extra}
         processes = [p for p in processes if p.label not in names] + list(extra)
+    check_eeg_source(processes)
     out = []
     for spec in processes:
         if not spec.is_node:
@@ -111,6 +114,19 @@ def lockstep_components(launch: str | Path, arguments: Sequence[str] | Mapping[s
     # the other processes as they come up, seconds before they publish).
     out.sort(key=lambda c: c.module == RECORDER_MODULE)
     return out
+
+
+def check_eeg_source(processes: Sequence[Any]) -> None:
+    """Raise :class:`LaunchError` when the launch's EEG comes from an LSL amplifier: lock-step
+    leaves the acquisition node out, and only the virtual amplifier can replace it."""
+    from mindgrasp_bringup.launch_system import LaunchError
+
+    modules = {spec.module for spec in processes}
+    if _ACQUISITION in modules and _VIRTUAL_AMP not in modules:
+        msg = ('lock-step cannot take EEG from an LSL amplifier (amp:=lsl): LSL runs on wall '
+               'time. Use amp:=virtual (the virtual amplifier publishes /eeg/raw on simulated '
+               'time), or launch without --lockstep.')
+        raise LaunchError(msg)
 
 
 def set_log_level(level: str) -> None:
