@@ -80,9 +80,10 @@ def test_lockstep_refuses_an_lsl_amplifier_with_one_line(tmp_path: Path) -> None
         capture_output=True, text=True, timeout=300, check=False)
     assert result.returncode == 2
     assert result.stderr.strip().splitlines() == [
-        'mindgrasp launch: error: lock-step cannot take EEG from an LSL amplifier (amp:=lsl): '
-        'LSL runs on wall time. Use amp:=virtual (the virtual amplifier publishes /eeg/raw on '
-        'simulated time), or launch without --lockstep.']
+        'mindgrasp launch: error: lock-step cannot take EEG from an LSL stream: LSL runs on wall '
+        'time, so the acquisition node is left out, and this launch has no virtual amplifier to '
+        'publish /eeg/raw on simulated time. Start one (amp:=virtual; virtual_amp:=true in the '
+        'eeg profile), or launch without --lockstep.']
     assert not (tmp_path / 'run').exists()       # refused before anything is created
 
 

@@ -123,9 +123,10 @@ def check_eeg_source(processes: Sequence[Any]) -> None:
 
     modules = {spec.module for spec in processes}
     if _ACQUISITION in modules and _VIRTUAL_AMP not in modules:
-        msg = ('lock-step cannot take EEG from an LSL amplifier (amp:=lsl): LSL runs on wall '
-               'time. Use amp:=virtual (the virtual amplifier publishes /eeg/raw on simulated '
-               'time), or launch without --lockstep.')
+        msg = ('lock-step cannot take EEG from an LSL stream: LSL runs on wall time, so the '
+               'acquisition node is left out, and this launch has no virtual amplifier to '
+               'publish /eeg/raw on simulated time. Start one (amp:=virtual; virtual_amp:=true '
+               'in the eeg profile), or launch without --lockstep.')
         raise LaunchError(msg)
 
 
