@@ -167,10 +167,10 @@ def test_committed_model_on_noisy_depth_images():
     noisy = collect_shape_dataset(45, seed=4243, realism='default')
     assert np.isnan(noisy.x).sum() == 0          # the network input is always complete
     accuracy = clf.score(noisy.x, noisy.y)
-    # The model committed today was trained on exact depth; on these 45 noisy views it names
-    # 80 % of the shapes (issue 17's target, >= 95 % after noise training, is open; the figure is
-    # printed by `python benchmarks/realism.py cnn`). The test checks it stays far above chance.
-    assert accuracy >= 0.6, f'accuracy on noisy depth {accuracy:.3f}'
+    # The committed model is trained on these noisy views (`mindgrasp train vision --realism
+    # default --n-images 900`): 42 of these 45 right (93.3 %; 97.3 % on its 150 independent test
+    # views, `python benchmarks/realism.py cnn`); the exact-depth model it replaced named 36 (80 %).
+    assert accuracy >= 0.85, f'accuracy on noisy depth {accuracy:.3f}'
 
 
 @pytest.mark.slow
@@ -184,3 +184,17 @@ def test_data_set_is_seeded_balanced_and_labelled_from_the_scene():
     assert all(0.10 <= i['distance'] <= 0.40 for i in a.info)
     c = collect_shape_dataset(3, seed=12)
     assert not np.array_equal(a.x, c.x)
+
+
+@pytest.mark.slow
+def test_realistic_data_set_draws_the_camera_errors_per_view():
+    """Each view of a realism data set has its own mount error, lighting and noise field (one
+    draw for the whole set let the network learn that one field), and the set stays seeded."""
+    from mindgrasp_vision.dataset import collect_shape_dataset
+
+    a = collect_shape_dataset(3, seed=21, realism='default')
+    b = collect_shape_dataset(3, seed=21, realism='default')
+    np.testing.assert_array_equal(a.x, b.x)
+    offsets = [tuple(i['camera_mount_offset_mm']) for i in a.info]
+    assert len(set(offsets)) == 3, offsets
+    assert all(0 < np.linalg.norm(o) <= 5.0 for o in offsets)      # profile: up to 5 mm
