@@ -20,6 +20,8 @@ from mindgrasp_experiments.sweep import (
     combinations,
     parse_accuracies,
     parse_param,
+    parse_seeds,
+    parse_subjects,
     point_figures,
     point_name,
 )
@@ -61,6 +63,23 @@ def test_combinations_and_point_names() -> None:
     assert point_name(0.55, combos[0]) == \
         'acc0.55_fsm.certainty_threshold-0.3_virtual_amp.decision_period-0.5'
     assert combinations([]) == [{}]
+    # subjects and seeds are point columns too; a subject file's path makes a flat name
+    assert point_name(1.0, {'subject': 'docs/subjects/s 1.yaml', 'seed': 2}) == \
+        'acc1_subject-docs_subjects_s_1.yaml_seed-2'
+    assert point_name(1.0, {'subject': 'eegmmidb:1'}) == 'acc1_subject-eegmmidb_1'
+
+
+def test_subjects_and_seeds_of_a_sweep() -> None:
+    assert parse_subjects('virtual, eegmmidb:1,s.yaml') == ['virtual', 'eegmmidb:1', 's.yaml']
+    assert parse_seeds('0,3, 7') == [0, 3, 7]
+    with pytest.raises(ExperimentError, match='repeats a subject'):
+        parse_subjects('virtual,virtual')
+    with pytest.raises(ExperimentError, match='an empty entry'):
+        parse_subjects('virtual,')
+    with pytest.raises(ExperimentError, match="'-1' is not a whole number >= 0"):
+        parse_seeds('0,-1')
+    with pytest.raises(ExperimentError, match='repeats a seed'):
+        parse_seeds('2,2')
 
 
 def test_decisions_are_the_decoded_majority_over_a_held_intent() -> None:
@@ -100,6 +119,8 @@ def test_point_figures_pool_windows_with_wilson_intervals() -> None:
     (['--param', 'nope.x=1'], "no node 'nope' in this experiment"),
     (['--param', 'fsm.no_such_parameter=1'], "fsm has no parameter 'no_such_parameter'"),
     (['--param', 'fsm.certainty_threshold=high'], 'certainty_threshold takes a number'),
+    (['--seeds', '1,x'], "--seeds: 'x' is not a whole number"),
+    (['--subject', 'virtual,nobody'], "--subject: unknown subject 'nobody'"),
 ])
 def test_bad_input_is_one_clear_line_and_exit_2(tmp_path: Path, args: list[str],
                                                 message: str) -> None:
@@ -113,16 +134,18 @@ def test_bad_input_is_one_clear_line_and_exit_2(tmp_path: Path, args: list[str],
 
 @pytest.mark.timeout(2400)   # 4 whole trials through the real nodes, on a loaded machine
 def test_a_small_sweep_writes_every_file_and_the_json(tmp_path: Path) -> None:
-    """2 accuracies x 2 trials (cut at 12 simulated s), with a swept parameter column."""
+    """2 seeds x 2 accuracies x 2 trials (cut at 12 simulated s), with a swept parameter
+    column."""
     out = tmp_path / 'sweep'
     result = mindgrasp('experiment', 'sweep', '--accuracy', '0.4,1.0', '--trials', '2',
-                       '--seed', '3', '--trial-timeout', '12', '--param',
+                       '--seeds', '3,4', '--trial-timeout', '12', '--param',
                        'fsm.certainty_threshold=0.5', '--out', str(out), '--json',
                        '--no-progress')
     assert result.returncode == 0, result.stderr[-3000:]
     doc = json.loads(result.stdout.strip().splitlines()[-1])
     points = doc['points']
-    assert [p['accuracy'] for p in points] == [0.4, 1.0]
+    assert [(p['seed'], p['accuracy']) for p in points] == [(3, 0.4), (3, 1.0), (4, 0.4),
+                                                            (4, 1.0)]
     for p in points:
         assert all(k in p for k in JSON_KEYS), p
         assert p['trials'] == 2 and p['fsm.certainty_threshold'] == 0.5
@@ -133,18 +156,21 @@ def test_a_small_sweep_writes_every_file_and_the_json(tmp_path: Path) -> None:
             assert (point_dir / name).is_file(), name
         records = read_records(point_dir)
         assert [r.trial for r in records] == [1, 2]
+        assert {r.seed for r in records} == {p['seed']}
         assert sum(r.decoder_windows for r in records) == p['online_windows']
     # the decoder does better for the subject that always imagines the right class
     assert points[1]['online_accuracy'] > points[0]['online_accuracy']
+    assert points[3]['online_accuracy'] > points[2]['online_accuracy']
     for name in ('sweep.csv', 'sweep.json', 'report.md', 'success_vs_accuracy.png',
                  'success_vs_accuracy.svg', 'time_vs_accuracy.png', 'time_vs_accuracy.svg'):
         assert (out / name).stat().st_size > 0, name
     rows = list(csv.DictReader((out / 'sweep.csv').open(encoding='utf-8')))
-    assert [float(r['accuracy']) for r in rows] == [0.4, 1.0]
+    assert [(r['seed'], float(r['accuracy'])) for r in rows] == [('3', 0.4), ('3', 1.0),
+                                                                  ('4', 0.4), ('4', 1.0)]
     assert all(r['fsm.certainty_threshold'] == '0.5' for r in rows)
     assert json.loads((out / 'sweep.json').read_text())['points'] == points
     report = (out / 'report.md').read_text()
-    assert '| accuracy | fsm.certainty_threshold |' in report
+    assert '| accuracy | seed | fsm.certainty_threshold |' in report
     assert 'success_vs_accuracy.png' in report
     assert all(math.isfinite(p['online_accuracy']) for p in points)
 

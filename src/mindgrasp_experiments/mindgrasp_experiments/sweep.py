@@ -35,12 +35,15 @@ from mindgrasp_experiments.report import finite
 from mindgrasp_experiments.summary import summarise, wilson
 
 __all__ = ['Param', 'apply_params', 'check_params', 'combinations', 'parse_accuracies',
-           'parse_param', 'point_figures', 'point_name', 'write_sweep']
+           'parse_param', 'parse_seeds', 'parse_subjects', 'point_figures', 'point_name',
+           'write_sweep']
 
 #: ``node.parameter=v1,v2,...``
 Param = tuple[str, str, list[str]]
 
 _PARAM = re.compile(r'^([A-Za-z_][\w]*)\.([A-Za-z_][\w.]*)=(.+)$')
+#: characters a point's directory name keeps (a subject file's path has slashes)
+_UNSAFE = re.compile(r'[^\w.+-]')
 
 
 def parse_accuracies(text: str) -> list[float]:
@@ -60,6 +63,39 @@ def parse_accuracies(text: str) -> list[float]:
         out.append(value)
     if len(set(out)) != len(out):
         msg = f'--accuracy: {text} repeats an accuracy; give each once.'
+        raise ExperimentError(msg)
+    return out
+
+
+def parse_subjects(text: str) -> list[str]:
+    """``'virtual,eegmmidb:1,s02.yaml'`` -> the subjects of a sweep, each once (each checked by
+    :func:`mindgrasp_experiments.cli.subject_type` where the command parses it)."""
+    out = [part.strip() for part in text.split(',')]
+    if not all(out):
+        msg = (f'--subject {text!r}: an empty entry; give subjects separated by commas, e.g. '
+               'virtual,eegmmidb:1,eegmmidb:2.')
+        raise ExperimentError(msg)
+    if len(set(out)) != len(out):
+        msg = f'--subject {text!r} repeats a subject; give each once.'
+        raise ExperimentError(msg)
+    return out
+
+
+def parse_seeds(text: str) -> list[int]:
+    """``'0,1,2'`` -> the seeds of a sweep, whole numbers >= 0, each once."""
+    out = []
+    for part in text.split(','):
+        try:
+            value = int(part)
+        except ValueError:
+            value = -1
+        if value < 0:
+            msg = (f'--seeds: {part.strip()!r} is not a whole number >= 0; give seeds separated '
+                   'by commas, e.g. 0,1,2.')
+            raise ExperimentError(msg)
+        out.append(value)
+    if len(set(out)) != len(out):
+        msg = f'--seeds {text} repeats a seed; give each once.'
         raise ExperimentError(msg)
     return out
 
@@ -148,8 +184,10 @@ def apply_params(components: Sequence[Any], combo: Mapping[str, Any]) -> list[An
 
 
 def point_name(accuracy: float, combo: Mapping[str, Any]) -> str:
-    """Directory name of a point: ``acc0.55`` or ``acc0.55_fsm.certainty_threshold-0.3``."""
-    return '_'.join([f'acc{accuracy:g}', *(f'{k}-{v}' for k, v in combo.items())])
+    """Directory name of a point: ``acc0.55`` or ``acc0.55_fsm.certainty_threshold-0.3`` (other
+    characters than letters, digits and ``.+-_`` become ``_``: ``subject-eegmmidb_1``)."""
+    return '_'.join([f'acc{accuracy:g}',
+                     *(_UNSAFE.sub('_', f'{k}-{v}') for k, v in combo.items())])
 
 
 def _mean_ci(values: Sequence[float]) -> tuple[float, list[float]]:

@@ -4,11 +4,14 @@ time to grasp against accuracy, with the decoder's realised online accuracy.
     mindgrasp experiment sweep --accuracy 0.3,0.4,0.55,0.7,0.85,1.0 --trials 45 --seed 0
     mindgrasp experiment sweep --accuracy 0.55,0.85 --trials 20 \\
         --param fsm.certainty_threshold=0.3,0.5,0.7 --json
+    mindgrasp experiment sweep --accuracy 0.7,1.0 --trials 20 \\
+        --subject virtual,eegmmidb:1,eegmmidb:2 --seeds 0,1,2 --workers 2
 
-Every point (accuracy x parameter combination) runs the experiment profile's nodes in lock-step
-exactly as ``mindgrasp experiment set-locations --subject virtual --accuracy A`` does, into
-``<out>/points/<point>/``; the sweep writes sweep.csv, sweep.json, success_vs_accuracy and
-time_vs_accuracy (PNG, SVG) and report.md into ``<out>``.
+Every point (subject x seed x parameter combination x accuracy) runs the experiment profile's
+nodes in lock-step exactly as ``mindgrasp experiment set-locations --subject S --seed N
+--accuracy A`` does, into ``<out>/points/<point>/``; the sweep writes sweep.csv, sweep.json,
+success_vs_accuracy and time_vs_accuracy (PNG, SVG) and report.md into ``<out>``. With several
+subjects or seeds, ``subject`` and ``seed`` are columns of the table like a swept parameter.
 """
 
 from __future__ import annotations
@@ -29,10 +32,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--accuracy', default='0.3,0.4,0.55,0.7,0.85,1.0', metavar='A1,A2,...',
                         help='virtual subject accuracies within (0, 1], comma-separated '
                              '(default 0.3,0.4,0.55,0.7,0.85,1.0)')
-    parser.add_argument('--subject', type=subject_type, default='virtual',
+    parser.add_argument('--subject', default='virtual', metavar='S1,S2,...',
                         help='virtual (synthetic EEG, default), eegmmidb:<subject> or a replay '
                              'subject file (.yaml): the same pursuing subject streaming real '
-                             'EEG of that EEGMMIDB subject or of the file\'s recordings')
+                             'EEG of that EEGMMIDB subject or of the file\'s recordings; '
+                             'several, comma-separated, are each a set of points')
+    parser.add_argument('--seeds', default=None, metavar='N1,N2,...',
+                        help='run every point with each of these seeds (comma-separated; '
+                             'instead of --seed)')
     parser.add_argument('--param', action='append', default=[], metavar='NODE.PARAM=V1,V2,...',
                         help='also vary a parameter of a node (names as in the profile\'s '
                              'parameter files), e.g. fsm.certainty_threshold=0.3,0.5,0.7; '
@@ -57,6 +64,8 @@ def main(args: argparse.Namespace) -> int:
         combinations,
         parse_accuracies,
         parse_param,
+        parse_seeds,
+        parse_subjects,
         point_figures,
         point_name,
         write_sweep,
@@ -66,6 +75,10 @@ def main(args: argparse.Namespace) -> int:
     try:
         accuracies = parse_accuracies(args.accuracy)
         params = [parse_param(p) for p in args.param]
+        subjects = [subject_type(s) for s in parse_subjects(args.subject)]
+        seeds = parse_seeds(args.seeds) if args.seeds is not None else [args.seed]
+    except argparse.ArgumentTypeError as exc:
+        return fail(COMMAND, f'--subject: {exc}.')
     except ExperimentError as exc:
         return fail(COMMAND, str(exc))
     # the shared checks of every experiment (our --accuracy is a list, checked above)
@@ -76,18 +89,19 @@ def main(args: argparse.Namespace) -> int:
         out = create_run_dir('sweep', args.out)
     except LaunchError as exc:
         return fail(COMMAND, str(exc))
-    if args.subject != 'virtual' and not is_replay(args.subject):
-        return fail(COMMAND, f'--subject {args.subject}: a sweep varies the accuracy of a '
-                             'pursuing subject; use virtual, eegmmidb:<subject> or a subject '
-                             'file (.yaml).')
-    try:
-        subject_args = subject_launch_args(args.subject, out)
+    for subject in subjects:
+        if subject != 'virtual' and not is_replay(subject):
+            return fail(COMMAND, f'--subject {subject}: a sweep varies the accuracy of a '
+                                 'pursuing subject; use virtual, eegmmidb:<subject> or a subject '
+                                 'file (.yaml).')
+    try:   # every replay subject is checked and calibrated before the first trial
+        subject_args = {subject: subject_launch_args(subject, out) for subject in subjects}
     except (ExperimentError, EEGError) as exc:
         return fail(COMMAND, str(exc))
     log = [] if args.json else None
 
-    def components_at(accuracy: float, params_dir):
-        launch_args = {**subject_args, 'protocol': 'set_locations', 'seed': str(args.seed),
+    def components_at(accuracy: float, params_dir, subject: str, seed: int):
+        launch_args = {**subject_args[subject], 'protocol': 'set_locations', 'seed': str(seed),
                        'trials': '1', 'accuracy': str(accuracy)}
         comps = lockstep_components('experiment', launch_args, params_dir, overlay=args.launch,
                                     log=log.append if log is not None else print)
@@ -99,53 +113,64 @@ def main(args: argparse.Namespace) -> int:
 
     try:
         # the names of --param are checked against the profile's nodes before any trial runs
-        params = check_params(params, components_at(accuracies[0], out / 'params'))
+        params = check_params(params, components_at(accuracies[0], out / 'params', subjects[0],
+                                                    seeds[0]))
     except ExperimentError as exc:
         return fail(COMMAND, str(exc))
     combos = combinations(params)
-    varied = list(combos[0])
+
+    def axis_of(subject: str, seed: int) -> dict[str, object]:
+        """The point's subject and seed as columns (like a swept parameter), when several."""
+        return {**({'subject': subject} if len(subjects) > 1 else {}),
+                **({'seed': seed} if len(seeds) > 1 else {})}
+
+    varied = [*axis_of(subjects[0], seeds[0]), *combos[0]]
     trials = list(range(1, args.trials + 1))
     points = []
     interrupted = False
     wall0 = time.perf_counter()
     sim_total = 0.0
-    bar = tqdm(total=len(accuracies) * len(combos) * len(trials), unit='trial',
+    points_to_run = [(subject, seed, combo, accuracy) for subject in subjects for seed in seeds
+                     for combo in combos for accuracy in accuracies]
+    bar = tqdm(total=len(points_to_run) * len(trials), unit='trial',
                disable=args.no_progress, file=sys.stderr, desc='sweep', dynamic_ncols=True)
     try:
-        for combo in combos:
-            for accuracy in accuracies:
-                name = point_name(accuracy, combo)
-                point_dir = out / 'points' / name
-                comps = apply_params(components_at(accuracy, point_dir / 'params'), combo)
-                bar.set_description(f'sweep {name}')
-                runs = []
-                wall_p = time.perf_counter()
-                try:
-                    for run in run_trials(comps, trials, seed=args.seed, workers=args.workers,
-                                          step_s=args.step, ray=args.ray):
-                        runs.append(run)
-                        write_records([r.record for r in runs], point_dir)
-                        bar.update(1)
-                except KeyboardInterrupt:
-                    interrupted = True
-                records = sorted((r.record for r in runs), key=lambda rec: rec.trial)
-                sim = sum(r.sim_s for r in runs)
-                sim_total += sim
-                if records:
-                    wall = time.perf_counter() - wall_p
-                    write_run(point_dir, records, {
-                        'command': f'mindgrasp experiment sweep (point {name})',
-                        'protocol': 'set_locations', 'subject': args.subject, 'seed': args.seed,
-                        'accuracy': accuracy, 'params': combo, 'workers': args.workers,
-                        'trials_requested': args.trials, 'interrupted': interrupted,
-                        'step_s': args.step, 'sim_s': sim, 'wall_s': wall,
-                        'cpu_s': sum(r.cpu_s for r in runs),
-                        'real_time_factor': sim / wall if wall > 0 else float('nan'),
-                        'cpu_s_per_sim_s': (sum(r.cpu_s for r in runs) / sim if sim > 0
-                                            else float('nan'))})
-                    points.append({'point': name, **point_figures(records, accuracy, combo)})
-                if interrupted:
-                    raise KeyboardInterrupt
+        for subject, seed, combo, accuracy in points_to_run:
+            axis = axis_of(subject, seed)
+            name = point_name(accuracy, {**axis, **combo})
+            point_dir = out / 'points' / name
+            comps = apply_params(components_at(accuracy, point_dir / 'params', subject,
+                                               seed), combo)
+            bar.set_description(f'sweep {name}')
+            runs = []
+            wall_p = time.perf_counter()
+            try:
+                for run in run_trials(comps, trials, seed=seed, workers=args.workers,
+                                      step_s=args.step, ray=args.ray):
+                    runs.append(run)
+                    write_records([r.record for r in runs], point_dir)
+                    bar.update(1)
+            except KeyboardInterrupt:
+                interrupted = True
+            records = sorted((r.record for r in runs), key=lambda rec: rec.trial)
+            sim = sum(r.sim_s for r in runs)
+            sim_total += sim
+            if records:
+                wall = time.perf_counter() - wall_p
+                write_run(point_dir, records, {
+                    'command': f'mindgrasp experiment sweep (point {name})',
+                    'protocol': 'set_locations', 'subject': subject, 'seed': seed,
+                    'accuracy': accuracy, 'params': combo, 'workers': args.workers,
+                    'trials_requested': args.trials, 'interrupted': interrupted,
+                    'step_s': args.step, 'sim_s': sim, 'wall_s': wall,
+                    'cpu_s': sum(r.cpu_s for r in runs),
+                    'real_time_factor': sim / wall if wall > 0 else float('nan'),
+                    'cpu_s_per_sim_s': (sum(r.cpu_s for r in runs) / sim if sim > 0
+                                        else float('nan'))})
+                points.append({'point': name,
+                               **point_figures(records, accuracy, {**axis, **combo})})
+            if interrupted:
+                raise KeyboardInterrupt
     except KeyboardInterrupt:
         interrupted = True
         print(f'\nInterrupted: writing the {len(points)} point(s) with finished trials.',
@@ -154,7 +179,9 @@ def main(args: argparse.Namespace) -> int:
         bar.close()
     wall = time.perf_counter() - wall0
     run_info = {'command': ' '.join(['mindgrasp', 'experiment', COMMAND, *sys.argv[3:]]),
-                'subject': args.subject, 'seed': args.seed, 'trials': args.trials,
+                'subject': ', '.join(subjects),
+                'seed': seeds[0] if len(seeds) == 1 else ', '.join(map(str, seeds)),
+                'trials': args.trials,
                 'accuracies': accuracies, 'params': {f'{n}.{p}': v for n, p, v in params},
                 'workers': args.workers, 'ray': args.ray, 'step_s': args.step, 'wall_s': wall,
                 'sim_s': sim_total, 'interrupted': interrupted}
