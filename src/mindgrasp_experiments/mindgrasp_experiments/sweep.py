@@ -301,9 +301,11 @@ def _plots(points: Sequence[Mapping[str, Any]], varied: Sequence[str], out: Path
 
 def _report(points: Sequence[Mapping[str, Any]], varied: Sequence[str],
             run: Mapping[str, Any], plots: Sequence[str]) -> str:
+    seed, subject = str(run.get('seed')), str(run.get('subject', 'virtual'))
     lines = [f"# Accuracy sweep: set locations, {len(points)} points", '',
-             f"Command: `{run.get('command', '')}`. Seed {run.get('seed')}, "
-             f"{run.get('trials')} trials per point, subject {run.get('subject', 'virtual')}.", '',
+             f"Command: `{run.get('command', '')}`. {'Seeds' if ',' in seed else 'Seed'} {seed}; "
+             f"{run.get('trials')} trials per point; {'subjects' if ',' in subject else 'subject'}"
+             f" {subject}.", '',
              'Rates with their Wilson 95 % CIs in brackets (%); the time to grasp over '
              'successful trials, with a Student-t 95 % CI. Online accuracy: the decoder\'s '
              'predictions against the subject\'s intent, per classifier window and per decision '
