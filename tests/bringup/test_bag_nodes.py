@@ -94,6 +94,7 @@ def recorded(tmp_path_factory):
         if publisher is not None and publisher.poll() is None:
             _stop(publisher)
         code = _stop(recorder)
+        rec_out.thread.join(30)   # the last lines may still be in the pipe when it has ended
     assert code == 0, rec_out.lines
     return prefix, bag, rec_out.lines
 
@@ -162,6 +163,7 @@ def test_bag_play_cli_republishes_identical_bytes_with_original_timing(recorded)
         time.sleep(0.5)
     finally:
         _stop(probe)
+        probe_out.thread.join(30)   # every line read from the pipe before they are counted
     rows = [line.split() for line in probe_out.lines if line.startswith('/')]
     got_eeg = [r for r in rows if r[0] == f'{out_prefix}/eeg']
     got_text = [r for r in rows if r[0] == f'{prefix}/chatter']

@@ -73,7 +73,8 @@ class _Proc:
         self.proc = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                                      text=True, env=env)
         self.lines: list[str] = []
-        threading.Thread(target=self._read, daemon=True).start()
+        self._reader = threading.Thread(target=self._read, daemon=True)
+        self._reader.start()
 
     def _read(self) -> None:
         assert self.proc.stdout is not None
@@ -92,13 +93,17 @@ class _Proc:
         return False
 
     def stop(self) -> int:
+        """SIGINT, then wait; returns the exit code once every output line is in ``lines``
+        (the reader thread may still be reading the pipe when the process has ended)."""
         if self.proc.poll() is None:
             self.proc.send_signal(signal.SIGINT)
         try:
-            return self.proc.wait(30)
+            code = self.proc.wait(30)
         except subprocess.TimeoutExpired:
             self.proc.kill()
-            return self.proc.wait(5)
+            code = self.proc.wait(5)
+        self._reader.join(30)
+        return code
 
 
 def _recorder(bag: Path, prefix: str, declared: str) -> _Proc:
