@@ -46,25 +46,37 @@ _PARAM = re.compile(r'^([A-Za-z_][\w]*)\.([A-Za-z_][\w.]*)=(.+)$')
 _UNSAFE = re.compile(r'[^\w.+-]')
 
 
-def parse_accuracies(text: str) -> list[float]:
-    """``'0.3,0.4,1.0'`` -> accuracies, each within (0, 1] (a probability of the right class)."""
+def _each_once(values: list, option: str, text: str, what: str) -> list:
+    """``values``, or :class:`ExperimentError` when one is given twice."""
+    if len(set(values)) != len(values):
+        msg = f'{option} {text} repeats {what}; give each once.'
+        raise ExperimentError(msg)
+    return values
+
+
+def _numbers(text: str, option: str, convert, valid, unreadable: str, invalid: str,
+             what: str) -> list:
+    """Comma-separated numbers of ``option``, each converted, checked by ``valid`` and given
+    once; ``unreadable`` / ``invalid`` (with ``{part}``) name a bad one and the fix."""
     out = []
     for part in text.split(','):
         try:
-            value = float(part)
+            value = convert(part)
         except ValueError:
-            msg = (f'--accuracy: {part.strip()!r} is not a number; give accuracies within (0, 1] '
-                   'separated by commas, e.g. 0.3,0.55,1.0.')
-            raise ExperimentError(msg) from None
-        if not (0.0 < value <= 1.0) or not math.isfinite(value):
-            msg = (f'--accuracy: {value:g} is outside (0, 1]; an accuracy is the probability '
-                   'that the subject imagines the right class, e.g. 0.3,0.55,1.0.')
-            raise ExperimentError(msg)
+            raise ExperimentError(f'{option}: ' + unreadable.format(part=part.strip())) from None
+        if not valid(value):
+            raise ExperimentError(f'{option}: ' + invalid.format(part=part.strip()))
         out.append(value)
-    if len(set(out)) != len(out):
-        msg = f'--accuracy: {text} repeats an accuracy; give each once.'
-        raise ExperimentError(msg)
-    return out
+    return _each_once(out, option, text, what)
+
+
+def parse_accuracies(text: str) -> list[float]:
+    """``'0.3,0.4,1.0'`` -> accuracies, each within (0, 1] (a probability of the right class)."""
+    return _numbers(text, '--accuracy', float, lambda v: 0.0 < v <= 1.0 and math.isfinite(v),
+                    '{part!r} is not a number; give accuracies within (0, 1] separated by '
+                    'commas, e.g. 0.3,0.55,1.0.',
+                    '{part} is outside (0, 1]; an accuracy is the probability that the subject '
+                    'imagines the right class, e.g. 0.3,0.55,1.0.', 'an accuracy')
 
 
 def parse_subjects(text: str) -> list[str]:
@@ -75,29 +87,13 @@ def parse_subjects(text: str) -> list[str]:
         msg = (f'--subject {text!r}: an empty entry; give subjects separated by commas, e.g. '
                'virtual,eegmmidb:1,eegmmidb:2.')
         raise ExperimentError(msg)
-    if len(set(out)) != len(out):
-        msg = f'--subject {text!r} repeats a subject; give each once.'
-        raise ExperimentError(msg)
-    return out
+    return _each_once(out, '--subject', repr(text), 'a subject')
 
 
 def parse_seeds(text: str) -> list[int]:
     """``'0,1,2'`` -> the seeds of a sweep, whole numbers >= 0, each once."""
-    out = []
-    for part in text.split(','):
-        try:
-            value = int(part)
-        except ValueError:
-            value = -1
-        if value < 0:
-            msg = (f'--seeds: {part.strip()!r} is not a whole number >= 0; give seeds separated '
-                   'by commas, e.g. 0,1,2.')
-            raise ExperimentError(msg)
-        out.append(value)
-    if len(set(out)) != len(out):
-        msg = f'--seeds {text} repeats a seed; give each once.'
-        raise ExperimentError(msg)
-    return out
+    bad = "{part!r} is not a whole number >= 0; give seeds separated by commas, e.g. 0,1,2."
+    return _numbers(text, '--seeds', int, lambda v: v >= 0, bad, bad, 'a seed')
 
 
 def parse_param(text: str) -> Param:
