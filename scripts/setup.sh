@@ -24,7 +24,9 @@ fi
 # missing and apt-get can (root); otherwise those tests are skipped with the reason.
 if ! command -v Xvfb >/dev/null 2>&1; then
   if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
-    { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq xvfb; } >/dev/null \
+    # The lock timeout makes a second setup running at the same time wait for the first's apt-get.
+    { apt-get -o DPkg::Lock::Timeout=600 update -qq \
+        && DEBIAN_FRONTEND=noninteractive apt-get -o DPkg::Lock::Timeout=600 install -y -qq xvfb; } >/dev/null \
       || echo "setup: could not install xvfb (window tests skip)"
   else
     echo "setup: Xvfb is missing; 'sudo apt-get install xvfb' runs the display window tests"
