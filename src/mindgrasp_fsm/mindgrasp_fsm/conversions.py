@@ -9,8 +9,6 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
-import numpy as np
-
 from mindgrasp_common.robot import FINGER_CLOSED, FINGER_OPEN
 from mindgrasp_fsm.types import GripperState, ObjectObservation, VisionFrame
 
@@ -59,13 +57,18 @@ def gripper_from_fingers(positions: Sequence[float], stamp: float,
     efforts (N m). Opening: 1 open .. 0 closed (mean over fingers); contact: at least two fingers
     touch (thumb against a finger), when contact flags are given; force: sum of the absolute
     efforts (N m), NaN without them."""
-    pos = np.asarray(positions, dtype=float)
-    opening = float(np.clip((closed_angle - pos.mean()) / (closed_angle - open_angle), 0.0, 1.0))
-    n = None if contacts is None else int(np.count_nonzero(contacts))
+    # plain floats: three fingers, twice per control tick, where numpy's per-call cost dominates
+    pos = [float(v) for v in positions]
+    mean = math.fsum(pos) / len(pos) if pos else math.nan
+    opening = min(max((closed_angle - mean) / (closed_angle - open_angle), 0.0), 1.0)
+    n = None if contacts is None else sum(1 for c in contacts if c)
     contact = None if n is None else n >= 2
-    force = float(np.sum(np.abs(efforts))) if efforts is not None else math.nan
     per_finger = None
-    if efforts is not None and len(efforts) == pos.size:
-        per_finger = tuple(float(e) for e in np.asarray(efforts, dtype=float))
+    force = math.nan
+    if efforts is not None:
+        eff = [float(e) for e in efforts]
+        force = math.fsum(abs(e) for e in eff)
+        if len(eff) == len(pos):
+            per_finger = tuple(eff)
     return GripperState(opening=opening, force=force, stamp=float(stamp), contact=contact,
                         fingers_in_contact=n, efforts=per_finger)

@@ -155,15 +155,33 @@ def typestore() -> Typestore:
 # --------------------------------------------------------------------------- message classes
 
 
+def _constant(value: Any) -> Any:
+    return value
+
+
+class _NestedDefault:
+    """Default of a nested message field: a new message of its class, looked up once (the class
+    may not exist yet when the enclosing class is made)."""
+
+    __slots__ = ('cls', 'typename')
+
+    def __init__(self, typename: str) -> None:
+        self.typename = typename
+        self.cls: type[Message] | None = None
+
+    def __call__(self) -> Message:
+        if self.cls is None:
+            self.cls = get_message_class(self.typename)
+        return self.cls()
+
+
 def _field_default_factory(desc: tuple) -> Any:
     kind, detail = desc
     if kind == Nodetype.BASE:
         base, _bound = detail
-        if base in _PY_DEFAULTS:
-            return lambda: _PY_DEFAULTS[base]
-        return lambda: 0
+        return functools.partial(_constant, _PY_DEFAULTS.get(base, 0))
     if kind == Nodetype.NAME:
-        return lambda: get_message_class(detail)()
+        return _NestedDefault(detail)
     (sub_kind, sub_detail), count = detail
     if sub_kind == Nodetype.BASE and sub_detail[0] in _NUMPY_DTYPES:
         dtype = _NUMPY_DTYPES[sub_detail[0]]
@@ -212,24 +230,32 @@ class Message:
     _fields_and_field_types: dict[str, str] = {}
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
-        if len(args) > len(self._fields):
-            msg = f'{self.__msgtype__} takes at most {len(self._fields)} positional fields.'
-            raise TypeError(msg)
-        if args and not kwargs and len(args) == len(self._fields):
-            # Fast path used by the deserialiser: values arrive complete and typed.
-            for name, value in zip(self._fields, args, strict=True):
-                object.__setattr__(self, name, value)
-            return
-        values = dict(zip(self._fields, args, strict=False))
-        for key, value in kwargs.items():
-            if key not in self._fields_and_field_types:
-                msg = (f'{self.__msgtype__} has no field {key!r}; its fields are: '
-                       f'{", ".join(self._fields)}.')
+        fields = self._fields
+        if args:
+            if len(args) > len(fields):
+                msg = f'{self.__msgtype__} takes at most {len(fields)} positional fields.'
                 raise TypeError(msg)
-            values[key] = value
-        for name, factory in zip(self._fields, self._defaults, strict=True):
-            if name in values:
-                setattr(self, name, values[name])
+            if not kwargs and len(args) == len(fields):
+                # Fast path used by the deserialiser: values arrive complete and typed.
+                for name, value in zip(fields, args, strict=True):
+                    object.__setattr__(self, name, value)
+                return
+            kwargs = {**dict(zip(fields, args, strict=False)), **kwargs}
+        if kwargs and not kwargs.keys() <= self._fields_and_field_types.keys():
+            key = next(k for k in kwargs if k not in self._fields_and_field_types)
+            msg = (f'{self.__msgtype__} has no field {key!r}; its fields are: '
+                   f'{", ".join(fields)}.')
+            raise TypeError(msg)
+        # Messages are built at every publish: one pass over the fields, numeric ones converted
+        # (as __setattr__ does), the others stored as given or as their default.
+        numeric = self._numeric
+        for name, factory in zip(fields, self._defaults, strict=True):
+            if name in kwargs:
+                value = kwargs[name]
+                spec = numeric.get(name)
+                if spec is not None:
+                    value = _as_array(self.__msgtype__, name, value, *spec)
+                object.__setattr__(self, name, value)
             else:
                 object.__setattr__(self, name, factory())
 
@@ -298,7 +324,7 @@ def _make_message_class(store: Typestore, typename: str) -> type[Message]:
     extra = _FIELD_DEFAULTS.get(typename, {})
     for fname, desc in fields:
         if fname in extra:
-            defaults.append(functools.partial(lambda v: v, extra[fname]))
+            defaults.append(functools.partial(_constant, extra[fname]))
         else:
             defaults.append(_field_default_factory(desc))
     namespace: dict[str, Any] = {
@@ -311,6 +337,9 @@ def _make_message_class(store: Typestore, typename: str) -> type[Message]:
         '_numeric': {_normalize(f): spec for f, d in fields if (spec := _numeric_dtype(d))},
         '_fields_and_field_types': {_normalize(f): _ros_type_string(d) for f, d in fields},
     }
+    if not namespace['_numeric']:
+        # nothing to convert: plain slot assignment, as fast as a generated rclpy class
+        namespace['__setattr__'] = object.__setattr__
     for cname, _ctype, value in consts:
         namespace[cname] = value
     return type(name, (Message,), namespace)

@@ -111,6 +111,8 @@ class SimParams:
                            min=-1, max=100)
     physics_hz: float = param(240.0, 'physics rate; contacts are tuned for 240 Hz', unit='Hz',
                               min=10.0, max=10000.0)
+    solver_iterations: int = param(50, "PyBullet's constraint solver iterations per physics "
+                                   'step (contacts, joint motors)', min=1, max=1000)
     camera_width: int = param(128, 'eye-in-hand RGB-D camera width', unit='px', min=1, max=8192)
     camera_height: int = param(128, 'eye-in-hand RGB-D camera height', unit='px', min=1,
                                max=8192)
@@ -205,6 +207,7 @@ class SimNode(rclpy.node.Node):
                                     float(p['camera_rate']), float(p['camera_fov_deg']),
                                     renderer=str(p['camera_renderer'])),
                 physics_hz=float(p['physics_hz']),
+                solver_iterations=int(p['solver_iterations']),
                 trainer_robot=bool(p['trainer_robot']), gui=gui,
                 n_objects=None if int(p['n_objects']) < 0 else int(p['n_objects']),
                 realism=str(p['realism']), realism_seed=int(p['realism_seed']))

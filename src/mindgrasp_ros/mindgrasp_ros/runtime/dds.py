@@ -260,6 +260,17 @@ class DdsReader:
     def matched_count(self) -> int:
         return _matched(self.reader.get_matched_publications)
 
+    def writer_participant(self, publication_handle: int) -> Any | None:
+        """Participant GUID of a matched writer (a SampleInfo's ``publication_handle``), or None
+        once that writer is gone."""
+        data = self.reader.get_matched_publication_data(publication_handle)
+        return None if data is None else data.participant_key
+
+    def writers_of(self, participant: Any) -> int:
+        """How many matched writers belong to ``participant``."""
+        return _count_in(self.reader.get_matched_publications,
+                         self.reader.get_matched_publication_data, participant)
+
 
 class DdsWriter:
     """A raw-CDR DataWriter."""
@@ -284,6 +295,26 @@ class DdsWriter:
 
     def matched_count(self) -> int:
         return _matched(self.writer.get_matched_subscriptions)
+
+    def readers_of(self, participant: Any) -> int:
+        """How many matched readers belong to ``participant`` (a participant GUID)."""
+        return _count_in(self.writer.get_matched_subscriptions,
+                         self.writer.get_matched_subscription_data, participant)
+
+
+def _count_in(handles: Callable[[], list[int]], data: Callable[[int], Any],
+              participant: Any) -> int:
+    """Matched endpoints of one participant (handles of endpoints that unmatch meanwhile give
+    None and are not counted)."""
+    for _ in range(3):
+        try:
+            found = handles()
+            break
+        except IndexError:      # an endpoint matched while listing (see _matched)
+            continue
+    else:
+        return 0
+    return sum(1 for h in found if (d := data(h)) is not None and d.participant_key == participant)
 
 
 def _matched(handles: Callable[[], list[int]]) -> int:

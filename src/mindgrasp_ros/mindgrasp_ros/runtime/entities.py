@@ -15,6 +15,7 @@ import itertools
 import os
 import struct
 import threading
+import time
 from collections import deque
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
@@ -32,6 +33,8 @@ if TYPE_CHECKING:
 __all__ = ['Client', 'GuardCondition', 'Publisher', 'Service', 'Subscription', 'Timer']
 
 _CDR_HEADER = b'\x00\x01\x00\x00'
+#: longest a service waits for a new caller's reply reader to be discovered (s)
+REPLY_READER_WAIT_S = 5.0
 
 
 class Entity:
@@ -421,24 +424,25 @@ class Service(Entity):
         self._local.append((request, future))
         self.node.wake_executor()
 
-    def take(self) -> list[tuple[int, int, Any]]:
+    def take(self) -> list[tuple[Any, int, Any, int]]:
         out: list[Any] = []
         while self._local:
             request, future = self._local.popleft()
-            out.append((future, 0, request))
+            out.append((future, 0, request, 0))
         if self._reader is None:
             return out
-        for data, _info in self._reader.take(64):
+        for data, info in self._reader.take(64):
             try:
                 guid, seq, payload = _unpack_service(data)
-                out.append((guid, seq, deserialize(payload, self._req_type)))
+                out.append((guid, seq, deserialize(payload, self._req_type),
+                            info.publication_handle))
             except Exception as exc:
                 self.node.get_logger().warning(
                     f"Dropped a malformed request on service '{self.srv_name}': {exc}")
         return out
 
-    def execute(self, item: tuple[int, int, Any]) -> None:
-        guid, seq, request = item
+    def execute(self, item: tuple[Any, int, Any, int]) -> None:
+        guid, seq, request, request_writer = item
         response = self.srv_type.Response()
         result = self.callback(request, response)
         if result is None:
@@ -449,7 +453,30 @@ class Service(Entity):
         if isinstance(guid, Future):  # an in-process call
             guid.set_result(result)
             return
+        self._wait_for_reply_reader(request_writer)
         self._writer.write(_pack_service(guid, seq, serialize(result, self._res_type)))
+
+    def _wait_for_reply_reader(self, request_writer: int) -> None:
+        """Wait until the caller's reply reader is matched, as rmw_cyclonedds does before it
+        sends a response. A client that saw this service (wait_for_service) may call before
+        this side has discovered the client's reply reader; a reply written then reaches no one
+        and the call never completes. Clients are counted per participant: every request writer
+        of the caller's participant must have a reply reader there. Bounded: a client that has
+        gone, or that is still unmatched after the deadline, gets the reply written anyway."""
+        deadline = time.monotonic() + REPLY_READER_WAIT_S
+        while True:
+            participant = self._reader.writer_participant(request_writer)
+            if participant is None:
+                return      # the client has gone (or the request came from no known writer)
+            if self._writer.readers_of(participant) >= self._reader.writers_of(participant):
+                return
+            if time.monotonic() >= deadline:
+                self.node.get_logger().warning(
+                    f"Service '{self.srv_name}': the caller's reply reader is still not "
+                    f'discovered after {REPLY_READER_WAIT_S:.0f} s; replying anyway (the reply '
+                    'may be lost).')
+                return
+            time.sleep(0.005)
 
     def destroy(self) -> None:
         dds = self.node.context.dds
@@ -502,8 +529,6 @@ class Client(Entity):
         return self._writer.matched_count() > 0 and self._reader.matched_count() > 0
 
     def wait_for_service(self, timeout_sec: float | None = None) -> bool:
-        import time
-
         deadline = None if timeout_sec is None else time.monotonic() + timeout_sec
         while not self.service_is_ready():
             if self.node.context.is_shutdown():
