@@ -193,6 +193,13 @@ def _subscribe_and_receive(ws, topic: str, node, rclpy, timeout: float = 60.0):
                     channel = ch
                     ws.send(json.dumps({'op': 'subscribe',
                                         'subscriptions': [{'id': 1, 'channelId': ch['id']}]}))
+            if (op['op'] == 'status' and channel is not None
+                    and op.get('message') == f'Unknown channel ID: {channel["id"]}'):
+                # The SDK (0.30, connected_client.rs advertise_channels) sends the advertisement
+                # before it enters the channel in the client's map, so a subscription that comes
+                # back at once can be refused; a client subscribes again, as Foxglove's user does.
+                ws.send(json.dumps({'op': 'subscribe',
+                                    'subscriptions': [{'id': 1, 'channelId': channel['id']}]}))
             continue
         decode = generate_dynamic(channel['schemaName'], channel['schema'])
         return decode[channel['schemaName']](bytes(frame[13:]))
