@@ -119,8 +119,9 @@ def test_a_reply_waits_for_the_callers_reply_reader(rclpy_ctx, spawn_node):
     the service waits for it (as rmw_cyclonedds does) instead of writing to no one. Here the
     reply reader is created only after the request has gone out."""
     from mindgrasp_ros.interfaces.std_srvs.srv import SetBool
-    from mindgrasp_ros.runtime.entities import _pack_service, _service_topics, _unpack_service
+
     from mindgrasp_ros import using_real_rclpy
+    from mindgrasp_ros.runtime.entities import _pack_service, _service_topics, _unpack_service
     from mindgrasp_ros.typesupport import deserialize, serialize
 
     if using_real_rclpy():

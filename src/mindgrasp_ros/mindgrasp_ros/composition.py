@@ -165,6 +165,7 @@ class LockstepRunner:
         self._clock_node = Node('lockstep_clock', context=self.context,
                                 start_parameter_services=False, enable_rosout=False)
         self._clock_cls = get_message_class('rosgraph_msgs/msg/Clock')
+        self._time_cls = get_message_class('builtin_interfaces/msg/Time')
         from mindgrasp_ros.runtime.qos import qos_profile_clock
         from mindgrasp_ros.topics import CLOCK
 
@@ -199,8 +200,7 @@ class LockstepRunner:
 
     def _publish_clock(self) -> None:
         sec, nsec = divmod(self._time_ns, 1_000_000_000)
-        stamp = self._clock_cls().clock.__class__(sec=sec, nanosec=nsec)
-        self._clock_pub.publish(self._clock_cls(clock=stamp))
+        self._clock_pub.publish(self._clock_cls(clock=self._time_cls(sec=sec, nanosec=nsec)))
 
     def spin_until_quiescent(self) -> int:
         """Run ready callbacks until none is ready; returns how many rounds ran.

@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import contextlib
 import ctypes
+import functools
 import math
 import os
 import sys
@@ -69,6 +70,18 @@ SKY_RGB = (70, 80, 100)
 #: camera light: mostly ambient so the task colours stay saturated (original thresholds 0.7/0.3)
 _LIGHT = {'lightDirection': [0.4, -0.3, 1.0], 'lightAmbientCoeff': 0.55,
           'lightDiffuseCoeff': 0.5, 'lightSpecularCoeff': 0.0}
+
+
+class _Client(BulletClient):
+    """BulletClient that binds each pybullet function to its client once: the stock one builds a
+    new ``functools.partial`` (after an ``inspect`` check) on every call, thousands per simulated
+    second in the physics loop."""
+
+    def __getattr__(self, name: str) -> object:
+        attribute = super().__getattr__(name)
+        if name != 'disconnect' and isinstance(attribute, functools.partial):
+            self.__dict__[name] = attribute
+        return attribute
 
 
 @contextlib.contextmanager
@@ -211,8 +224,8 @@ class Simulation:
                   '(headless) or from a desktop session.'
             raise SimError(msg)
         with _c_stdout_to_stderr():
-            self._p = BulletClient(connection_mode=pb.GUI if self.gui else pb.DIRECT)
-            self._kin = BulletClient(connection_mode=pb.DIRECT)   # kinematic twin for IK / FK
+            self._p = _Client(connection_mode=pb.GUI if self.gui else pb.DIRECT)
+            self._kin = _Client(connection_mode=pb.DIRECT)   # kinematic twin for IK / FK
         p = self._p
         p.setPhysicsEngineParameter(fixedTimeStep=self.dt, numSolverIterations=solver_iterations,
                                     deterministicOverlappingPairs=1, numSubSteps=0)

@@ -112,6 +112,11 @@ class Executor:
             return list(self._nodes)
 
     def wake(self) -> None:
+        if self._woken:
+            # A wake is pending: whoever waits next returns at once and collects this work with
+            # the rest (it was queued before this check). Lock-step never waits, so this skips
+            # a lock and a notify per delivered message.
+            return
         with self._cond:
             self._woken = True
             self._cond.notify_all()
