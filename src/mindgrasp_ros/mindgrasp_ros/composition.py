@@ -247,6 +247,11 @@ class LockstepRunner:
                 if timer.is_ready():
                     timer._mark_called()
                     work.append((timer, None))
+            # queues fill only through deliveries, which flag the node (Node.wake_executor); a
+            # node nothing was delivered to since the last look is skipped
+            if not node.has_work:
+                continue
+            node.has_work = False
             for sub in node.subscriptions:
                 if sub._queue:
                     work.extend((sub, item) for item in sub.take())

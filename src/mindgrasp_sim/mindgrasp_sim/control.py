@@ -54,23 +54,27 @@ class CommandGate:
             raise SimError(msg)
         self.timeout = float(timeout)
         self.n_joints = n_joints
-        self._cmd = np.zeros(n_joints)
+        self._zeros = _read_only(np.zeros(n_joints))
+        self._cmd = self._zeros
         self._stamp = -math.inf
         self.timed_out = True
 
     def command(self, values: object, now: float) -> np.ndarray:
         """Accept a command at time ``now`` (s); raises SimError (command ignored) if invalid."""
-        self._cmd = validate_velocities(values, self.n_joints)
+        self._cmd = _read_only(validate_velocities(values, self.n_joints).copy())
         self._stamp = now
         self.timed_out = False
         return self._cmd
 
     def current(self, now: float) -> np.ndarray:
-        """The command in force at ``now`` (s): the latest one, or zeros after the timeout."""
+        """The command in force at ``now`` (s): the latest one, or zeros after the timeout.
+
+        Read-only, and the same object until the command changes (the simulator checks it every
+        physics step: ``is`` instead of an element-wise comparison)."""
         if now - self._stamp > self.timeout:
             self.timed_out = True
-            return np.zeros(self.n_joints)
-        return self._cmd.copy()
+            return self._zeros
+        return self._cmd
 
     def shift(self, seconds: float) -> None:
         """Move the command's time by ``seconds`` (s): when the clock skips ahead, a command that
@@ -79,9 +83,14 @@ class CommandGate:
 
     def clear(self) -> None:
         """Forget the command (e.g. after a reset)."""
-        self._cmd = np.zeros(self.n_joints)
+        self._cmd = self._zeros
         self._stamp = -math.inf
         self.timed_out = True
+
+
+def _read_only(a: np.ndarray) -> np.ndarray:
+    a.flags.writeable = False
+    return a
 
 
 __all__ = ['CommandGate', 'gripper_closure', 'validate_velocities']

@@ -324,8 +324,10 @@ class SimNode(rclpy.node.Node):
             now = self.sim_now()
             for io in self.robots.values():
                 v = io.gate.current(now)
-                if not np.array_equal(v, io.applied):
-                    sim.set_joint_velocities(v, robot=io.name)
+                # the gate hands out a new array only for a new command (or the timeout)
+                if v is not io.applied:
+                    if not np.array_equal(v, io.applied):
+                        sim.set_joint_velocities(v, robot=io.name)
                     io.applied = v
             sim.step()
             self.total_steps += 1

@@ -60,6 +60,8 @@ from mindgrasp_sim.scene import ObjectSpec, SceneSpec, load_scene
 
 #: PD motor position gain (pybullet's per-step error fraction): stiff, so gravity sag < 1 mrad
 ARM_POSITION_GAIN = 0.8
+_ARM_POSITION_GAINS = (ARM_POSITION_GAIN,) * 6
+_ARM_VELOCITY_GAINS = (1.0,) * 6
 GROUND_RGBA = (0.78, 0.77, 0.74, 1.0)
 TRAINER_RGBA = (0.1, 0.85, 0.1, 0.35)
 ROBOTS = ('user', 'trainer')
@@ -513,7 +515,7 @@ class Simulation:
                     p.setJointMotorControlArray(
                         r.body, self._arm_idx, pb.POSITION_CONTROL, targetPositions=r.q_ref,
                         targetVelocities=[0.0] * 6, forces=self.max_effort,
-                        positionGains=[ARM_POSITION_GAIN] * 6, velocityGains=[1.0] * 6)
+                        positionGains=_ARM_POSITION_GAINS, velocityGains=_ARM_VELOCITY_GAINS)
                     r.holding = True
                 if r.gripper_dirty:
                     target = FINGER_OPEN + (FINGER_CLOSED - FINGER_OPEN) * r.closure
@@ -529,15 +531,16 @@ class Simulation:
     def _track(self, p: BulletClient, r: _Robot, dt: float) -> None:
         """Advance the joint reference by the velocity command and send it to the motors."""
         q = np.array([s[0] for s in p.getJointStates(r.body, self._arm_idx)])
-        # keep the reference near the real joints (a blocked arm does not wind up)
-        q_ref = np.clip(r.q_ref, q - 0.05, q + 0.05)
-        new_ref = np.clip(q_ref + r.v_applied * dt, self.lower, self.upper)
+        # keep the reference near the real joints (a blocked arm does not wind up); ufuncs
+        # rather than np.clip, whose wrapper costs more than the arithmetic at 240 Hz
+        q_ref = np.minimum(np.maximum(r.q_ref, q - 0.05), q + 0.05)
+        new_ref = np.minimum(np.maximum(q_ref + r.v_applied * dt, self.lower), self.upper)
         v_ff = (new_ref - q_ref) / dt
         r.q_ref = new_ref
         p.setJointMotorControlArray(
             r.body, self._arm_idx, pb.POSITION_CONTROL, targetPositions=new_ref,
             targetVelocities=v_ff, forces=self.max_effort,
-            positionGains=[ARM_POSITION_GAIN] * 6, velocityGains=[1.0] * 6)
+            positionGains=_ARM_POSITION_GAINS, velocityGains=_ARM_VELOCITY_GAINS)
 
     # ------------------------------------------------------------------ state
     def joint_positions(self, robot: str = 'user') -> np.ndarray:

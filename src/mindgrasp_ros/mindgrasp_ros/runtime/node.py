@@ -74,6 +74,8 @@ class Node:
         from mindgrasp_ros.runtime.arguments import RosArguments, parse_ros_args
 
         self.context = context or get_default_context()
+        #: set by every delivery to this node (wake_executor), cleared by the lock-step runner
+        self.has_work = True
         if not self.context.ok():
             raise NotInitializedException('context')
         args = RosArguments()
@@ -171,6 +173,9 @@ class Node:
 
     # ------------------------------------------------------------------ executor hooks
     def wake_executor(self) -> None:
+        # something arrived for one of this node's entities (or they changed): the lock-step
+        # runner looks at the node's queues only when this is set
+        self.has_work = True
         executor = self.executor
         if executor is not None:
             executor.wake()
