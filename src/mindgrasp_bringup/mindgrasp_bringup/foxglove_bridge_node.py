@@ -75,14 +75,17 @@ class FoxgloveBridgeNode(rclpy.node.Node):
         self.params = declare_params(self, BridgeParams)
         self.done = rclpy.task.Future()
         self.whitelist = [re.compile(p) for p in self.params.topic_whitelist]
+        # the SDK's thread triggers it when a client (un)subscribes: no polling timer, so an
+        # idle view wakes the node once per discovery period only
+        client_events = self.create_guard_condition(self.clients_callback)
+        server_options = {'message_backlog_size': self.params.message_backlog_size,
+                          'on_subscription_change': client_events.trigger}
         try:
-            self.server = FoxgloveServer(self.params.address, self.params.port,
-                                         message_backlog_size=self.params.message_backlog_size)
+            self.server = FoxgloveServer(self.params.address, self.params.port, **server_options)
         except LiveViewError as exc:
             if self.params.port_in_use != 'any' or 'in use' not in str(exc):
                 raise
-            self.server = FoxgloveServer(self.params.address, 0,
-                                         message_backlog_size=self.params.message_backlog_size)
+            self.server = FoxgloveServer(self.params.address, 0, **server_options)
             self.get_logger().warning(
                 f'The live view port {self.params.port} is in use (another live view?); '
                 f'serving on port {self.server.port} instead.')
@@ -92,7 +95,6 @@ class FoxgloveBridgeNode(rclpy.node.Node):
         self.get_logger().info(f'Live view on {self.server.url}: open it in Foxglove '
                                '(Open connection > Foxglove WebSocket).')
         self.create_timer(self.params.discovery_period, self.discover_callback)
-        self.create_timer(0.05, self.clients_callback)
         end_after(self, self.params.duration)
         self.discover_callback()
 

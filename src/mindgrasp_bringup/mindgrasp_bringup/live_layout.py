@@ -17,7 +17,6 @@ from pathlib import Path
 from mindgrasp_common.resources import resource_path
 from mindgrasp_ros.topics import (
     BCI_PREDICTION,
-    COLOR_IMAGE,
     EEG_RAW,
     FSM_STATE,
     ROBOT_DESCRIPTION,
@@ -32,9 +31,10 @@ __all__ = ['LAYOUT_FILE', 'TOPICS', 'build_layout']
 #: the committed layout file (package data of mindgrasp_bringup)
 LAYOUT_FILE = resource_path('mindgrasp_bringup', 'foxglove') / 'mindgrasp_live.json'
 
-#: topics the layout shows (each published by the demo)
-TOPICS = tuple(t.name for t in (VISION_OVERLAY, COLOR_IMAGE, ROBOT_DESCRIPTION, TF, TF_STATIC,
-                                 SIM_OBJECTS, EEG_RAW, BCI_PREDICTION, FSM_STATE))
+#: topics the layout's panels show (each published by the demo): what the Foxglove app
+#: subscribes to with this layout open
+TOPICS = tuple(t.name for t in (VISION_OVERLAY, ROBOT_DESCRIPTION, TF, TF_STATIC, SIM_OBJECTS,
+                                 EEG_RAW, BCI_PREDICTION, FSM_STATE))
 
 
 def build_layout() -> str:

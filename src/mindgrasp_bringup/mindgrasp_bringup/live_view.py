@@ -21,6 +21,7 @@ from __future__ import annotations
 import collections
 import ipaddress
 import queue
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 __all__ = ['DEFAULT_PORT', 'FoxgloveServer', 'LiveViewError']
@@ -44,16 +45,23 @@ class _Topic:
 
 
 class _Listener:
-    """foxglove ServerListener: queues client (un)subscriptions for the caller's thread."""
+    """foxglove ServerListener: queues client (un)subscriptions for the caller's thread and
+    calls ``notify`` (from the SDK's thread) after each."""
 
-    def __init__(self) -> None:
+    def __init__(self, notify: Callable[[], None] | None = None) -> None:
         self.events: queue.SimpleQueue[tuple[str, str]] = queue.SimpleQueue()
+        self.notify = notify
+
+    def _put(self, event: str, channel: object) -> None:
+        self.events.put((event, channel.topic))  # type: ignore[attr-defined]
+        if self.notify is not None:
+            self.notify()
 
     def on_subscribe(self, client: object, channel: object) -> None:
-        self.events.put(('subscribe', channel.topic))  # type: ignore[attr-defined]
+        self._put('subscribe', channel)
 
     def on_unsubscribe(self, client: object, channel: object) -> None:
-        self.events.put(('unsubscribe', channel.topic))  # type: ignore[attr-defined]
+        self._put('unsubscribe', channel)
 
 
 class FoxgloveServer:
@@ -69,10 +77,15 @@ class FoxgloveServer:
     message_backlog_size : int
         Messages queued per client before its oldest are dropped (a slow client loses frames,
         the graph does not wait).
+    on_subscription_change : callable | None
+        Called with no argument, from the SDK's thread, when a client (un)subscribes: e.g. a
+        ROS guard condition's ``trigger``, so the caller reads :meth:`subscription_events` when
+        there are some instead of polling.
     """
 
     def __init__(self, host: str = '127.0.0.1', port: int = DEFAULT_PORT, *,
-                 message_backlog_size: int = 1024, name: str = 'MIndGrasp-ROS') -> None:
+                 message_backlog_size: int = 1024, name: str = 'MIndGrasp-ROS',
+                 on_subscription_change: Callable[[], None] | None = None) -> None:
         import foxglove
 
         try:
@@ -86,7 +99,7 @@ class FoxgloveServer:
             raise LiveViewError(msg)
         self._foxglove = foxglove
         self._context = foxglove.Context()  # our own: channels of other code stay out
-        self._listener = _Listener()
+        self._listener = _Listener(on_subscription_change)
         try:
             self._server = foxglove.start_server(
                 name=name, host=host, port=int(port), context=self._context,
