@@ -207,8 +207,9 @@ class Subscription(Entity):
         remote = self._reader.lost if self._reader is not None else 0
         return remote + self._local_lost
 
-    def take(self) -> list[tuple[Any, MessageInfo]]:
-        """Everything that has arrived: (message or bytes, info) pairs, oldest first."""
+    def take(self, dds: bool = True) -> list[tuple[Any, MessageInfo]]:
+        """Everything that has arrived: (message or bytes, info) pairs, oldest first (``dds``
+        False: only the in-process deliveries, the executor saw no DDS data)."""
         out: list[tuple[Any, MessageInfo]] = []
         while self._queue:
             delivery = self._queue.popleft()
@@ -216,7 +217,7 @@ class Subscription(Entity):
                 out.append((delivery.raw() if self.raw else delivery.message(), MessageInfo()))
             except Exception as exc:
                 self._report_malformed(exc)
-        if self._reader is not None:
+        if self._reader is not None and dds:
             for data, info in self._reader.take(256):
                 if self.raw:
                     out.append((data, MessageInfo(source_timestamp=info.source_timestamp)))
@@ -424,12 +425,12 @@ class Service(Entity):
         self._local.append((request, future))
         self.node.wake_executor()
 
-    def take(self) -> list[tuple[Any, int, Any, int]]:
+    def take(self, dds: bool = True) -> list[tuple[Any, int, Any, int]]:
         out: list[Any] = []
         while self._local:
             request, future = self._local.popleft()
             out.append((future, 0, request, 0))
-        if self._reader is None:
+        if self._reader is None or not dds:
             return out
         for data, info in self._reader.take(64):
             try:
@@ -578,9 +579,9 @@ class Client(Entity):
                 if f is future:
                     del self._pending[seq]
 
-    def take(self) -> list[tuple[Future, Any]]:
+    def take(self, dds: bool = True) -> list[tuple[Future, Any]]:
         out: list[tuple[Future, Any]] = []
-        if self._reader is None:
+        if self._reader is None or not dds:
             return out
         for data, _info in self._reader.take(64):
             try:
