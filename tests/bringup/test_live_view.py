@@ -226,3 +226,66 @@ def test_latched_topic_reaches_every_client_that_joins_later(rclpy_ctx, spawn_no
             second = _subscribe_and_receive(second_ws, '/robot_description', node, rclpy)
     assert second is not None and second.data == '<robot name="once"/>', proc.output()
     assert proc.stop() == 0
+
+
+def test_server_reports_a_client_that_does_not_keep_up() -> None:
+    """A client that stops reading: logging never waits for it, and the server names it in a
+    drop report (the SDK's 'outbox full'), as an event and in ``drop_reports``."""
+    from mindgrasp_bringup.live_view import FoxgloveServer
+
+    server = FoxgloveServer('127.0.0.1', 0, message_backlog_size=4)
+    try:
+        server.add_channel('/camera/color/image_raw', 'std_msgs/msg/String', 'string data')
+        with connect(f'ws://127.0.0.1:{server.port}', subprotocols=SUBPROTOCOLS, proxy=None,
+                     open_timeout=30, max_size=None) as ws:
+            advertised = json.loads(ws.recv(timeout=30))
+            while advertised.get('op') != 'advertise':
+                advertised = json.loads(ws.recv(timeout=30))
+            ws.send(json.dumps({'op': 'subscribe', 'subscriptions': [
+                {'id': 1, 'channelId': advertised['channels'][0]['id']}]}))
+            host, client_port = ws.local_address[:2]
+            client = f'{host}:{client_port}'
+            deadline = time.monotonic() + 60.0
+            while not server.wanted('/camera/color/image_raw') and time.monotonic() < deadline:
+                time.sleep(0.01)
+            frame = b'\x00\x01\x00\x00' + bytes(200_000)   # the client never reads them
+            events: list[tuple[str, str]] = []
+            while ('dropping', client) not in events and time.monotonic() < deadline:
+                for _ in range(50):
+                    server.log('/camera/color/image_raw', frame, time.time_ns())
+                events += server.events()
+            assert ('dropping', client) in events, events
+            assert server.drop_reports[client] >= 1
+    finally:
+        server.stop()
+
+
+def test_bridge_warns_about_a_slow_client_and_serves_the_others(rclpy_ctx, spawn_node) -> None:
+    """One client stops reading big messages: the bridge says which client is too slow, and a
+    second client is still served."""
+    from mindgrasp_ros.interfaces.std_msgs.msg import String
+
+    rclpy = rclpy_ctx
+    proc, port = _start_bridge(spawn_node, message_backlog_size=4)
+    node = rclpy.create_node('live_view_slow_probe')
+    pub = node.create_publisher(String, '/scene/image_raw', 10)
+    big = String(data='x' * 200_000)
+    node.create_timer(0.02, lambda: pub.publish(big))   # runs while the test spins the node
+    url = f'ws://127.0.0.1:{port}'
+    with connect(url, subprotocols=SUBPROTOCOLS, proxy=None, open_timeout=30,
+                 max_size=None) as slow_ws:
+        first = _subscribe_and_receive(slow_ws, '/scene/image_raw', node, rclpy)
+        assert first is not None, proc.output()
+        host, client_port = slow_ws.local_address[:2]
+        warning = f'client {host}:{client_port} is too slow'
+        # from here the slow client reads nothing while the graph keeps publishing
+        deadline = time.monotonic() + 90.0
+        while warning not in proc.output() and time.monotonic() < deadline:
+            rclpy.spin_once(node, timeout_sec=0.02)
+        assert warning in proc.output(), proc.output()
+        with connect(url, subprotocols=SUBPROTOCOLS, proxy=None, open_timeout=30,
+                     max_size=None) as other_ws:
+            other = _subscribe_and_receive(other_ws, '/scene/image_raw', node, rclpy)
+        assert other is not None and other.data == big.data, proc.output()
+    assert proc.stop() == 0
+    assert f'reports of dropped messages: {host}:{client_port} (' in proc.output(), proc.output()

@@ -13,7 +13,7 @@ that has a publisher and matches a ``topic_whitelist`` regex is advertised with 
 the node subscribes to it (raw CDR, with the publishers' QoS: transient local for
 /robot_description and /tf_static, best effort for the camera) only while a client watches it, so
 an unwatched live view costs the graph nothing. A slow client loses its oldest messages beyond
-``message_backlog_size``; the graph never waits for it. Listens on
+``message_backlog_size``, and the node warns about it; the graph never waits for it. Listens on
 loopback only unless ``address`` says otherwise. A port in use ends the node with exit code 2 and
 one line naming the fix; with ``port_in_use:=any`` (the launch profiles) it serves on a free port
 instead and says which.
@@ -129,8 +129,16 @@ class FoxgloveBridgeNode(rclpy.node.Node):
                                     latched_depth=qos['depth'] if latched else 0)
 
     def clients_callback(self) -> None:
-        """Subscribe to a topic when a client starts watching it, drop it when nobody does."""
-        for event, topic in self.server.subscription_events():
+        """Subscribe to a topic when a client starts watching it, drop it when nobody does; say
+        when a client is too slow for what it watches."""
+        for event, topic in self.server.events():
+            if event == 'dropping':
+                self.get_logger().warning(
+                    f'Live view client {topic} is too slow: its oldest messages were dropped '
+                    f'(more than message_backlog_size={self.params.message_backlog_size} '
+                    'queued); the graph does not wait for it. Watch fewer topics in it, or give '
+                    'it a faster link.')
+                continue
             if topic not in self.server.topics:
                 continue
             if event == 'subscribe':
@@ -157,8 +165,10 @@ class FoxgloveBridgeNode(rclpy.node.Node):
 
     def destroy_node(self) -> None:
         sent = sum(t.messages for t in self.server.topics.values())
+        slow = ', '.join(f'{client} ({n})' for client, n in self.server.drop_reports.items())
         self.get_logger().info(f'Live view served {len(self.server.topics)} topic(s), '
-                               f'{sent} message(s) to clients.')
+                               f'{sent} message(s) to clients'
+                               + (f'; reports of dropped messages: {slow}.' if slow else '.'))
         self.server.stop()
         super().destroy_node()
 

@@ -12,15 +12,22 @@ it decodes a ROS 2 bag or ``foxglove_bridge``::
 
 A slow client never slows the caller: :meth:`log` hands the message to the SDK, which queues at most
 ``message_backlog_size`` messages per client and drops that client's oldest ones beyond it.
-:meth:`subscription_events` tells which channels clients (un)subscribed, so the caller subscribes
-to a ROS topic only while someone watches it (as foxglove_bridge does).
+:meth:`events` tells which channels clients (un)subscribed, so the caller subscribes to a ROS
+topic only while someone watches it (as foxglove_bridge does), and which clients lose messages.
+
+The SDK counts no dropped messages: it logs "outbox for client <address> full" (through Python's
+``logging``, at most once per 30 s per process). :attr:`FoxgloveServer.drop_reports` counts those
+reports per client address; the number of messages behind a report is not known.
 """
 
 from __future__ import annotations
 
 import collections
 import ipaddress
+import logging
 import queue
+import re
+import weakref
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -45,23 +52,55 @@ class _Topic:
 
 
 class _Listener:
-    """foxglove ServerListener: queues client (un)subscriptions for the caller's thread and
-    calls ``notify`` (from the SDK's thread) after each."""
+    """foxglove ServerListener: queues client (un)subscriptions (and drop reports) for the
+    caller's thread and calls ``notify`` (from the SDK's thread) after each."""
 
     def __init__(self, notify: Callable[[], None] | None = None) -> None:
         self.events: queue.SimpleQueue[tuple[str, str]] = queue.SimpleQueue()
         self.notify = notify
 
-    def _put(self, event: str, channel: object) -> None:
-        self.events.put((event, channel.topic))  # type: ignore[attr-defined]
+    def put(self, event: str, name: str) -> None:
+        self.events.put((event, name))
         if self.notify is not None:
             self.notify()
 
     def on_subscribe(self, client: object, channel: object) -> None:
-        self._put('subscribe', channel)
+        self.put('subscribe', channel.topic)  # type: ignore[attr-defined]
 
     def on_unsubscribe(self, client: object, channel: object) -> None:
-        self._put('unsubscribe', channel)
+        self.put('unsubscribe', channel.topic)  # type: ignore[attr-defined]
+
+
+#: what the SDK logs (foxglove.websocket.connected_client.send_lossy) when a client's queue is full
+_DROP_REPORT = re.compile(r'outbox for client (\S+) full')
+
+
+class _SdkDropReports(logging.Handler):
+    """Reads the SDK's log records (Rust ``log`` to Python ``logging`` via pyo3-log) and passes
+    each "outbox for client <address> full" to the servers of this process."""
+
+    def __init__(self) -> None:
+        super().__init__(logging.INFO)
+        self.servers: weakref.WeakSet[FoxgloveServer] = weakref.WeakSet()
+
+    def emit(self, record: logging.LogRecord) -> None:
+        match = _DROP_REPORT.search(record.getMessage())
+        if match is not None:
+            for server in list(self.servers):
+                server._drop_reported(match.group(1))
+
+
+_DROP_REPORTS = _SdkDropReports()
+
+
+def _watch_drop_reports(server: FoxgloveServer) -> None:
+    # before the server starts: pyo3-log caches each logger's level when it first logs
+    logger = logging.getLogger('foxglove.websocket')
+    if _DROP_REPORTS not in logger.handlers:
+        logger.addHandler(_DROP_REPORTS)
+    if logger.getEffectiveLevel() > logging.INFO:
+        logger.setLevel(logging.INFO)
+    _DROP_REPORTS.servers.add(server)
 
 
 class FoxgloveServer:
@@ -78,9 +117,9 @@ class FoxgloveServer:
         Messages queued per client before its oldest are dropped (a slow client loses frames,
         the graph does not wait).
     on_subscription_change : callable | None
-        Called with no argument, from the SDK's thread, when a client (un)subscribes: e.g. a
-        ROS guard condition's ``trigger``, so the caller reads :meth:`subscription_events` when
-        there are some instead of polling.
+        Called with no argument, from the SDK's thread, when a client (un)subscribes or loses
+        messages: e.g. a ROS guard condition's ``trigger``, so the caller reads :meth:`events`
+        when there are some instead of polling.
     """
 
     def __init__(self, host: str = '127.0.0.1', port: int = DEFAULT_PORT, *,
@@ -100,6 +139,10 @@ class FoxgloveServer:
         self._foxglove = foxglove
         self._context = foxglove.Context()  # our own: channels of other code stay out
         self._listener = _Listener(on_subscription_change)
+        #: client address -> "outbox full" reports of the SDK (it dropped that client's oldest
+        #: messages; at most one report per 30 s per process)
+        self.drop_reports: collections.Counter[str] = collections.Counter()
+        _watch_drop_reports(self)
         try:
             self._server = foxglove.start_server(
                 name=name, host=host, port=int(port), context=self._context,
@@ -160,9 +203,14 @@ class FoxgloveServer:
         entry.channel.log(bytes(cdr), log_time=int(time_ns))
         entry.messages += 1
 
-    def subscription_events(self) -> list[tuple[str, str]]:
-        """``('subscribe' | 'unsubscribe', topic)`` of the clients since the last call (the SDK
-        reports them from its own thread; call this from the thread that calls :meth:`log`)."""
+    def _drop_reported(self, client: str) -> None:
+        self.drop_reports[client] += 1
+        self._listener.put('dropping', client)
+
+    def events(self) -> list[tuple[str, str]]:
+        """What happened since the last call: ``('subscribe' | 'unsubscribe', topic)`` and
+        ``('dropping', client address)`` (the SDK dropped that client's oldest messages). The
+        SDK reports them from its own threads; call this from the thread that calls :meth:`log`."""
         out = []
         while True:
             try:
@@ -182,6 +230,7 @@ class FoxgloveServer:
 
     def stop(self) -> None:
         """Close the channels and the server (clients see the connection end)."""
+        _DROP_REPORTS.servers.discard(self)
         for entry in self.topics.values():
             entry.channel.close()
         self._server.stop()
