@@ -124,3 +124,14 @@ def test_protocol_draws_depend_on_seed_and_trial_only() -> None:
     assert random_locations_trial(0, 17) == specs[16]
     with pytest.raises(ValueError, match='no objects'):
         set_locations_target(0, 1, 0)
+
+
+@pytest.mark.parametrize(('certainty', 'shown'), [(None, 'n/a'), (math.nan, 'n/a'), (0.0, '0.00'),
+                                                  (0.166, '0.17')])
+def test_report_shows_mean_certainty_or_n_a(certainty, shown) -> None:
+    """No decoder (oracle, autonomous) gives n/a; a decoder that was never sure shows 0.00."""
+    from mindgrasp_experiments.report import render_report
+
+    text = render_report({'trials': 1, 'mean_certainty': certainty},
+                         {'protocol': 'random_locations', 'subject': 'autonomous'})
+    assert f'mean certainty {shown}.' in text

@@ -72,9 +72,11 @@ def render_report(summary: Mapping[str, Any], run: Mapping[str, Any]) -> str:
                  f"{_s(paper.get('mean_duration_s'))} |")
     lines.append(f"| mean time to a successful grasp | {_s(summary.get('mean_time_to_grasp_s'))}"
                  f" (median {_s(summary.get('median_time_to_grasp_s'))}) | | |")
+    certainty = summary.get('mean_certainty')
+    certainty_text = ('n/a' if certainty is None or not math.isfinite(certainty)
+                      else f'{certainty:.2f}')    # n/a: no decoder (oracle, autonomous)
     lines += ['', f"Decoder online accuracy against the subject's intent: "
-              f"{_pct(summary.get('decoder_accuracy'))}; mean certainty "
-              f"{summary.get('mean_certainty') or float('nan'):.2f}.", '']
+              f"{_pct(summary.get('decoder_accuracy'))}; mean certainty {certainty_text}.", '']
     failures = summary.get('failures') or {}
     if failures:
         lines += ['Trials without a successful end, by kind: ' + ', '.join(
