@@ -5,11 +5,31 @@ Imported only through :mod:`mindgrasp_bringup.launch_api` when the real ``launch
 
 from __future__ import annotations
 
+import datetime as dt
+import sys
+from pathlib import Path
+from typing import Any
+
+import launch.logging
+from launch.action import Action
+from launch.actions import RegisterEventHandler, Shutdown, TimerAction
+from launch.event_handlers import OnProcessExit, OnShutdown
 from launch.launch_context import LaunchContext
 from launch.some_substitutions_type import SomeSubstitutionsType
 from launch.substitution import Substitution
 from launch.substitutions.substitution_failure import SubstitutionFailure
 from launch.utilities import normalize_to_list_of_substitutions, perform_substitutions
+from launch_ros.actions import Node
+
+from mindgrasp_bringup.launch_system import rundir
+from mindgrasp_bringup.launch_system.run_extras import (
+    RECORDER_EXECUTABLE,
+    RECORDER_NAME,
+    RECORDER_PACKAGE,
+    duration_limit,
+    record_enabled,
+    recorder_parameters,
+)
 
 
 class CameraSpec(Substitution):
@@ -56,3 +76,92 @@ class SplitArguments(Substitution):
                    f'profile with mindgrasp launch, or start the driver with its own launch file.')
             raise SubstitutionFailure(msg)
         return text.strip()
+
+
+_MARK = 'mindgrasp_run_directory'  # in the launch's globals once a run directory exists
+
+
+class RunDirectory(Action):
+    """What ``mindgrasp launch`` adds around a launch file, as one action for ``ros2 launch``.
+
+    When executed it creates the run directory (``run_dir:=PATH``, else
+    ``$MINDGRASP_RUNS_DIR`` or ``runs/`` + ``<UTC time>_<launch file name>``), writes
+    ``launch.yaml``, ``launch_arguments.yaml`` and ``provenance.yaml`` there, sets
+    ``MINDGRASP_RUN_DIR`` for the nodes launched after it and the launch configuration
+    ``run_dir``, and then launches the recorder into ``<run dir>/bag`` (``record:=true``) and a
+    timer that shuts the launch down after ``duration:=`` seconds. ``summary.yaml`` gets each
+    process's exit code as it ends, and the shutdown reason. Put it after the launch arguments
+    and before the first node, so that the recorder starts first. A second one in the same launch
+    (an included profile) reuses the first one's directory and recorder.
+    """
+
+    def __init__(self, **kwargs: Any) -> None:
+        super().__init__(**kwargs)
+        self.path: Path | None = None
+        self._summary: dict[str, Any] = {}
+
+    def execute(self, context: LaunchContext) -> list[Any] | None:
+        configurations = context.launch_configurations
+        if context.get_locals_as_dict().get(_MARK) is not None:
+            return None  # an outer profile made the run directory, and records
+        # every value is checked before anything is created or started; ros2 launch prints a
+        # LaunchError's text on one line and ends
+        record = record_enabled(configurations)
+        duration = duration_limit(configurations)
+        launch_file = context.get_locals_as_dict().get('current_launch_file_path')
+        profile = Path(launch_file).name.removesuffix('.launch.py') if launch_file else 'launch'
+        self.path = rundir.create_run_dir(profile, configurations.get('run_dir') or None)
+        context.extend_globals({_MARK: self.path})
+        configurations['run_dir'] = str(self.path)
+        context.environment['MINDGRASP_RUN_DIR'] = str(self.path)
+        self._write_start(context, profile, launch_file, record, duration)
+        launch.logging.get_logger('launch').info(f'run directory: {self.path}')
+        entities: list[Any] = [
+            RegisterEventHandler(OnProcessExit(on_exit=self._process_exited)),
+            RegisterEventHandler(OnShutdown(on_shutdown=self._shutting_down)),
+        ]
+        if record:
+            entities.insert(0, Node(
+                package=RECORDER_PACKAGE, executable=RECORDER_EXECUTABLE, name=RECORDER_NAME,
+                parameters=[recorder_parameters(configurations, str(self.path / 'bag'))]))
+        if duration is not None:
+            entities.append(TimerAction(period=duration, actions=[
+                Shutdown(reason=f'duration:={duration:g} s elapsed')]))
+        return entities
+
+    def _write_start(self, context: LaunchContext, profile: str, launch_file: str | None,
+                     record: bool, duration: float | None) -> None:
+        assert self.path is not None
+        rundir.write_yaml(self.path / 'launch_arguments.yaml',
+                          dict(sorted(context.launch_configurations.items())),
+                          header='launch arguments (given or default); rerun with name:=value')
+        rundir.write_yaml(self.path / 'launch.yaml', {
+            'profile': profile,
+            'launch_file': launch_file,
+            'launcher': 'ros2 launch',
+            'command_line': list(sys.argv),
+            'started_utc': dt.datetime.now(dt.timezone.utc).isoformat(timespec='seconds'),
+            'record': record,
+            'duration_s': duration,
+            # ros2 launch keeps the nodes' output in its own log directory
+            'logs': str(getattr(launch.logging.launch_config, 'log_dir', '')) or None,
+        })
+        rundir.write_yaml(self.path / 'provenance.yaml', rundir.provenance())
+        self._summary = {'ended_utc': None, 'stop_reason': None, 'processes': []}
+
+    def _write_summary(self) -> None:
+        assert self.path is not None
+        self._summary['ended_utc'] = dt.datetime.now(dt.timezone.utc).isoformat(
+            timespec='seconds')
+        rundir.write_yaml(self.path / 'summary.yaml', self._summary,
+                          header='rewritten as each process ends')
+
+    def _process_exited(self, event: Any, context: LaunchContext) -> None:
+        self._summary['processes'].append({'label': event.process_name, 'pid': event.pid,
+                                           'returncode': event.returncode,
+                                           'clean': event.returncode == 0})
+        self._write_summary()
+
+    def _shutting_down(self, event: Any, context: LaunchContext) -> None:
+        self._summary['stop_reason'] = event.reason
+        self._write_summary()

@@ -33,6 +33,7 @@ from mindgrasp_bringup.launch_api import (
     live_view_arguments,
     live_view_nodes,
     number_argument,
+    run_directory_actions,
     sim_scene_camera,
 )
 
@@ -71,6 +72,7 @@ def generate_launch_description() -> LaunchDescription:
                                     'Ctrl-C)'),
         *display_arguments(),
         *live_view_arguments(),
+        *run_directory_actions(),  # ros2 launch: run directory, recorder, duration
         # 0 the trials: which object to grasp, reset between grasps
         Node(package='mindgrasp_experiments', executable='trial_manager_node', name='trial_manager',
              parameters=[*config_files('demo'),

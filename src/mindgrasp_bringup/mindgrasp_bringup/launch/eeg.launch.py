@@ -20,6 +20,7 @@ from mindgrasp_bringup.launch_api import (
     Node,
     config_files,
     number_argument,
+    run_directory_actions,
 )
 
 
@@ -45,6 +46,7 @@ def generate_launch_description() -> LaunchDescription:
                         description='virtual subject/EEG seed'),
         number_argument('duration', default_value='0.0', kind=float, minimum=0,
                         description='seconds until the nodes end by themselves (0: never)'),
+        *run_directory_actions(),  # ros2 launch: run directory, recorder, duration
         Node(package='mindgrasp_eeg', executable='virtual_amp_node', name='virtual_amp',
              condition=IfCondition(LaunchConfiguration('virtual_amp')),
              parameters=[*config_files('eeg'),

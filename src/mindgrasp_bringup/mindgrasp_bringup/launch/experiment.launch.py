@@ -29,6 +29,7 @@ from mindgrasp_bringup.launch_api import (
     config_files,
     file_argument,
     number_argument,
+    run_directory_actions,
 )
 
 
@@ -92,6 +93,7 @@ def generate_launch_description() -> LaunchDescription:
                                           'spread; mindgrasp_sim.realism), seeded by seed'),
         DeclareLaunchArgument('gui', default_value='false', choices=['true', 'false'],
                               description='open the PyBullet window (needs a display)'),
+        *run_directory_actions(),  # ros2 launch: run directory, recorder, duration
         *[Node(package='mindgrasp_experiments', executable='trial_manager_node',
                name='trial_manager', parameters=[*manager, {'wait_for': topics}],
                condition=_when(name), on_exit=Shutdown())

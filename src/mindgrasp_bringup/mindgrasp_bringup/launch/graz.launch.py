@@ -25,6 +25,7 @@ from mindgrasp_bringup.launch_api import (
     eeg_source_nodes,
     file_argument,
     number_argument,
+    run_directory_actions,
 )
 
 
@@ -44,6 +45,7 @@ def generate_launch_description() -> LaunchDescription:
                       description='classifier model for feedback:=true (.json written '
                                   'by mindgrasp train classifier); empty: the one in '
                                   'mindgrasp_classifier/param/classifier.yaml'),
+        *run_directory_actions(),  # ros2 launch: run directory, recorder, duration
         *eeg_source_nodes(config_files('eeg'), seed, 'follow'),
         GroupAction(classifier_nodes(config_files('classifier')),
                     condition=IfCondition(LaunchConfiguration('feedback'))),

@@ -24,6 +24,7 @@ from mindgrasp_bringup.launch_api import (
     classifier_nodes,
     config_files,
     file_argument,
+    run_directory_actions,
 )
 
 
@@ -48,6 +49,7 @@ def generate_launch_description() -> LaunchDescription:
                                           'arm driver or another system publishes the camera)'),
         DeclareLaunchArgument('camera_driver_args', default_value='',
                               description='command-line arguments of the camera driver'),
+        *run_directory_actions(),  # ros2 launch: run directory, recorder, duration
         Node(executable=LaunchConfiguration('arm_driver'), name='arm_driver',
              arguments=[SplitArguments(LaunchConfiguration('arm_driver_args'))]),
         Node(executable=LaunchConfiguration('camera_driver'), name='camera_driver',

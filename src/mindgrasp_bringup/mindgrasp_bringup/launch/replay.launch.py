@@ -19,6 +19,7 @@ from mindgrasp_bringup.launch_api import (
     Node,
     Shutdown,
     file_argument,
+    run_directory_actions,
 )
 
 
@@ -34,6 +35,7 @@ def generate_launch_description() -> LaunchDescription:
                                   'classifier); empty: the one the run used'),
         DeclareLaunchArgument('output', default_value='',
                               description='report directory; empty: <run>/replays/<time>'),
+        *run_directory_actions(),  # ros2 launch: run directory, recorder, duration
         Node(package='mindgrasp_bringup', executable='replay_node', name='replay',
              parameters=[{'bag': LaunchConfiguration('bag'),
                           'controller': LaunchConfiguration('controller'),

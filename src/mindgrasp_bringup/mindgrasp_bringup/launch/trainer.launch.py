@@ -22,6 +22,7 @@ from mindgrasp_bringup.launch_api import (
     eeg_source_nodes,
     file_argument,
     number_argument,
+    run_directory_actions,
     sim_scene_camera,
 )
 
@@ -45,6 +46,7 @@ def generate_launch_description() -> LaunchDescription:
                       description='classifier model (.json written by mindgrasp train '
                                   'classifier); empty: the one in '
                                   'mindgrasp_classifier/param/classifier.yaml'),
+        *run_directory_actions(),  # ros2 launch: run directory, recorder, duration
         *[Node(package='mindgrasp_sim', executable='sim_node', name='sim',
                parameters=[*config_files('sim'),
                            {'gui': LaunchConfiguration('gui'), 'seed': seed,

@@ -121,3 +121,30 @@ def live_view_nodes() -> list[Any]:
                              'port_in_use': 'any'}],
                 condition=la.IfCondition(la.LaunchConfiguration('live_view'))),
     ]
+
+
+def run_directory_actions() -> list[Any]:
+    """The run directory, the recorder and the ``duration:=`` limit as ordinary launch actions,
+    for ``ros2 launch``: the launch arguments ``record``, ``record_topics``, ``record_regex``,
+    ``duration`` and ``run_dir``, then a
+    :class:`~mindgrasp_bringup.launch_ros_extras.RunDirectory`. Put them after the profile's
+    own arguments and before its first node.
+
+    Under ``mindgrasp launch`` the list is empty: that launcher adds the same to every launch
+    file (a user's too), with the same arguments and rules (:mod:`.run_extras`).
+    """
+    if not la.using_real_launch():
+        return []
+    from mindgrasp_bringup.launch_ros_extras import RunDirectory
+    from mindgrasp_bringup.launch_system.run_extras import COMMON_ARGUMENTS
+
+    return [
+        *(la.DeclareLaunchArgument(a.name, default_value=a.default_text(),
+                                   description=a.description, choices=a.choices)
+          for a in COMMON_ARGUMENTS),
+        la.DeclareLaunchArgument('run_dir', default_value='',
+                                 description='the run directory (empty: a new '
+                                             '<UTC time>_<profile> in $MINDGRASP_RUNS_DIR or '
+                                             'runs/)'),
+        RunDirectory(),
+    ]

@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import datetime as dt
 import logging
-import math
 import os
 import re
 import sys
@@ -24,7 +23,6 @@ from mindgrasp_bringup.launch_system import rundir
 from mindgrasp_bringup.launch_system.actions.declare_launch_argument import DeclareLaunchArgument
 from mindgrasp_bringup.launch_system.actions.execute_process import ProcessSpec
 from mindgrasp_bringup.launch_system.actions.node import Node
-from mindgrasp_bringup.launch_system.conditions import evaluate_bool
 from mindgrasp_bringup.launch_system.context import LaunchContext
 from mindgrasp_bringup.launch_system.description import (
     LaunchDescription,
@@ -38,33 +36,19 @@ from mindgrasp_bringup.launch_system.output import (
     configure_launch_logger,
     remove_handlers,
 )
+from mindgrasp_bringup.launch_system.run_extras import (
+    COMMON_ARGUMENTS,
+    RECORDER_EXECUTABLE,
+    RECORDER_NAME,
+    RECORDER_PACKAGE,
+    duration_limit,
+    record_enabled,
+    recorder_parameters,
+)
 from mindgrasp_bringup.launch_system.supervisor import ProcessResult, Supervisor
 
 logger = logging.getLogger('launch')
 
-RECORDER_PACKAGE = 'mindgrasp_bringup'
-RECORDER_EXECUTABLE = 'recorder_node'
-RECORDER_NAME = 'recorder'
-
-#: arguments every launch accepts (the launcher handles them; profiles may read them too)
-COMMON_ARGUMENTS = (
-    DeclareLaunchArgument(
-        'record', default_value='true', choices=['true', 'false'],
-        description='record every topic into <run dir>/bag (rosbag2, MCAP) with the recorder '
-                    'node'),
-    DeclareLaunchArgument(
-        'record_topics', default_value='',
-        description='topic names to record, separated by spaces or commas (empty: every topic, '
-                    'or those matching record_regex)'),
-    DeclareLaunchArgument(
-        'record_regex', default_value='',
-        description='record the topics matching this regular expression (empty: no filter)'),
-    DeclareLaunchArgument(
-        'duration', default_value='0',
-        description='end the launch after this many seconds (0: run until Ctrl-C or until '
-                    'every node has ended)'),
-)
-COMMON_NAMES = tuple(a.name for a in COMMON_ARGUMENTS)
 
 
 def parse_launch_arguments(items: Sequence[str] | Mapping[str, Any]) -> dict[str, str]:
@@ -194,16 +178,8 @@ class LaunchService:
         for argument in COMMON_ARGUMENTS:
             argument.visit(context)
         self.description.visit(context)
-        record = evaluate_bool(context.launch_configurations['record'], "launch argument 'record'")
-        duration_text = context.launch_configurations['duration']
-        try:
-            duration = float(duration_text)
-        except ValueError:
-            duration = math.nan
-        if not math.isfinite(duration) or duration < 0:
-            msg = (f"launch argument 'duration' must be a number of seconds >= 0 (0: no limit), "
-                   f"got {duration_text!r}.")
-            raise LaunchError(msg)
+        record = record_enabled(context.launch_configurations)
+        duration = duration_limit(context.launch_configurations)
         processes = list(context.processes)
         if record:
             processes.insert(0, self._recorder(context))
@@ -218,18 +194,11 @@ class LaunchService:
                      for a in self.declared_arguments()
                      if a.name in context.launch_configurations}
         return LaunchPlan(name=self.name, launch_file=self.launch_file, arguments=arguments,
-                          processes=processes, record=record,
-                          duration=duration if duration > 0 else None)
+                          processes=processes, record=record, duration=duration)
 
     def _recorder(self, context: LaunchContext) -> ProcessSpec:
-        bag = '<run dir>/bag'  # set when the run directory exists
-        topics = context.launch_configurations.get('record_topics', '')
-        regex = context.launch_configurations.get('record_regex', '')
-        parameters: dict[str, Any] = {'output': bag}
-        if topics.strip():
-            parameters['topics'] = [t for t in topics.replace(',', ' ').split() if t]
-        if regex:
-            parameters['regex'] = regex
+        # the bag's path is set when the run directory exists
+        parameters = recorder_parameters(context.launch_configurations, '<run dir>/bag')
         inner = LaunchContext(launch_configurations=dict(context.launch_configurations))
         Node(package=RECORDER_PACKAGE, executable=RECORDER_EXECUTABLE, name=RECORDER_NAME,
              parameters=[parameters]).visit(inner)
