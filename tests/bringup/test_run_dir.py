@@ -2,11 +2,19 @@
 
 from __future__ import annotations
 
+import re
 from concurrent.futures import ThreadPoolExecutor
 
 import pytest
+import yaml
 
 from mindgrasp_bringup.launch_system import LaunchError, rundir
+from mindgrasp_bringup.launch_system.run_extras import (
+    RunFiles,
+    duration_limit,
+    record_enabled,
+    recorder_parameters,
+)
 
 
 def test_launches_in_the_same_second_get_their_own_directories(tmp_path, monkeypatch) -> None:
@@ -26,3 +34,52 @@ def test_an_explicit_run_dir_with_files_is_refused(tmp_path) -> None:
     empty = tmp_path / 'empty'
     empty.mkdir()
     assert rundir.create_run_dir('demo', empty) == empty.resolve()
+
+
+def test_run_files_of_another_launcher_are_complete_whenever_it_stops(tmp_path) -> None:
+    """What ros2 launch's RunDirectory action writes (mindgrasp_bringup.launch_ros_extras)."""
+    path = rundir.create_run_dir('demo', None, tmp_path)
+    files = RunFiles(path)
+    files.write_start(profile='demo', launch_file='/ws/share/demo.launch.py',
+                      launcher='ros2 launch', command_line=['ros2', 'launch', 'x'],
+                      arguments={'trials': '1', 'record': 'true'}, record=True, duration=None,
+                      logs='/home/u/.ros/log/x')
+    launch = yaml.safe_load((path / 'launch.yaml').read_text())
+    assert (launch['profile'], launch['launcher'], launch['record']) == ('demo', 'ros2 launch',
+                                                                        True)
+    assert yaml.safe_load((path / 'launch_arguments.yaml').read_text()) == {
+        'record': 'true', 'trials': '1'}
+    assert 'git' in yaml.safe_load((path / 'provenance.yaml').read_text())
+    assert not (path / 'summary.yaml').exists()
+    files.process_ended('trial_manager_node-2', 41, 0)
+    summary = yaml.safe_load((path / 'summary.yaml').read_text())
+    assert summary['processes'] == [
+        {'label': 'trial_manager_node-2', 'pid': 41, 'returncode': 0, 'clean': True}]
+    files.stopping("process[trial_manager_node-2] was required")
+    files.process_ended('recorder_node-1', 40, -2)
+    summary = yaml.safe_load((path / 'summary.yaml').read_text())
+    assert summary['stop_reason'] == 'process[trial_manager_node-2] was required'
+    assert [(p['label'], p['clean']) for p in summary['processes']] == [
+        ('trial_manager_node-2', True), ('recorder_node-1', False)]
+
+
+@pytest.mark.parametrize(('arguments', 'record', 'duration', 'parameters'), [
+    ({}, True, None, {'output': 'B'}),
+    ({'record': 'false', 'duration': '30', 'record_topics': '/a, /b /c', 'record_regex': '/x.*'},
+     False, 30.0, {'output': 'B', 'topics': ['/a', '/b', '/c'], 'regex': '/x.*'}),
+])
+def test_both_launchers_read_the_common_arguments_alike(arguments, record, duration,
+                                                         parameters) -> None:
+    assert record_enabled(arguments) is record
+    assert duration_limit(arguments) == duration
+    assert recorder_parameters(arguments, 'B') == parameters
+
+
+@pytest.mark.parametrize(('name', 'value', 'problem'), [
+    ('record', 'maybe', "'record' expects true or false, got 'maybe'"),
+    ('duration', '-1', "'duration' must be a number of seconds >= 0"),
+    ('duration', 'nan', "'duration' must be a number of seconds >= 0"),
+])
+def test_a_bad_common_argument_is_one_clear_error(name, value, problem) -> None:
+    with pytest.raises(LaunchError, match=re.escape(problem)):
+        record_enabled({name: value}) if name == 'record' else duration_limit({name: value})

@@ -5,7 +5,6 @@ Imported only through :mod:`mindgrasp_bringup.launch_api` when the real ``launch
 
 from __future__ import annotations
 
-import datetime as dt
 import sys
 from pathlib import Path
 from typing import Any
@@ -26,6 +25,7 @@ from mindgrasp_bringup.launch_system.run_extras import (
     RECORDER_EXECUTABLE,
     RECORDER_NAME,
     RECORDER_PACKAGE,
+    RunFiles,
     duration_limit,
     record_enabled,
     recorder_parameters,
@@ -97,8 +97,7 @@ class RunDirectory(Action):
 
     def __init__(self, **kwargs: Any) -> None:
         super().__init__(**kwargs)
-        self.path: Path | None = None
-        self._summary: dict[str, Any] = {}
+        self.files: RunFiles | None = None
 
     def execute(self, context: LaunchContext) -> list[Any] | None:
         configurations = context.launch_configurations
@@ -110,58 +109,28 @@ class RunDirectory(Action):
         duration = duration_limit(configurations)
         launch_file = context.get_locals_as_dict().get('current_launch_file_path')
         profile = Path(launch_file).name.removesuffix('.launch.py') if launch_file else 'launch'
-        self.path = rundir.create_run_dir(profile, configurations.get('run_dir') or None)
-        context.extend_globals({_MARK: self.path})
-        configurations['run_dir'] = str(self.path)
-        context.environment['MINDGRASP_RUN_DIR'] = str(self.path)
-        self._write_start(context, profile, launch_file, record, duration)
-        launch.logging.get_logger('launch').info(f'run directory: {self.path}')
+        path = rundir.create_run_dir(profile, configurations.get('run_dir') or None)
+        context.extend_globals({_MARK: path})
+        configurations['run_dir'] = str(path)
+        context.environment['MINDGRASP_RUN_DIR'] = str(path)
+        self.files = files = RunFiles(path)
+        # ros2 launch keeps the nodes' output in its own log directory
+        logs = getattr(launch.logging.launch_config, 'log_dir', None)
+        files.write_start(profile=profile, launch_file=launch_file, launcher='ros2 launch',
+                               command_line=sys.argv, arguments=configurations, record=record,
+                               duration=duration, logs=str(logs) if logs else None)
+        launch.logging.get_logger('launch').info(f'run directory: {path}')
         entities: list[Any] = [
-            RegisterEventHandler(OnProcessExit(on_exit=self._process_exited)),
-            RegisterEventHandler(OnShutdown(on_shutdown=self._shutting_down)),
+            RegisterEventHandler(OnProcessExit(on_exit=lambda event, _: files.process_ended(
+                event.process_name, event.pid, event.returncode))),
+            RegisterEventHandler(OnShutdown(on_shutdown=lambda event, _: files.stopping(
+                event.reason))),
         ]
         if record:
             entities.insert(0, Node(
                 package=RECORDER_PACKAGE, executable=RECORDER_EXECUTABLE, name=RECORDER_NAME,
-                parameters=[recorder_parameters(configurations, str(self.path / 'bag'))]))
+                parameters=[recorder_parameters(configurations, str(path / 'bag'))]))
         if duration is not None:
             entities.append(TimerAction(period=duration, actions=[
                 Shutdown(reason=f'duration:={duration:g} s elapsed')]))
         return entities
-
-    def _write_start(self, context: LaunchContext, profile: str, launch_file: str | None,
-                     record: bool, duration: float | None) -> None:
-        assert self.path is not None
-        rundir.write_yaml(self.path / 'launch_arguments.yaml',
-                          dict(sorted(context.launch_configurations.items())),
-                          header='launch arguments (given or default); rerun with name:=value')
-        rundir.write_yaml(self.path / 'launch.yaml', {
-            'profile': profile,
-            'launch_file': launch_file,
-            'launcher': 'ros2 launch',
-            'command_line': list(sys.argv),
-            'started_utc': dt.datetime.now(dt.timezone.utc).isoformat(timespec='seconds'),
-            'record': record,
-            'duration_s': duration,
-            # ros2 launch keeps the nodes' output in its own log directory
-            'logs': str(getattr(launch.logging.launch_config, 'log_dir', '')) or None,
-        })
-        rundir.write_yaml(self.path / 'provenance.yaml', rundir.provenance())
-        self._summary = {'ended_utc': None, 'stop_reason': None, 'processes': []}
-
-    def _write_summary(self) -> None:
-        assert self.path is not None
-        self._summary['ended_utc'] = dt.datetime.now(dt.timezone.utc).isoformat(
-            timespec='seconds')
-        rundir.write_yaml(self.path / 'summary.yaml', self._summary,
-                          header='rewritten as each process ends')
-
-    def _process_exited(self, event: Any, context: LaunchContext) -> None:
-        self._summary['processes'].append({'label': event.process_name, 'pid': event.pid,
-                                           'returncode': event.returncode,
-                                           'clean': event.returncode == 0})
-        self._write_summary()
-
-    def _shutting_down(self, event: Any, context: LaunchContext) -> None:
-        self._summary['stop_reason'] = event.reason
-        self._write_summary()

@@ -9,10 +9,13 @@ through the functions here, so ``record_topics:=...`` or ``duration:=30`` mean t
 
 from __future__ import annotations
 
+import datetime as dt
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
+from pathlib import Path
 from typing import Any
 
+from mindgrasp_bringup.launch_system import rundir
 from mindgrasp_bringup.launch_system.actions.declare_launch_argument import DeclareLaunchArgument
 from mindgrasp_bringup.launch_system.conditions import evaluate_bool
 from mindgrasp_bringup.launch_system.errors import LaunchError
@@ -71,3 +74,51 @@ def recorder_parameters(configurations: Mapping[str, str], bag: str) -> dict[str
     if regex:
         parameters['regex'] = regex
     return parameters
+
+
+def _now() -> str:
+    return dt.datetime.now(dt.timezone.utc).isoformat(timespec='seconds')
+
+
+class RunFiles:
+    """The files of a run directory whose processes another launcher runs (``ros2 launch``).
+
+    ``launch.yaml``, ``launch_arguments.yaml`` and ``provenance.yaml`` when the launch starts;
+    ``summary.yaml`` rewritten as each process ends (label, pid, exit code) and when the launch
+    shuts down (the reason), so that it is complete whenever the launch stops.
+
+    Args:
+        path: an existing run directory (:func:`rundir.create_run_dir`).
+    """
+
+    def __init__(self, path: Path) -> None:
+        self.path = path
+        self.summary: dict[str, Any] = {'ended_utc': None, 'stop_reason': None, 'processes': []}
+
+    def write_start(self, *, profile: str, launch_file: str | None, launcher: str,
+                    command_line: Sequence[str], arguments: Mapping[str, str], record: bool,
+                    duration: float | None, logs: str | None) -> None:
+        """Write what the launch is: arguments, profile, command line, provenance."""
+        rundir.write_yaml(self.path / 'launch_arguments.yaml', dict(sorted(arguments.items())),
+                          header='launch arguments (given or default); rerun with name:=value')
+        rundir.write_yaml(self.path / 'launch.yaml', {
+            'profile': profile, 'launch_file': launch_file, 'launcher': launcher,
+            'command_line': list(command_line), 'started_utc': _now(), 'record': record,
+            'duration_s': duration, 'logs': logs})
+        rundir.write_yaml(self.path / 'provenance.yaml', rundir.provenance())
+
+    def process_ended(self, label: str, pid: int | None, returncode: int | None) -> None:
+        """One process ended (``returncode`` as ``subprocess``: negative for a signal)."""
+        self.summary['processes'].append({'label': label, 'pid': pid, 'returncode': returncode,
+                                          'clean': returncode == 0})
+        self._write_summary()
+
+    def stopping(self, reason: str) -> None:
+        """The launch is shutting down (``reason`` as the launcher gives it)."""
+        self.summary['stop_reason'] = reason
+        self._write_summary()
+
+    def _write_summary(self) -> None:
+        self.summary['ended_utc'] = _now()
+        rundir.write_yaml(self.path / 'summary.yaml', self.summary,
+                          header='rewritten as each process ends')
