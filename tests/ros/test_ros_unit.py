@@ -7,6 +7,7 @@ import time
 
 import numpy as np
 import pytest
+import yaml
 from rosbags.typesys import Stores, get_typestore
 
 from mindgrasp_ros import typesupport
@@ -144,6 +145,20 @@ def test_names_and_arguments(tmp_path):
         parse_ros_args(['--ros-args', '--params-file', str(tmp_path / 'missing.yaml')])
     with pytest.raises(Exception, match='Unknown ROS argument'):
         parse_ros_args(['--ros-args', '--bogus'])
+
+
+def test_a_params_file_written_by_launch_ros_loads_and_nothing_unsafe_does(tmp_path):
+    # what launch_ros (Jazzy) writes for Node(parameters=[{'wait_for': ['/a', '/b']}]): yaml.dump
+    # of a dict whose lists it turned into tuples
+    f = tmp_path / 'launch_params_x'
+    f.write_text(yaml.dump({'/**': {'ros__parameters': {'wait_for': ('/a', '/b'), 'n': 2}}}))
+    assert '!!python/tuple' in f.read_text()
+    args = parse_ros_args(['--ros-args', '--params-file', str(f)])
+    assert args.parameters_for('fsm', '/') == {'wait_for': ['/a', '/b'], 'n': 2}
+    evil = tmp_path / 'evil.yaml'
+    evil.write_text("/**:\n  ros__parameters:\n    a: !!python/object/apply:os.system ['true']\n")
+    with pytest.raises(ParamsFileError, match='is not valid YAML'):
+        parse_ros_args(['--ros-args', '--params-file', str(evil)])
 
 
 def test_parameters_typed_and_callbacks(rclpy_ctx):

@@ -181,6 +181,16 @@ def _collect(node: Any, path: list[str], found: list[tuple[str, dict]], file: Pa
 _file_cache: dict[tuple[Path, float], list[tuple[str, dict]]] = {}
 
 
+class _ParamsFileLoader(yaml.SafeLoader):
+    """``yaml.safe_load`` plus ``!!python/tuple``, read as a list: launch_ros (Jazzy) writes a
+    node's dict parameters with ``yaml.dump``, which tags list values as tuples, and rcl's parser
+    ignores tags. Nothing else beyond safe YAML is accepted."""
+
+
+_ParamsFileLoader.add_constructor('tag:yaml.org,2002:python/tuple',
+                                  lambda loader, node: loader.construct_sequence(node))
+
+
 def _read_params_file(path: Path) -> list[tuple[str, dict]]:
     try:
         mtime = path.stat().st_mtime
@@ -190,7 +200,7 @@ def _read_params_file(path: Path) -> list[tuple[str, dict]]:
     key = (path.resolve(), mtime)
     if key not in _file_cache:
         try:
-            data = yaml.safe_load(path.read_text(encoding='utf-8'))
+            data = yaml.load(path.read_text(encoding='utf-8'), Loader=_ParamsFileLoader)
         except yaml.YAMLError as exc:
             msg = f'Parameter file {path} is not valid YAML: {exc}'
             raise ParamsFileError(msg) from None
