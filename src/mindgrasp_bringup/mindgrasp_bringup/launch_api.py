@@ -72,6 +72,7 @@ _HELPERS = {
     'live_view_arguments': 'mindgrasp_bringup.launch_system.common',
     'live_view_nodes': 'mindgrasp_bringup.launch_system.common',
     'run_directory_actions': 'mindgrasp_bringup.launch_system.common',
+    'driver_nodes': 'mindgrasp_bringup.launch_system.common',
 }
 
 __all__ = ['own_launcher', 'using_real_launch', *_SOURCES, *_HELPERS]

@@ -5,6 +5,8 @@ Imported only through :mod:`mindgrasp_bringup.launch_api` when the real ``launch
 
 from __future__ import annotations
 
+import shlex
+import shutil
 import sys
 from pathlib import Path
 from typing import Any
@@ -21,6 +23,8 @@ from launch.utilities import normalize_to_list_of_substitutions, perform_substit
 from launch_ros.actions import Node
 
 from mindgrasp_bringup.launch_system import rundir
+from mindgrasp_bringup.launch_system.actions.node import find_module
+from mindgrasp_bringup.launch_system.errors import LaunchError
 from mindgrasp_bringup.launch_system.run_extras import (
     RECORDER_EXECUTABLE,
     RECORDER_NAME,
@@ -59,7 +63,7 @@ class SplitArguments(Substitution):
 
     ``launch`` passes each item of ``arguments`` as one argument, so under ``ros2 launch`` this
     substitution holds at most one argument; several need ``mindgrasp launch`` (which splits them
-    with shell quoting) or the driver's own launch file.
+    with shell quoting), or a node built when the launch runs, as :func:`driver_node` does.
     """
 
     def __init__(self, value: SomeSubstitutionsType) -> None:
@@ -88,7 +92,8 @@ class RunDirectory(Action):
     ``$MINDGRASP_RUNS_DIR`` or ``runs/`` + ``<UTC time>_<launch file name>``), writes
     ``launch.yaml``, ``launch_arguments.yaml`` and ``provenance.yaml`` there, sets
     ``MINDGRASP_RUN_DIR`` for the nodes launched after it and the launch configuration
-    ``run_dir``, and then launches the recorder into ``<run dir>/bag`` (``record:=true``) and a
+    ``run_dir``, has the nodes log to stderr as rclpy's do (``RCUTILS_LOGGING_USE_STDOUT=0``),
+    and then launches the recorder into ``<run dir>/bag`` (``record:=true``) and a
     timer that shuts the launch down after ``duration:=`` seconds. ``summary.yaml`` gets each
     process's exit code as it ends, and the shutdown reason. Put it after the launch arguments
     and before the first node, so that the recorder starts first. A second one in the same launch
@@ -113,6 +118,10 @@ class RunDirectory(Action):
         context.extend_globals({_MARK: path})
         configurations['run_dir'] = str(path)
         context.environment['MINDGRASP_RUN_DIR'] = str(path)
+        # ros2 launch shows a node's stderr only (output='log'); rcutils logs every level to
+        # stderr, our runtime INFO to stdout unless told otherwise: the nodes' progress then
+        # reaches the screen as an rclpy node's does (a value the user set is kept)
+        context.environment.setdefault('RCUTILS_LOGGING_USE_STDOUT', '0')
         self.files = files = RunFiles(path)
         # ros2 launch keeps the nodes' output in its own log directory
         logs = getattr(launch.logging.launch_config, 'log_dir', None)
@@ -134,3 +143,52 @@ class RunDirectory(Action):
             entities.append(TimerAction(period=duration, actions=[
                 Shutdown(reason=f'duration:={duration:g} s elapsed')]))
         return entities
+
+
+def driver_executable(text: str, argument: str) -> str:
+    """The program ``ros2 launch`` runs for a driver named in a launch argument: a path, a
+    program on PATH, or ``package/executable`` (``lib/<package>/<executable>`` of the sourced
+    workspaces, as ``ros2 run``). A Python module (``pkg.module``, which ``mindgrasp launch``
+    runs with ``python -m``) is refused with the fix, as is a name found nowhere."""
+    path = Path(text).expanduser()
+    if path.is_file():
+        return str(path)
+    if text and shutil.which(text):
+        return text
+    pkg, sep, exe = text.partition('/')
+    if sep and pkg and exe and '/' not in exe:
+        from ament_index_python.packages import PackageNotFoundError, get_package_prefix
+
+        try:
+            program = Path(get_package_prefix(pkg)) / 'lib' / pkg / exe
+        except PackageNotFoundError:
+            msg = (f"{argument}:={text}: package '{pkg}' is not in the sourced workspaces; "
+                   f"source its install/setup.bash, or give the driver's path.")
+            raise LaunchError(msg) from None
+        if not program.is_file():
+            msg = f"{argument}:={text}: package '{pkg}' has no executable {program}."
+            raise LaunchError(msg)
+        return str(program)
+    if '.' in text and find_module(text):
+        msg = (f"{argument}:={text} is a Python module, which ros2 launch cannot start as a node "
+               f"executable: give package/executable or a path, or use mindgrasp launch.")
+        raise LaunchError(msg)
+    msg = (f"{argument}:={text!r} was found neither as a path, on PATH, nor as "
+           f"package/executable: install the driver, or give its path.")
+    raise LaunchError(msg)
+
+
+def driver_node(context: LaunchContext, role: str) -> list[Any]:
+    """Body of an ``OpaqueFunction``: the ``<role>_driver`` node, started from the program
+    ``<role>_driver:=`` names with ``<role>_driver_args:=`` split by shell rules (no argument at
+    all when it is empty), built when the launch runs because only then is the number of
+    arguments known."""
+    configurations = context.launch_configurations
+    executable = driver_executable(configurations.get(f'{role}_driver', ''), f'{role}_driver')
+    text = configurations.get(f'{role}_driver_args', '')
+    try:
+        arguments = shlex.split(text)
+    except ValueError as exc:
+        msg = f'{role}_driver_args:={text!r} cannot be split into arguments ({exc}): check quotes.'
+        raise LaunchError(msg) from None
+    return [Node(executable=executable, name=f'{role}_driver', arguments=arguments)]

@@ -78,7 +78,7 @@ def generate_launch_description() -> LaunchDescription:
              parameters=[*config_files('demo'),
                          {'targets': LaunchConfiguration('targets'),
                           'n_trials': LaunchConfiguration('trials'), 'seed': seed}],
-             on_exit=Shutdown()),  # trials:=N done: the demo ends
+             on_exit=Shutdown(reason='the trials are done')),
         # 1 simulator: arm, gripper, objects, RGB-D camera (the arm contract of ros2_control)
         *[Node(package='mindgrasp_sim', executable='sim_node', name='sim',
                parameters=[*config_files('sim', 'demo'),

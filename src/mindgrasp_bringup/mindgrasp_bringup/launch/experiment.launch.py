@@ -96,7 +96,7 @@ def generate_launch_description() -> LaunchDescription:
         *run_directory_actions(),  # ros2 launch: run directory, recorder, duration
         *[Node(package='mindgrasp_experiments', executable='trial_manager_node',
                name='trial_manager', parameters=[*manager, {'wait_for': topics}],
-               condition=_when(name), on_exit=Shutdown())
+               condition=_when(name), on_exit=Shutdown(reason='the trials are done'))
           for name, topics in waits.items()],
         Node(package='mindgrasp_sim', executable='sim_node', name='sim',
              parameters=[*config_files('sim', 'experiment'),

@@ -53,5 +53,5 @@ def generate_launch_description() -> LaunchDescription:
         Node(package='mindgrasp_trainer', executable='graz_node', name='graz_prompter',
              parameters=[*config_files('trainer'),
                          {'n_trials': LaunchConfiguration('trials'), 'seed': seed}],
-             on_exit=Shutdown()),
+             on_exit=Shutdown(reason='the Graz session ended')),
     ])

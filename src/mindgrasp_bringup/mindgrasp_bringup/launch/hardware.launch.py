@@ -20,9 +20,9 @@ from mindgrasp_bringup.launch_api import (
     LaunchConfigurationNotEquals,
     LaunchDescription,
     Node,
-    SplitArguments,
     classifier_nodes,
     config_files,
+    driver_nodes,
     file_argument,
     run_directory_actions,
 )
@@ -34,9 +34,10 @@ def generate_launch_description() -> LaunchDescription:
                               description='LSL stream name of the amplifier (as its streaming '
                                           'software names it)'),
         DeclareLaunchArgument('arm_driver',
-                              description='arm driver: an executable on PATH, a path, a Python '
-                                          'module (pkg.module, run with python -m) or '
-                                          'package/executable (ros2 run)'),
+                              description='arm driver: an executable on PATH, a path, '
+                                          'package/executable (as ros2 run) or, with '
+                                          'mindgrasp launch, a Python module (pkg.module, run '
+                                          'with python -m)'),
         DeclareLaunchArgument('arm_driver_args', default_value='',
                               description='command-line arguments of the arm driver (shell '
                                           'quoting)'),
@@ -50,11 +51,8 @@ def generate_launch_description() -> LaunchDescription:
         DeclareLaunchArgument('camera_driver_args', default_value='',
                               description='command-line arguments of the camera driver'),
         *run_directory_actions(),  # ros2 launch: run directory, recorder, duration
-        Node(executable=LaunchConfiguration('arm_driver'), name='arm_driver',
-             arguments=[SplitArguments(LaunchConfiguration('arm_driver_args'))]),
-        Node(executable=LaunchConfiguration('camera_driver'), name='camera_driver',
-             arguments=[SplitArguments(LaunchConfiguration('camera_driver_args'))],
-             condition=LaunchConfigurationNotEquals('camera_driver', '')),
+        *driver_nodes('arm'),
+        *driver_nodes('camera', condition=LaunchConfigurationNotEquals('camera_driver', '')),
         Node(package='mindgrasp_eeg', executable='acquisition_node', name='eeg_acquisition',
              parameters=[*config_files('eeg', 'hardware'),
                          {'stream_name': LaunchConfiguration('eeg_stream')}]),

@@ -41,5 +41,5 @@ def generate_launch_description() -> LaunchDescription:
                           'controller': LaunchConfiguration('controller'),
                           'model': LaunchConfiguration('model'),
                           'output': LaunchConfiguration('output')}],
-             on_exit=Shutdown()),
+             on_exit=Shutdown(reason='the replay ended')),
     ])

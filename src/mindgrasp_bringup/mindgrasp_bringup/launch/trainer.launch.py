@@ -63,5 +63,5 @@ def generate_launch_description() -> LaunchDescription:
         Node(package='mindgrasp_trainer', executable='trainer_node', name='trainer',
              parameters=[*config_files('trainer'),
                          {'n_trials': LaunchConfiguration('trials'), 'seed': seed}],
-             on_exit=Shutdown()),
+             on_exit=Shutdown(reason='the trainer ended')),
     ])

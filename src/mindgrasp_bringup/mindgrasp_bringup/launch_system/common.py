@@ -148,3 +148,21 @@ def run_directory_actions() -> list[Any]:
                                              'runs/)'),
         RunDirectory(),
     ]
+
+
+def driver_nodes(role: str, condition: Any = None) -> list[Any]:
+    """The ``<role>_driver`` node of a real arm or camera: the program ``<role>_driver:=`` names
+    (on PATH, a path, ``package/executable``; under ``mindgrasp launch`` also a Python module)
+    with ``<role>_driver_args:=`` split by shell rules into its arguments. Declare both launch
+    arguments in the profile."""
+    if la.using_real_launch():
+        from launch.actions import OpaqueFunction
+
+        from mindgrasp_bringup.launch_ros_extras import driver_node
+
+        return [OpaqueFunction(function=driver_node, args=[role], condition=condition)]
+    from mindgrasp_bringup.launch_system.substitutions import SplitArguments
+
+    return [la.Node(executable=la.LaunchConfiguration(f'{role}_driver'), name=f'{role}_driver',
+                    arguments=[SplitArguments(la.LaunchConfiguration(f'{role}_driver_args'))],
+                    condition=condition)]
