@@ -44,6 +44,8 @@ _SOURCES: dict[str, tuple[str, str]] = {
     'LaunchConfigurationNotEquals': ('launch.conditions', _OWN),
     'PythonLaunchDescriptionSource': ('launch.launch_description_sources', _OWN),
     'EnvironmentVariable': ('launch.substitutions', _OWN),
+    'EqualsSubstitution': ('launch.substitutions', _OWN),
+    'NotEqualsSubstitution': ('launch.substitutions', _OWN),
     'LaunchConfiguration': ('launch.substitutions', _OWN),
     'PathJoinSubstitution': ('launch.substitutions', _OWN),
     'PythonExpression': ('launch.substitutions', _OWN),

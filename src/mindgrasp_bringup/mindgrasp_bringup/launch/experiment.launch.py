@@ -19,12 +19,13 @@ the launch arguments below.
 
 from mindgrasp_bringup.launch_api import (
     DeclareLaunchArgument,
+    EqualsSubstitution,
+    GroupAction,
     IfCondition,
     LaunchConfiguration,
-    LaunchConfigurationEquals,
     LaunchDescription,
     Node,
-    PythonExpression,
+    NotEqualsSubstitution,
     Shutdown,
     config_files,
     file_argument,
@@ -33,21 +34,15 @@ from mindgrasp_bringup.launch_api import (
 )
 
 
-def _eeg(*extra: object) -> IfCondition:
-    """True for the EEG subjects (noise, virtual) when ``extra`` (more of the Python expression,
-    text and substitutions) holds too."""
-    return IfCondition(PythonExpression([
-        "'", LaunchConfiguration('subject'), "' in ('noise', 'virtual')", *extra]))
-
-
-def _when(subject: str) -> LaunchConfigurationEquals:
-    return LaunchConfigurationEquals('subject', subject)
+def _when(subject: str) -> IfCondition:
+    return IfCondition(EqualsSubstitution(LaunchConfiguration('subject'), subject))
 
 
 def generate_launch_description() -> LaunchDescription:
     seed = LaunchConfiguration('seed')
     subject = LaunchConfiguration('subject')
     stream = LaunchConfiguration('eeg_stream')
+    model = LaunchConfiguration('model')
     manager = [*config_files('experiment'),
                {'protocol': LaunchConfiguration('protocol'), 'n_trials': LaunchConfiguration(
                    'trials'), 'first_trial': LaunchConfiguration('first_trial'), 'seed': seed,
@@ -102,32 +97,29 @@ def generate_launch_description() -> LaunchDescription:
              parameters=[*config_files('sim', 'experiment'),
                          {'gui': LaunchConfiguration('gui'), 'seed': seed,
                           'realism': LaunchConfiguration('realism'), 'realism_seed': seed,
-                          'scene': PythonExpression(["'random_locations' if '",
-                                                     LaunchConfiguration('protocol'),
-                                                     "' == 'random_locations' else "
-                                                     "'set_locations'"])}]),
-        Node(package='mindgrasp_eeg', executable='virtual_amp_node', name='virtual_amp',
-             parameters=[*eeg, {'stream_name': stream, 'source_id': stream, 'seed': seed,
-                                'accuracy': LaunchConfiguration('accuracy'),
-                                'eeg_source': LaunchConfiguration('eeg_source'),
-                                'subject_mode': PythonExpression([
-                                    "'pursue' if '", subject, "' == 'virtual' else 'noise'"])}],
-             condition=_eeg()),
-        Node(package='mindgrasp_eeg', executable='acquisition_node', name='eeg_acquisition',
-             parameters=[*eeg, {'stream_name': stream, 'source_id': stream}],
-             condition=_eeg()),
-        Node(package='mindgrasp_classifier', executable='classifier_node', name='classifier',
-             parameters=classifier,
-             condition=_eeg(" and '", LaunchConfiguration('model'), "' == ''")),
-        Node(package='mindgrasp_classifier', executable='classifier_node', name='classifier',
-             parameters=[*classifier, {'model': LaunchConfiguration('model')}],
-             condition=_eeg(" and '", LaunchConfiguration('model'), "' != ''")),
+                          'scene': LaunchConfiguration('protocol')}]),  # a scene per protocol
+        # EEG subjects: the virtual amplifier (pursue: the virtual subject; noise: the unworn
+        # cap), acquisition and the classifier
+        *[GroupAction([
+            Node(package='mindgrasp_eeg', executable='virtual_amp_node', name='virtual_amp',
+                 parameters=[*eeg, {'stream_name': stream, 'source_id': stream, 'seed': seed,
+                                    'accuracy': LaunchConfiguration('accuracy'),
+                                    'eeg_source': LaunchConfiguration('eeg_source'),
+                                    'subject_mode': mode}]),
+            Node(package='mindgrasp_eeg', executable='acquisition_node', name='eeg_acquisition',
+                 parameters=[*eeg, {'stream_name': stream, 'source_id': stream}]),
+            Node(package='mindgrasp_classifier', executable='classifier_node', name='classifier',
+                 parameters=classifier, condition=IfCondition(EqualsSubstitution(model, ''))),
+            Node(package='mindgrasp_classifier', executable='classifier_node', name='classifier',
+                 parameters=[*classifier, {'model': model}],
+                 condition=IfCondition(NotEqualsSubstitution(model, ''))),
+        ], condition=_when(name)) for name, mode in (('noise', 'noise'), ('virtual', 'pursue'))],
         Node(package='mindgrasp_experiments', executable='oracle_subject_node',
              name='oracle_subject', parameters=[{'seed': seed}], condition=_when('oracle')),
         Node(package='mindgrasp_vision', executable='vision_node', name='vision',
              parameters=config_files('vision', 'experiment')),
         Node(package='mindgrasp_fsm', executable='fsm_node', name='fsm',
              parameters=[*config_files('fsm', 'experiment'),
-                         {'autonomous': PythonExpression(["'", subject, "' == 'autonomous'"])}]),
+                         {'autonomous': EqualsSubstitution(subject, 'autonomous')}]),
     ])
 

@@ -16,10 +16,11 @@ camera_driver) publishes /camera/color/image_raw (rgb8), /camera/depth/image_raw
 
 from mindgrasp_bringup.launch_api import (
     DeclareLaunchArgument,
+    IfCondition,
     LaunchConfiguration,
-    LaunchConfigurationNotEquals,
     LaunchDescription,
     Node,
+    NotEqualsSubstitution,
     classifier_nodes,
     config_files,
     driver_nodes,
@@ -52,7 +53,8 @@ def generate_launch_description() -> LaunchDescription:
                               description='command-line arguments of the camera driver'),
         *run_directory_actions(),  # ros2 launch: run directory, recorder, duration
         *driver_nodes('arm'),
-        *driver_nodes('camera', condition=LaunchConfigurationNotEquals('camera_driver', '')),
+        *driver_nodes('camera', condition=IfCondition(
+            NotEqualsSubstitution(LaunchConfiguration('camera_driver'), ''))),
         Node(package='mindgrasp_eeg', executable='acquisition_node', name='eeg_acquisition',
              parameters=[*config_files('eeg', 'hardware'),
                          {'stream_name': LaunchConfiguration('eeg_stream')}]),

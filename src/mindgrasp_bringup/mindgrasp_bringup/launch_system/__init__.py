@@ -52,7 +52,9 @@ from mindgrasp_bringup.launch_system.service import LaunchService
 from mindgrasp_bringup.launch_system.substitutions import (
     CameraSpec,
     EnvironmentVariable,
+    EqualsSubstitution,
     LaunchConfiguration,
+    NotEqualsSubstitution,
     PathJoinSubstitution,
     PythonExpression,
     SplitArguments,
@@ -61,10 +63,11 @@ from mindgrasp_bringup.launch_system.substitutions import (
 )
 
 __all__ = [
-    'Action', 'CameraSpec', 'DeclareLaunchArgument', 'EnvironmentVariable',
+    'Action', 'CameraSpec', 'DeclareLaunchArgument', 'EnvironmentVariable', 'EqualsSubstitution',
     'ExecuteProcess', 'GroupAction', 'IfCondition', 'IncludeLaunchDescription',
     'LaunchConfiguration', 'LaunchConfigurationEquals', 'LaunchConfigurationNotEquals',
     'LaunchContext', 'LaunchDescription', 'LaunchError', 'LaunchService', 'LogInfo', 'Node',
+    'NotEqualsSubstitution',
     'PathJoinSubstitution', 'ProcessSpec', 'PushRosNamespace', 'PythonExpression',
     'PythonLaunchDescriptionSource', 'SetLaunchConfiguration', 'SetParameter', 'SetRemap',
     'Shutdown', 'SplitArguments', 'TextSubstitution',

@@ -9,16 +9,27 @@ from typing import Any
 from mindgrasp_bringup import launch_api as la
 
 
+def _if_equal(argument: str, value: str) -> Any:
+    """``IfCondition(EqualsSubstitution(LaunchConfiguration(argument), value))`` (what Jazzy's
+    launch recommends instead of the deprecated LaunchConfigurationEquals)."""
+    return la.IfCondition(la.EqualsSubstitution(la.LaunchConfiguration(argument), value))
+
+
+def _if_differs(argument: str, value: str) -> Any:
+    """``IfCondition(NotEqualsSubstitution(LaunchConfiguration(argument), value))``."""
+    return la.IfCondition(la.NotEqualsSubstitution(la.LaunchConfiguration(argument), value))
+
+
 def classifier_nodes(files: list[Path], model_argument: str = 'model') -> list[Any]:
     """The classifier node (name ``classifier``), with ``model:=<file>`` when that launch argument
     is not empty, else the model of its parameter files. Declare the argument in the profile."""
     return [
         la.Node(package='mindgrasp_classifier', executable='classifier_node', name='classifier',
                 parameters=list(files),
-                condition=la.LaunchConfigurationEquals(model_argument, '')),
+                condition=_if_equal(model_argument, '')),
         la.Node(package='mindgrasp_classifier', executable='classifier_node', name='classifier',
                 parameters=[*files, {'model': la.LaunchConfiguration(model_argument)}],
-                condition=la.LaunchConfigurationNotEquals(model_argument, '')),
+                condition=_if_differs(model_argument, '')),
     ]
 
 
@@ -42,7 +53,7 @@ def eeg_source_nodes(files: list[Path], seed: object, subject_mode: object) -> l
         la.Node(package='mindgrasp_eeg', executable='virtual_amp_node', name='virtual_amp',
                 parameters=[*files, {'stream_name': stream, 'seed': seed,
                                      'subject_mode': subject_mode}],
-                condition=la.LaunchConfigurationEquals('amp', 'virtual')),
+                condition=_if_equal('amp', 'virtual')),
         la.Node(package='mindgrasp_eeg', executable='acquisition_node', name='eeg_acquisition',
                 parameters=[*files, {'stream_name': stream}]),
     ]
@@ -81,7 +92,7 @@ def display_nodes(files: list[Path], n_trials: object = 0) -> list[Any]:
         la.Node(package='mindgrasp_trainer', executable='display_node', name='participant_display',
              parameters=[*files, {**common, 'headless': mode == 'headless',
                                   'fullscreen': mode == 'fullscreen'}],
-             condition=la.LaunchConfigurationEquals('display', mode))
+             condition=_if_equal('display', mode))
         for mode in DISPLAY_MODES[1:]
     ]
 
@@ -93,8 +104,8 @@ def sim_scene_camera(display_rate: float = 3.0) -> list[tuple[object, dict]]:
     3 Hz: a 320x240 view with the training robot takes two TinyRenderer passes (about 30 ms on
     an idle core, several times that on a loaded machine; benchmarks/display.py), which the
     simulator pays inside its real-time loop; the training robot moves slowly enough for 3 Hz."""
-    return [(la.LaunchConfigurationEquals('display', 'off'), {'scene_camera_rate': 0.0}),
-            (la.LaunchConfigurationNotEquals('display', 'off'),
+    return [(_if_equal('display', 'off'), {'scene_camera_rate': 0.0}),
+            (_if_differs('display', 'off'),
              {'scene_camera_rate': display_rate})]
 
 

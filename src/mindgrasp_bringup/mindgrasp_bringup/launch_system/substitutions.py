@@ -131,6 +131,42 @@ class PythonExpression(Substitution):
         return str(value).lower() if isinstance(value, bool) else str(value)
 
 
+def _equal_texts(left: str, right: str) -> bool:
+    """launch's comparison: as booleans when both are 'true'/'false'/'1'/'0', as numbers when
+    both are numbers, else as text."""
+    booleans = ('true', 'false', '1', '0')
+    if left.lower() in booleans and right.lower() in booleans:
+        return (left.lower() in ('true', '1')) == (right.lower() in ('true', '1'))
+    try:
+        return math.isclose(float(left), float(right))
+    except ValueError:
+        return left == right
+
+
+class EqualsSubstitution(Substitution):
+    """``'true'`` when both sides resolve to equal values (``launch``'s rules: booleans, then
+    numbers, then text), else ``'false'``; e.g. ``IfCondition(EqualsSubstitution(
+    LaunchConfiguration('amp'), 'virtual'))``."""
+
+    def __init__(self, left: SomeSubstitutions | None, right: SomeSubstitutions | None) -> None:
+        self.left = '' if left is None else left
+        self.right = '' if right is None else right
+
+    def _equal(self, context: LaunchContext) -> bool:
+        return _equal_texts(perform_substitutions(context, self.left),
+                            perform_substitutions(context, self.right))
+
+    def perform(self, context: LaunchContext) -> str:
+        return str(self._equal(context)).lower()
+
+
+class NotEqualsSubstitution(EqualsSubstitution):
+    """``'true'`` when the two sides differ (the negation of :class:`EqualsSubstitution`)."""
+
+    def perform(self, context: LaunchContext) -> str:
+        return str(not self._equal(context)).lower()
+
+
 class CameraSpec(Substitution):
     """One field (``'width'``, ``'height'`` or ``'rate'``) of a ``WIDTHxHEIGHT@HZ`` text, e.g.
     ``CameraSpec(LaunchConfiguration('camera'), 'width')``: parsed, never evaluated."""
