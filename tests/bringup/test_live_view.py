@@ -159,20 +159,56 @@ def test_bad_whitelist_regex_exits_2(spawn_node) -> None:
     assert 'is not a regular expression' in proc.output()
 
 
-def test_committed_layout_is_the_generated_one_and_shows_demo_topics() -> None:
-    from mindgrasp_bringup.live_layout import LAYOUT_FILE, TOPICS, build_layout
+def test_committed_layouts_are_the_generated_ones_and_show_demo_topics() -> None:
+    from mindgrasp_bringup.live_layout import (
+        LAYOUT_FILE,
+        STUDIO_LAYOUT_FILE,
+        TOPICS,
+        build_layout,
+        studio_layout,
+    )
     from mindgrasp_common.resources import resource_path
 
     # shipped as package data (and to share/mindgrasp_bringup/ by colcon)
     assert resource_path('mindgrasp_bringup', 'foxglove/mindgrasp_live.json') == LAYOUT_FILE
     text = LAYOUT_FILE.read_text(encoding='utf-8')
     assert text.strip() == build_layout(), 'run python -m mindgrasp_bringup.live_layout'
+    studio_text = STUDIO_LAYOUT_FILE.read_text(encoding='utf-8')
+    assert studio_text.strip() == studio_layout(text), 'run python -m mindgrasp_bringup.live_layout'
     layout = json.loads(text)
     assert layout['version'] == 1
-    used = set(re.findall(r'"(/[a-z_/]+)', text))
-    assert used <= set(TOPICS), used - set(TOPICS)
-    assert {'/vision/overlay', '/robot_description', '/eeg/raw', '/bci/prediction',
-            '/fsm/state'} <= used
+    for shown in (text, studio_text):
+        used = set(re.findall(r'"(/[a-z_/]+)', shown))
+        assert used <= set(TOPICS), used - set(TOPICS)
+        assert {'/vision/overlay', '/robot_description', '/eeg/raw', '/bci/prediction',
+                '/fsm/state'} <= used
+
+
+def test_studio_layout_has_what_lichtblick_requires_and_every_panel() -> None:
+    """Lichtblick's import refuses a layout without configById, globalVariables and
+    playbackConfig; its mosaic tree names each panel of configById once."""
+    from mindgrasp_bringup.live_layout import build_layout, studio_layout
+
+    sdk = json.loads(build_layout())
+    studio = json.loads(studio_layout(build_layout()))
+    assert {'configById', 'globalVariables', 'playbackConfig', 'userNodes', 'layout'} <= set(
+        studio)
+
+    def leaves(node):
+        return [node] if isinstance(node, str) else leaves(node['first']) + leaves(
+            node['second'])
+
+    def panels(node):
+        return [node] if node['type'] == 'panel' else [
+            p for item in node['items'] for p in panels(item['content'])]
+
+    assert leaves(studio['layout']) == list(studio['configById'])
+    sdk_panels = panels(sdk['content'])
+    assert [i.split('!')[0] for i in studio['configById']] == [
+        {'ThreeDee': '3D'}.get(p['panelType'], p['panelType']) for p in sdk_panels]
+    assert [c['lichtblickPanelTitle'] for c in studio['configById'].values()] == [
+        p['title'] for p in sdk_panels]
+    assert all(s['enabled'] for c in studio['configById'].values() for s in c.get('paths', []))
 
 
 def _subscribe_and_receive(ws, topic: str, node, rclpy, timeout: float = 60.0):
