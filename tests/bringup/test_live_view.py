@@ -28,13 +28,15 @@ def _start_bridge(spawn_node, **params):
     return proc, port
 
 
-def test_client_receives_camera_eeg_and_state_with_their_schemas(rclpy_ctx, spawn_node) -> None:
+@pytest.mark.parametrize('poll_period', [0.04, 0.0])  # in bursts (default); each as it comes
+def test_client_receives_camera_eeg_and_state_with_their_schemas(rclpy_ctx, spawn_node,
+                                                                  poll_period) -> None:
     from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import EEGChunk, FsmState
     from mindgrasp_ros.interfaces.sensor_msgs.msg import Image
     from mindgrasp_ros.interfaces.std_msgs.msg import String
 
     rclpy = rclpy_ctx
-    proc, port = _start_bridge(spawn_node)
+    proc, port = _start_bridge(spawn_node, poll_period=poll_period)
     node = rclpy.create_node('live_view_probe')
     latched = rclpy.qos.QoSProfile(depth=1, reliability=rclpy.qos.ReliabilityPolicy.RELIABLE,
                                    durability=rclpy.qos.DurabilityPolicy.TRANSIENT_LOCAL)

@@ -233,6 +233,26 @@ def test_in_process_delivery_skips_serialisation(rclpy_ctx, monkeypatch):
     executor.shutdown()
 
 
+def test_a_polled_subscription_is_read_by_its_owner_not_by_the_executor(rclpy_ctx):
+    rclpy = rclpy_ctx
+    from mindgrasp_ros.interfaces.std_msgs.msg import String
+
+    a, b = rclpy.node.Node('writer'), rclpy.node.Node('poller')
+    calls = []
+    sub = b.create_subscription(String, '/polled', calls.append, 10, raw=True, polled=True)
+    pub = a.create_publisher(String, '/polled', 10)
+    executor = rclpy.executors.SingleThreadedExecutor()
+    executor.add_node(b)
+    for i in range(3):
+        pub.publish(String(data=f'm{i}'))
+    for _ in range(5):
+        executor.spin_once(timeout_sec=0.05)
+    assert calls == []  # the executor never takes it
+    got = [typesupport.deserialize(data, 'std_msgs/msg/String').data for data, _ in sub.take()]
+    assert got == ['m0', 'm1', 'm2'] and sub.take() == []
+    executor.shutdown()
+
+
 def test_malformed_sample_is_dropped_with_a_warning(rclpy_ctx, capfd):
     rclpy = rclpy_ctx
     from mindgrasp_ros.interfaces.std_msgs.msg import String

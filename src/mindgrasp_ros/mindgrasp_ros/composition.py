@@ -253,7 +253,7 @@ class LockstepRunner:
                 continue
             node.has_work = False
             for sub in node.subscriptions:
-                if sub._queue:
+                if sub._queue and not sub.polled:
                     work.extend((sub, item) for item in sub.take())
             for srv in node.services:
                 if srv._local:

@@ -166,8 +166,11 @@ class Subscription(Entity):
 
     def __init__(self, node: Node, msg_type: type | None, topic: str, callback: Callable,
                  qos: QoSProfile, callback_group: CallbackGroup | None, *, raw: bool = False,
-                 type_name: str | None = None) -> None:
+                 type_name: str | None = None, polled: bool = False) -> None:
         super().__init__(node, callback_group)
+        #: executors leave it alone: its owner reads it with :meth:`take` (see
+        #: ``Node.create_subscription``)
+        self.polled = polled
         self.msg_type = msg_type
         self.type_name = type_name or type_name_of(msg_type)
         self.topic_name = topic
@@ -209,7 +212,9 @@ class Subscription(Entity):
 
     def take(self, dds: bool = True) -> list[tuple[Any, MessageInfo]]:
         """Everything that has arrived: (message or bytes, info) pairs, oldest first (``dds``
-        False: only the in-process deliveries, the executor saw no DDS data)."""
+        False: only the in-process deliveries, the executor saw no DDS data). Executors call it;
+        so does the owner of a ``polled`` subscription, as ``rclcpp::Subscription::take``.
+        ``info['source_timestamp']``: the publisher's write time, ns (DDS samples only)."""
         out: list[tuple[Any, MessageInfo]] = []
         while self._queue:
             delivery = self._queue.popleft()
@@ -299,11 +304,8 @@ class Timer(Entity):
         self._next_ns = clock.now().nanoseconds + self.timer_period_ns
         self._last_ns = clock.now().nanoseconds
 
-    @property
     def is_canceled(self) -> bool:
-        return self._canceled
-
-    def is_canceled_fn(self) -> bool:
+        """Whether the timer is canceled (a method, as rclpy's)."""
         return self._canceled
 
     def cancel(self) -> None:

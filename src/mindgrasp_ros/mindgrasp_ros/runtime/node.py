@@ -248,12 +248,18 @@ class Node:
                             callback_group: CallbackGroup | None = None,
                             event_callbacks: object = None,
                             qos_overriding_options: object = None,
-                            raw: bool = False) -> Subscription:
-        """Subscription; ``raw=True`` hands the callback CDR bytes (with the 4-byte header)."""
+                            raw: bool = False, polled: bool = False) -> Subscription:
+        """Subscription; ``raw=True`` hands the callback CDR bytes (with the 4-byte header).
+
+        ``polled=True`` (this runtime only, not rclpy): no executor waits for it or calls
+        ``callback``; the node reads what has arrived with ``subscription.take()``, e.g. from a
+        timer. A node that forwards many topics (the live view) then wakes once per period
+        instead of once per message, at a fraction of the CPU.
+        """
         cls, name = self._resolve_type(msg_type)
         resolved = self.resolve_topic_name(topic)
         sub = Subscription(self, cls, resolved, callback, as_profile(qos_profile),
-                           callback_group, raw=raw, type_name=name)
+                           callback_group, raw=raw, type_name=name, polled=polled)
         return self._add(self.subscriptions, sub)
 
     def create_timer(self, timer_period_sec: float, callback: Callable | None,
