@@ -2,6 +2,7 @@
 
     .venv/bin/python benchmarks/live_view.py                 # 30 s per phase
     .venv/bin/python benchmarks/live_view.py --seconds 60
+    .venv/bin/python benchmarks/live_view.py --poll-period 0     # a wake per message
 
 Runs ``mindgrasp launch demo trials:=0`` (every node its own process, no recording) with the live
 view on a free port, then measures the CPU time of every process of the launch with psutil:
@@ -116,15 +117,24 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split('\n')[0])
     parser.add_argument('--seconds', type=float, default=30.0, help='measurement per phase (s)')
     parser.add_argument('--warmup', type=float, default=25.0, help='start-up before measuring')
+    parser.add_argument('--poll-period', type=float, default=None,
+                        help="the bridge's poll_period (s; 0: each message as it arrives); "
+                             "default: the node's")
     args = parser.parse_args()
     port = _free_port()
     run_dir = Path(tempfile.mkdtemp(prefix='mg-live-view-'))
+    env = dict(os.environ)
+    if args.poll_period is not None:  # a parameter file for the bridge, as `mindgrasp session`
+        params = run_dir.with_name(run_dir.name + '-bridge.yaml')
+        params.write_text(f'/foxglove_bridge:\n  ros__parameters:\n'
+                          f'    poll_period: {args.poll_period}\n', encoding='utf-8')
+        env['MINDGRASP_PARAMS_FILES'] = str(params)
     stream = f'mg-live-view-bench-{uuid.uuid4().hex[:8]}'  # LSL names are host-wide
     cmd = [sys.executable, '-m', 'mindgrasp_bringup', 'launch', 'demo', 'trials:=0',
            'record:=false', f'live_view_port:={port}', f'eeg_stream:={stream}',
            f'duration:={args.warmup + 3 * args.seconds + 40}', '--run-dir', str(run_dir)]
     launcher = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-                                start_new_session=True, env=dict(os.environ))
+                                start_new_session=True, env=env)
     try:
         time.sleep(args.warmup)
         root = psutil.Process(launcher.pid)

@@ -128,7 +128,9 @@ def live_view_nodes() -> list[Any]:
     return [
         la.Node(package='mindgrasp_bringup', executable='foxglove_bridge_node',
                 name='foxglove_bridge',
-                parameters=[{'port': la.LaunchConfiguration('live_view_port'),
+                # no parameter file of its own; $MINDGRASP_PARAMS_FILES reach it like any node
+                parameters=[*la.config_files('live_view'),
+                            {'port': la.LaunchConfiguration('live_view_port'),
                              'port_in_use': 'any'}],
                 condition=la.IfCondition(la.LaunchConfiguration('live_view'))),
     ]
