@@ -13,9 +13,9 @@ that has a publisher and matches a ``topic_whitelist`` regex is advertised with 
 the node subscribes to it (raw CDR, with the publishers' QoS: transient local for
 /robot_description and /tf_static, best effort for the camera) only while a client watches it, so
 an unwatched live view costs the graph nothing. The watched topics are read every
-``poll_period`` (40 ms) and sent on in one burst, which costs a third of waking for each message
-(benchmarks/live_view.py); with the real rclpy, or ``poll_period:=0``, each message is sent on as
-it arrives. A slow client loses its oldest messages beyond
+``poll_period`` (40 ms) and sent on in one burst, which costs a half to a third of the CPU of
+waking for each message (benchmarks/live_view.py); with the real rclpy, or ``poll_period:=0``,
+each message is sent on as it arrives. A slow client loses its oldest messages beyond
 ``message_backlog_size``, and the node warns about it; the graph never waits for it. Listens on
 loopback only unless ``address`` says otherwise. A port in use ends the node with exit code 2 and
 one line naming the fix; with ``port_in_use:=any`` (the launch profiles) it serves on a free port
@@ -61,7 +61,7 @@ class BridgeParams:
     duration: float = param(0.0, 'end after this long (0: run until stopped)', unit='s', min=0.0)
     poll_period: float = param(
         0.04, 'how often the watched topics are read and sent on, in one burst (0: each message '
-        'as it arrives, at about three times the CPU)', unit='s', min=0.0)
+        'as it arrives, at two to three times the CPU)', unit='s', min=0.0)
 
     def __post_init__(self) -> None:
         for pattern in self.topic_whitelist:

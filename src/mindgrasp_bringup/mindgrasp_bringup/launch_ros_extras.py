@@ -126,8 +126,8 @@ class RunDirectory(Action):
         # ros2 launch keeps the nodes' output in its own log directory
         logs = getattr(launch.logging.launch_config, 'log_dir', None)
         files.write_start(profile=profile, launch_file=launch_file, launcher='ros2 launch',
-                               command_line=sys.argv, arguments=configurations, record=record,
-                               duration=duration, logs=str(logs) if logs else None)
+                          command_line=sys.argv, arguments=configurations, record=record,
+                          duration=duration, logs=str(logs) if logs else None)
         launch.logging.get_logger('launch').info(f'run directory: {path}')
         entities: list[Any] = [
             RegisterEventHandler(OnProcessExit(on_exit=lambda event, _: files.process_ended(
