@@ -6,9 +6,10 @@ Two files of the same layout (in mindgrasp_bringup's ``foxglove/``;
 ``share/mindgrasp_bringup/foxglove/`` of a colcon install), for Layouts > Import from file:
 
 - ``mindgrasp_live.json``: Foxglove's layout format, as the SDK writes it (the Foxglove app);
-- ``mindgrasp_live_lichtblick.json``: the format of Lichtblick and of the open-source Foxglove
-  Studio (<= 1.87), which refuse the SDK's ("missing configById, globalVariables,
-  playbackConfig"). The SDK writes no such file, so :func:`studio_layout` converts its tree.
+- ``mindgrasp_live_lichtblick.json``: the format Lichtblick imports (that of the open-source
+  Foxglove Studio it was forked from); Lichtblick refuses the SDK's ("missing configById,
+  globalVariables, playbackConfig"). The SDK writes no such file, so :func:`studio_layout`
+  converts its tree.
 
 Panels: the eye-in-hand camera with the vision overlay, the 3D scene (URDF from
 /robot_description moved by /tf, the objects from /sim/objects), the EEG (first sample of the
