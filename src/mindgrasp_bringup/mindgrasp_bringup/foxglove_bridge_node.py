@@ -103,9 +103,9 @@ class FoxgloveBridgeNode(rclpy.node.Node):
         self.create_timer(self.params.discovery_period, self.discover_callback)
         # polled subscriptions are this runtime's (rclpy has no take); the timer runs only while
         # a client watches something
-        self._polling = self.params.poll_period > 0 and not using_real_rclpy()
+        polling = self.params.poll_period > 0 and not using_real_rclpy()
         self._poll_timer = (self.create_timer(self.params.poll_period, self.poll_callback,
-                                              autostart=False) if self._polling else None)
+                                              autostart=False) if polling else None)
         end_after(self, self.params.duration)
         self.discover_callback()
 
@@ -173,19 +173,17 @@ class FoxgloveBridgeNode(rclpy.node.Node):
         def forward(data: bytes, topic: str = topic) -> None:
             self.server.log(topic, data, time.time_ns())
 
-        if self._poll_timer is None:
-            self._subscriptions[topic] = self.create_subscription(
-                message_class(self._types[topic]), topic, forward, qos_profile(rclpy, qos),
-                raw=True)
-            return
-        if qos['durability'] != 'transient_local':
-            # a period's worth of a fast topic (a 500 Hz arm driver) fits the reader's history
-            qos = {**qos, 'depth': max(int(qos['depth']), 64)}
+        polled: dict[str, bool] = {}
+        if self._poll_timer is not None:
+            polled = {'polled': True}
+            if qos['durability'] != 'transient_local':
+                # a period's worth of a fast topic (a 500 Hz arm driver) fits the reader's history
+                qos = {**qos, 'depth': max(int(qos['depth']), 64)}
+            if self._poll_timer.is_canceled():
+                self._poll_timer.reset()
         self._subscriptions[topic] = self.create_subscription(
             message_class(self._types[topic]), topic, forward, qos_profile(rclpy, qos), raw=True,
-            polled=True)
-        if self._poll_timer.is_canceled():
-            self._poll_timer.reset()
+            **polled)
 
     def poll_callback(self) -> None:
         """Send on what arrived on each watched topic since the last period, logged at the time

@@ -100,10 +100,6 @@ class RunDirectory(Action):
     (an included profile) reuses the first one's directory and recorder.
     """
 
-    def __init__(self, **kwargs: Any) -> None:
-        super().__init__(**kwargs)
-        self.files: RunFiles | None = None
-
     def execute(self, context: LaunchContext) -> list[Any] | None:
         configurations = context.launch_configurations
         if context.get_locals_as_dict().get(_MARK) is not None:
@@ -122,7 +118,7 @@ class RunDirectory(Action):
         # stderr, our runtime INFO to stdout unless told otherwise: the nodes' progress then
         # reaches the screen as an rclpy node's does (a value the user set is kept)
         context.environment.setdefault('RCUTILS_LOGGING_USE_STDOUT', '0')
-        self.files = files = RunFiles(path)
+        files = RunFiles(path)
         # ros2 launch keeps the nodes' output in its own log directory
         logs = getattr(launch.logging.launch_config, 'log_dir', None)
         files.write_start(profile=profile, launch_file=launch_file, launcher='ros2 launch',

@@ -40,6 +40,9 @@ REPLY_READER_WAIT_S = 5.0
 class Entity:
     """Something an executor can run: it has a callback group and may be busy."""
 
+    #: read by its owner, never by executors (only a subscription can be; see Subscription)
+    polled = False
+
     def __init__(self, node: Node, callback_group: CallbackGroup | None) -> None:
         self.node = node
         self.callback_group = callback_group or node.default_callback_group

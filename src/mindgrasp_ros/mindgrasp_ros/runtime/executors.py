@@ -175,7 +175,7 @@ class Executor:
         for node in self._nodes:
             for entity in (*node.subscriptions, *node.services, *node.clients):
                 reader = getattr(entity, '_reader', None)
-                if reader is not None and not getattr(entity, 'polled', False):
+                if reader is not None and not entity.polled:
                     wanted[id(reader)] = reader
         for key in list(self._conditions):
             if key not in wanted:
@@ -268,7 +268,7 @@ class Executor:
                     timer._mark_called()
                     work.append((timer, None))
             for entity in (*node.subscriptions, *node.services, *node.clients):
-                if entity._busy or getattr(entity, 'polled', False):
+                if entity._busy or entity.polled:
                     continue
                 dds = ready is None or id(entity._reader) in ready
                 if isinstance(entity, Client):
