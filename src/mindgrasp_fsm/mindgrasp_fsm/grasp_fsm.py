@@ -62,14 +62,16 @@ def clamp_to_limits(q: np.ndarray, v: np.ndarray, params: FsmParams) -> np.ndarr
     """Joint velocities (6,) limited to ``max_joint_velocity`` and so that one control period
     cannot carry a joint past ``limit -/+ joint_limit_margin``; moving away from a limit is
     allowed."""
-    v = np.clip(np.asarray(v, dtype=float), -np.asarray(params.max_joint_velocity),
-                np.asarray(params.max_joint_velocity))
+    # np.minimum(np.maximum()) is np.clip's arithmetic without its wrapper (this runs at the
+    # control rate)
+    v_max = np.asarray(params.max_joint_velocity)
+    v = np.minimum(np.maximum(np.asarray(v, dtype=float), -v_max), v_max)
     lo = np.asarray(params.joint_lower_limits) + params.joint_limit_margin
     hi = np.asarray(params.joint_upper_limits) - params.joint_limit_margin
     dt = params.control_period
     up_room = np.maximum(hi - q, 0.0) / dt
     down_room = np.maximum(q - lo, 0.0) / dt
-    return np.clip(v, -down_room, up_room)
+    return np.minimum(np.maximum(v, -down_room), up_room)
 
 
 class GraspFsm:
@@ -261,7 +263,7 @@ class GraspFsm:
         pos = np.asarray(joints.position, dtype=float)
         if pos.shape != (6,):
             return f'stopped: joint states hold {pos.size} positions, 6 expected'
-        if not np.all(np.isfinite(pos)) or not np.all(np.isfinite(np.asarray(joints.velocity))):
+        if not np.isfinite(pos).all() or not np.isfinite(np.asarray(joints.velocity)).all():
             return 'stopped: joint states contain NaN or infinite values; check the arm driver'
         if not p.autonomous:
             pred = inputs.prediction

@@ -326,7 +326,7 @@ class SimNode(rclpy.node.Node):
                 v = io.gate.current(now)
                 # the gate hands out a new array only for a new command (or the timeout)
                 if v is not io.applied:
-                    if not np.array_equal(v, io.applied):
+                    if (v != io.applied).any():     # cheaper than np.array_equal
                         sim.set_joint_velocities(v, robot=io.name)
                     io.applied = v
             sim.step()
@@ -514,9 +514,12 @@ class SimNode(rclpy.node.Node):
             if io.name == 'user' and self.total_steps >= self._next_tf_step:
                 # the tree robot_state_publisher makes of these joint states
                 self._next_tf_step = self.total_steps + self.tf_every - 1e-6
-                positions = dict(zip(sim.joint_names, q, strict=True))
-                positions.update(zip(sim.finger_names, state['positions'], strict=True))
-                self.tf_pub.publish(msgs.tf_message(hdr.stamp, self.tf_tree.transforms(positions)))
+                # nobody listening (lock-step experiments): no tree to build
+                if self.tf_pub.get_subscription_count():
+                    positions = dict(zip(sim.joint_names, q, strict=True))
+                    positions.update(zip(sim.finger_names, state['positions'], strict=True))
+                    self.tf_pub.publish(msgs.tf_message(hdr.stamp,
+                                                        self.tf_tree.transforms(positions)))
 
     def publish_camera(self) -> None:
         """Colour and depth images of the user's eye-in-hand camera, with camera_info."""

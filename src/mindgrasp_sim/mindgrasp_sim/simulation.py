@@ -148,11 +148,24 @@ class CameraConfig:
 class _Robot:
     body: int
     q_ref: np.ndarray
-    v_cmd: np.ndarray
     closure: float = 0.0
     gripper_dirty: bool = True
     holding: bool = False     # zero command already given to the motors: nothing to update
-    v_applied: np.ndarray = field(default_factory=lambda: np.zeros(6))  # after the lag, rad/s
+    # the velocity command and the velocity the motors follow after the lag (6,) rad/s, set
+    # through command() and apply(), which note whether they are non-zero: the physics loop asks
+    # at every step, and ndarray.any() there cost more than the rest of an idle step
+    v_cmd: np.ndarray = field(default_factory=lambda: np.zeros(6))
+    v_applied: np.ndarray = field(default_factory=lambda: np.zeros(6))
+    cmd_moving: bool = False
+    applied_moving: bool = False
+
+    def command(self, v: np.ndarray) -> None:
+        self.v_cmd = v
+        self.cmd_moving = bool(v.any())
+
+    def apply(self, v: np.ndarray) -> None:
+        self.v_applied = v
+        self.applied_moving = bool(v.any())
 
 
 class Simulation:
@@ -344,7 +357,7 @@ class Simulation:
                 p.changeDynamics(body, link, linearDamping=0.0, angularDamping=0.0,
                                  jointDamping=0.05)
         # velocity motors off: joints are driven by the PD reference in step()
-        return _Robot(body=body, q_ref=np.array(HOME_POSE, dtype=float), v_cmd=np.zeros(6))
+        return _Robot(body=body, q_ref=np.array(HOME_POSE, dtype=float))
 
     def _spawn(self, spec: ObjectSpec) -> int:
         p = self._p
@@ -419,8 +432,8 @@ class Simulation:
             for j in self._finger_idx:
                 p.resetJointState(robot.body, j, FINGER_OPEN, 0.0)
             robot.q_ref = self.home_pose.copy()
-            robot.v_cmd = np.zeros(6)
-            robot.v_applied = np.zeros(6)
+            robot.command(np.zeros(6))
+            robot.apply(np.zeros(6))
             robot.closure = 0.0
             robot.gripper_dirty = True
             robot.holding = False
@@ -463,12 +476,12 @@ class Simulation:
         """
         v = validate_velocities(velocities, 6)
         r = self._robot(robot)
-        r.v_cmd = np.clip(v, -self.max_velocity, self.max_velocity)
+        r.command(np.clip(v, -self.max_velocity, self.max_velocity))
         r.holding = False
 
     def stop(self, robot: str = 'user') -> None:
         """Zero velocity command (the arm holds its current reference)."""
-        self._robot(robot).v_cmd = np.zeros(6)
+        self._robot(robot).command(np.zeros(6))
 
     def set_gripper(self, closure: float, robot: str = 'user') -> None:
         """Gripper target: 0 open .. 1 closed; fingers close with limited torque (they stop on
@@ -488,8 +501,8 @@ class Simulation:
         for i, j in enumerate(self._arm_idx):
             self._p.resetJointState(r.body, j, q[i], 0.0)
         r.q_ref = q.copy()
-        r.v_cmd = np.zeros(6)
-        r.v_applied = np.zeros(6)
+        r.command(np.zeros(6))
+        r.apply(np.zeros(6))
         r.holding = False
 
     def step(self, n: int = 1) -> None:
@@ -500,15 +513,16 @@ class Simulation:
         for _ in range(int(n)):
             for name, r in self._robots.items():
                 lagging = lag and name == 'user'     # the training robot is a drawn prompt
-                if lagging and (r.v_cmd.any() or r.v_applied.any()):
+                if lagging and (r.cmd_moving or r.applied_moving):
                     # a real velocity controller follows the command with a lag
-                    r.v_applied = self.realism.lagged_velocity(r.v_applied, r.v_cmd, dt)
-                    if not r.v_cmd.any() and np.max(np.abs(r.v_applied)) < 1e-4:
-                        r.v_applied = np.zeros(6)
+                    v = self.realism.lagged_velocity(r.v_applied, r.v_cmd, dt)
+                    if not r.cmd_moving and np.max(np.abs(v)) < 1e-4:
+                        v = np.zeros(6)
+                    r.apply(v)
                     r.holding = False
-                elif not lagging:
-                    r.v_applied = r.v_cmd
-                if r.v_applied.any():
+                elif not lagging and r.v_applied is not r.v_cmd:
+                    r.v_applied, r.applied_moving = r.v_cmd, r.cmd_moving
+                if r.applied_moving:
                     self._track(p, r, dt)
                 elif not r.holding:
                     # stopping: hold the current reference (set once, then left alone)
