@@ -153,3 +153,16 @@ def test_640x480_frame_gives_the_same_objects():
     dets = ColourDetector(intrinsics=CameraModel.from_k(width, height, k)).detect(rgb, depth)
     assert [d.colour for d in sorted(dets, key=lambda d: d.centre[0])] == ['blue', 'red', 'yellow']
     assert all(d.pixel_count > 500 and 0.4 < d.distance < 0.8 for d in dets)
+
+
+@pytest.mark.parametrize('dtype', [np.float32, np.float64])
+def test_median_is_numpys_to_the_last_bit(dtype) -> None:
+    from mindgrasp_vision.detector import _median
+
+    rng = np.random.default_rng(7)
+    for _ in range(2000):
+        n = int(rng.integers(1, 300))
+        values = (rng.random(n) * rng.choice([1e-3, 1.0, 3.0])).astype(dtype)
+        if rng.random() < 0.3:     # ties, as quantised depth has
+            values = np.round(values, 2).astype(dtype)
+        assert _median(values) == float(np.median(values))

@@ -322,7 +322,7 @@ class ColourDetector:
                 values = depth[y:y + h, x:x + w][sub]
                 values = values[np.isfinite(values) & (values > 0) & (values < self.max_depth)]
                 if values.size:
-                    distance, source = float(np.median(values)), 'depth'
+                    distance, source = _median(values), 'depth'
             if source == 'none':
                 distance = self._distance_from_size(count)
                 source = 'none' if math.isnan(distance) else 'size'
@@ -385,7 +385,7 @@ class ColourDetector:
             if values.size == 0:
                 continue
             parent = int(labels[y:y + h, x:x + w][sub][0])
-            parent_of.setdefault(parent, []).append((float(np.median(values)), j))
+            parent_of.setdefault(parent, []).append((_median(values), j))
         new_labels = labels.copy()
         next_label = n
         split_any = False
@@ -428,6 +428,17 @@ class ColourDetector:
         if not split_any:
             return n, labels, stats
         return next_label, new_labels, _stats(new_labels, next_label)
+
+
+def _median(values: np.ndarray) -> float:
+    """np.median of a non-empty 1-D float array without NaN, to the last bit (same partition,
+    middle pair added and halved in the array's dtype), without its ~13 us of wrapper: the
+    detector takes one per object and frame."""
+    k = values.size // 2
+    if values.size % 2:
+        return float(np.partition(values, k)[k])
+    part = np.partition(values, (k - 1, k))
+    return float((part[k - 1] + part[k]) / 2)
 
 
 def _stats(labels: np.ndarray, n: int) -> np.ndarray:
