@@ -12,6 +12,7 @@ import numpy as np
 from scipy import signal
 
 from mindgrasp_classifier.errors import ClassifierError
+from mindgrasp_common.sos_stream import SosStream
 
 #: Motor strip (10-10 names): the default channel selection.
 MOTOR_STRIP: tuple[str, ...] = (
@@ -124,11 +125,11 @@ class CausalBandpass:
         self.sos = np.asarray(sos, dtype=float)
         self.n_channels = int(n_channels)
         self._zi_unit = signal.sosfilt_zi(self.sos)  # (n_sections, 2)
-        self._zi: np.ndarray | None = None
+        self._stream: SosStream | None = None
 
     def reset(self) -> None:
         """Forget the filter state (next chunk starts a new segment)."""
-        self._zi = None
+        self._stream = None
 
     def process(self, chunk: np.ndarray) -> np.ndarray:
         """Filter one chunk.
@@ -149,10 +150,10 @@ class CausalBandpass:
             raise ClassifierError(msg)
         if chunk.shape[0] == 0:
             return chunk.copy()
-        if self._zi is None:
-            self._zi = self._zi_unit[:, :, None] * chunk[0][None, None, :]
-        out, self._zi = signal.sosfilt(self.sos, chunk, axis=0, zi=self._zi)
-        return out
+        if self._stream is None:
+            self._stream = SosStream(self.sos, self.n_channels,
+                                     zi=self._zi_unit[:, :, None] * chunk[0][None, None, :])
+        return self._stream(chunk)
 
 
 def step_samples(rate: float, step: float) -> int:

@@ -26,6 +26,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import signal
 
+from mindgrasp_common.sos_stream import SosStream
+
 from . import EEGError
 from .montage import BOTH_FEET, BOTH_HANDS, LEFT_HAND, NAUTILUS_32, NAUTILUS_RATE, RIGHT_HAND
 
@@ -199,18 +201,17 @@ class SyntheticEEG:
         # 1/f filter (Kasdin/Kellet approximation, ~3 decades), scaled to unit output variance
         b = np.array([0.049922035, -0.095993537, 0.050612699, -0.004408786])
         a = np.array([1.0, -2.494956002, 2.017265875, -0.522189400])
-        self._pink_sos = _unit_variance_sos(signal.tf2sos(b, a))
-        self._pink_zi = np.zeros((self._pink_sos.shape[0], 2, n_ch))
-        self._band_sos = {band: _unit_variance_sos(signal.butter(2, lohi, 'bandpass', fs=fs,
-                                                                 output='sos'))
-                          for band, lohi in _BANDS_HZ.items()}
+        self._pink = SosStream(_unit_variance_sos(signal.tf2sos(b, a)), n_ch)
+        band_sos = {band: _unit_variance_sos(signal.butter(2, lohi, 'bandpass', fs=fs,
+                                                           output='sos'))
+                    for band, lohi in _BANDS_HZ.items()}
         self._src_bands = [band for _e, _d, band in SOURCES.values()]
-        # the sources of one band go through one sosfilt call (columns are filtered
+        # the sources of one band go through one filter call (columns are filtered
         # independently, so this is the same signal as one call per source, for half the calls)
         self._band_cols = {band: np.array([i for i, b in enumerate(self._src_bands) if b == band])
                            for band in dict.fromkeys(self._src_bands)}
-        self._band_zi = {band: np.zeros((self._band_sos[band].shape[0], 2, len(cols)))
-                         for band, cols in self._band_cols.items()}
+        self._band_filters = {band: SosStream(band_sos[band], len(cols))
+                              for band, cols in self._band_cols.items()}
         rms = {'alpha': alpha_rms, 'mu': mu_rms, 'beta': beta_rms}
         self._src_rms = np.array([rms[b] for b in self._src_bands])
         self._src_area = [name.split('_', 1)[1] for name in SOURCES]
@@ -255,7 +256,7 @@ class SyntheticEEG:
         # one draw per sample row keeps the output independent of how it is chunked
         noise = self._rng.standard_normal((n, 2 * self.n_channels + len(SOURCES)))
         white, src_white = noise[:, :self.n_channels], noise[:, self.n_channels:-self.n_channels]
-        pink, self._pink_zi = signal.sosfilt(self._pink_sos, white, axis=0, zi=self._pink_zi)
+        pink = self._pink(white)
         data = self.background_rms * pink @ self.head.smoothing.T
         # smoothed ERD gain, sample by sample (first-order low-pass towards the target)
         target = self.erd_target(mi_class)
@@ -264,8 +265,7 @@ class SyntheticEEG:
         self._gain = gains[-1].copy()
         sources = np.empty((n, len(SOURCES)))
         for band, cols in self._band_cols.items():
-            sources[:, cols], self._band_zi[band] = signal.sosfilt(
-                self._band_sos[band], src_white[:, cols], axis=0, zi=self._band_zi[band])
+            sources[:, cols] = self._band_filters[band](src_white[:, cols])
         data += (sources * gains * self._src_rms) @ self.head.mixing.T
         data += self.sensor_noise_rms * noise[:, -self.n_channels:]
         self._add_artefacts(data)
