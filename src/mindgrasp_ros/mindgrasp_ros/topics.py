@@ -143,7 +143,7 @@ ROBOT_DESCRIPTION = _t('/robot_description', 'std_msgs/msg/String', LATCHED,
                        'sim (or robot_state_publisher)', 'viewers (RViz, Foxglove)', 'URDF')
 TF = _t('/tf', 'tf2_msgs/msg/TFMessage', Qos(depth=100),
         'sim (or robot_state_publisher)', 'viewers',
-        'arm and finger joints, 20 Hz (tf_publish_frequency)')
+        'arm and finger joints, 20 Hz (tf_publish_frequency) while subscribed')
 TF_STATIC = _t('/tf_static', 'tf2_msgs/msg/TFMessage', LATCHED,
                'sim (or robot_state_publisher)', 'viewers', 'world->base_link, camera, TCP')
 SIM_STATUS = _t('/sim/status', 'diagnostic_msgs/msg/DiagnosticArray', RELIABLE, 'sim', 'all')
