@@ -132,3 +132,26 @@ def test_grasp_through_ros_topics_reports_task_result(tmp_path):
     results_b, trajectory_b, _ = run_grasp(path, scene)
     np.testing.assert_array_equal(trajectory, trajectory_b)
     assert results_b[0].duration == r.duration
+
+
+
+def test_tf_tree_is_built_only_while_someone_subscribes():
+    """No /tf tree is computed for nobody (lock-step experiments have no viewer); a subscriber
+    that joins later gets /tf at tf_publish_frequency (20 Hz)."""
+    from mindgrasp_ros.interfaces.tf2_msgs.msg import TFMessage
+
+    with LockstepRunner() as runner:
+        sim = runner.add(SimNode)
+        built = []
+        transforms = sim.tf_tree.transforms
+        sim.tf_tree.transforms = lambda positions: built.append(1) or transforms(positions)
+        for _ in range(50):
+            runner.step(0.02)
+        assert built == []
+        listener = runner.add(rclpy.node.Node, 'tf_listener')
+        received = []
+        listener.create_subscription(TFMessage, '/tf', received.append, 100)
+        for _ in range(50):
+            runner.step(0.02)
+        assert 18 <= len(received) <= 22 and len(built) == len(received)
+        assert {t.child_frame_id for t in received[-1].transforms} >= {'link_1', 'finger_left'}

@@ -24,8 +24,8 @@ As robot_state_publisher would for a real arm: ``/robot_description`` (std_msgs/
 transient local), ``/tf_static`` (``world`` -> ``base_link`` and the URDF's fixed joints: camera
 optical frame, TCP) and ``/tf`` (the URDF's moving joints, arm and fingers, from the published
 joint states, at most ``tf_publish_frequency`` Hz as robot_state_publisher's
-``publish_frequency``, 20 Hz by default, while anyone subscribes: no tree is computed for
-nobody); camera topics carry the frame
+``publish_frequency``, 20 Hz by default; with no subscriber the tree is not computed); camera
+topics carry the frame
 ``camera_color_optical_frame`` of that tree, and the objects are the markers on ``/sim/objects``
 (in ``world``).
 Services ``/sim/reset`` (ResetSim), ``/sim/load_scene`` (LoadScene) and, in lock-step mode,
