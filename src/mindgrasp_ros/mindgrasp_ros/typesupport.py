@@ -381,17 +381,15 @@ def _keyword_init(typename: str, fields: tuple[str, ...], defaults: tuple,
             value = f"_m_as_array(_m_type, '{name}', {name}, *_m_s{i})"
         lines.append(f"    _m_set(_m_self, '{name}', {default} if {name} is _m_missing "
                      f'else {value})')
-    given = ', '.join(f"('{name}', {name})" for name in fields)
+    # a ROS message has at least one field (an empty .msg gets structure_needs_at_least_one_member)
+    given = ''.join(f"('{name}', {name}), " for name in fields)
     src = '\n'.join([
-        f"def __init__(_m_self, *_m_args, {', '.join(params)}{', ' if params else ''}"
-        '**_m_extra):',
+        f"def __init__(_m_self, *_m_args, {', '.join(params)}, **_m_extra):",
         '    if _m_args or _m_extra:',
-        f'        _m_kw = {{k: v for k, v in ({given}{"," if len(fields) == 1 else ""}) '
-        'if v is not _m_missing}' if fields else '        _m_kw = {}',
+        f'        _m_kw = {{k: v for k, v in ({given}) if v is not _m_missing}}',
         '        _m_generic(_m_self, *_m_args, **_m_kw, **_m_extra)',
         '        return',
         *lines,
-        '    return' if not lines else '',
     ])
     exec(compile(src, f'<{typename} __init__>', 'exec'), glb)     # names only: see docstring
     return glb['__init__']
