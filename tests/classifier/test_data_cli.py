@@ -119,7 +119,7 @@ def test_load_bag_errors(tmp_path, bags):
 def test_event_map_parsing():
     assert parse_event_map('T1=left_hand, T2=right_hand') == {'T1': 0, 'T2': 1}
     assert parse_event_map('769=0,770=1,771=both_feet') == {'769': 0, '770': 1, '771': 3}
-    with pytest.raises(ClassifierError, match="Unknown MI class 'elbow'"):
+    with pytest.raises(ClassifierError, match="Unknown decoder class 'elbow'"):
         parse_event_map('T1=elbow')
     with pytest.raises(ClassifierError, match='has no "="'):
         parse_event_map('T1')

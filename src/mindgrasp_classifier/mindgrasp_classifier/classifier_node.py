@@ -176,7 +176,8 @@ class ClassifierNode(rclpy.node.Node):
         msg = MIPrediction(class_index=pred.class_index, class_names=self.model.class_names,
                            certainty=float(pred.certainty),
                            distances=np.asarray(pred.distances, dtype=np.float32),
-                           window_length=float(self.model.window))
+                           window_length=float(self.model.window),
+                           probabilities=np.asarray(pred.probabilities, dtype=np.float32))
         msg.header.stamp = rclpy.time.Time(nanoseconds=round(end_s * 1e9)).to_msg()
         msg.header.frame_id = self.p.frame_id
         self.pub_pred.publish(msg)

@@ -17,7 +17,9 @@ import numpy as np
 
 from mindgrasp_classifier.errors import ClassifierError
 from mindgrasp_classifier.model import CLASS_NAMES, class_index
+from mindgrasp_common.errors import CommonError
 from mindgrasp_common.mi import NO_CLASS
+from mindgrasp_common.mi import class_index as mi_class_index
 from mindgrasp_common.types import Recording
 from mindgrasp_ros.topics import EEG_RAW, TRAINER_PROMPT, VIRTUAL_SUBJECT_INTENT
 
@@ -152,8 +154,8 @@ def intent_events(changes: Sequence[tuple[float, str]], end: float, tmin: float,
     events: list[tuple[float, int]] = []
     for (t0, name), t1 in zip(changes, [t for t, _ in changes[1:]] + [end], strict=True):
         try:
-            k = class_index(name)
-        except ClassifierError:
+            k = mi_class_index(name)
+        except CommonError:
             continue                      # 'rest' and other non-MI states
         t = t0
         while t + tmax <= t1:

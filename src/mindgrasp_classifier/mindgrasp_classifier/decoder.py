@@ -17,7 +17,7 @@ from pyriemann.geometry.geodesic import geodesic_riemann
 from pyriemann.geometry.mean import mean_riemann
 
 from mindgrasp_classifier.errors import ClassifierError
-from mindgrasp_classifier.model import CLASS_NAMES, SCALE_V_TO_UV, MiModel
+from mindgrasp_classifier.model import DECODER_CLASS_NAMES, SCALE_V_TO_UV, MiModel
 from mindgrasp_classifier.pipelines import certainty as certainty_of
 from mindgrasp_classifier.preprocessing import (
     CausalBandpass,
@@ -105,7 +105,7 @@ def check_classes(model: MiModel, expected: Sequence[int | str]) -> None:
 
     want = sorted(class_index(c) for c in expected)
     if want != sorted(model.classes):
-        names = [CLASS_NAMES[c] for c in want]
+        names = [DECODER_CLASS_NAMES[c] for c in want]
         msg = (f'The model decodes classes {model.class_names} but {names} are expected; '
                'train the model on those classes or change the expected classes.')
         raise ClassifierError(msg)
@@ -310,7 +310,7 @@ class MiDecoder:
         pos = int(np.argmin(d))
         cls = int(self.model.classes[pos])
         pred = Prediction(class_index=cls, certainty=float(certainty_of(d)), sample_index=end,
-                          distances=d)
+                          distances=d, probabilities=self.model.probabilities(d))
         self._adapt(cov[0], rec[0], pred, pos)
         return pred
 

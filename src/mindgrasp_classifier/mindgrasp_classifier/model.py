@@ -21,11 +21,11 @@ from pyriemann.geometry.base import invsqrtm
 from pyriemann.geometry.covariance import covariances
 
 from mindgrasp_classifier.errors import ClassifierError
-from mindgrasp_classifier.pipelines import _DistanceClassifier, classifier_from_arrays
+from mindgrasp_classifier.pipelines import _DistanceClassifier, classifier_from_arrays, softmax
 from mindgrasp_classifier.preprocessing import oas_covariances
 from mindgrasp_common.errors import CommonError
-from mindgrasp_common.mi import CLASS_NAMES
-from mindgrasp_common.mi import class_index as mi_class_index
+from mindgrasp_common.mi import CLASS_NAMES, DECODER_CLASS_NAMES  # noqa: F401 - CLASS_NAMES re-exported
+from mindgrasp_common.mi import decoder_class_index as mi_class_index
 from mindgrasp_common.resources import ResourceNotFoundError, resolve_path
 
 FORMAT = 'mindgrasp-mi-model'
@@ -37,7 +37,8 @@ SCALE_V_TO_UV = 1e6
 
 
 def class_index(name_or_index: str | int) -> int:
-    """MIndGrasp class index from a name (``left_hand``) or index; raises on unknown names."""
+    """Decoder class index from a name (``left_hand``, ``rest``) or index; raises on unknown
+    names."""
     try:
         return mi_class_index(name_or_index)
     except CommonError as exc:
@@ -64,7 +65,7 @@ class MiModel:
     Attributes
     ----------
     classes : list of int
-        MIndGrasp class indices the classifier knows (0 left hand ... 3 both feet), sorted.
+        Class indices the classifier knows (0 left hand ... 3 both feet, 4 rest), sorted.
     channels : list of str
         Channel names the model decodes, in classifier order.
     rate : float
@@ -85,6 +86,9 @@ class MiModel:
         Re-centering reference of the training data (Riemannian mean of its covariances).
     estimator : str
         Covariance estimator (pyRiemann name), ``oas`` by default.
+    temperature : float
+        Probability calibration: class probabilities are the softmax of the classifier's
+        logits divided by this (temperature scaling, fitted on held-out predictions).
     provenance : dict
         Training data, settings and cross-validation results.
     versions : dict
@@ -102,13 +106,21 @@ class MiModel:
     classifier: _DistanceClassifier
     reference: np.ndarray
     estimator: str = 'oas'
+    temperature: float = 1.0
     provenance: dict[str, Any] = field(default_factory=dict)
     versions: dict[str, str] = field(default_factory=library_versions)
 
     @property
     def class_names(self) -> list[str]:
         """Names of :attr:`classes`."""
-        return [CLASS_NAMES[c] for c in self.classes]
+        return [DECODER_CLASS_NAMES[c] for c in self.classes]
+
+    def probabilities(self, distances: np.ndarray) -> np.ndarray:
+        """Calibrated class probabilities from the classifier's distances.
+
+        ``distances`` has shape (..., n_classes); returns the same shape, rows summing to 1.
+        """
+        return softmax(self.classifier.logits(distances) / self.temperature)
 
     def copy(self) -> MiModel:
         """Deep copy (adaptation changes a copy, never the loaded model)."""
@@ -148,6 +160,8 @@ class MiModel:
             'window': {'length': float(self.window), 'step': float(self.step)},
             'covariance': {'estimator': self.estimator},
             'pipeline': self.pipeline,
+            'calibration': {'method': 'temperature_scaling',
+                            'temperature': float(self.temperature)},
             'provenance': self.provenance,
             'versions': self.versions,
         }
@@ -223,6 +237,7 @@ class MiModel:
                 step=float(meta['window']['step']), pipeline=str(meta['pipeline']),
                 classifier=clf, reference=np.asarray(arrays['reference'], dtype=float),
                 estimator=str(meta['covariance']['estimator']),
+                temperature=float(meta.get('calibration', {}).get('temperature', 1.0)),
                 provenance=dict(meta.get('provenance', {})),
                 versions=dict(meta.get('versions', {})))
         except ClassifierError:
@@ -231,6 +246,10 @@ class MiModel:
             msg = (f'The model {json_path} is incomplete or inconsistent ({type(exc).__name__}: '
                    f'{exc}); retrain it with `mindgrasp train classifier`.')
             raise ClassifierError(msg) from None
+        if not (np.isfinite(model.temperature) and model.temperature > 0):
+            msg = (f'The model {json_path} has calibration temperature {model.temperature}; it '
+                   'must be a positive number. Retrain the model or fix calibration.temperature.')
+            raise ClassifierError(msg)
         n = len(channels)
         if model.reference.shape != (n, n) or len(set(classes)) != len(classes):
             msg = (f'The model {json_path} lists {n} channels but its arrays have shape '

@@ -65,6 +65,14 @@ def certainty(distances: np.ndarray) -> np.ndarray:
     return d.mean(axis=-1) - d.min(axis=-1)
 
 
+def softmax(logits: np.ndarray) -> np.ndarray:
+    """Probabilities from logits along the last axis (shifted by the maximum, so no overflow)."""
+    z = np.asarray(logits, dtype=float)
+    z = z - z.max(axis=-1, keepdims=True)
+    p = np.exp(z)
+    return p / p.sum(axis=-1, keepdims=True)
+
+
 def _check_covs(X: np.ndarray) -> np.ndarray:
     X = np.asarray(X, dtype=float)
     if X.ndim != 3 or X.shape[1] != X.shape[2]:
@@ -87,12 +95,14 @@ class _DistanceClassifier(ClassifierMixin, BaseEstimator):
         return self.classes_[np.argmin(self.distances(X), axis=1)]
 
     def predict_proba(self, X: np.ndarray) -> np.ndarray:
-        """Softmax of ``-d**2`` (as pyRiemann's MDM)."""
-        d = self.distances(X)
-        z = -(d ** 2)
-        z -= z.max(axis=1, keepdims=True)
-        p = np.exp(z)
-        return p / p.sum(axis=1, keepdims=True)
+        """Softmax of :meth:`logits` (for MDM: of ``-d**2``, as pyRiemann's MDM)."""
+        return softmax(self.logits(self.distances(X)))
+
+    @staticmethod
+    def logits(distances: np.ndarray) -> np.ndarray:
+        """Unnormalised log-probabilities from distances, shape as ``distances``: ``-d**2``
+        (pyRiemann's MDM ``predict_proba``). A model's temperature divides them."""
+        return -(np.asarray(distances, dtype=float) ** 2)
 
     def certainty(self, X: np.ndarray) -> np.ndarray:
         """Certainty of each matrix, ``mean(d) - min(d)``, shape (n_matrices,)."""
@@ -249,6 +259,11 @@ class TsLrClassifier(_DistanceClassifier):
     def distances(self, X: np.ndarray) -> np.ndarray:
         """``-log p(class)``, shape (n_matrices, n_classes)."""
         return -self._log_proba(X)
+
+    @staticmethod
+    def logits(distances: np.ndarray) -> np.ndarray:
+        """The log-probabilities themselves: ``-distances``."""
+        return -np.asarray(distances, dtype=float)
 
     def to_arrays(self) -> dict[str, np.ndarray]:
         """State as named arrays."""

@@ -27,7 +27,8 @@ from mindgrasp_classifier.decoder import (
     window_covariances,
 )
 from mindgrasp_classifier.errors import ClassifierError
-from mindgrasp_classifier.model import CLASS_NAMES, MiModel, library_versions
+from mindgrasp_classifier.model import DECODER_CLASS_NAMES as CLASS_NAMES
+from mindgrasp_classifier.model import MiModel, library_versions
 from mindgrasp_classifier.pipelines import PIPELINES, certainty, make_classifier
 from mindgrasp_classifier.preprocessing import (
     select_channels,

@@ -15,14 +15,23 @@ Modules (each defines its names once; the other packages import them from here):
 from mindgrasp_common.errors import CommonError, ResourceNotFoundError
 from mindgrasp_common.geometry import top_down_quat, wrap_angle
 from mindgrasp_common.markers import objects_from_markers
-from mindgrasp_common.mi import CLASS_NAMES, NO_CLASS, MiClass, class_index, class_name
+from mindgrasp_common.mi import (
+    CLASS_NAMES,
+    DECODER_CLASS_NAMES,
+    NO_CLASS,
+    REST,
+    MiClass,
+    class_index,
+    class_name,
+    decoder_class_index,
+)
 from mindgrasp_common.resources import resolve_path, resource_path
 from mindgrasp_common.states import STATE_NAMES, State
 from mindgrasp_common.types import CameraModel, Prediction, Recording, SceneObject
 
 __all__ = [
-    'CLASS_NAMES', 'NO_CLASS', 'STATE_NAMES', 'CameraModel', 'CommonError', 'MiClass',
-    'Prediction', 'Recording', 'ResourceNotFoundError', 'SceneObject', 'State', 'class_index',
-    'class_name', 'objects_from_markers', 'resolve_path', 'resource_path', 'top_down_quat',
-    'wrap_angle',
+    'CLASS_NAMES', 'DECODER_CLASS_NAMES', 'NO_CLASS', 'REST', 'STATE_NAMES', 'CameraModel',
+    'CommonError', 'MiClass', 'Prediction', 'Recording', 'ResourceNotFoundError', 'SceneObject',
+    'State', 'class_index', 'class_name', 'decoder_class_index', 'objects_from_markers',
+    'resolve_path', 'resource_path', 'top_down_quat', 'wrap_angle',
 ]

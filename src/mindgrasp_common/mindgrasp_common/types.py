@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from mindgrasp_common.errors import CommonError
-from mindgrasp_common.mi import CLASS_NAMES, NO_CLASS
+from mindgrasp_common.mi import class_name
 
 __all__ = ['CameraModel', 'Prediction', 'Recording', 'SceneObject']
 
@@ -98,6 +98,9 @@ class Prediction:
         Stream index of the window's last sample; -1 when not known.
     distances : ndarray, shape (n_classes,), or None
         Per-class distances in the order of the model's classes, when the decoder gives them.
+    probabilities : ndarray, shape (n_classes,), or None
+        Calibrated class probabilities ``p(class | window)`` in the order of the model's classes
+        (which may include :data:`mindgrasp_common.mi.REST`), when the decoder gives them.
     """
 
     class_index: int
@@ -105,11 +108,12 @@ class Prediction:
     stamp: float = math.nan
     sample_index: int = -1
     distances: np.ndarray | None = None
+    probabilities: np.ndarray | None = None
 
     @property
     def class_name(self) -> str:
-        """``'left_hand'`` ... ``'both_feet'``."""
-        return CLASS_NAMES[self.class_index] if self.class_index != NO_CLASS else 'rest'
+        """``'left_hand'`` ... ``'both_feet'``, or ``'rest'``."""
+        return class_name(self.class_index)
 
 
 @dataclass(frozen=True)
