@@ -101,7 +101,7 @@ def project(fsm: GraspFsm, q: np.ndarray, obj: PointObject, t: float) -> VisionF
 @pytest.fixture
 def params() -> FsmParams:
     """Default parameters with a short lock (faster tests)."""
-    return FsmParams(lock_duration=0.5)
+    return FsmParams(lock_duration=0.5, paradigm='paper')
 
 
 @pytest.fixture

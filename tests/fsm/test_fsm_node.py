@@ -22,7 +22,8 @@ def test_fsm_node_turns_on_left_hand_and_stops_when_predictions_end(rclpy_ctx, s
     from mindgrasp_ros.interfaces.std_msgs.msg import Float64MultiArray
 
     proc = spawn_node('mindgrasp_fsm.fsm_node', '--ros-args', '-p', 'duration:=300.0',
-                      '-p', 'lock_duration:=0.5', '-p', 'search_gain:=0.4')
+                      '-p', 'lock_duration:=0.5', '-p', 'search_gain:=0.4',
+                      '-p', 'paradigm:=paper')
     assert proc.wait_for_output('Grasp controller ready', 60.0), proc.output()
 
     node = rclpy.node.Node('fsm_test_driver')

@@ -184,6 +184,7 @@ class MiDecoder:
             msg = (f'The {self.model.pipeline} pipeline has no class means to adapt; use an mdm '
                    'or fgmdm model, or set adaptation mode to none (re-centering still works).')
             raise ClassifierError(msg)
+        self._classes = tuple(int(c) for c in self.model.classes)
         self.n_window = window_samples(self.model.rate, self.model.window)
         self.n_step = step_samples(self.model.rate, self.model.step)
         self._flat = flat_threshold * SCALE_V_TO_UV
@@ -310,7 +311,8 @@ class MiDecoder:
         pos = int(np.argmin(d))
         cls = int(self.model.classes[pos])
         pred = Prediction(class_index=cls, certainty=float(certainty_of(d)), sample_index=end,
-                          distances=d, probabilities=self.model.probabilities(d))
+                          distances=d, probabilities=self.model.probabilities(d),
+                          classes=self._classes)
         self._adapt(cov[0], rec[0], pred, pos)
         return pred
 

@@ -99,8 +99,11 @@ class Prediction:
     distances : ndarray, shape (n_classes,), or None
         Per-class distances in the order of the model's classes, when the decoder gives them.
     probabilities : ndarray, shape (n_classes,), or None
-        Calibrated class probabilities ``p(class | window)`` in the order of the model's classes
-        (which may include :data:`mindgrasp_common.mi.REST`), when the decoder gives them.
+        Calibrated class probabilities ``p(class | window)`` in the order of ``classes``, when
+        the decoder gives them.
+    classes : tuple of int, or None
+        The decoder's class indices in the order of ``distances`` and ``probabilities`` (may
+        include :data:`mindgrasp_common.mi.REST`).
     """
 
     class_index: int
@@ -109,6 +112,7 @@ class Prediction:
     sample_index: int = -1
     distances: np.ndarray | None = None
     probabilities: np.ndarray | None = None
+    classes: tuple[int, ...] | None = None
 
     @property
     def class_name(self) -> str:

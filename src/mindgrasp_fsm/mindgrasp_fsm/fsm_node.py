@@ -23,6 +23,8 @@ from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import DetectionArray, FsmState
 from mindgrasp_ros.interfaces.sensor_msgs.msg import CameraInfo, JointState
 from mindgrasp_ros.interfaces.std_msgs.msg import Float64MultiArray, UInt8MultiArray
 
+from mindgrasp_common.errors import CommonError
+from mindgrasp_common.mi import decoder_class_index
 from mindgrasp_fsm.conversions import gripper_from_fingers, vision_frame_from_msg
 from mindgrasp_fsm.errors import FsmError
 from mindgrasp_fsm.grasp_fsm import GraspFsm
@@ -104,8 +106,14 @@ class FsmNode(rclpy.node.Node):
 
     # ------------------------------------------------------------------ callbacks
     def prediction_callback(self, msg: MIPrediction) -> None:
-        self.inputs.prediction = Prediction(int(msg.class_index), float(msg.certainty),
-                                            self._stamp_or_now(msg.header))
+        probabilities = np.asarray(msg.probabilities, dtype=float)
+        try:
+            classes = tuple(decoder_class_index(n) for n in msg.class_names)
+        except CommonError:
+            classes = None                   # a decoder of classes the controller cannot use
+        self.inputs.prediction = Prediction(
+            int(msg.class_index), float(msg.certainty), self._stamp_or_now(msg.header),
+            probabilities=probabilities if probabilities.size else None, classes=classes)
 
     def detections_callback(self, msg: DetectionArray) -> None:
         if msg.image_width == 0 or msg.image_height == 0:
@@ -179,7 +187,8 @@ class FsmNode(rclpy.node.Node):
         changing age ("0.53 s old"): numbers do not count as a change, so a stopped controller
         says so once per second, not at the control rate."""
         reason = _NUMBER.sub('#', out.reason) if out.stopped else out.reason
-        key = (int(out.state), out.locked, out.stopped, reason, out.object_of_interest)
+        key = (int(out.state), out.locked, out.stopped, reason, out.object_of_interest,
+               out.offered)
         if key == self._last_state_msg and now - self._last_state_pub < 1.0:
             return
         if out.stopped and (self._last_state_msg is None or not self._last_state_msg[2]):
@@ -188,7 +197,9 @@ class FsmNode(rclpy.node.Node):
         msg = FsmState(state=int(out.state), state_name=STATE_NAMES[out.state],
                        previous_state=int(out.previous_state),
                        object_of_interest=out.object_of_interest, locked=bool(out.locked),
-                       stopped=bool(out.stopped), reason=out.reason)
+                       stopped=bool(out.stopped), reason=out.reason, paradigm=out.paradigm,
+                       offered=bool(out.offered), confirm_evidence=float(out.confirm_evidence),
+                       cancel_evidence=float(out.cancel_evidence))
         msg.header.stamp = self.get_clock().now().to_msg()
         self.state_pub.publish(msg)
 

@@ -28,6 +28,17 @@ when predictions (BCI mode) or joint states are older than ``watchdog_timeout``,
 hold NaN, or when no camera frames arrive; the output says why. Commands never drive a joint past
 its limits.
 
+Two BCI paradigms (``paradigm``). ``paper``: the person steers with four classes as in the
+paper (left/right hand turn, both hands select and approach, both feet back off). ``scan``
+(hybrid shared control, after Xu et al., IEEE TASE 2022): the arm searches by itself as in
+autonomous mode and *offers* each object it centres; the person commits to it with both-hands
+imagery against rest, or lets it pass by resting (after ``offer_timeout`` the arm turns on by
+``scan_skip_angle`` to the next object). Once committed, the approach and grasp run by
+themselves, and both-feet imagery cancels them until the gripper closes (the arm returns to the
+start and goes on scanning past that object). Both decisions are taken on evidence accumulated
+over decoder windows from the calibrated class probabilities (:mod:`mindgrasp_fsm.evidence`);
+weak evidence means the arm waits.
+
 After the MI predictions went stale and came back (``resume_after_stale: require_new_command``,
 the default) the arm does not move again by itself: it holds still until a *fresh decision*, one
 MI class decoded in every prediction for ``resume_hold`` seconds (by the predictions' stamps),
@@ -41,7 +52,9 @@ import math
 
 import numpy as np
 
+from mindgrasp_common.mi import REST
 from mindgrasp_fsm.errors import FsmError
+from mindgrasp_fsm.evidence import Evidence
 from mindgrasp_fsm.grasp_policy import GraspPolicy, PolicyStep, fingers_loaded
 from mindgrasp_fsm.kinematics import ArmKinematics
 from mindgrasp_fsm.params import FsmParams
@@ -55,7 +68,7 @@ from mindgrasp_fsm.types import (
     VisionFrame,
 )
 
-_CLASS_WORDS = {0: 'left hand', 1: 'right hand', 2: 'both hands', 3: 'both feet'}
+_CLASS_WORDS = {0: 'left hand', 1: 'right hand', 2: 'both hands', 3: 'both feet', REST: 'rest'}
 
 
 def clamp_to_limits(q: np.ndarray, v: np.ndarray, params: FsmParams) -> np.ndarray:
@@ -116,6 +129,7 @@ class GraspFsm:
         self.previous_state = State.OBJECT_SEARCH
         self.reason = 'started'
         self._clock = time            # active clock: wall/sim time minus time spent stopped
+        self._now = time              # the inputs' time of this tick (the predictions' clock)
         self._last_time: float | None = None
         self._state_since = 0.0
         self._lock_until: float | None = None
@@ -129,6 +143,7 @@ class GraspFsm:
         self._sweep = 0
         self._sweep_dir = 1.0
         self._ignore_from: float | None = None
+        self._ignore_angle = self.params.search_ignore_angle
         self._gave_up_at = -math.inf
         self._both_since: float | None = None   # since when both-hands is decoded without break
         # after a prediction loss: the stamp of the first fresh prediction (None: no loss
@@ -137,6 +152,17 @@ class GraspFsm:
         self._back_at: float | None = None
         self._fresh: tuple[int, float] | None = None
         self._return_lift: bool | None = None
+        # scan paradigm: when the current offer began (None: no offer), whether the person
+        # committed to the object of interest, and the evidence of each decision
+        self._offer_since: float | None = None
+        self._committed = False
+        self._confirm = Evidence(MiClass.BOTH_HANDS, [REST],
+                                 threshold=self.params.confirm_threshold,
+                                 clip=self.params.evidence_clip)
+        self._cancel = Evidence(MiClass.BOTH_FEET, [REST, MiClass.BOTH_HANDS, MiClass.LEFT_HAND,
+                                                    MiClass.RIGHT_HAND],
+                                threshold=self.params.cancel_threshold,
+                                clip=self.params.evidence_clip)
         self._attempt = 0
         self._outcome = ''
         self._gripper = GripperCommand(self.params.gripper_open_position, 0.0)
@@ -178,6 +204,9 @@ class GraspFsm:
         if new == State.OBJECT_SEARCH:
             self._seen_since = None
             self._attempt = 0
+            self._committed = False
+            self._offer_since = None
+
         elif new == State.FINAL_APPROACH:
             shape = self._ooi.shape if self._ooi is not None else 'unknown'
             self.policy.begin_approach(self._clock, shape, self._attempt)
@@ -201,7 +230,20 @@ class GraspFsm:
             previous_state=self.previous_state, locked=self._lock_until is not None,
             stopped=stopped, reason=self.reason if reason is None else reason,
             object_of_interest=self._ooi_label, phase=phase, grasp_attempts=self._attempt,
-            grasp_outcome=self._outcome, events=events)
+            grasp_outcome=self._outcome, events=events,
+            paradigm='autonomous' if self.params.autonomous else self.params.paradigm,
+            offered=self._offer_since is not None,
+            confirm_evidence=self._confirm.fraction if self._offer_since is not None else 0.0,
+            cancel_evidence=self._cancel.fraction if self._cancellable() else 0.0)
+
+    @property
+    def _scan(self) -> bool:
+        return not self.params.autonomous and self.params.paradigm == 'scan'
+
+    def _cancellable(self) -> bool:
+        """Scan: the committed approach may still be cancelled (the gripper has not closed)."""
+        return self._scan and self._committed and self.state in (
+            State.CENTER_OBJECT, State.INITIAL_APPROACH, State.FINAL_APPROACH)
 
     def _stop(self, why: str) -> FsmOutput:
         return self._output(np.zeros(6), stopped=True, reason=why)
@@ -216,6 +258,7 @@ class GraspFsm:
             raise FsmError(msg)
         dt = 0.0 if self._last_time is None else max(now - self._last_time, 0.0)
         self._last_time = now
+        self._now = now
 
         # --- watchdog: nothing moves on stale or broken inputs -------------------------------
         why = self._watchdog(inputs, now) or self._await_fresh_decision(inputs)
@@ -237,6 +280,12 @@ class GraspFsm:
             new, reason = self._pending
             self._pending = None
             self._enter(new, reason)
+
+        if self._cancellable():
+            self._cancel.threshold, self._cancel.clip = p.cancel_threshold, p.evidence_clip
+            if self._cancel.update(inputs.prediction):
+                self._cancel_approach(q)
+                return self._output(np.zeros(6), phase='cancelled')
 
         handler = {
             State.OBJECT_SEARCH: self._search,
@@ -300,8 +349,10 @@ class GraspFsm:
         assert pred is not None            # the watchdog passed: fresh predictions arrive
         if self._back_at is None:
             self._back_at = pred.stamp
-        if pred.stamp >= self._back_at and (self._fresh is None or
-                                            self._fresh[0] != pred.class_index):
+        if pred.class_index == REST:
+            self._fresh = None           # rest is no command: it cannot restart the arm
+        elif pred.stamp >= self._back_at and (self._fresh is None or
+                                              self._fresh[0] != pred.class_index):
             self._fresh = (pred.class_index, pred.stamp)
         held = pred.stamp - self._fresh[1] if self._fresh is not None else 0.0
         if held >= p.resume_hold:
@@ -345,6 +396,8 @@ class GraspFsm:
         pred = inputs.prediction
         if pred is None or self.params.autonomous:
             return -1, 0.0
+        if pred.class_index == REST:
+            return REST, 0.0              # no imagery: no command, as a class below threshold
         cert = float(pred.certainty)
         if not math.isfinite(cert):
             cert = 0.0
@@ -368,16 +421,18 @@ class GraspFsm:
             # the fingers only hide the camera's view, so open them
             self._gripper = GripperCommand(p.gripper_open_position, 0.0)
         ooi = self._visible(inputs)
-        if p.autonomous:
+        if p.autonomous or self._scan:
             if self._ignore_from is not None:
-                if abs(q[0] - self._ignore_from) < p.search_ignore_angle:
-                    return self._sweep_step(q), 'turning away from an object out of reach'
+                if abs(q[0] - self._ignore_from) < self._ignore_angle:
+                    return self._sweep_step(q), 'turning away from an object out of reach' \
+                        if p.autonomous else 'turning on to the next object'
                 self._ignore_from = None
                 self._seen_since = None
             if ooi is not None and self._seen_since is not None \
                     and t - self._seen_since >= p.search_confirm_time:
                 self._center_next = State.INITIAL_APPROACH
-                self._goto(State.CENTER_OBJECT, f'{ooi.label} seen by the autonomous search')
+                found = 'autonomous search' if p.autonomous else 'scan'
+                self._goto(State.CENTER_OBJECT, f'{ooi.label} seen by the {found}')
                 return v, 'found'
             if ooi is not None:
                 return v, 'confirming'
@@ -440,9 +495,14 @@ class GraspFsm:
         assert inputs.vision is not None
         ex, ey = self._errors(ooi, inputs.vision)
         v = self._centring(ooi, inputs.vision, 1.0)
+        if self._offer_since is not None:
+            return self._offer(t, q, inputs, ooi, v)
         if abs(ex) < p.center_tolerance and abs(ey) < p.center_tolerance:
             self._centred_since = self._centred_since if self._centred_since is not None else t
             if t - self._centred_since >= p.center_hold_time:
+                if self._scan and not self._committed and \
+                        self._center_next == State.INITIAL_APPROACH:
+                    return self._offer(t, q, inputs, ooi, v)
                 self._goto(self._center_next, f'{ooi.label} centred')
                 return np.zeros(6), 'centred'
         else:
@@ -479,8 +539,48 @@ class GraspFsm:
         if abs(v[0]) > 1e-3:
             self._sweep_dir = -float(np.sign(v[0]))
         self._ignore_from = float(q[0])
+        self._ignore_angle = self.params.search_ignore_angle
         self._gave_up_at = self._clock
+        self._offer_since = None
         self._goto(State.OBJECT_SEARCH, reason)
+
+    # ---------------------------------------------------------------------------- scan
+    def _offer(self, t: float, q: np.ndarray, inputs: FsmInputs, ooi: ObjectObservation,
+               v: np.ndarray) -> tuple[np.ndarray, str]:
+        """Scan, state 2: the centred object is offered; commit on both-hands evidence, pass
+        on after ``offer_timeout``. The arm keeps the object centred meanwhile."""
+        p = self.params
+        if self._offer_since is None:
+            self._offer_since = t
+            self._confirm.reset(self._now + p.offer_delay)
+            self._events.append(f'offering the {ooi.label}')
+        self._confirm.threshold, self._confirm.clip = p.confirm_threshold, p.evidence_clip
+        if self._confirm.update(inputs.prediction):
+            self._committed = True
+            self._offer_since = None
+            self._cancel.reset(self._now)
+            self._goto(self._center_next, f'confirmed the {ooi.label} (both-hands evidence '
+                       f'{self._confirm.value:.2f} nat s)')
+            return np.zeros(6), 'confirmed'
+        if t - self._offer_since > p.offer_timeout:
+            self._offer_since = None
+            self._ignore_from = float(q[0])
+            self._ignore_angle = p.scan_skip_angle
+            self._goto(State.OBJECT_SEARCH, f'passed the {ooi.label}: not confirmed in '
+                       f'{p.offer_timeout:.1f} s')
+            return np.zeros(6), 'passed'
+        return v, f'offering the {ooi.label}: evidence {self._confirm.fraction:.0%}'
+
+    def _cancel_approach(self, q: np.ndarray) -> None:
+        """Scan: both-feet evidence backs out of the approach: return to the start, then scan
+        on past this object."""
+        label = self._ooi_label or 'object'
+        self._outcome = 'cancelled'
+        self._committed = False
+        self._ignore_from = float(q[0])
+        self._ignore_angle = self.params.scan_skip_angle
+        self._goto(State.RETURN_TO_START, f'cancelled the approach to the {label} (both-feet '
+                   f'evidence {self._cancel.value:.2f} nat s)')
 
     # ---------------------------------------------------------------------------- state 3
     def _initial_approach(self, t: float, q: np.ndarray, inputs: FsmInputs
@@ -512,7 +612,7 @@ class GraspFsm:
             self._goto(State.FINAL_APPROACH, f'joint {p.approach_joint} near its limit')
             return v, 'limit'
         cls, cert = self._certainty(inputs)
-        if p.autonomous or cert <= p.certainty_threshold:
+        if p.autonomous or self._scan or cert <= p.certainty_threshold:
             v += self._centring(ooi, inputs.vision, p.approach_center_gain)
             v[j] = p.approach_sign * p.default_approach_velocity
             return v, 'default approach'

@@ -28,6 +28,8 @@ from mindgrasp_ros.params import param
 
 SHAPES = ('cube', 'cylinder', 'sphere')
 RESUME_MODES = ('require_new_command', 'resume')
+#: interaction paradigms of the BCI mode (see :mod:`mindgrasp_fsm.grasp_fsm`)
+PARADIGMS = ('paper', 'scan')
 
 
 @dataclass
@@ -75,6 +77,32 @@ class FsmParams:
     resume_hold: float = param(1.0, 'a fresh decision after a loss: one class decoded without '
                                'a break for this long', unit='s', min=0.0, max=10.0, live=True)
     # --- BCI -----------------------------------------------------------------------------------
+    # paper: the person steers with 4 classes (left/right turn, both hands select and approach,
+    # both feet back off). scan: the arm turns from object to object itself and offers each one;
+    # the person confirms with both hands (against rest) and cancels an approach with both feet,
+    # each decision taken on accumulated evidence (mindgrasp_fsm.evidence). Measured on real EEG
+    # (src/mindgrasp_experiments/README.md), scan gives far fewer wrong grasps.
+    paradigm: str = param('scan', 'BCI interaction: paper (4-class steering) or scan (the arm '
+                          'offers each object, the person confirms or cancels)',
+                          choices=PARADIGMS)
+    confirm_threshold: float = param(1.5, 'scan: evidence for both hands against rest that '
+                                     'commits to the offered object', unit='nat s', min=0.01,
+                                     max=100.0, live=True)
+    cancel_threshold: float = param(1.5, 'scan: evidence for both feet against the other '
+                                    'classes that cancels an approach before the gripper closes',
+                                    unit='nat s', min=0.01, max=100.0, live=True)
+    evidence_clip: float = param(2.0, 'scan: largest log-probability ratio one decoder window '
+                                 'adds to the evidence', unit='nat', min=0.01, max=20.0,
+                                 live=True)
+    offer_timeout: float = param(8.0, 'scan: an object is offered this long; without a '
+                                 'confirmation the arm passes on to the next', unit='s',
+                                 min=0.5, max=120.0, live=True)
+    offer_delay: float = param(0.5, 'scan: decoder windows ending this soon after an offer '
+                               'began are not counted (the person sees the offer first)',
+                               unit='s', min=0.0, max=10.0, live=True)
+    scan_skip_angle: float = param(0.45, 'scan: after passing an object, joint 1 turns this far '
+                                   'before the next object is offered', unit='rad', min=0.0,
+                                   max=6.3, live=True)
     certainty_threshold: float = param(0.5, 'certainty below which state 3 uses the default '
                                        'slow approach', min=0.0, max=100.0, live=True)
     certainty_cap: float = param(2.0, 'certainty that gives full speed (certainty is unbounded, '

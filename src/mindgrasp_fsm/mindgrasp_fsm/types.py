@@ -104,8 +104,12 @@ class FsmOutput:
     object_of_interest: str = ''
     phase: str = ''                 # sub-step inside the grasp policy
     grasp_attempts: int = 0
-    grasp_outcome: str = ''         # '', 'holding', 'failed'
+    grasp_outcome: str = ''         # '', 'holding', 'failed', 'cancelled'
     events: list[str] = field(default_factory=list)
+    paradigm: str = ''              # 'paper', 'scan' or 'autonomous'
+    offered: bool = False           # scan: the object of interest is offered for confirmation
+    confirm_evidence: float = 0.0   # scan: confirmation evidence / confirm_threshold (0..1)
+    cancel_evidence: float = 0.0    # scan: cancel evidence / cancel_threshold (0..1)
 
     @property
     def state_name(self) -> str:

@@ -1,0 +1,124 @@
+"""Evidence for one binary decision, accumulated over decoder windows (dynamic stopping).
+
+A decision ("confirm this object": both hands against rest; "cancel": both feet against the rest
+of the classes) is taken only when the decoder's calibrated probabilities have favoured it for
+long enough. Each new prediction adds its log-probability ratio
+
+    llr = log p(for) - log p(against),  clipped to +-``clip``,
+
+weighted by the time it covers (the gap to the previous prediction, at most ``max_gap`` s), so the
+evidence is a time integral in nat-seconds and does not depend on the decoder's window step. The
+sum never falls below 0 (a CUSUM, Page 1954): evidence against the decision before the person
+starts to imagine (their reaction time) cannot delay the decision afterwards. The decision is
+taken when the sum reaches ``threshold``: holding ``p(for) / p(against) = e`` (73 % against rest)
+for 2 s gives 2 nat-s.
+
+When the decoder knows no ``rest`` class (a model of the four imagery classes only), "against"
+is every other class the decoder knows.
+
+    >>> import numpy as np
+    >>> from mindgrasp_common.types import Prediction
+    >>> ev = Evidence(2, [4], threshold=1.0)
+    >>> ev.reset(since=0.0)
+    >>> for k in range(1, 11):       # 1 s of p(both hands) = 3 p(rest)
+    ...     done = ev.update(Prediction(2, 0.0, stamp=k * 0.1, classes=(0, 1, 2, 3, 4),
+    ...                                 probabilities=np.array([.05, .05, .6, .1, .2])))
+    >>> round(ev.value, 3), done
+    (1.099, True)
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import numpy as np
+
+from mindgrasp_common.types import Prediction
+
+__all__ = ['Evidence', 'log_ratio']
+
+_FLOOR = 1e-6     # probabilities are clipped here: a 0 from a float32 message is not certainty
+
+
+def log_ratio(probabilities: np.ndarray, classes: Sequence[int], for_class: int,
+              against: Sequence[int]) -> float | None:
+    """``log p(for_class) - log sum p(against)`` from one prediction's probabilities.
+
+    ``classes`` are the decoder's class indices in the order of ``probabilities``; classes of
+    ``against`` the decoder does not know are left out, and when none is known "against" is
+    every other class. None when ``for_class`` is unknown to the decoder or the probabilities
+    do not match ``classes``.
+    """
+    p = np.asarray(probabilities, dtype=float)
+    classes = [int(c) for c in classes]
+    if p.shape != (len(classes),) or for_class not in classes or not np.isfinite(p).all():
+        return None
+    known = [c for c in against if c in classes and c != for_class]
+    if not known:
+        known = [c for c in classes if c != for_class]
+    p_for = max(p[classes.index(for_class)], _FLOOR)
+    p_against = max(sum(p[classes.index(c)] for c in known), _FLOOR)
+    return math.log(p_for) - math.log(p_against)
+
+
+class Evidence:
+    """Accumulated evidence (nat-s) for one decision; see the module docstring.
+
+    Parameters
+    ----------
+    for_class : int
+        Decoder class that speaks for the decision (2 both hands, 3 both feet).
+    against : sequence of int
+        Classes that speak against it (4 rest, ...).
+    threshold : float
+        Evidence (nat-s) at which the decision is taken.
+    clip : float
+        Largest log-ratio (nats) one prediction may add or remove.
+    max_gap : float
+        Longest time (s) one prediction stands for (a gap in the predictions adds nothing).
+    """
+
+    def __init__(self, for_class: int, against: Sequence[int], *, threshold: float,
+                 clip: float = 2.0, max_gap: float = 0.25) -> None:
+        self.for_class, self.against = int(for_class), [int(c) for c in against]
+        self.threshold, self.clip, self.max_gap = float(threshold), float(clip), float(max_gap)
+        self.reset()
+
+    def reset(self, since: float = -math.inf) -> None:
+        """Forget the evidence; only predictions stamped after ``since`` (s) count from now."""
+        self.value = 0.0
+        self.peak = 0.0
+        self.n_windows = 0
+        self._last_stamp = float(since)
+
+    @property
+    def reached(self) -> bool:
+        """Whether the evidence has reached the threshold."""
+        return self.value >= self.threshold
+
+    @property
+    def fraction(self) -> float:
+        """Evidence as a fraction of the threshold (0..1), for displays."""
+        return min(self.value / self.threshold, 1.0) if self.threshold > 0 else 1.0
+
+    def update(self, prediction: Prediction | None) -> bool:
+        """Add ``prediction`` if it is newer than the last one counted; True once reached.
+
+        A prediction without probabilities (or without its decoder's ``classes``) adds nothing.
+        """
+        if prediction is None or not prediction.stamp > self._last_stamp:
+            return self.reached
+        gap = prediction.stamp - self._last_stamp
+        self._last_stamp = prediction.stamp
+        if prediction.probabilities is None or prediction.classes is None:
+            return self.reached
+        llr = log_ratio(prediction.probabilities, prediction.classes, self.for_class,
+                        self.against)
+        if llr is None:
+            return self.reached
+        llr = min(max(llr, -self.clip), self.clip)
+        self.value = max(self.value + llr * min(gap, self.max_gap), 0.0)
+        self.peak = max(self.peak, self.value)
+        self.n_windows += 1
+        return self.reached
