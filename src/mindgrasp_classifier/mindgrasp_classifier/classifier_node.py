@@ -47,7 +47,7 @@ class ClassifierParams:
     model: str = param(DEFAULT_MODEL, 'model written by `mindgrasp train classifier` (.json next '
                        'to its .npz): a path or a package:// URI')
     classes: list[str] = param(list(CLASS_NAMES), 'classes the application needs; a model with '
-                               'other classes is refused ([] = any)')
+                               'other classes (besides rest) is refused ([] = any)')
     adaptation: str = param('none', 'adaptive class means', choices=ADAPT_MODES)
     adaptation_rate: float = param(0.005, 'geodesic step of an adaptive update per window',
                                    min=0.0, max=1.0)

@@ -27,6 +27,7 @@ from mindgrasp_classifier.preprocessing import (
     step_samples,
     window_samples,
 )
+from mindgrasp_common.mi import REST
 from mindgrasp_common.types import Prediction
 
 ADAPT_MODES = ('none', 'supervised', 'unsupervised', 'both')
@@ -100,11 +101,12 @@ def check_stream(model: MiModel, channels: Sequence[str], rate: float) -> np.nda
 
 
 def check_classes(model: MiModel, expected: Sequence[int | str]) -> None:
-    """Raise when the model's classes differ from the classes the application expects."""
+    """Raise when the model's classes differ from the classes the application expects; a model
+    may know ``rest`` besides them (rest is no command, every application can take it)."""
     from mindgrasp_classifier.model import class_index
 
     want = sorted(class_index(c) for c in expected)
-    if want != sorted(model.classes):
+    if want != sorted(c for c in model.classes if c != REST or REST in want):
         names = [DECODER_CLASS_NAMES[c] for c in want]
         msg = (f'The model decodes classes {model.class_names} but {names} are expected; '
                'train the model on those classes or change the expected classes.')
