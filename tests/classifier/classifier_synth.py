@@ -22,22 +22,30 @@ def class_mixings(n_channels: int, classes, seed: int = 1234) -> dict[int, np.nd
 
 def make_recording(classes=(0, 1, 2, 3), trials_per_class: int = 10, seed: int = 0,
                    rate: float = RATE, channels=CHANNELS, drift: np.ndarray | None = None,
-                   mixing_seed: int = 1234, amplitude: float = 10e-6) -> Recording:
-    """Continuous EEG (V): rest = white noise, each cue 3 s of class-mixed noise, 2 s rest."""
+                   mixing_seed: int = 1234, amplitude: float = 10e-6,
+                   annotate: bool = False, source: str | None = None) -> Recording:
+    """Continuous EEG (V): rest = white noise, each cue 3 s of class-mixed noise, 2 s rest.
+
+    ``annotate`` adds EEGMMIDB-like annotations (s): ``C<class>`` over each 3 s cue and ``T0``
+    (rest) over the 3 s from each cue's end to the next cue (2 s at the end)."""
     rng = np.random.RandomState(seed)
     n_ch = len(channels)
     mix = class_mixings(n_ch, classes, mixing_seed)
     order = rng.permutation(np.repeat(np.asarray(classes), trials_per_class))
     pre, cue, rest = round(1.0 * rate), round(3.0 * rate), round(2.0 * rate)
-    blocks, events, t = [], [], 0
-    for cls in order:
+    blocks, events, t, annotations = [], [], 0, []
+    for i, cls in enumerate(order):
         blocks.append(rng.randn(pre, n_ch))
         events.append((t + pre, int(cls)))
         blocks.append(rng.randn(cue, n_ch) @ mix[int(cls)].T)
         blocks.append(rng.randn(rest, n_ch))
+        annotations += [((t + pre) / rate, cue / rate, f'C{int(cls)}'),
+                        ((t + pre + cue) / rate, (rest + (pre if i + 1 < len(order) else 0)) / rate,
+                         'T0')]
         t += pre + cue + rest
     data = np.concatenate(blocks) * amplitude + 20e-6   # DC offset as real amplifiers have
     if drift is not None:
         data = data @ drift.T
     return Recording(data=data, rate=rate, channels=list(channels),
-                     events=np.array(events, dtype=int), source=f'synthetic seed {seed}')
+                     events=np.array(events, dtype=int), source=source or f'synthetic seed {seed}',
+                     annotations=annotations if annotate else [])

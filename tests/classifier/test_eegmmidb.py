@@ -2,9 +2,10 @@
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
-from mindgrasp_classifier.data import eegbci_files, eegmmidb_run, load_edf
+from mindgrasp_classifier.data import eegbci_files, eegmmidb_run, load_edf, parse_event_map
 from mindgrasp_classifier.errors import ClassifierError
 from mindgrasp_classifier.training import TrainingConfig, evaluate, train
 
@@ -47,3 +48,14 @@ def test_non_eegmmidb_file_needs_event_map(tmp_path, runs):
         load_edf(other)
     rec = load_edf(other, {'T1': 0, 'T2': 1})
     assert len(rec.events) == len(runs[4].events)
+
+
+def test_rest_epochs_from_t0(runs):
+    rec = load_edf(runs[4].source, rest=True)
+    assert int((rec.events[:, 1] == 4).sum()) == 15 and len(rec.annotations) == 30
+    assert rec.annotations[0] == (0.0, 4.2, 'T0') and rec.annotations[1][2] == 'T2'
+    np.testing.assert_array_equal(rec.events[rec.events[:, 1] != 4], runs[4].events)
+    with pytest.raises(ClassifierError, match='need an event-map entry for its rest annotation'):
+        load_edf(runs[4].source, {'T1': 0, 'T2': 1}, rest=True)
+    emap = parse_event_map('T0=rest,T1=left_hand,T2=right_hand')
+    assert int((load_edf(runs[4].source, emap, rest=True).events[:, 1] == 4).sum()) == 15

@@ -38,17 +38,22 @@ def add_data_arguments(parser: argparse.ArgumentParser) -> None:
     g.add_argument('--keep-aborted', action='store_true',
                    help='keep trainer trials cut short by a robot reset (left out by default: '
                         'their epochs hold rest and the next trial)')
+    g.add_argument('--rest', action='store_true',
+                   help="label rest epochs as class 'rest' (EEGMMIDB: the T0 annotations; other "
+                        'files: map their rest annotation in --event-map, e.g. T0=rest)')
     g.add_argument('--tmin', type=float, default=0.5, help='epoch start after the cue (s, 0.5)')
     g.add_argument('--tmax', type=float, default=2.5, help='epoch end after the cue (s, 2.5)')
 
 
-def load_from_args(args: argparse.Namespace) -> list[Recording]:
-    """Recordings named by :func:`add_data_arguments` options."""
+def load_from_args(args: argparse.Namespace, rest: bool = False) -> list[Recording]:
+    """Recordings named by :func:`add_data_arguments` options; ``rest`` (or ``--rest``) labels
+    rest epochs."""
     recordings = load_inputs(edf=args.edf, bags=args.bag, event_map=args.event_map,
                              eegbci_subject=args.eegbci, eegbci_runs=args.runs,
                              eeg_topic=args.eeg_topic, prompt_topic=args.prompt_topic,
                              labels=args.labels, keep_aborted=args.keep_aborted,
-                             intent_topic=args.intent_topic, tmin=args.tmin, tmax=args.tmax)
+                             intent_topic=args.intent_topic, tmin=args.tmin, tmax=args.tmax,
+                             rest=rest or args.rest)
     aborted = sum(r.n_aborted for r in recordings)
     if aborted:
         print(f"{'Kept' if args.keep_aborted else 'Left out'} {aborted} aborted trial(s) "
@@ -76,6 +81,53 @@ def format_report(report: dict[str, Any], title: str) -> str:
     for name, st in report['certainty'].items():
         lines.append(f"    {name:<{width}}{st['mean']:.3f} +- {st['std']:.3f} "
                      f"[{st['q25']:.3f} {st['median']:.3f} {st['q75']:.3f}]")
+    return '\n'.join(lines)
+
+
+def _pct(value: float | None) -> str:
+    return 'n/a' if value is None else f'{100 * value:.1f} %'
+
+
+def format_cv_report(report: dict[str, Any]) -> str:
+    """Cross-validation of :func:`~mindgrasp_classifier.training.cross_validate_model`: the
+    scheme, the confound sentence, per held-out run and the optimistic figure, calibration."""
+    if report['scheme'] == 'trial_grouped_kfold':
+        text = format_report(report, f"Cross-validation ({report['folds']} folds, grouped by "
+                                     'trial; scheme trial_grouped_kfold, one recording):')
+    elif report['n_trials']:
+        text = format_report(report, f"Cross-validation (leave_one_run_out over {report['folds']} "
+                                     'recordings; scored classes: '
+                                     f"{', '.join(report['scored_classes'])}):")
+    else:
+        text = ('Cross-validation (leave_one_run_out over '
+                f"{report['folds']} recordings): no held-out trial has a class that the other "
+                'recordings contain, so it measures nothing here.')
+    lines = [text]
+    if report['scheme'] == 'leave_one_run_out':
+        if report.get('confound'):
+            lines.append(f"  {report['confound']}")
+        lines.append('  per held-out recording (trial accuracy / balanced / window accuracy on '
+                     'the scored classes):')
+        for run in report['per_run']:
+            scored = ', '.join(run['scored_classes']) or 'none'
+            lines.append(f"    {run['recording']}: {_pct(run['accuracy'])} / "
+                         f"{_pct(run['balanced_accuracy'])} / {_pct(run['window_accuracy'])}  "
+                         f"({run['n_trials']} trials of {scored}; it has "
+                         f"{', '.join(run['classes'])})")
+        if report['n_unscored_trials']:
+            lines.append(f"  {report['n_unscored_trials']} trial(s) not scored: their class is "
+                         'missing from the other recordings.')
+        opt = report.get('optimistic')
+        if opt:
+            lines.append(f"  optimistic (trial_grouped_kfold, {opt['folds']} folds over all "
+                         f"recordings): accuracy {_pct(opt['accuracy'])}, balanced "
+                         f"{_pct(opt['balanced_accuracy'])}, window {_pct(opt['window_accuracy'])}")
+    cal = report.get('calibration')
+    if cal and cal.get('source'):
+        lines.append(f"  probability calibration (held-out windows of {cal['source']}, "
+                     f"{cal['n_windows']}): temperature {cal['temperature']:.3f}; ECE "
+                     f"{_pct(cal['ece_uncalibrated'])} -> {_pct(cal['ece'])}, NLL "
+                     f"{cal['nll_uncalibrated']:.3f} -> {cal['nll']:.3f}")
     return '\n'.join(lines)
 
 

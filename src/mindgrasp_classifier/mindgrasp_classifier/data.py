@@ -7,6 +7,7 @@ decoder does.
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import os
 import re
@@ -18,7 +19,7 @@ import numpy as np
 from mindgrasp_classifier.errors import ClassifierError
 from mindgrasp_classifier.model import CLASS_NAMES, class_index
 from mindgrasp_common.errors import CommonError
-from mindgrasp_common.mi import NO_CLASS
+from mindgrasp_common.mi import NO_CLASS, REST
 from mindgrasp_common.mi import class_index as mi_class_index
 from mindgrasp_common.types import Recording
 from mindgrasp_ros.topics import EEG_RAW, TRAINER_PROMPT, VIRTUAL_SUBJECT_INTENT
@@ -29,6 +30,8 @@ EEGMMIDB_RUNS: dict[int, dict[str, int]] = {
     **{r: {'T1': 2, 'T2': 3} for r in (5, 6, 9, 10, 12, 13, 14)},  # both fists / both feet
 }
 EEGMMIDB_IMAGERY_RUNS = (4, 6, 8, 10, 12, 14)
+#: EEGMMIDB's rest annotation (between every two cues, ~4.2 s), labelled :data:`REST` on request
+EEGMMIDB_REST = 'T0'
 _EEGMMIDB_NAME = re.compile(r'^S(\d{3})R(\d{2})\.edf$', re.IGNORECASE)
 
 
@@ -54,11 +57,16 @@ def eegmmidb_run(path: str | Path) -> tuple[int, int] | None:
     return (int(m.group(1)), int(m.group(2))) if m else None
 
 
-def load_edf(path: str | Path, event_map: dict[str, int] | None = None) -> Recording:
+def load_edf(path: str | Path, event_map: dict[str, int] | None = None,
+             rest: bool = False) -> Recording:
     """Load an EDF/BDF/GDF file (through MNE) with cue events from its annotations.
 
     EEGMMIDB files (SxxxRyy.edf) are labelled with the dataset's run/class mapping and their
-    channel names standardised; other files need ``event_map`` (annotation -> class).
+    channel names standardised; other files need ``event_map`` (annotation -> class, which may
+    map an annotation to ``rest``). ``rest`` labels EEGMMIDB's T0 annotations as rest epochs
+    (class :data:`~mindgrasp_common.mi.REST`). The file's annotations are kept in
+    ``Recording.annotations`` (onset s from the first sample, duration s, description), so
+    evaluations can label windows by the annotation they lie in.
     """
     import mne
 
@@ -76,7 +84,14 @@ def load_edf(path: str | Path, event_map: dict[str, int] | None = None) -> Recor
             msg = (f'{path.name} is EEGMMIDB run {run[1]}, a baseline run without MI cues; use '
                    'runs 4, 8, 12 (left/right) or 6, 10, 14 (hands/feet).')
             raise ClassifierError(msg)
-        event_map = EEGMMIDB_RUNS[run[1]]
+        event_map = dict(EEGMMIDB_RUNS[run[1]])
+        if rest:
+            event_map[EEGMMIDB_REST] = REST
+    elif rest and REST not in event_map.values():
+        msg = (f'Rest epochs of {path.name} need an event-map entry for its rest annotation, '
+               'e.g. --event-map T0=rest,T1=left_hand,T2=right_hand (--rest alone labels '
+               "EEGMMIDB's T0).")
+        raise ClassifierError(msg)
     try:
         raw = mne.io.read_raw(path, preload=True, verbose='error')
     except Exception as exc:  # MNE raises many types for unreadable files
@@ -86,14 +101,36 @@ def load_edf(path: str | Path, event_map: dict[str, int] | None = None) -> Recor
         mne.datasets.eegbci.standardize(raw)
     raw.pick('eeg')
     rate = float(raw.info['sfreq'])
-    events = []
+    events, annotations = [], []
     for ann in raw.annotations:
         label = ann['description']
+        onset = int(raw.time_as_index(ann['onset'], use_rounding=True)[0])
+        annotations.append((onset / rate, float(ann['duration']), str(label)))
         if label in event_map:
-            onset = int(raw.time_as_index(ann['onset'], use_rounding=True)[0])
             events.append((onset, event_map[label]))
     return Recording(data=raw.get_data().T, rate=rate, channels=list(raw.ch_names),
-                     events=np.array(events, dtype=int).reshape(-1, 2), source=str(path))
+                     events=np.array(events, dtype=int).reshape(-1, 2),
+                     annotations=annotations, source=str(path))
+
+
+def add_rest_events(rec: Recording, description: str = EEGMMIDB_REST) -> Recording:
+    """``rec`` with its ``description`` annotations (EEGMMIDB: T0) added as rest events.
+
+    Returns ``rec`` itself when it already has rest events; raises when it has no such
+    annotation (recorded runs and synthetic recordings have none).
+    """
+    if np.any(rec.events[:, 1] == REST):
+        return rec
+    onsets = sorted({round(onset * rec.rate) for onset, _, name in rec.annotations
+                     if name == description})
+    if not onsets:
+        msg = (f'{rec.source or "The recording"} has no {description!r} annotations to label as '
+               'rest; rest epochs come from EEGMMIDB files (T0) or an event map such as '
+               'T0=rest.')
+        raise ClassifierError(msg)
+    events = np.concatenate([rec.events, [(o, REST) for o in onsets]]).astype(int)
+    events = events[np.argsort(events[:, 0], kind='stable')]
+    return dataclasses.replace(rec, events=events)
 
 
 def eegbci_files(subject: int, runs: Sequence[int], path: str | None = None) -> list[Path]:
@@ -295,12 +332,23 @@ def load_inputs(edf: Iterable[str] = (), bags: Iterable[str] = (), event_map: st
                 eeg_topic: str = EEG_RAW.name,
                 prompt_topic: str = TRAINER_PROMPT.name, *, labels: str = 'prompt',
                 keep_aborted: bool = False, intent_topic: str = VIRTUAL_SUBJECT_INTENT.name,
-                tmin: float = 0.5, tmax: float = 2.5) -> list[Recording]:
-    """Load every input named on a command line; raises if none is given."""
+                tmin: float = 0.5, tmax: float = 2.5, rest: bool = False) -> list[Recording]:
+    """Load every input named on a command line; raises if none is given.
+
+    ``rest`` labels rest epochs of EDF files (:func:`load_edf`); recorded runs have no rest
+    labels, so it refuses bags.
+    """
+    bags = list(bags)
+    if rest and bags:
+        msg = ('Rest epochs come from EDF files (EEGMMIDB T0, or an event map entry such as '
+               'T0=rest); recorded runs have no rest labels, so train rest on EDF data or leave '
+               'out --rest.')
+        raise ClassifierError(msg)
     emap = parse_event_map(event_map) if event_map else None
-    recs = [load_edf(p, emap) for p in edf]
+    recs = [load_edf(p, emap, rest=rest) for p in edf]
     if eegbci_subject is not None:
-        recs += [load_edf(p) for p in eegbci_files(eegbci_subject, eegbci_runs or (4, 6, 8, 10))]
+        recs += [load_edf(p, rest=rest)
+                 for p in eegbci_files(eegbci_subject, eegbci_runs or (4, 6, 8, 10))]
     recs += [load_bag(p, eeg_topic, prompt_topic, labels=labels, keep_aborted=keep_aborted,
                       intent_topic=intent_topic, tmin=tmin, tmax=tmax) for p in bags]
     if not recs:

@@ -3,20 +3,28 @@
 Windows are cut from the causally filtered continuous recording on the online decoder's window
 grid (see :mod:`mindgrasp_classifier.decoder`), so offline figures describe the online decoder.
 A trial is decided by the smallest mean distance over its windows.
+
+Cross-validation holds out whole recordings (leave one run out) when the training data has
+several, because epochs of one run share more than their class (electrode contact, fatigue, the
+run's class set); only a single recording is cross-validated by trial-grouped k-fold. The
+held-out window predictions calibrate the model's probabilities (temperature scaling,
+:mod:`mindgrasp_classifier.calibration`).
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass, field
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 from pyriemann.geometry.mean import mean_riemann
-from sklearn.metrics import balanced_accuracy_score, confusion_matrix
-from sklearn.model_selection import StratifiedGroupKFold
+from sklearn.metrics import confusion_matrix, recall_score
+from sklearn.model_selection import LeaveOneGroupOut, StratifiedGroupKFold
 
-from mindgrasp_classifier.data import Recording
+from mindgrasp_classifier.calibration import calibration_summary, fit_temperature, label_positions
+from mindgrasp_classifier.data import Recording, add_rest_events
 from mindgrasp_classifier.decoder import (
     AdaptationConfig,
     CueLabels,
@@ -36,6 +44,10 @@ from mindgrasp_classifier.preprocessing import (
     window_ends,
     window_samples,
 )
+from mindgrasp_common.mi import REST
+
+#: ``cross_validation['scheme']`` values
+LORO, KFOLD = 'leave_one_run_out', 'trial_grouped_kfold'
 
 
 @dataclass
@@ -60,9 +72,14 @@ class TrainingConfig:
     estimator : str
         pyRiemann covariance estimator (``oas``).
     classes : list of int or None
-        Classes to keep (None: every class in the data).
+        Classes to keep (None: every class in the data); may include 4 (rest).
+    rest : bool
+        Label rest epochs: recordings without rest events get their EEGMMIDB T0 annotations as
+        class 4 (:func:`~mindgrasp_classifier.data.add_rest_events`). Implied when ``classes``
+        includes rest.
     cv_folds : int
-        Cross-validation folds (grouped by trial).
+        Folds of the trial-grouped k-fold (the scheme of a single recording, and the
+        optimistic figure when classes and recordings are confounded).
     min_trials : int
         Fewest trials per class to train.
     seed : int
@@ -80,6 +97,7 @@ class TrainingConfig:
     tmax: float = 2.5
     estimator: str = 'oas'
     classes: list[int] | None = None
+    rest: bool = False
     cv_folds: int = 5
     min_trials: int = 5
     seed: int = 0
@@ -97,6 +115,10 @@ class TrainingConfig:
             msg = (f'Window steps must be positive; got step={self.step}, '
                    f'train_step={self.train_step}.')
             raise ClassifierError(msg)
+        if self.rest and self.classes is not None and REST not in self.classes:
+            msg = (f'Rest epochs are requested but the classes {self.classes} leave rest out; '
+                   'add rest to --classes or leave out --rest.')
+            raise ClassifierError(msg)
 
 
 @dataclass
@@ -112,6 +134,10 @@ class Windows:
     ends : ndarray of int, shape (n_windows,)
         Last sample of each window, in its recording.
     trial_labels : ndarray of int, shape (n_trials,)
+    trial_groups : ndarray of int, shape (n_trials,)
+        Index (in the recordings given) of the recording of each trial.
+    session_covs : list of ndarray
+        Covariances over each whole recording (``session_step``), for session re-centering.
     """
 
     covs: np.ndarray
@@ -120,6 +146,12 @@ class Windows:
     ends: np.ndarray
     trial_labels: np.ndarray
     session_covs: list[np.ndarray] = field(default_factory=list)
+    trial_groups: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
+
+    @property
+    def groups(self) -> np.ndarray:
+        """Recording index of each window, shape (n_windows,)."""
+        return self.trial_groups[self.trials]
 
 
 def epoch_windows(model: MiModel, recordings: Sequence[Recording], tmin: float, tmax: float,
@@ -132,9 +164,9 @@ def epoch_windows(model: MiModel, recordings: Sequence[Recording], tmin: float, 
     """
     n_window = window_samples(model.rate, model.window)
     n_step = step_samples(model.rate, step)
-    covs, labels, trials, ends_all, trial_labels = [], [], [], [], []
+    covs, labels, trials, ends_all, trial_labels, trial_groups = [], [], [], [], [], []
     session_covs = []
-    for rec in recordings:
+    for r, rec in enumerate(recordings):
         filtered = filter_recording(model, rec.data, rec.channels, rec.rate)
         finite = np.isfinite(filtered).all(axis=1)
         bad_before = np.concatenate([[0], np.cumsum(~finite)])
@@ -152,6 +184,7 @@ def epoch_windows(model: MiModel, recordings: Sequence[Recording], tmin: float, 
             trials += [len(trial_labels)] * len(ends)
             ends_all.append(ends)
             trial_labels.append(int(cls))
+            trial_groups.append(r)
         if session_step is not None:
             ends = window_ends(0, filtered.shape[0], n_window,
                                step_samples(model.rate, session_step))
@@ -162,7 +195,8 @@ def epoch_windows(model: MiModel, recordings: Sequence[Recording], tmin: float, 
         covs=np.concatenate(covs) if covs else np.zeros((0, n, n)),
         labels=np.array(labels, dtype=int), trials=np.array(trials, dtype=int),
         ends=np.concatenate(ends_all) if ends_all else np.zeros(0, dtype=int),
-        trial_labels=np.array(trial_labels, dtype=int), session_covs=session_covs)
+        trial_labels=np.array(trial_labels, dtype=int), session_covs=session_covs,
+        trial_groups=np.array(trial_groups, dtype=int))
 
 
 def _check_counts(trial_labels: np.ndarray, min_trials: int) -> list[int]:
@@ -192,6 +226,21 @@ def trial_decisions(distances: np.ndarray, trials: np.ndarray,
     return mean, np.argmin(mean, axis=1)
 
 
+def balanced_accuracy(y_true: np.ndarray, y_pred: np.ndarray) -> float:
+    """Mean recall over the classes present in ``y_true`` (scikit-learn's balanced accuracy,
+    without its warning when ``y_pred`` holds classes ``y_true`` lacks). Shapes (n,)."""
+    return float(recall_score(y_true, y_pred, labels=np.unique(y_true), average='macro'))
+
+
+def _certainty(distances: np.ndarray) -> np.ndarray:
+    """Certainty over the classes with a finite distance (a fold may lack some classes)."""
+    d = np.asarray(distances, dtype=float)
+    if np.isfinite(d).all():
+        return certainty(d)
+    d = np.where(np.isfinite(d), d, np.nan)
+    return np.nanmean(d, axis=-1) - np.nanmin(d, axis=-1)
+
+
 def score(classes: Sequence[int], distances: np.ndarray, window_labels: np.ndarray,
           trials: np.ndarray, trial_labels: np.ndarray) -> dict[str, Any]:
     """Accuracy figures of window distances against labels.
@@ -201,21 +250,23 @@ def score(classes: Sequence[int], distances: np.ndarray, window_labels: np.ndarr
     classes : sequence of int
         Model classes, the column order of ``distances``.
     distances : ndarray, shape (n_windows, n_classes)
+        ``inf`` for a class the deciding model did not know (a cross-validation fold).
     window_labels, trials : ndarray of int, shape (n_windows,)
     trial_labels : ndarray of int, shape (n_trials,)
 
     Returns
     -------
     report : dict
-        ``accuracy`` and ``balanced_accuracy`` (per trial), ``window_accuracy``, ``n_trials``,
-        ``n_windows``, ``confusion`` (rows true, columns predicted, order of ``classes``),
-        ``classes`` (names), ``chance``, and ``certainty`` per true class (window statistics).
+        ``accuracy`` and ``balanced_accuracy`` (per trial), ``window_accuracy``,
+        ``window_balanced_accuracy``, ``n_trials``, ``n_windows``, ``confusion`` (rows true,
+        columns predicted, order of ``classes``), ``classes`` (names), ``chance``, and
+        ``certainty`` per true class (window statistics).
     """
     classes = np.asarray(classes)
     win_pred = classes[np.argmin(distances, axis=1)]
     _, pos = trial_decisions(distances, trials, len(trial_labels))
     trial_pred = classes[pos]
-    cert = certainty(distances)
+    cert = _certainty(distances)
     cert_stats = {}
     for c in classes:
         sel = cert[window_labels == c]
@@ -229,9 +280,9 @@ def score(classes: Sequence[int], distances: np.ndarray, window_labels: np.ndarr
             }
     return {
         'accuracy': float(np.mean(trial_pred == trial_labels)),
-        'balanced_accuracy': float(balanced_accuracy_score(trial_labels, trial_pred)),
+        'balanced_accuracy': balanced_accuracy(trial_labels, trial_pred),
         'window_accuracy': float(np.mean(win_pred == window_labels)),
-        'window_balanced_accuracy': float(balanced_accuracy_score(window_labels, win_pred)),
+        'window_balanced_accuracy': balanced_accuracy(window_labels, win_pred),
         'n_trials': len(trial_labels),
         'n_windows': len(window_labels),
         'trials_per_class': {CLASS_NAMES[c]: int(np.sum(trial_labels == c)) for c in classes},
@@ -264,10 +315,14 @@ def train(recordings: Sequence[Recording], cfg: TrainingConfig | None = None,
     Returns
     -------
     model : MiModel
-        Fitted on all trials; ``model.provenance`` holds the data, settings and CV results.
+        Fitted on all trials; ``model.provenance`` holds the data, settings, cross-validation
+        (``cross_validation``: ``scheme``, ``accuracy``, ``balanced_accuracy`` ...) and the
+        probability calibration (``calibration``); ``model.temperature`` is fitted on the
+        held-out predictions (1.0 without cross-validation).
     report : dict
-        Cross-validation figures from :func:`score` (empty when ``cross_validate`` is False),
-        plus ``trials_per_class``.
+        Cross-validation figures (:func:`cross_validate`, empty when ``cross_validate`` is
+        False) with ``calibration`` (:func:`~mindgrasp_classifier.calibration.calibration_summary`
+        plus the scheme its predictions came from).
     """
     cfg = cfg or TrainingConfig()
     cfg.check()
@@ -279,6 +334,8 @@ def train(recordings: Sequence[Recording], cfg: TrainingConfig | None = None,
         msg = (f'The recordings have different sampling rates {sorted(rates)} Hz; train on '
                'recordings of one rate (resample the others first).')
         raise ClassifierError(msg)
+    if cfg.rest or (cfg.classes is not None and REST in cfg.classes):
+        recordings = [add_rest_events(rec) for rec in recordings]
     all_events = np.concatenate([rec.events[:, 1] for rec in recordings])
     present = sorted(set(all_events.tolist()))
     wanted = cfg.classes if cfg.classes is not None else present
@@ -292,24 +349,87 @@ def train(recordings: Sequence[Recording], cfg: TrainingConfig | None = None,
         raise ClassifierError(msg)
     model.classes = classes
     report: dict[str, Any] = {}
+    calibration: dict[str, Any] = {'method': 'temperature_scaling', 'temperature': 1.0,
+                                   'source': None}
     if cross_validate:
-        report = cross_validate_windows(model, win, cfg.cv_folds, cfg.seed)
+        names = [_short_name(rec.source, i) for i, rec in enumerate(recordings)]
+        report, held = cross_validate_model(model, win, names, cfg.cv_folds, cfg.seed)
+        logits = model.classifier.logits(held.distances)
+        positions = label_positions(classes, held.labels)
+        model.temperature = fit_temperature(logits, positions)
+        calibration.update(calibration_summary(logits, positions, model.temperature),
+                           source=held.scheme)
+        report['calibration'] = calibration
     _fit(model, win.covs, win.labels)
     model.provenance = {
         'sources': [rec.source for rec in recordings],
         'trials_per_class': {CLASS_NAMES[c]: int(np.sum(win.trial_labels == c)) for c in classes},
         'n_windows': len(win.labels),
         'config': asdict(cfg),
-        'cross_validation': {k: report[k] for k in ('accuracy', 'balanced_accuracy',
-                                                    'window_accuracy', 'confusion', 'folds')
-                             if k in report},
+        'cross_validation': {k: report[k] for k in CV_KEYS if k in report},
+        'calibration': calibration,
     }
     model.versions = library_versions()
     return model, report
 
 
-def cross_validate_windows(model: MiModel, win: Windows, folds: int, seed: int) -> dict[str, Any]:
-    """Trial-grouped stratified cross-validation (windows of a trial stay in one fold)."""
+#: cross-validation figures kept in a model's provenance
+CV_KEYS = ('scheme', 'accuracy', 'balanced_accuracy', 'window_accuracy', 'confusion', 'folds',
+           'scored_classes', 'confounded', 'confound', 'per_run', 'n_unscored_trials',
+           'optimistic')
+
+
+def _short_name(source: str, index: int) -> str:
+    return Path(source).name if source else f'recording {index + 1}'
+
+
+@dataclass
+class WindowPredictions:
+    """Scored window predictions: held out by a cross-validation, or of an evaluation.
+
+    Attributes
+    ----------
+    distances : ndarray, shape (n_windows, n_classes)
+        Class distances in the order of the model's classes; in cross-validation, from the fold
+        that held each window out, ``inf`` for classes that fold's training data lacked.
+    labels : ndarray of int, shape (n_windows,)
+        True class of each window.
+    scheme : str
+        Where they come from: :data:`LORO`, :data:`KFOLD`, ``offline`` or ``pseudo_online``.
+    """
+
+    distances: np.ndarray
+    labels: np.ndarray
+    scheme: str
+
+
+def _fold_distances(model: MiModel, win: Windows, train_idx: np.ndarray,
+                    test_idx: np.ndarray) -> np.ndarray:
+    """Distances of the ``test_idx`` windows under a model fitted on the ``train_idx`` windows,
+    in the columns of ``model.classes`` (``inf`` for classes the fold's training data lacks)."""
+    fold = model.copy()
+    known = sorted(set(win.labels[train_idx].tolist()))
+    fold.classes = known
+    _fit(fold, win.covs[train_idx], win.labels[train_idx])
+    out = np.full((len(test_idx), len(model.classes)), np.inf)
+    out[:, [model.classes.index(c) for c in known]] = decode_windows(fold, win.covs[test_idx])
+    return out
+
+
+def _subset(win: Windows, keep: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Window trials renumbered 0.. over the windows ``keep`` (bool, shape (n_windows,)), and
+    the labels of those trials."""
+    old = np.unique(win.trials[keep])
+    return np.searchsorted(old, win.trials[keep]), win.trial_labels[old]
+
+
+def trial_grouped_kfold(model: MiModel, win: Windows, folds: int,
+                        seed: int) -> tuple[dict[str, Any], np.ndarray]:
+    """Trial-grouped stratified k-fold (windows of a trial stay in one fold).
+
+    Returns the :func:`score` report (with ``scheme`` and ``folds``) and the held-out
+    distances, shape (n_windows, n_classes).
+    """
     n_folds = int(min(folds, np.bincount(win.trial_labels).max(initial=0),
                       min(np.sum(win.trial_labels == c) for c in model.classes)))
     if n_folds < 2:
@@ -317,13 +437,124 @@ def cross_validate_windows(model: MiModel, win: Windows, folds: int, seed: int) 
         raise ClassifierError(msg)
     cv = StratifiedGroupKFold(n_splits=n_folds, shuffle=True, random_state=seed)
     distances = np.zeros((len(win.labels), len(model.classes)))
-    fold_model = model.copy()
     for train_idx, test_idx in cv.split(win.covs, win.labels, win.trials):
-        _fit(fold_model, win.covs[train_idx], win.labels[train_idx])
-        distances[test_idx] = decode_windows(fold_model, win.covs[test_idx])
+        distances[test_idx] = _fold_distances(model, win, train_idx, test_idx)
     report = score(model.classes, distances, win.labels, win.trials, win.trial_labels)
-    report['folds'] = n_folds
-    return report
+    report.update(scheme=KFOLD, folds=n_folds)
+    return report, distances
+
+
+def cross_validate_windows(model: MiModel, win: Windows, folds: int, seed: int) -> dict[str, Any]:
+    """Trial-grouped stratified cross-validation report (:func:`trial_grouped_kfold`)."""
+    return trial_grouped_kfold(model, win, folds, seed)[0]
+
+
+def confound_sentence(classes: Sequence[int], run_classes: Sequence[set[int]],
+                      names: Sequence[str]) -> str | None:
+    """One sentence on classes that only some recordings contain, or None if every recording
+    has every class.
+
+    ``run_classes[i]`` holds the classes with trials in recording ``names[i]``.
+    """
+    where: dict[tuple[str, ...], list[str]] = {}
+    for c in classes:
+        holders = tuple(n for n, have in zip(names, run_classes, strict=True) if c in have)
+        if len(holders) < len(names):
+            where.setdefault(holders, []).append(CLASS_NAMES[c])
+    if not where:
+        return None
+    parts = '; '.join(f"{', '.join(cls)} only in {', '.join(h)}" for h, cls in where.items())
+    return (f'Classes and recordings are confounded ({parts}): a held-out recording is scored '
+            'only on the classes the other recordings also contain, and the trial-grouped '
+            'k-fold figure is optimistic because its folds share recordings, whose identity '
+            'then gives the class away.')
+
+
+def leave_one_run_out(model: MiModel, win: Windows,
+                      names: Sequence[str]) -> tuple[dict[str, Any], np.ndarray, np.ndarray]:
+    """Leave-one-recording-out cross-validation.
+
+    Each recording is decoded by a model fitted on the others, on the trials whose class those
+    others contain (a fold can only name classes it was trained on).
+
+    Returns
+    -------
+    report : dict
+        Pooled :func:`score` figures of the scored trials (``accuracy`` etc. ``None`` when no
+        trial could be scored), ``scheme``, ``folds`` (recordings), ``per_run`` (per held-out
+        recording: its classes, the scored ones, accuracies), ``n_unscored_trials``.
+    distances : ndarray, shape (n_windows, n_classes)
+        Held-out distances (``inf`` for classes a fold lacked; rows of unscored windows too).
+    scored : ndarray of bool, shape (n_windows,)
+    """
+    groups = win.groups
+    distances = np.full((len(win.labels), len(model.classes)), np.inf)
+    scored = np.zeros(len(win.labels), dtype=bool)
+    per_run = []
+    for train_idx, test_idx in LeaveOneGroupOut().split(win.covs, win.labels, groups):
+        r = int(groups[test_idx[0]])
+        test = groups == r
+        known = set(win.labels[train_idx].tolist())
+        have = sorted(set(win.trial_labels[win.trial_groups == r].tolist()))
+        entry: dict[str, Any] = {'recording': names[r], 'classes': [CLASS_NAMES[c] for c in have]}
+        sel = test & np.isin(win.labels, sorted(known)) if len(known) >= 2 else np.zeros_like(test)
+        entry['scored_classes'] = sorted({CLASS_NAMES[c] for c in win.labels[sel]},
+                                         key=CLASS_NAMES.index)
+        entry['n_trials'] = len(np.unique(win.trials[sel]))
+        if sel.any():
+            scored_idx = np.flatnonzero(sel)
+            distances[scored_idx] = _fold_distances(model, win, train_idx, scored_idx)
+            scored |= sel
+            trials, labels = _subset(win, sel)
+            fold = score(model.classes, distances[sel], win.labels[sel], trials, labels)
+            entry.update({k: fold[k] for k in ('accuracy', 'balanced_accuracy',
+                                                'window_accuracy')})
+        else:
+            entry.update(accuracy=None, balanced_accuracy=None, window_accuracy=None)
+        per_run.append(entry)
+    n_unscored = len(win.trial_labels) - len(np.unique(win.trials[scored]))
+    if scored.any():
+        trials, labels = _subset(win, scored)
+        report = score(model.classes, distances[scored], win.labels[scored], trials, labels)
+        report['scored_classes'] = [CLASS_NAMES[c] for c in np.unique(labels)]
+    else:
+        report = {'accuracy': None, 'balanced_accuracy': None, 'window_accuracy': None,
+                  'window_balanced_accuracy': None, 'n_trials': 0, 'n_windows': 0,
+                  'classes': model.class_names, 'chance': 1.0 / len(model.classes),
+                  'scored_classes': []}
+    report.update(scheme=LORO, folds=len(per_run), per_run=per_run,
+                  n_unscored_trials=int(n_unscored))
+    return report, distances, scored
+
+
+def cross_validate_model(model: MiModel, win: Windows, names: Sequence[str], folds: int = 5,
+                         seed: int = 0) -> tuple[dict[str, Any], WindowPredictions]:
+    """Cross-validate by recording when there are several, else by trial-grouped k-fold.
+
+    With several recordings the report is :func:`leave_one_run_out`'s, plus ``confounded``
+    and, when classes and recordings are confounded, ``confound`` (:func:`confound_sentence`)
+    and ``optimistic`` (the trial-grouped k-fold over all recordings, labelled optimistic).
+    The held-out predictions for calibration come from leave-one-run-out when they cover at
+    least two classes, else from the k-fold.
+    """
+    runs = np.unique(win.trial_groups)
+    if len(runs) < 2:
+        report, dist = trial_grouped_kfold(model, win, folds, seed)
+        return report, WindowPredictions(dist, win.labels, KFOLD)
+    report, dist, scored = leave_one_run_out(model, win, names)
+    run_classes = [set(win.trial_labels[win.trial_groups == r].tolist()) for r in runs]
+    sentence = confound_sentence(model.classes, run_classes, [names[r] for r in runs])
+    report['confounded'] = sentence is not None
+    held = WindowPredictions(dist[scored], win.labels[scored], LORO)
+    if sentence is not None:
+        report['confound'] = sentence
+        kfold, kdist = trial_grouped_kfold(model, win, folds, seed)
+        report['optimistic'] = {k: kfold[k] for k in (
+            'scheme', 'folds', 'accuracy', 'balanced_accuracy', 'window_accuracy',
+            'window_balanced_accuracy', 'confusion', 'n_trials')}
+        if len(np.unique(held.labels)) < 2:
+            held = WindowPredictions(kdist, win.labels, KFOLD)
+    return report, held
 
 
 def evaluate(model: MiModel, recordings: Sequence[Recording], tmin: float = 0.5,
@@ -331,8 +562,17 @@ def evaluate(model: MiModel, recordings: Sequence[Recording], tmin: float = 0.5,
     """Score a model on labelled recordings with the online window grid (step = model step).
 
     ``recenter='session'`` re-centres each recording on the Riemannian mean of all its windows
-    (unsupervised re-centering between sessions) instead of the training reference.
+    (unsupervised re-centering between sessions) instead of the training reference. The report
+    is :func:`score`'s with ``calibration`` (NLL and ECE of the window probabilities,
+    :func:`~mindgrasp_classifier.calibration.calibration_summary`).
     """
+    return evaluate_windows(model, recordings, tmin, tmax, recenter)[0]
+
+
+def evaluate_windows(model: MiModel, recordings: Sequence[Recording], tmin: float = 0.5,
+                     tmax: float = 2.5,
+                     recenter: str = 'fixed') -> tuple[dict[str, Any], WindowPredictions]:
+    """:func:`evaluate`, also returning the scored windows' predictions (reliability plots)."""
     if recenter not in ('fixed', 'session'):
         msg = f"Unknown re-centering {recenter!r}; choose 'fixed' or 'session'."
         raise ClassifierError(msg)
@@ -353,11 +593,15 @@ def evaluate(model: MiModel, recordings: Sequence[Recording], tmin: float = 0.5,
         msg = (f'No trials of the model classes {model.class_names} in the data; check the files '
                'and the event map.')
         raise ClassifierError(msg)
-    report = score(model.classes, np.concatenate(dists), np.concatenate(labels),
-                   np.concatenate(trials), np.array(trial_labels))
+    windows = WindowPredictions(np.concatenate(dists), np.concatenate(labels), 'offline')
+    report = score(model.classes, windows.distances, windows.labels, np.concatenate(trials),
+                   np.array(trial_labels))
     report['skipped_trials_other_classes'] = skipped
     report['recenter'] = recenter
-    return report
+    report['calibration'] = calibration_summary(
+        model.classifier.logits(windows.distances), label_positions(model.classes, windows.labels),
+        model.temperature)
+    return report, windows
 
 
 def stream_recording(model: MiModel, rec: Recording, adaptation: AdaptationConfig | None = None,
