@@ -11,7 +11,8 @@ Modes (all seeded: same seed and same inputs, same decisions):
     with probability ``lapse_rate``; otherwise it imagines the prompted class with probability
     ``accuracy`` and one of the three other classes (uniformly) otherwise.
 ``pursue``
-    Acts as a competent user of the MIndGrasp controller (see :func:`pursue_class`), from the task
+    Acts as a competent user of the MIndGrasp controller, instructed in its paradigm (see
+    :func:`pursue_class` for ``paper`` and :func:`scan_class` for ``scan``), from the task
     target, the scene objects, the base joint angle and the controller state. Every
     ``decision_period`` seconds it re-decides; the decision is right with probability ``accuracy``.
     A new target cancels what was still to come for the old one: the subject rests and decides
@@ -110,6 +111,50 @@ def pursue_class(target: SceneObject | None, base_yaw: float, fsm_state: int,
     return BOTH_HANDS
 
 
+def scan_class(target: SceneObject | None, base_yaw: float, fsm_state: int, *,
+               offered: bool = False, heading_tolerance: float = 0.3,
+               stopped: bool = False) -> int | None:
+    """What a person instructed in the ``scan`` paradigm imagines (pure function).
+
+    The arm turns from object to object by itself and offers each one it has centred
+    (``FsmState.offered``); the person looks where the arm points. Instructions: while the arm
+    offers an object, imagine both hands for the one you want and both feet for any other;
+    while it approaches the one you want keep imagining both hands, and both feet if it
+    approaches another; rest while it searches.
+
+    Parameters
+    ----------
+    target : SceneObject or None
+        The desired object in the base frame; None -> rest.
+    base_yaw : float
+        Heading of the arm (rad), as for :func:`pursue_class`.
+    fsm_state : int
+        ``FsmState.state``.
+    offered : bool
+        ``FsmState.offered``: the controller waits for a confirmation of the object it faces.
+    heading_tolerance : float
+        Heading error (rad) under which the person sees the arm pointing at the target (set
+        locations are 0.7 rad apart).
+    stopped : bool
+        ``FsmState.stopped``: after a prediction loss the controller waits for a fresh command;
+        the person imagines both hands ("go on") until it moves again.
+
+    Returns
+    -------
+    int or None
+        2 both hands (yes / go on), 3 both feet (no / cancel), None (rest).
+    """
+    if target is None:
+        return None
+    if stopped:
+        return BOTH_HANDS
+    facing = abs(wrap_angle(math.atan2(target.y, target.x) - base_yaw)) <= heading_tolerance
+    if (fsm_state in (State.OBJECT_SEARCH, State.CENTER_OBJECT) and offered) or \
+            fsm_state in (State.INITIAL_APPROACH, State.FINAL_APPROACH):
+        return BOTH_HANDS if facing else BOTH_FEET
+    return None
+
+
 class VirtualSubject:
     """Seeded virtual BCI user (see module docstring for the modes).
 
@@ -163,6 +208,7 @@ class VirtualSubject:
         self._target_changed = False
         self.base_yaw, self.fsm_state, self.object_of_interest = 0.0, 0, ''
         self.fsm_stopped = False
+        self.paradigm, self.offered = 'paper', False
         #: (time, asked class or None, imagined class or None) for every decision taken
         self.decisions: list[tuple[float, int | None, int | None]] = []
 
@@ -198,14 +244,21 @@ class VirtualSubject:
         """Arm heading (rad), from ``/joint_states``."""
         self.base_yaw = float(yaw)
 
-    def set_fsm(self, state: int, object_of_interest: str = '', stopped: bool = False) -> None:
-        """Controller state (``/fsm/state``): its number, object of interest and stop flag."""
+    def set_fsm(self, state: int, object_of_interest: str = '', stopped: bool = False,
+                paradigm: str = '', offered: bool = False) -> None:
+        """Controller state (``/fsm/state``): its number, object of interest, stop flag, the
+        paradigm it runs (``''``: a controller that does not say is taken as ``paper``) and
+        whether it offers its object of interest (scan)."""
         self.fsm_state, self.object_of_interest = int(state), object_of_interest
         self.fsm_stopped = bool(stopped)
+        self.paradigm, self.offered = paradigm or 'paper', bool(offered)
 
     def competent_class(self) -> int | None:
         """What a competent user would imagine now (pursue mode inputs, no errors)."""
         target = find_target(self.objects, self.target_id, self.target_colour, self.target_shape)
+        if self.paradigm == 'scan':
+            return scan_class(target, self.base_yaw, self.fsm_state, offered=self.offered,
+                              stopped=self.fsm_stopped)
         return pursue_class(target, self.base_yaw, self.fsm_state, self.object_of_interest,
                             heading_tolerance=self.heading_tolerance, stopped=self.fsm_stopped)
 

@@ -5,9 +5,9 @@
 No EEG and no classifier: the virtual subject in pursue mode (:class:`~mindgrasp_eeg.subject.
 VirtualSubject`, accuracy 1) decides what to imagine from ``/task/target``, ``/sim/objects``,
 ``/joint_states`` and ``/fsm/state``, and that class is published every ``period`` seconds as an
-MIPrediction with ``certainty``. While the subject rests, it publishes both feet with certainty 0
-(below every threshold of the controller, which then acts on its own). The upper bound of what
-the controller achieves with a BCI.
+MIPrediction with ``certainty`` and probability ``probability`` (the decoder classes include
+rest). While the subject rests, it publishes rest with certainty 0 (no command: the controller
+acts on its own or waits). The upper bound of what the controller achieves with a BCI.
 """
 
 from __future__ import annotations
@@ -21,7 +21,7 @@ from mindgrasp_ros.interfaces.std_msgs.msg import String
 from mindgrasp_ros.interfaces.visualization_msgs.msg import MarkerArray
 
 from mindgrasp_common.markers import objects_from_markers
-from mindgrasp_common.mi import CLASS_NAMES
+from mindgrasp_common.mi import DECODER_CLASS_NAMES, REST
 from mindgrasp_eeg.montage import class_name
 from mindgrasp_eeg.ros_conversions import base_yaw_from_joint_state
 from mindgrasp_eeg.subject import VirtualSubject
@@ -47,6 +47,8 @@ class OracleParams:
     # 0.2: the default decoder's mean certainty on the virtual subject (records' mean_certainty),
     # so the arm moves as fast as with real decoding and the controller's gains fit both
     certainty: float = param(0.2, 'certainty of the intended class', min=0.0)
+    probability: float = param(0.9, 'probability of the intended class (rest while the subject '
+                               'rests)', min=0.0, max=1.0)
     reaction_delay: float = param(0.3, 'from a decision to its prediction', unit='s', min=0.0)
     decision_period: float = param(0.25, 'time between decisions', unit='s', min=1e-3)
     heading_tolerance: float = param(0.1, 'heading error taken as centred', unit='rad',
@@ -94,18 +96,25 @@ class OracleSubjectNode(rclpy.node.Node):
             self.subject.set_base_yaw(yaw)
 
     def fsm_callback(self, msg: FsmState) -> None:
-        self.subject.set_fsm(int(msg.state), msg.object_of_interest, msg.stopped)
+        self.subject.set_fsm(int(msg.state), msg.object_of_interest, msg.stopped,
+                             paradigm=msg.paradigm, offered=msg.offered)
 
     def predict_callback(self) -> None:
         now = self.now_s()
         if now <= 0.0:
             return                                    # no /clock yet
         intent = self.subject.intent(now)
-        cls, certainty = (3, 0.0) if intent is None else (int(intent), self.p['certainty'])
-        distances = np.full(4, 1.0 + certainty, dtype=np.float32)
+        cls = REST if intent is None else int(intent)
+        certainty = 0.0 if intent is None else self.p['certainty']
+        distances = np.full(len(DECODER_CLASS_NAMES), 1.0 + certainty, dtype=np.float32)
         distances[cls] = 1.0
-        msg = MIPrediction(class_index=cls, class_names=list(CLASS_NAMES),
-                           certainty=float(certainty), distances=distances, window_length=0.0)
+        # the intended class (rest included) with p = oracle_probability, the rest shared
+        others = (1.0 - self.p['probability']) / (len(DECODER_CLASS_NAMES) - 1)
+        probabilities = np.full(len(DECODER_CLASS_NAMES), others, dtype=np.float32)
+        probabilities[cls] = self.p['probability']
+        msg = MIPrediction(class_index=cls, class_names=list(DECODER_CLASS_NAMES),
+                           certainty=float(certainty), distances=distances, window_length=0.0,
+                           probabilities=probabilities)
         msg.header.stamp = self.get_clock().now().to_msg()
         self.pub.publish(msg)
         if intent != self._last_intent:

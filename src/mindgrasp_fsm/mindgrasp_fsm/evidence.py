@@ -8,10 +8,12 @@ long enough. Each new prediction adds its log-probability ratio
 
 weighted by the time it covers (the gap to the previous prediction, at most ``max_gap`` s), so the
 evidence is a time integral in nat-seconds and does not depend on the decoder's window step. The
-sum never falls below 0 (a CUSUM, Page 1954): evidence against the decision before the person
-starts to imagine (their reaction time) cannot delay the decision afterwards. The decision is
-taken when the sum reaches ``threshold``: holding ``p(for) / p(against) = e`` (73 % against rest)
-for 2 s gives 2 nat-s.
+decision is taken when the sum reaches ``threshold``: holding ``p(for) / p(against) = e`` (73 %
+against the other side) for 2 s gives 2 nat-s. With a ``reject_threshold`` the same sum also
+decides the other way when it falls to ``-reject_threshold`` (Wald's sequential probability
+ratio test: both answers are active imagery, e.g. both hands "yes" and both feet "no"); without
+one the sum never falls below 0 (a CUSUM, Page 1954), so evidence against the decision before
+the person starts to imagine cannot delay it afterwards.
 
 When the decoder knows no ``rest`` class (a model of the four imagery classes only), "against"
 is every other class the decoder knows.
@@ -77,12 +79,17 @@ class Evidence:
         Largest log-ratio (nats) one prediction may add or remove.
     max_gap : float
         Longest time (s) one prediction stands for (a gap in the predictions adds nothing).
+    reject_threshold : float or None
+        Evidence (nat-s) against the decision at which it is rejected; None: never rejected,
+        the sum stays >= 0.
     """
 
     def __init__(self, for_class: int, against: Sequence[int], *, threshold: float,
-                 clip: float = 2.0, max_gap: float = 0.25) -> None:
+                 clip: float = 2.0, max_gap: float = 0.25,
+                 reject_threshold: float | None = None) -> None:
         self.for_class, self.against = int(for_class), [int(c) for c in against]
         self.threshold, self.clip, self.max_gap = float(threshold), float(clip), float(max_gap)
+        self.reject_threshold = reject_threshold
         self.reset()
 
     def reset(self, since: float = -math.inf) -> None:
@@ -98,12 +105,18 @@ class Evidence:
         return self.value >= self.threshold
 
     @property
+    def rejected(self) -> bool:
+        """Whether the evidence against the decision has reached ``reject_threshold``."""
+        return self.reject_threshold is not None and self.value <= -self.reject_threshold
+
+    @property
     def fraction(self) -> float:
         """Evidence as a fraction of the threshold (0..1), for displays."""
         return min(self.value / self.threshold, 1.0) if self.threshold > 0 else 1.0
 
     def update(self, prediction: Prediction | None) -> bool:
-        """Add ``prediction`` if it is newer than the last one counted; True once reached.
+        """Add ``prediction`` if it is newer than the last one counted; True once reached (see
+        :attr:`rejected` for the other answer).
 
         A prediction without probabilities (or without its decoder's ``classes``) adds nothing.
         """
@@ -118,7 +131,8 @@ class Evidence:
         if llr is None:
             return self.reached
         llr = min(max(llr, -self.clip), self.clip)
-        self.value = max(self.value + llr * min(gap, self.max_gap), 0.0)
+        floor = 0.0 if self.reject_threshold is None else -self.reject_threshold
+        self.value = max(self.value + llr * min(gap, self.max_gap), floor)
         self.peak = max(self.peak, self.value)
         self.n_windows += 1
         return self.reached

@@ -31,13 +31,15 @@ its limits.
 Two BCI paradigms (``paradigm``). ``paper``: the person steers with four classes as in the
 paper (left/right hand turn, both hands select and approach, both feet back off). ``scan``
 (hybrid shared control, after Xu et al., IEEE TASE 2022): the arm searches by itself as in
-autonomous mode and *offers* each object it centres; the person commits to it with both-hands
-imagery against rest, or lets it pass by resting (after ``offer_timeout`` the arm turns on by
-``scan_skip_angle`` to the next object). Once committed, the approach and grasp run by
-themselves, and both-feet imagery cancels them until the gripper closes (the arm returns to the
-start and goes on scanning past that object). Both decisions are taken on evidence accumulated
-over decoder windows from the calibrated class probabilities (:mod:`mindgrasp_fsm.evidence`);
-weak evidence means the arm waits.
+autonomous mode and *offers* each object it centres; the person answers yes with both-hands
+imagery or no with both-feet imagery, the two classes real EEG tells apart best (0.93 on
+EEGMMIDB S001 against 0.60 for left/right hand). Yes commits to the object; no, or no answer
+within ``offer_timeout``, lets the arm turn on by ``scan_skip_angle`` to the next object. Once
+committed, the approach and grasp run by themselves; the person keeps imagining both hands, and
+both feet cancel them until the gripper closes (the arm returns to the start and scans on past
+that object). Both decisions are taken on evidence accumulated over decoder windows from the
+calibrated class probabilities (:mod:`mindgrasp_fsm.evidence`); weak evidence means the arm
+waits.
 
 After the MI predictions went stale and came back (``resume_after_stale: require_new_command``,
 the default) the arm does not move again by itself: it holds still until a *fresh decision*, one
@@ -156,11 +158,11 @@ class GraspFsm:
         # committed to the object of interest, and the evidence of each decision
         self._offer_since: float | None = None
         self._committed = False
-        self._confirm = Evidence(MiClass.BOTH_HANDS, [REST],
+        self._confirm = Evidence(MiClass.BOTH_HANDS, [MiClass.BOTH_FEET],
                                  threshold=self.params.confirm_threshold,
-                                 clip=self.params.evidence_clip)
-        self._cancel = Evidence(MiClass.BOTH_FEET, [REST, MiClass.BOTH_HANDS, MiClass.LEFT_HAND,
-                                                    MiClass.RIGHT_HAND],
+                                 clip=self.params.evidence_clip,
+                                 reject_threshold=self.params.pass_threshold)
+        self._cancel = Evidence(MiClass.BOTH_FEET, [MiClass.BOTH_HANDS],
                                 threshold=self.params.cancel_threshold,
                                 clip=self.params.evidence_clip)
         self._attempt = 0
@@ -555,6 +557,7 @@ class GraspFsm:
             self._confirm.reset(self._now + p.offer_delay)
             self._events.append(f'offering the {ooi.label}')
         self._confirm.threshold, self._confirm.clip = p.confirm_threshold, p.evidence_clip
+        self._confirm.reject_threshold = p.pass_threshold
         if self._confirm.update(inputs.prediction):
             self._committed = True
             self._offer_since = None
@@ -562,12 +565,14 @@ class GraspFsm:
             self._goto(self._center_next, f'confirmed the {ooi.label} (both-hands evidence '
                        f'{self._confirm.value:.2f} nat s)')
             return np.zeros(6), 'confirmed'
-        if t - self._offer_since > p.offer_timeout:
+        declined = self._confirm.rejected
+        if declined or t - self._offer_since > p.offer_timeout:
             self._offer_since = None
             self._ignore_from = float(q[0])
             self._ignore_angle = p.scan_skip_angle
-            self._goto(State.OBJECT_SEARCH, f'passed the {ooi.label}: not confirmed in '
-                       f'{p.offer_timeout:.1f} s')
+            why = (f'declined (both-feet evidence {-self._confirm.value:.2f} nat s)' if declined
+                   else f'not confirmed in {p.offer_timeout:.1f} s')
+            self._goto(State.OBJECT_SEARCH, f'passed the {ooi.label}: {why}')
             return np.zeros(6), 'passed'
         return v, f'offering the {ooi.label}: evidence {self._confirm.fraction:.0%}'
 

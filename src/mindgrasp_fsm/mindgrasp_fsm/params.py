@@ -79,23 +79,27 @@ class FsmParams:
     # --- BCI -----------------------------------------------------------------------------------
     # paper: the person steers with 4 classes (left/right turn, both hands select and approach,
     # both feet back off). scan: the arm turns from object to object itself and offers each one;
-    # the person confirms with both hands (against rest) and cancels an approach with both feet,
-    # each decision taken on accumulated evidence (mindgrasp_fsm.evidence). Measured on real EEG
-    # (src/mindgrasp_experiments/README.md), scan gives far fewer wrong grasps.
+    # the person answers yes (both hands) or no (both feet) and cancels an approach with both
+    # feet, each decision taken on accumulated evidence (mindgrasp_fsm.evidence). Thresholds
+    # chosen on docs/subjects/eegmmidb_s001_swapped.yaml (benchmarks/decision_layer.py); measured
+    # in the loop on other runs (src/mindgrasp_experiments/README.md).
     paradigm: str = param('scan', 'BCI interaction: paper (4-class steering) or scan (the arm '
                           'offers each object, the person confirms or cancels)',
                           choices=PARADIGMS)
-    confirm_threshold: float = param(1.5, 'scan: evidence for both hands against rest that '
-                                     'commits to the offered object', unit='nat s', min=0.01,
-                                     max=100.0, live=True)
-    cancel_threshold: float = param(1.5, 'scan: evidence for both feet against the other '
-                                    'classes that cancels an approach before the gripper closes',
+    confirm_threshold: float = param(3.0, 'scan: evidence for both hands against both feet '
+                                     'that commits to the offered object', unit='nat s',
+                                     min=0.01, max=100.0, live=True)
+    pass_threshold: float = param(3.0, 'scan: evidence for both feet against both hands that '
+                                  'passes the offered object at once', unit='nat s', min=0.01,
+                                  max=100.0, live=True)
+    cancel_threshold: float = param(4.0, 'scan: evidence for both feet against both hands that '
+                                    'cancels an approach before the gripper closes',
                                     unit='nat s', min=0.01, max=100.0, live=True)
     evidence_clip: float = param(2.0, 'scan: largest log-probability ratio one decoder window '
                                  'adds to the evidence', unit='nat', min=0.01, max=20.0,
                                  live=True)
-    offer_timeout: float = param(8.0, 'scan: an object is offered this long; without a '
-                                 'confirmation the arm passes on to the next', unit='s',
+    offer_timeout: float = param(10.0, 'scan: an object is offered this long; without an '
+                                 'answer the arm passes on to the next', unit='s',
                                  min=0.5, max=120.0, live=True)
     offer_delay: float = param(0.5, 'scan: decoder windows ending this soon after an offer '
                                'began are not counted (the person sees the offer first)',
