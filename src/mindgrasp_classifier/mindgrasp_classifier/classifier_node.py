@@ -53,7 +53,7 @@ class ClassifierParams:
                                    min=0.0, max=1.0)
     min_certainty: float = param(0.5, 'certainty needed for an unsupervised update', min=0.0,
                                  max=1000.0)
-    recenter: str = param('fixed', 'Riemannian re-centering: the training reference or the '
+    recenter: str = param('adaptive', 'Riemannian re-centering: the training reference or the '
                           "session's running mean", choices=RECENTER_MODES)
     recenter_rate: float = param(0.005, 'smallest weight of a new window in the running session '
                                  'mean', min=0.0, max=1.0)
