@@ -179,7 +179,10 @@ def test_pseudo_online_report(rest_runs, tmp_path):
     assert set(report['window']) >= {'accuracy', 'balanced_accuracy', 'per_class', 'confusion',
                                      'n_windows', 'windows_per_class', 'n_left_out'}
     assert set(report['binary']) == {'left_vs_right', 'hands_vs_feet', 'rest_vs_imagery',
-                                     'rest_vs_both_hands', 'rest_vs_both_feet'}
+                                     'rest_vs_both_hands', 'rest_vs_both_feet',
+                                     'both_feet_vs_others'}
+    assert report['binary']['both_feet_vs_others']['n_windows'][1] > \
+        report['binary']['rest_vs_imagery']['n_windows'][0]        # rest and hands both count
     for b in report['binary'].values():
         assert set(b) == {'accuracy', 'balanced_accuracy', 'auc', 'n_windows'}
         assert b['accuracy'] >= 0.9
@@ -194,7 +197,7 @@ def test_pseudo_online_report(rest_runs, tmp_path):
     no_rest, _ = train(rest_runs, TrainingConfig(channels='all', classes=[0, 1, 2, 3]))
     rep2, win2 = pseudo_online(no_rest, [test])
     assert REST not in win2.labels and 'rest' not in rep2['window']['per_class']
-    assert set(rep2['binary']) == {'left_vs_right', 'hands_vs_feet'}
+    assert set(rep2['binary']) == {'left_vs_right', 'hands_vs_feet', 'both_feet_vs_others'}
 
 
 def test_reliability_diagram_is_written(tmp_path):
@@ -233,8 +236,21 @@ def test_train_and_evaluate_rest_model_on_eegmmidb(tmp_path, eegbci_path):
     assert online['trial']['trials_per_class'] == {'both_hands': 7, 'both_feet': 8, 'rest': 15}
     assert online['window']['windows_per_class']['rest'] > 0
     assert set(online['binary']) == {'hands_vs_feet', 'rest_vs_imagery', 'rest_vs_both_hands',
-                                     'rest_vs_both_feet'}
+                                     'rest_vs_both_feet', 'both_feet_vs_others'}
     assert online['binary']['hands_vs_feet']['accuracy'] >= 0.7      # 0.89 when written
     assert (tmp_path / 'plots' / 'reliability_pseudo_online.png').is_file()
     assert (tmp_path / 'plots' / 'reliability_offline.png').is_file()
     assert 'Pseudo-online (' in res.stdout and 'rest_vs_both_hands' in res.stdout
+
+
+def test_ts_lr_carries_no_prior_from_the_class_counts():
+    from pyriemann.datasets import make_matrices
+
+    from mindgrasp_classifier.pipelines import TsLrClassifier
+
+    # one distribution, four times as many windows of class 4 as of class 2: nothing to learn
+    covs = make_matrices(200, 4, 'spd', np.random.RandomState(3))
+    y = np.array([REST] * 160 + [2] * 40)
+    balanced = TsLrClassifier().fit(covs, y).predict_proba(covs).mean(axis=0)
+    counted = TsLrClassifier(class_weight=None).fit(covs, y).predict_proba(covs).mean(axis=0)
+    assert abs(balanced[1] - 0.5) < 0.1 and counted[1] > 0.7   # columns: 2, rest

@@ -43,6 +43,9 @@ BINARY_TASKS: dict[str, tuple[tuple[int, ...], tuple[int, ...]]] = {
     'rest_vs_imagery': ((REST,), tuple(int(c) for c in MiClass)),
     'rest_vs_both_hands': ((REST,), (MiClass.BOTH_HANDS,)),
     'rest_vs_both_feet': ((REST,), (MiClass.BOTH_FEET,)),
+    # the controller's cancel: both feet against every other class
+    'both_feet_vs_others': ((MiClass.BOTH_FEET,), (*(int(c) for c in MiClass
+                                                     if c != MiClass.BOTH_FEET), REST)),
 }
 
 
