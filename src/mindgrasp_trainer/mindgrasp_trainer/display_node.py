@@ -58,7 +58,12 @@ from mindgrasp_ros.node_main import end_after, run_node
 from mindgrasp_ros.params import declare_params, param
 from mindgrasp_trainer.display import FEEDBACK_MODES
 from mindgrasp_trainer.protocol import PromptEvent, TrainerError
-from mindgrasp_trainer.screen import LAYOUTS, ParticipantScreen, ScreenState
+from mindgrasp_trainer.screen import (
+    LAYOUTS,
+    ParticipantScreen,
+    ScreenState,
+    controller_instruction,
+)
 from mindgrasp_trainer.window import Window
 
 
@@ -192,6 +197,9 @@ class DisplayNode(rclpy.node.Node):
 
     def fsm_callback(self, msg: FsmState) -> None:
         self.state.fsm_state_name = str(msg.state_name) or str(int(msg.state))
+        self.state.instruction = controller_instruction(msg.paradigm, int(msg.state),
+                                                        bool(msg.offered))
+        self.state.evidence = float(max(msg.confirm_evidence, msg.cancel_evidence))
 
     def target_callback(self, msg: TaskTarget) -> None:
         self.state.target = f'{msg.colour} {msg.shape}'.strip()

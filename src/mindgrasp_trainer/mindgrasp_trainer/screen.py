@@ -37,7 +37,28 @@ FOLLOW_TEXT = {0: 'turn left (left hand)', 1: 'turn right (right hand)',
                2: 'approach (both hands)', 3: 'back away (both feet)'}
 #: rgb of the object colours named in /task/target
 OBJECT_RGB = {'red': (220, 40, 40), 'blue': (40, 80, 230), 'yellow': (235, 210, 40)}
+INSTRUCTION_COLOUR = (255, 220, 80)
 PARADIGM_LABEL = {'graz': 'Graz-BCI', 'trainer': 'MIndGrasp Trainer', 'test': 'Test'}
+
+
+def controller_instruction(paradigm: str, state: int, offered: bool = False) -> str:
+    """What the participant is asked to imagine now, from ``/fsm/state`` ('' = nothing to say).
+
+    ``scan`` (mindgrasp_fsm.grasp_fsm): the arm offers objects; both hands answer yes, both feet
+    no, and both feet cancel an approach. ``paper``: the four-class steering. Two lines (a
+    heading and the classes), separated by a newline.
+    """
+    if paradigm == 'scan':
+        if offered:
+            return 'Offered: want it?\nboth hands = yes, both feet = no'
+        if state in (3, 4):
+            return 'Approaching\nboth hands = go on, both feet = cancel'
+        if state in (1, 2):
+            return 'Searching\nrest'
+        return 'Rest'
+    if paradigm == 'paper' and state in (1, 2, 3):
+        return 'Left/right hand: turn\nboth hands: select/approach, feet: back'
+    return ''
 
 
 @dataclass
@@ -66,6 +87,11 @@ class ScreenState:
         Name of the session phase for the banner ('' derives it from the prompt's paradigm).
     n_trials : int
         Trials planned in this phase (0 when unknown).
+    instruction : str
+        What to imagine now (:func:`controller_instruction`), '' when nothing.
+    evidence : float
+        The controller's evidence for the decision at hand as a fraction of its threshold
+        (0..1; the scan paradigm's confirmation or cancel).
     """
 
     prompt: PromptEvent | None = None
@@ -78,6 +104,8 @@ class ScreenState:
     ee_distance: float = math.nan
     phase_label: str = ''
     n_trials: int = 0
+    instruction: str = ''
+    evidence: float = 0.0
 
 
 def choose_layout(layout: str, state: ScreenState) -> str:
@@ -224,9 +252,18 @@ class ParticipantScreen:
         else:
             _text(img, '-', (rx, y + 82), 0.8)
         scene_y = y + 110
-        scene_h = min(rw * 3 // 4, h - 180)
+        scene_h = min(rw * 3 // 4, h - 250)
         _paste(img, state.scene, (rx, scene_y, rw, scene_h), 'no scene view')
         self._mini_bar(img, state, (rx, scene_y + scene_h + 12, rw, 26))
+        if state.instruction:
+            iy = scene_y + scene_h + 88
+            for i, line in enumerate(state.instruction.split('\n')):
+                _text(img, line, (rx, iy + 26 * i), 0.65 if i == 0 else 0.55,
+                      INSTRUCTION_COLOUR, 2 if i == 0 else 1)
+            frac = min(max(state.evidence, 0.0), 1.0)
+            if frac > 0:        # the evidence for the decision at hand, of its threshold
+                cv2.rectangle(img, (rx, iy + 40), (rx + int(rw * frac), iy + 48), BAR_COLOUR,
+                              -1)
 
     def _draw_idle(self, img: np.ndarray, state: ScreenState, box: tuple) -> None:
         x, y, w, h = box
