@@ -34,6 +34,13 @@ __all__ = ['SUBJECTS', 'is_replay', 'noise_model', 'replay_model']
 
 SUBJECTS = ('noise', 'virtual', 'oracle', 'autonomous')
 
+#: how :func:`replay_model` calibrates a replay subject's decoder: the four imagery classes and
+#: rest, tangent space + logistic regression (chosen by measurement on real EEG:
+#: src/mindgrasp_classifier/README.md); ``REPLAY_TAG`` names the cached model file, so a change
+#: here calibrates anew
+REPLAY_TRAINING = {'pipeline': 'ts_lr', 'classes': [0, 1, 2, 3, 4]}
+REPLAY_TAG = 'tslr_rest'
+
 
 def is_replay(subject: str) -> bool:
     """A replay subject (``eegmmidb:<subject>`` or a subject file ``*.yaml``)?"""
@@ -56,28 +63,31 @@ def replay_model(subject: str | SubjectFiles, directory: str | Path) -> Path:
     """
     from mindgrasp_classifier.errors import ClassifierError
     from mindgrasp_classifier.training import TrainingConfig, train
-    from mindgrasp_common.mi import CLASS_NAMES
+    from mindgrasp_common.mi import DECODER_CLASS_NAMES, REST
     from mindgrasp_eeg import EEGError
     from mindgrasp_eeg.replay_eeg import ReplayEEG, segments
     from mindgrasp_eeg.subject_file import check_layout, replay_subject
 
     files = replay_subject(subject) if isinstance(subject, str) else subject
-    json_path = Path(directory) / f'{files.name}_classifier_{files.calibration_digest()[:12]}.json'
+    json_path = (Path(directory) /
+                 f'{files.name}_classifier_{files.calibration_digest()[:12]}_{REPLAY_TAG}.json')
     if json_path.exists():
         return json_path
     calibration, play = files.recordings('calibration'), files.recordings('play')
     check_layout([*calibration, *play], files.source)
     ReplayEEG.from_subject(files, recordings=play)          # enough epochs to play?
-    # cues: the onsets of the class epochs (rest left out); training windows lie 0.5-2.5 s after
-    # each (TrainingConfig tmin/tmax), as for every model
+    # cues: the onsets of the class epochs and of the rest epochs (class REST: the decoder says
+    # "nothing meant" instead of guessing an imagery class); training windows lie 0.5-2.5 s
+    # after each (TrainingConfig tmin/tmax), as for every model
     labelled = []
     for f, rec in zip(files.calibration, calibration, strict=True):
-        events = [(k0, cls) for k0, _k1, cls in segments(rec, f.events) if cls is not None]
+        events = [(k0, REST if cls is None else cls) for k0, _k1, cls in segments(rec, f.events)]
         labelled.append(replace(rec, events=np.array(events, dtype=int).reshape(-1, 2)))
-    cfg = TrainingConfig(pipeline='mdm', channels=files.channels if isinstance(files.channels, str)
+    cfg = TrainingConfig(**REPLAY_TRAINING,
+                         channels=files.channels if isinstance(files.channels, str)
                          else list(files.channels))
     counts = {name: sum(int((r.events[:, 1] == c).sum()) for r in labelled)
-              for c, name in enumerate(CLASS_NAMES)}
+              for c, name in enumerate(DECODER_CLASS_NAMES)}
     few = {name: n for name, n in counts.items() if n < cfg.min_trials}
     if few:
         msg = (f'The replay subject {files.source} has too few calibration epochs: {few} (at '
