@@ -36,6 +36,7 @@ from pathlib import Path
 
 import numpy as np
 
+from mindgrasp_classifier.classifier_node import ClassifierParams
 from mindgrasp_classifier.decoder import AdaptationConfig, MiDecoder
 from mindgrasp_classifier.model import MiModel
 from mindgrasp_common.mi import MiClass
@@ -133,15 +134,18 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument('--clip', type=float, default=d.evidence_clip)
     parser.add_argument('--approach', type=float, default=8.0, help='s of an approach')
     parser.add_argument('--reaction', type=float, default=1.0, help='s before imagery starts')
-    parser.add_argument('--recenter', default='fixed', choices=['fixed', 'adaptive'],
+    parser.add_argument('--recenter', default=ClassifierParams().recenter,
+                        choices=['fixed', 'adaptive'],
                         help="the classifier's re-centering (its parameter recenter)")
     parser.add_argument('--cache', default=str(Path(tempfile.gettempdir()) / 'mindgrasp_models'))
     args = parser.parse_args(argv)
     confirms = [float(x) for x in args.confirm.split(',')]
     passes = [float(x) for x in args.pass_.split(',')]
     generate, gen, model = source(args.subject, args.seed, Path(args.cache))
+    node = ClassifierParams()       # the classifier node's defaults, as in the loop
     decoder = MiDecoder(model, gen.channel_names, gen.sample_rate,
-                        AdaptationConfig(recenter=args.recenter))
+                        AdaptationConfig(recenter=args.recenter, recenter_rate=node.recenter_rate,
+                                         recenter_prior=node.recenter_prior))
     rate = gen.sample_rate
     rng = np.random.default_rng(args.seed)
     yes, no = MiClass.BOTH_HANDS, MiClass.BOTH_FEET

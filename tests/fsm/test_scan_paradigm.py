@@ -86,7 +86,9 @@ def test_cusum_floor_and_sprt_reject():
 
 # ------------------------------------------------------------------------------ controller
 def scan_fsm(**kw: object) -> GraspFsm:
-    return GraspFsm(FsmParams(paradigm='scan', lock_duration=0.5, offer_timeout=6.0, **kw))
+    return GraspFsm(FsmParams(paradigm='scan', lock_duration=0.5, offer_timeout=6.0,
+                              offer_delay=0.5, confirm_threshold=3.0, pass_threshold=3.0,
+                              cancel_threshold=3.0, **kw))
 
 
 def tick(fsm: GraspFsm, t: float, p: np.ndarray, obs=CENTRED, q=None) -> object:

@@ -57,6 +57,9 @@ class ClassifierParams:
                           "session's running mean", choices=RECENTER_MODES)
     recenter_rate: float = param(0.005, 'smallest weight of a new window in the running session '
                                  'mean', min=0.0, max=1.0)
+    recenter_prior: float = param(10.0, 'adaptive re-centering starts from the training '
+                                  'reference weighted as this many seconds of windows',
+                                  unit='s', min=0.0, max=3600.0)
     label_tmin: float = param(0.5, 'windows in [cue + label_tmin, cue + label_tmax] get the '
                               "cue's class for supervised adaptation", unit='s', min=-60.0,
                               max=60.0)
@@ -92,7 +95,7 @@ class ClassifierNode(rclpy.node.Node):
         self.adaptation = AdaptationConfig(
             mode=self.p.adaptation, rate=self.p.adaptation_rate,
             min_certainty=self.p.min_certainty, recenter=self.p.recenter,
-            recenter_rate=self.p.recenter_rate)
+            recenter_rate=self.p.recenter_rate, recenter_prior=self.p.recenter_prior)
         self.adaptation.check()
         self.cues = CueLabels(self.p.label_tmin, self.p.label_tmax)
         self._last_trial = -1

@@ -61,6 +61,10 @@ class AdaptationConfig:
         (a cumulative mean at first, then exponential forgetting at ``recenter_rate``).
     recenter_rate : float
         Smallest weight (0..1) of a new window in the running reference.
+    recenter_prior : float
+        Seconds of windows the training reference counts for in the running reference when
+        adaptive re-centering starts, so the first windows of a session do not decide it alone
+        (0: the first window replaces it).
 
     Notes
     -----
@@ -74,6 +78,7 @@ class AdaptationConfig:
     min_certainty: float = 0.5
     recenter: str = 'fixed'
     recenter_rate: float = 0.005
+    recenter_prior: float = 0.0
 
     def check(self) -> None:
         """Raise :class:`ClassifierError` on an invalid setting."""
@@ -89,6 +94,10 @@ class AdaptationConfig:
             if not 0.0 <= value <= 1.0:
                 msg = f'The adaptation {name} must lie in [0, 1]; {value} is invalid.'
                 raise ClassifierError(msg)
+        if not 0.0 <= self.recenter_prior < float('inf'):
+            msg = (f'recenter_prior must be a finite number of seconds >= 0; '
+                   f'{self.recenter_prior} is invalid.')
+            raise ClassifierError(msg)
 
 
 def check_stream(model: MiModel, channels: Sequence[str], rate: float) -> np.ndarray:
@@ -195,7 +204,8 @@ class MiDecoder:
             len(self._idx))
         self.reference = np.array(self.model.reference, dtype=float)
         self._ref_invsqrt = invsqrtm(self.reference)
-        self._n_ref_updates = 0
+        # the training reference counts as this many windows of the running mean
+        self._n_ref_updates = round(self.adaptation.recenter_prior / self.model.step)
         self.label: int | None = None
         self.n_updates = 0
         self.reset()

@@ -92,7 +92,7 @@ class FsmParams:
     pass_threshold: float = param(3.0, 'scan: evidence for both feet against both hands that '
                                   'passes the offered object at once', unit='nat s', min=0.01,
                                   max=100.0, live=True)
-    cancel_threshold: float = param(4.0, 'scan: evidence for both feet against both hands that '
+    cancel_threshold: float = param(5.0, 'scan: evidence for both feet against both hands that '
                                     'cancels an approach before the gripper closes',
                                     unit='nat s', min=0.01, max=100.0, live=True)
     evidence_clip: float = param(2.0, 'scan: largest log-probability ratio one decoder window '
@@ -101,8 +101,9 @@ class FsmParams:
     offer_timeout: float = param(10.0, 'scan: an object is offered this long; without an '
                                  'answer the arm passes on to the next', unit='s',
                                  min=0.5, max=120.0, live=True)
-    offer_delay: float = param(0.5, 'scan: decoder windows ending this soon after an offer '
-                               'began are not counted (the person sees the offer first)',
+    offer_delay: float = param(2.5, 'scan: decoder windows ending this soon after an offer '
+                               'began are not counted (the person sees the offer and starts '
+                               'to imagine; a 2 s window then still holds what came before)',
                                unit='s', min=0.0, max=10.0, live=True)
     scan_skip_angle: float = param(0.45, 'scan: after passing an object, joint 1 turns this far '
                                    'before the next object is offered', unit='rad', min=0.0,
