@@ -92,8 +92,8 @@ def test_the_virtual_subject_at_accuracy_1_picks_the_desired_object_through_the_
                             '--out', str(out), '--json', '--no-progress'))
     records = read_records(out)
     assert all(r.correct_and_successful for r in records), [
-        (r.desired, r.chosen, r.grasped, r.states, r.decoder_accuracy) for r in records]
-    assert s['decoder_accuracy'] < 0.98, s      # the decoder errs; the controller copes
+        (r.desired, r.chosen, r.grasped, r.states, r.online_accuracy) for r in records]
+    assert s['online_accuracy'] < 0.98, s      # the decoder errs; the controller copes
 
 
 @pytest.mark.slow
@@ -113,7 +113,7 @@ def test_same_seed_same_csv_with_1_and_2_workers(tmp_path: Path) -> None:
     assert csv[0] == csv[1]
     records = read_records(tmp_path / 'w1')
     assert all(r.subject == 'virtual' and r.n_predictions > 0 for r in records)
-    assert all(math.isfinite(r.decoder_accuracy) for r in records)
+    assert all(math.isfinite(r.online_accuracy) for r in records)
 
 
 @pytest.mark.slow

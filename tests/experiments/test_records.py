@@ -41,7 +41,7 @@ def test_tracker_builds_the_record() -> None:
     assert rec.states == '1-2-3-4-5' and rec.chosen == 'red cube'
     assert math.isclose(rec.path_length_m, 0.5)
     assert rec.class_switches == 1 and rec.n_predictions == 2
-    assert rec.decoder_accuracy == 0.5 and rec.mean_certainty == 0.75
+    assert rec.online_accuracy == 0.5 and rec.mean_certainty == 0.75
     assert rec.failure == '' and 'lifted above 0.22 m' in rec.reason
     assert (rec.protocol, rec.subject, rec.seed) == ('set_locations', 'virtual', 3)
     assert SUCCESS_HEIGHT == 0.22

@@ -26,8 +26,10 @@ from mindgrasp_experiments.sweep import (
     point_name,
 )
 
-JSON_KEYS = ('accuracy', 'trials', 'success_rate', 'correct_and_success_rate',
-             'online_accuracy', 'mean_time_s')
+JSON_KEYS = ('accuracy', 'trials', 'interrupted_trials', 'success_rate',
+             'correct_and_successful_rate', 'wrong_grasp_rate', 'wrong_grasp_ci95',
+             'no_grasp_rate', 'median_time_to_correct_grasp_s', 'itr_bits_per_min',
+             'online_accuracy', 'calibration_accuracy', 'mean_time_s')
 
 
 def mindgrasp(*args: str, timeout: float = 1500.0) -> subprocess.CompletedProcess:
@@ -107,7 +109,7 @@ def test_point_figures_pool_windows_with_wilson_intervals() -> None:
     assert p['online_decision_accuracy'] == pytest.approx(3 / 4)
     low, high = p['online_accuracy_ci95']
     assert low < 0.5 < high
-    assert p['success_rate'] == 1.0 and p['correct_and_success_rate'] == 0.5
+    assert p['success_rate'] == 1.0 and p['correct_and_successful_rate'] == 0.5
     assert p['mean_time_s'] == pytest.approx(50.0)
     assert p['mean_time_ci95'][0] < 50.0 < p['mean_time_ci95'][1]
     assert p['fsm.certainty_threshold'] == 0.5

@@ -234,11 +234,19 @@ def run_experiment(args: argparse.Namespace, protocol: str, command: str) -> int
     }
     doc = write_run(out, records, info)
     s = doc['summary']
-    print(f"{protocol.replace('_', ' ').capitalize()}, subject {subject}: {s['trials']} trials "
-          f"in {out}")
-    print(f"  grasp success {_pct(s['success_rate'])}, correct choice "
-          f"{_pct(s['correct_choice_rate'])}, correct and successful "
-          f"{_pct(s['correct_and_successful_rate'])}; mean trial {s['mean_duration_s']:.1f} s")
+    cut = (f" (and {s['interrupted_trials']} interrupted, left out)"
+           if s['interrupted_trials'] else '')
+    print(f"{protocol.replace('_', ' ').capitalize()}, subject {subject}: {s['trials']} trials"
+          f"{cut} in {out}")
+    print(f"  correct grasp {_pct(s['correct_and_successful_rate'])}, wrong grasp "
+          f"{_pct(s['wrong_grasp_rate'])}, no grasp {_pct(s['no_grasp_rate'])}; grasp success "
+          f"{_pct(s['success_rate'])}, correct choice {_pct(s['correct_choice_rate'])}")
+    print(f"  mean trial {_secs(s['mean_duration_s'])}, median time to a correct grasp "
+          f"{_secs(s['median_time_to_correct_grasp_s'])}; information transfer rate "
+          f"{_bits(s['itr_bits_per_min'])}")
+    if s['online_windows'] or math.isfinite(s['calibration_accuracy']):
+        print(f"  decoder online accuracy {_pct(s['online_accuracy'])} of "
+              f"{s['online_windows']} windows (calibration {_pct(s['calibration_accuracy'])})")
     print(f'  simulated {sim:.0f} s in {wall:.0f} s wall: real-time factor '
           f"{info['real_time_factor']:.1f}, {info['cpu_s_per_sim_s']:.3f} CPU s per simulated s")
     print(f"  report: {out / 'report.md'}")
@@ -252,3 +260,11 @@ def run_experiment(args: argparse.Namespace, protocol: str, command: str) -> int
 
 def _pct(rate: float) -> str:
     return 'n/a' if not math.isfinite(rate) else f'{100 * rate:.1f} %'
+
+
+def _secs(value: float) -> str:
+    return 'n/a' if not math.isfinite(value) else f'{value:.1f} s'
+
+
+def _bits(value: float) -> str:
+    return 'n/a' if not math.isfinite(value) else f'{value:.2f} bits/min'

@@ -1,9 +1,13 @@
 """Plots of an experiment's records (matplotlib, Agg), each written as PNG and SVG.
 
-- ``set_location_map``: each object's place around the base, with attempted (desired) and
-  successful grasps.
+- ``set_location_map``: each object's place around the base with the outcomes of the trials
+  that asked for it (correct grasp, wrong grasp, no grasp: separate markers, sized by count) and
+  arrows from the desired object to the one grasped instead.
 - ``random_location_scatter``: successes and failures by shape at their places.
-- ``time_to_grasp``: histogram of the simulated time to a successful grasp.
+- ``time_to_grasp``: histogram of the simulated time to a successful grasp, correct and wrong
+  grasps stacked apart.
+
+Interrupted trials are left out, as from the figures (:func:`~.summary.counted`).
 """
 
 from __future__ import annotations
@@ -13,11 +17,18 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from mindgrasp_experiments.records import TrialRecord, shape_of
+from mindgrasp_experiments.summary import counted
 
 __all__ = ['write_plots']
 
 _MARKERS = {'cube': 's', 'cylinder': 'o', 'sphere': '^'}
 _COLOURS = {'red': 'tab:red', 'yellow': 'gold', 'blue': 'tab:blue'}
+#: how each outcome is drawn on the set-location map (scatter keywords) and named in its legend
+_OUTCOME_STYLE = {
+    'correct_grasp': ('correct grasp', {'marker': 'o', 'c': 'tab:green', 'edgecolors': 'k'}),
+    'wrong_grasp': ('wrong grasp', {'marker': 'X', 'c': 'tab:red', 'edgecolors': 'k'}),
+    'no_grasp': ('no grasp', {'marker': 'o', 'facecolors': 'none', 'edgecolors': 'tab:grey'}),
+}
 
 
 def _save(fig, run_dir: Path, stem: str) -> list[Path]:
@@ -50,6 +61,63 @@ def _set_location_places() -> dict[str, tuple[float, float]]:
         return {}
 
 
+def _set_location_map(plt, records: Sequence[TrialRecord], placed: Sequence[TrialRecord],
+                      run_dir: Path) -> list[Path]:
+    """Each object of the scene with the outcomes of the trials that asked for it, just outside
+    its place (marker size: trials), and an arrow to each object grasped instead of it."""
+    from matplotlib.lines import Line2D
+
+    fig, ax = plt.subplots(figsize=(7, 7))
+    places = _set_location_places()
+    for r in placed:
+        places.setdefault(r.desired, (r.desired_x, r.desired_y))
+    wrong: dict[tuple[str, str], int] = {}     # (desired, grasped instead) -> trials
+    for r in records:
+        instead = r.grasped or r.chosen
+        if r.outcome == 'wrong_grasp' and instead in places and r.desired in places:
+            wrong[(r.desired, instead)] = wrong.get((r.desired, instead), 0) + 1
+    for (desired, instead), n in wrong.items():
+        ax.annotate('', xy=places[instead], xytext=places[desired], zorder=1,
+                    arrowprops={'arrowstyle': '-|>', 'color': 'tab:red', 'alpha': 0.45,
+                                'lw': 0.8 + 0.6 * n, 'shrinkA': 12, 'shrinkB': 12,
+                                'connectionstyle': 'arc3,rad=0.15'})
+    for label, (x, y) in places.items():
+        asked = [r for r in records if r.desired == label]
+        colour, _, shape = label.partition(' ')
+        ax.scatter(x, y, s=170, marker=_MARKERS.get(shape, 'o'), c=_COLOURS.get(colour, 'grey'),
+                   edgecolors='k', alpha=0.85, zorder=2)
+        # the outcomes side by side just outside the object (away from the base), each count
+        # further out; the object's name inside, towards the base
+        norm = math.hypot(x, y) or 1.0
+        ux, uy = x / norm, y / norm
+        counts = {o: sum(r.outcome == o for r in asked) for o in _OUTCOME_STYLE}
+        for i, (outcome, (_name, style)) in enumerate(_OUTCOME_STYLE.items()):
+            if not counts[outcome]:
+                continue
+            along = (i - 1) * 0.075
+            ox, oy = x + 0.11 * ux - along * uy, y + 0.11 * uy + along * ux
+            ax.scatter(ox, oy, s=25 + 30 * counts[outcome], zorder=3, **style)
+            ax.annotate(str(counts[outcome]), (ox + 0.065 * ux, oy + 0.065 * uy), fontsize=7,
+                        ha='center', va='center', zorder=4)
+        ax.annotate(f'{label}\nasked {len(asked)}', (x - 0.13 * ux, y - 0.13 * uy), fontsize=7,
+                    ha='center', va='center')
+    _base(ax)
+    ax.margins(0.25)
+    handles = [Line2D([], [], linestyle='none', markersize=8,
+                      markerfacecolor=style.get('c', style.get('facecolors')),
+                      markeredgecolor=style['edgecolors'], marker=style['marker'],
+                      label=f'{name} ({sum(r.outcome == o for r in records)})')
+               for o, (name, style) in _OUTCOME_STYLE.items()]
+    handles.append(Line2D([], [], color='tab:red', alpha=0.45, lw=1.4,
+                          label='grasped instead of the desired object'))
+    ax.legend(handles=handles, fontsize=7, loc='upper left', bbox_to_anchor=(1.01, 1.0))
+    ax.set_title('Set locations: outcomes of the trials asking for each object\n'
+                 '(marker size and number: trials)')
+    paths = _save(fig, run_dir, 'set_location_map')
+    plt.close(fig)
+    return paths
+
+
 def write_plots(records: Sequence[TrialRecord], run_dir: str | Path,
                 protocol: str = '') -> list[Path]:
     """Write the plots that fit ``protocol``; returns the files written."""
@@ -60,29 +128,10 @@ def write_plots(records: Sequence[TrialRecord], run_dir: str | Path,
 
     run_dir = Path(run_dir)
     out: list[Path] = []
+    records = counted(records)
     placed = [r for r in records if math.isfinite(r.desired_x) and math.isfinite(r.desired_y)]
     if protocol == 'set_locations' and records:
-        fig, ax = plt.subplots(figsize=(6.5, 6.5))
-        places = _set_location_places()
-        for r in placed:
-            places.setdefault(r.desired, (r.desired_x, r.desired_y))
-        for label, (x, y) in places.items():
-            asked = sum(r.desired == label for r in records)
-            gone_for = sum((r.grasped or r.chosen) == label for r in records)
-            lifted = sum(r.success and r.grasped == label for r in records)
-            right = sum(r.correct_and_successful and r.desired == label for r in records)
-            colour, _, shape = label.partition(' ')
-            ax.scatter(x, y, s=90 + 60 * gone_for, marker=_MARKERS.get(shape, 'o'),
-                       c=_COLOURS.get(colour, 'grey'), edgecolors='k', alpha=0.85)
-            ax.annotate(f'{label}\nasked {asked}, attempted {gone_for}\nlifted {lifted}, '
-                        f'correct {right}', (x, y), fontsize=7, textcoords='offset points',
-                        xytext=(9, 5))
-        _base(ax)
-        ax.margins(0.18)
-        ax.set_title('Set locations: per object, trials asking for it, grasps attempted on it\n'
-                     '(marker size), lifts, and correct successful grasps')
-        out += _save(fig, run_dir, 'set_location_map')
-        plt.close(fig)
+        out += _set_location_map(plt, records, placed, run_dir)
     if protocol == 'random_locations' and placed:
         fig, ax = plt.subplots(figsize=(6, 6))
         for shape, marker in _MARKERS.items():
@@ -98,13 +147,21 @@ def write_plots(records: Sequence[TrialRecord], run_dir: str | Path,
         ax.set_title('Random locations: successes and failures by shape')
         out += _save(fig, run_dir, 'random_location_scatter')
         plt.close(fig)
-    times = [r.time_to_grasp_s for r in records if r.success and math.isfinite(r.time_to_grasp_s)]
+    kinds = [(label, colour, [r.time_to_grasp_s for r in records
+                              if r.success and r.outcome == outcome
+                              and math.isfinite(r.time_to_grasp_s)])
+             for outcome, label, colour in (('correct_grasp', 'correct grasp', 'tab:green'),
+                                            ('wrong_grasp', 'wrong grasp', 'tab:red'))]
+    n_times = sum(len(times) for _, _, times in kinds)
     fig, ax = plt.subplots(figsize=(6, 4))
-    if times:
-        ax.hist(times, bins=min(30, max(5, len(times) // 3)), color='tab:blue', alpha=0.8)
+    if n_times:
+        ax.hist([times for _, _, times in kinds], bins=min(30, max(5, n_times // 3)),
+                stacked=True, color=[c for _, c, _ in kinds], alpha=0.8,
+                label=[f'{label} ({len(times)})' for label, _, times in kinds])
+        ax.legend(fontsize=8)
     ax.set_xlabel('time to a successful grasp (simulated s)')
     ax.set_ylabel('trials')
-    ax.set_title(f'Time to grasp ({len(times)} successful trials of {len(records)})')
+    ax.set_title(f'Time to grasp ({n_times} successful trials of {len(records)})')
     out += _save(fig, run_dir, 'time_to_grasp')
     plt.close(fig)
     return out

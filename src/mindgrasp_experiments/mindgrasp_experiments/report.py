@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from mindgrasp_experiments.records import TrialRecord, read_records, write_records
-from mindgrasp_experiments.summary import PAPER, summarise
+from mindgrasp_experiments.summary import PAPER, calibration_accuracy_of, summarise
 
 __all__ = ['finite', 'rebuild', 'render_report', 'write_run']
 
@@ -46,12 +46,33 @@ def _s(value: float | None) -> str:
     return 'n/a' if value is None or not math.isfinite(value) else f'{value:.1f} s'
 
 
+def _rate_row(label: str, summary: Mapping[str, Any], key: str, paper: Mapping[str, Any]) -> str:
+    """A table row of the rate ``<key>_rate`` with its count, Wilson CI and the paper's."""
+    return (f"| {label} | {_pct(summary.get(f'{key}_rate'))} "
+            f"({summary.get(f'{key}_count', 0)}/{summary['trials']}) | "
+            f"{_ci(summary.get(f'{key}_ci95'))} | {_pct(paper.get(f'{key}_rate'))} |")
+
+
+def _itr_text(summary: Mapping[str, Any]) -> str:
+    itr = summary.get('itr_bits_per_min')
+    if itr is None or not math.isfinite(itr):
+        return 'n/a'
+    bits = summary.get('itr_bits_per_selection')
+    each = f', {bits:.2f} bits each' if bits is not None and math.isfinite(bits) else ''
+    return f"{itr:.2f} bits/min ({summary.get('selections', 0)} selections{each})"
+
+
 def render_report(summary: Mapping[str, Any], run: Mapping[str, Any]) -> str:
-    """report.md: our figures (with Wilson 95 % CIs) beside the paper's, speed, failures."""
+    """report.md: our figures (with Wilson 95 % CIs) beside the paper's, the three outcomes,
+    the selection's information transfer rate, the decoder's online accuracy beside its
+    calibration estimate, speed, failures."""
     protocol = run.get('protocol', '')
     paper = PAPER.get(protocol, {})
+    interrupted = summary.get('interrupted_trials') or 0
     lines = [f"# {protocol.replace('_', ' ').capitalize() or 'Experiment'}: "
-             f"{summary['trials']} trials, subject {run.get('subject', '?')}", '']
+             f"{summary['trials']} trials"
+             + (f' (and {interrupted} interrupted)' if interrupted else '')
+             + f", subject {run.get('subject', '?')}", '']
     settings = ', '.join(f'{k} {run[k]}' for k in ('seed', 'accuracy', 'realism', 'workers')
                          if k in run and run[k] is not None)
     if settings:
@@ -59,11 +80,12 @@ def render_report(summary: Mapping[str, Any], run: Mapping[str, Any]) -> str:
     lines += ['| figure | ours | Wilson 95 % CI | paper |', '|---|---|---|---|']
     rows = [('grasp success (lifted above 0.22 m)', 'success'),
             ('correct object chosen', 'correct_choice'),
-            ('correct and successful', 'correct_and_successful')]
-    for label, key in rows:
-        lines.append(f"| {label} | {_pct(summary.get(f'{key}_rate'))} "
-                     f"({summary.get(f'{key}_count', 0)}/{summary['trials']}) | "
-                     f"{_ci(summary.get(f'{key}_ci95'))} | {_pct(paper.get(f'{key}_rate'))} |")
+            ('outcome **correct grasp**: the desired object lifted (correct and successful)',
+             'correct_and_successful'),
+            ('outcome **wrong grasp**: another object lifted, or a grasp closed on one',
+             'wrong_grasp'),
+            ('outcome **no grasp**: timeout, stall, cancelled, nothing attempted', 'no_grasp')]
+    lines += [_rate_row(label, summary, key, paper) for label, key in rows]
     for shape, r in summary.get('success_by_shape', {}).items():
         if r['trials']:
             lines.append(f"| success, {shape} | {_pct(r['rate'])} ({r['count']}/{r['trials']}) "
@@ -72,16 +94,35 @@ def render_report(summary: Mapping[str, Any], run: Mapping[str, Any]) -> str:
                  f"{_s(paper.get('mean_duration_s'))} |")
     lines.append(f"| mean time to a successful grasp | {_s(summary.get('mean_time_to_grasp_s'))}"
                  f" (median {_s(summary.get('median_time_to_grasp_s'))}) | | |")
+    lines.append(f"| median time to a correct grasp | "
+                 f"{_s(summary.get('median_time_to_correct_grasp_s'))} | | |")
+    p_sel = summary.get('selection_accuracy')
+    p_text = 'n/a' if p_sel is None or not math.isfinite(p_sel) else f'{p_sel:.2f}'
+    lines.append(f"| information transfer rate (Wolpaw; N = {summary.get('itr_choices', '?')} "
+                 f"objects, P = {p_text} correct of the grasps) | {_itr_text(summary)} | | |")
+    windows = summary.get('online_windows') or 0
+    lines.append(f"| decoder online accuracy (classifier windows against the subject's intent) "
+                 f"| {_pct(summary.get('online_accuracy'))} of {windows} windows | "
+                 f"{_ci(summary.get('online_accuracy_ci95'))} | |")
+    lines.append(f"| decoder calibration accuracy (the model's cross-validation) | "
+                 f"{_pct(summary.get('calibration_accuracy'))} | | |")
     certainty = summary.get('mean_certainty')
     certainty_text = ('n/a' if certainty is None or not math.isfinite(certainty)
                       else f'{certainty:.2f}')    # n/a: no decoder (oracle, autonomous)
-    lines += ['', f"Decoder online accuracy against the subject's intent: "
-              f"{_pct(summary.get('decoder_accuracy'))}; mean certainty {certainty_text}.", '']
+    lines += ['', f"Decoder per decision (the most frequent class over one held intent): "
+              f"{_pct(summary.get('online_decision_accuracy'))} of "
+              f"{summary.get('online_decisions') or 0}; mean certainty {certainty_text}.", '']
     failures = summary.get('failures') or {}
     if failures:
         lines += ['Trials without a successful end, by kind: ' + ', '.join(
             f'{k} {v}' for k, v in sorted(failures.items())) + f" (node errors: "
             f"{summary.get('node_errors', 0)}).", '']
+    if summary.get('cancels'):
+        lines += [f"The person cancelled {summary['cancels']} approach(es) (a cancelled trial "
+                  'is a no grasp unless a later attempt grasps).', '']
+    if interrupted:
+        lines += [f'{interrupted} interrupted trial(s) (Ctrl-C) are left out of every figure.',
+                  '']
     if 'real_time_factor' in run:
         lines += ['## Speed', '',
                   f"Simulated {run['sim_s']:.0f} s in {run['wall_s']:.0f} s of wall time with "
@@ -105,8 +146,12 @@ def render_report(summary: Mapping[str, Any], run: Mapping[str, Any]) -> str:
 
 
 def write_run(run_dir: str | Path, records: Sequence[TrialRecord],
-              run: Mapping[str, Any]) -> dict:
-    """Write records, summary.json, report.md and the plots; returns the summary dict."""
+              run: Mapping[str, Any], calibration_accuracy: float | None = None) -> dict:
+    """Write records, summary.json, report.md and the plots; returns the summary document.
+
+    ``calibration_accuracy``: the classifier's cross-validated accuracy, shown beside its
+    online accuracy; by default ``run['calibration_accuracy']``, else read from the model the
+    run's ``params/classifier.yaml`` names (:func:`~.summary.calibration_accuracy_of`)."""
     from mindgrasp_experiments.plots import write_plots
 
     run_dir = Path(run_dir)
@@ -114,7 +159,11 @@ def write_run(run_dir: str | Path, records: Sequence[TrialRecord],
     write_records(records, run_dir)
     run = dict(run)
     run['plots'] = [p.name for p in write_plots(records, run_dir, run.get('protocol', ''))]
-    summary = summarise(records)
+    if calibration_accuracy is None:
+        calibration_accuracy = run.get('calibration_accuracy')
+    if calibration_accuracy is None:
+        calibration_accuracy = calibration_accuracy_of(run_dir)
+    summary = summarise(records, calibration_accuracy)
     doc = {'summary': summary, 'run': run, 'paper': PAPER.get(run.get('protocol', ''), {})}
     (run_dir / 'summary.json').write_text(json.dumps(finite(doc), indent=2) + '\n',
                                           encoding='utf-8')

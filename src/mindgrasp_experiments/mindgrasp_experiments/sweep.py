@@ -5,11 +5,14 @@ written by :func:`mindgrasp_experiments.report.write_run`) in ``<out>/points/<po
 module turns the points into one table (``sweep.csv``, ``sweep.json``), the sweep plots (success
 and time to grasp against accuracy, PNG and SVG) and ``report.md``.
 
-Per point: grasp success, correct choice, correct and successful (Wilson 95 % CIs, from
-:func:`~mindgrasp_experiments.summary.summarise`), the mean time to a successful grasp (Student-t
-95 % CI) and the decoder's realised online accuracy against the subject's intent, over classifier
-windows and over decisions (a decision: the most frequent decoded class over one span of a held
-intent), each with its Wilson 95 % CI.
+Per point, under the names of :func:`~mindgrasp_experiments.summary.summarise`: grasp success,
+correct choice and the three outcomes (``correct_and_successful_rate`` = correct grasp,
+``wrong_grasp_rate``, ``no_grasp_rate``; Wilson 95 % CIs), ``median_time_to_correct_grasp_s``,
+the selection's ``itr_bits_per_min``, and the decoder's realised ``online_accuracy`` against the
+subject's intent, over classifier windows and over decisions (a decision: the most frequent
+decoded class over one span of a held intent), each with its Wilson 95 % CI, beside its
+``calibration_accuracy``; and the mean time to a successful grasp (``mean_time_s``, Student-t
+95 % CI).
 
     >>> parse_accuracies('0.3,0.55,1')
     [0.3, 0.55, 1.0]
@@ -32,11 +35,11 @@ from typing import Any
 from mindgrasp_experiments import ExperimentError
 from mindgrasp_experiments.records import TrialRecord
 from mindgrasp_experiments.report import finite
-from mindgrasp_experiments.summary import summarise, wilson
+from mindgrasp_experiments.summary import counted, summarise
 
-__all__ = ['Param', 'apply_params', 'check_params', 'combinations', 'parse_accuracies',
-           'parse_param', 'parse_seeds', 'parse_subjects', 'point_figures', 'point_name',
-           'write_sweep']
+__all__ = ['SUMMARY_KEYS', 'Param', 'apply_params', 'check_params', 'combinations',
+           'parse_accuracies', 'parse_param', 'parse_seeds', 'parse_subjects', 'point_figures',
+           'point_name', 'write_sweep']
 
 #: ``node.parameter=v1,v2,...``
 Param = tuple[str, str, list[str]]
@@ -200,30 +203,27 @@ def _mean_ci(values: Sequence[float]) -> tuple[float, list[float]]:
     return mean, [mean - half, mean + half]
 
 
-def point_figures(records: Sequence[TrialRecord], accuracy: float,
-                  combo: Mapping[str, Any]) -> dict[str, Any]:
-    """One row of the sweep table: rates with Wilson 95 % CIs, mean time to grasp (s) with a
-    t interval, the decoder's online accuracy over windows and decisions."""
-    s = summarise(records)
+#: figures of a point taken from :func:`~mindgrasp_experiments.summary.summarise` under its names
+SUMMARY_KEYS = ('interrupted_trials', 'success_rate', 'success_ci95', 'correct_choice_rate',
+                'correct_choice_ci95', 'correct_and_successful_rate',
+                'correct_and_successful_ci95', 'wrong_grasp_rate', 'wrong_grasp_ci95',
+                'no_grasp_rate', 'no_grasp_ci95', 'median_time_to_correct_grasp_s',
+                'itr_bits_per_min', 'online_accuracy', 'online_accuracy_ci95', 'online_windows',
+                'online_decision_accuracy', 'online_decision_accuracy_ci95', 'online_decisions',
+                'calibration_accuracy', 'mean_duration_s', 'failures')
+
+
+def point_figures(records: Sequence[TrialRecord], accuracy: float, combo: Mapping[str, Any],
+                  calibration_accuracy: float | None = None) -> dict[str, Any]:
+    """One row of the sweep table: the summary's rates with Wilson 95 % CIs (the three outcomes
+    among them), the selection's information transfer rate, the decoder's online accuracy over
+    windows and decisions beside its ``calibration_accuracy`` (the model's cross-validated
+    accuracy, when known), and the mean time to grasp (s) with a Student-t interval."""
+    s = summarise(records, calibration_accuracy)
     row: dict[str, Any] = {'accuracy': accuracy, **combo, 'trials': s['trials']}
-    for field in ('success', 'correct_choice', 'correct_and_successful'):
-        row[f'{field}_rate'] = s[f'{field}_rate']
-        row[f'{field}_ci95'] = s[f'{field}_ci95']
-    row['correct_and_success_rate'] = s['correct_and_successful_rate']   # the JSON's name
-    windows = sum(r.decoder_windows for r in records)
-    hits = sum(r.decoder_hits for r in records)
-    decisions = sum(r.decoder_decisions for r in records)
-    decision_hits = sum(r.decoder_decision_hits for r in records)
-    row['online_accuracy'] = hits / windows if windows else math.nan
-    row['online_accuracy_ci95'] = list(wilson(hits, windows))
-    row['online_windows'] = windows
-    row['online_decision_accuracy'] = decision_hits / decisions if decisions else math.nan
-    row['online_decision_accuracy_ci95'] = list(wilson(decision_hits, decisions))
-    row['online_decisions'] = decisions
+    row.update({k: s[k] for k in SUMMARY_KEYS})
     row['mean_time_s'], row['mean_time_ci95'] = _mean_ci(
-        [r.time_to_grasp_s for r in records if r.success])
-    row['mean_duration_s'] = s['mean_duration_s']
-    row['failures'] = s['failures']
+        [r.time_to_grasp_s for r in counted(records) if r.success])
     return row
 
 
@@ -266,8 +266,9 @@ def _plots(points: Sequence[Mapping[str, Any]], varied: Sequence[str], out: Path
     for stem, ylabel, series in (
             ('success_vs_accuracy', 'rate (Wilson 95 % CI)',
              (('success', 'success_rate', 'success_ci95'),
-              ('correct and successful', 'correct_and_successful_rate',
-               'correct_and_successful_ci95'))),
+              ('correct grasp (correct and successful)', 'correct_and_successful_rate',
+               'correct_and_successful_ci95'),
+              ('wrong grasp', 'wrong_grasp_rate', 'wrong_grasp_ci95'))),
             ('time_vs_accuracy', 'mean time to a successful grasp (simulated s, 95 % CI)',
              (('time to grasp', 'mean_time_s', 'mean_time_ci95'),))):
         fig, ax = plt.subplots(figsize=(6.5, 4.2))
@@ -303,24 +304,36 @@ def _report(points: Sequence[Mapping[str, Any]], varied: Sequence[str],
              f"{run.get('trials')} trials per point; {'subjects' if ',' in subject else 'subject'}"
              f" {subject}.", '',
              'Rates with their Wilson 95 % CIs in brackets (%); the time to grasp over '
-             'successful trials, with a Student-t 95 % CI. Online accuracy: the decoder\'s '
-             'predictions against the subject\'s intent, per classifier window and per decision '
-             '(the most frequent class over one held intent).', '',
+             'successful trials, with a Student-t 95 % CI. Outcomes: correct grasp (the desired '
+             'object lifted), wrong grasp (another object lifted, or a grasp closed on one), no '
+             'grasp. ITR: the selection\'s information transfer rate (Wolpaw). Online accuracy: '
+             'the decoder\'s predictions against the subject\'s intent, per classifier window '
+             'and per decision (the most frequent class over one held intent), beside the '
+             'model\'s cross-validated calibration accuracy.', '',
              '| accuracy | ' + ''.join(f'{k} | ' for k in varied) + 'trials | success | '
-             'correct choice | correct and successful | time to grasp | online accuracy '
-             '(windows) | online accuracy (decisions) |',
-             '|---|' + '---|' * len(varied) + '---|---|---|---|---|---|---|']
+             'correct choice | correct grasp (correct and successful) | wrong grasp | no grasp | '
+             'time to grasp | median time to a correct grasp | ITR | online accuracy '
+             '(windows) | online accuracy (decisions) | calibration accuracy |',
+             '|---|' + '---|' * len(varied) + '---|' * 12]
     for p in points:
+        itr = p.get('itr_bits_per_min')
+        itr_text = 'n/a' if itr is None or not math.isfinite(itr) else f'{itr:.2f} bits/min'
         lines.append(
             f"| {p['accuracy']:g} | " + ''.join(f'{p.get(k)} | ' for k in varied)
             + f"{p['trials']} | {_pct(p['success_rate'], p['success_ci95'])} | "
             f"{_pct(p['correct_choice_rate'], p['correct_choice_ci95'])} | "
             f"{_pct(p['correct_and_successful_rate'], p['correct_and_successful_ci95'])} | "
+            f"{_pct(p['wrong_grasp_rate'], p['wrong_grasp_ci95'])} | "
+            f"{_pct(p['no_grasp_rate'], p['no_grasp_ci95'])} | "
             f"{_secs(p['mean_time_s'], p['mean_time_ci95'])} | "
+            f"{_secs(p['median_time_to_correct_grasp_s'])} | {itr_text} | "
             f"{_pct(p['online_accuracy'], p['online_accuracy_ci95'])} of "
             f"{p['online_windows']} | "
             f"{_pct(p['online_decision_accuracy'], p['online_decision_accuracy_ci95'])} of "
-            f"{p['online_decisions']} |")
+            f"{p['online_decisions']} | {_pct(p['calibration_accuracy'])} |")
+    interrupted = sum(p.get('interrupted_trials') or 0 for p in points)
+    if interrupted:
+        lines += ['', f'{interrupted} interrupted trial(s) (Ctrl-C) are left out of the figures.']
     lines += ['', 'Plots: ' + ', '.join(f'[{p}]({p})' for p in plots), '',
               'Each point\'s records, summary and report: '
               + ', '.join(f"[{p['point']}](points/{p['point']}/report.md)" for p in points), '']
@@ -337,11 +350,14 @@ def write_sweep(out: str | Path, points: Sequence[Mapping[str, Any]], varied: Se
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     points = [dict(p) for p in points]
-    columns = ['point', 'accuracy', *varied, 'trials', 'success_rate', 'success_ci95',
-               'correct_choice_rate', 'correct_choice_ci95', 'correct_and_successful_rate',
-               'correct_and_successful_ci95', 'mean_time_s', 'mean_time_ci95',
+    columns = ['point', 'accuracy', *varied, 'trials', 'interrupted_trials', 'success_rate',
+               'success_ci95', 'correct_choice_rate', 'correct_choice_ci95',
+               'correct_and_successful_rate', 'correct_and_successful_ci95', 'wrong_grasp_rate',
+               'wrong_grasp_ci95', 'no_grasp_rate', 'no_grasp_ci95', 'mean_time_s',
+               'mean_time_ci95', 'median_time_to_correct_grasp_s', 'itr_bits_per_min',
                'online_accuracy', 'online_accuracy_ci95', 'online_windows',
-               'online_decision_accuracy', 'online_decision_accuracy_ci95', 'online_decisions']
+               'online_decision_accuracy', 'online_decision_accuracy_ci95', 'online_decisions',
+               'calibration_accuracy']
     with (out / 'sweep.csv').open('w', newline='', encoding='utf-8') as f:
         writer = csv.writer(f, lineterminator='\n')
         writer.writerow([c.replace('_ci95', '_ci95_low') for c in columns]

@@ -6,8 +6,9 @@ Per trial: reset the scene (``/sim/reset``; random locations: ``/sim/load_scene`
 trial's one-object scene), wait until every topic of ``wait_for`` is publishing (the EEG, the
 classifier, the vision: it says what it waits for, and gives up after ``ready_timeout`` s),
 publish ``/task/target`` (mindgrasp_msgs/TaskTarget, transient local), then follow the trial
-until the grasp result (``/task/result``), a grasp attempt that ends without one, no controller
-state change for ``stall_timeout`` s, or ``trial_timeout`` s. Every time is on the node clock
+until the grasp result (``/task/result``), a grasp attempt that ends without one (a return to
+start the person cancelled is not one: the trial goes on), no controller state change for
+``stall_timeout`` s, or ``trial_timeout`` s. Every time is on the node clock
 (simulated time with ``use_sim_time``), so lock-step experiments and live runs behave alike.
 
 Records (:class:`~mindgrasp_experiments.records.TrialRecord`) are kept in ``records``; with
@@ -185,12 +186,14 @@ class TrialManagerNode(rclpy.node.Node):
     def fsm_callback(self, msg: FsmState) -> None:
         self.fsm_state = int(msg.state)
         if self.phase == 'trial':
-            self.tracker.on_state(int(msg.state), msg.object_of_interest, self.now_s())
+            self.tracker.on_state(int(msg.state), msg.object_of_interest, self.now_s(),
+                                  msg.reason)
 
     def prediction_callback(self, msg: MIPrediction) -> None:
         self._seen(BCI_PREDICTION.name)
         if self.phase == 'trial':
-            self.tracker.on_prediction(int(msg.class_index), float(msg.certainty), self.now_s())
+            self.tracker.on_prediction(int(msg.class_index), float(msg.certainty), self.now_s(),
+                                       list(msg.class_names))
 
     def intent_callback(self, msg: String) -> None:
         self.tracker.on_intent(msg.data)
@@ -316,7 +319,7 @@ class TrialManagerNode(rclpy.node.Node):
             return
         _label, x, y = self.scene[self.target_id]
         self.tracker.start(self.trial, self.target_label, self.target_id, now, (x, y),
-                           state=self.fsm_state)
+                           state=self.fsm_state, n_objects=len(self.scene))
         colour, _, shape = self.target_label.partition(' ')
         msg = TaskTarget(trial=self.trial, object_id=self.target_id, colour=colour, shape=shape,
                          scene=str(self.p['protocol']))
@@ -336,7 +339,7 @@ class TrialManagerNode(rclpy.node.Node):
             self._finish(now, 'stalled', f'no controller state change for '
                                          f"{self.p['stall_timeout']:g} s (state "
                                          f'{self.fsm_state})')
-        elif tracker._states[-3:] in ([5, 6, 1], [4, 6, 1]):
+        elif tracker.attempt_over:      # a return the person cancelled goes on
             self._finish(now, 'no_grasp', 'the grasp attempt ended without a lift')
 
     def _finish(self, now: float, failure: str, reason: str) -> None:
@@ -347,7 +350,7 @@ class TrialManagerNode(rclpy.node.Node):
                    f'grasped the {rec.grasped}' if rec.success else
                    f'failed ({rec.failure}: {rec.reason})')
         self.get_logger().info(f'Trial {rec.trial} ({rec.desired}): {verdict} after '
-                               f'{rec.duration_s:.1f} s.')
+                               f"{rec.duration_s:.1f} s: {rec.outcome.replace('_', ' ')}.")
         if self.records_dir is not None:
             write_records(self.records, self.records_dir)
         last = self.p['n_trials'] and self.n_done >= self.p['n_trials']
@@ -365,7 +368,8 @@ class TrialManagerNode(rclpy.node.Node):
         super().destroy_node()
 
     def finish_interrupted(self, reason: str, failure: str = 'interrupted') -> None:
-        """End the running trial now (Ctrl-C, a node error): recorded as a failure."""
+        """End the running trial now: recorded with ``failure`` (``interrupted``, Ctrl-C: left
+        out of the rates; or the engine's ``timeout`` / ``node_error``)."""
         if self.tracker.active:
             rec = self.tracker.finish(self.now_s(), failure, reason)
             self.records.append(rec)
@@ -382,10 +386,17 @@ class TrialManagerNode(rclpy.node.Node):
         if not self.records:
             return
         s = summarise(self.records)
+        cut = (f" ({s['interrupted_trials']} interrupted, not counted)"
+               if s['interrupted_trials'] else '')
+        if not s['trials']:
+            self.get_logger().info(f'No finished trial{cut}.')
+            return
         self.get_logger().info(
-            f"{s['trials']} trials: grasp success {100 * s['success_rate']:.1f} %, correct "
-            f"choice {100 * s['correct_choice_rate']:.1f} %, correct and successful "
-            f"{100 * s['correct_and_successful_rate']:.1f} %, mean trial time "
+            f"{s['trials']} trials{cut}: correct grasp "
+            f"{100 * s['correct_and_successful_rate']:.1f} %, wrong grasp "
+            f"{100 * s['wrong_grasp_rate']:.1f} %, no grasp {100 * s['no_grasp_rate']:.1f} %; "
+            f"grasp success {100 * s['success_rate']:.1f} %, correct choice "
+            f"{100 * s['correct_choice_rate']:.1f} %, mean trial time "
             f"{s['mean_duration_s']:.1f} s.")
 
 

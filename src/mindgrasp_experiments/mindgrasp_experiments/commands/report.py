@@ -29,5 +29,6 @@ def main(args: argparse.Namespace) -> int:
         print(f'mindgrasp experiment report: {exc}', file=sys.stderr)
         return 2
     s = doc['summary']
-    print(f"{s['trials']} trials: report {run_dir / 'report.md'}")
+    cut = f" (and {s['interrupted_trials']} interrupted)" if s['interrupted_trials'] else ''
+    print(f"{s['trials']} trials{cut}: report {run_dir / 'report.md'}")
     return 0

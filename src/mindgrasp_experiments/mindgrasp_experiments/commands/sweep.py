@@ -157,7 +157,7 @@ def main(args: argparse.Namespace) -> int:
             sim_total += sim
             if records:
                 wall = time.perf_counter() - wall_p
-                write_run(point_dir, records, {
+                point_doc = write_run(point_dir, records, {
                     'command': f'mindgrasp experiment sweep (point {name})',
                     'protocol': 'set_locations', 'subject': subject, 'seed': seed,
                     'accuracy': accuracy, 'params': combo, 'workers': args.workers,
@@ -167,8 +167,9 @@ def main(args: argparse.Namespace) -> int:
                     'real_time_factor': sim / wall if wall > 0 else float('nan'),
                     'cpu_s_per_sim_s': (sum(r.cpu_s for r in runs) / sim if sim > 0
                                         else float('nan'))})
-                points.append({'point': name,
-                               **point_figures(records, accuracy, {**axis, **combo})})
+                points.append({'point': name, **point_figures(
+                    records, accuracy, {**axis, **combo},
+                    point_doc['summary']['calibration_accuracy'])})
             if interrupted:
                 raise KeyboardInterrupt
     except KeyboardInterrupt:
@@ -190,14 +191,20 @@ def main(args: argparse.Namespace) -> int:
           f'({wall:.0f} s wall)')
     for p in doc['points']:
         extra = ''.join(f', {k}={p[k]}' for k in varied)
-        success = p['success_rate']
-        online = p['online_accuracy']
-        print(f"  accuracy {p['accuracy']:g}{extra}: success "
-              f"{'n/a' if success is None else f'{100 * success:.1f} %'}, online accuracy "
-              f"{'n/a' if online is None else f'{100 * online:.1f} %'}")
+        itr = p['itr_bits_per_min']
+        print(f"  accuracy {p['accuracy']:g}{extra}: success {_pct(p['success_rate'])}, "
+              f"correct grasp {_pct(p['correct_and_successful_rate'])}, wrong grasp "
+              f"{_pct(p['wrong_grasp_rate'])}, ITR "
+              f"{'n/a' if itr is None else f'{itr:.2f} bits/min'}, online accuracy "
+              f"{_pct(p['online_accuracy'])} (calibration {_pct(p['calibration_accuracy'])})")
     print(f"  report: {out / 'report.md'}")
     if args.json:
         print(json.dumps({'points': doc['points'], 'run_dir': str(out),
                           'report_path': str(out / 'report.md'), 'wall_s': wall,
                           'interrupted': interrupted}))
     return 130 if interrupted else 0
+
+
+def _pct(rate: float | None) -> str:
+    """A rate of the sweep document (None: not defined) in per cent."""
+    return 'n/a' if rate is None else f'{100 * rate:.1f} %'
