@@ -7,7 +7,9 @@ tested on runs 8 10, and the reverse (calibrate 8 10, test 4 6). Calibration is
 ``mindgrasp train classifier`` (``training.train``: leave-one-run-out cross-validation, the
 temperature fitted on held-out windows); the test is ``mindgrasp evaluate classifier
 --pseudo-online`` (``pseudo_online.pseudo_online``: each run streamed through ``MiDecoder``, every
-window on the online grid labelled by the annotation it lies in wholly). Epochs 0.5-4.0 s after
+window on the online grid labelled by the annotation it lies in wholly), decoded as the classifier
+node does by default (``recenter`` adaptive, its running session mean) and, for comparison, with
+the training reference (``fixed``). Epochs 0.5-4.0 s after
 the cue for training and trial decisions (T0/T1/T2 last 4.1-4.2 s; a 2 s window needs a longer
 epoch than the default 0.5-2.5 s).
 
@@ -42,12 +44,27 @@ BINARY = ('left_vs_right', 'hands_vs_feet', 'rest_vs_imagery', 'rest_vs_both_han
           'rest_vs_both_feet')
 
 
-def measure(split: str, classes: str, pipeline: str, window: float) -> dict[str, Any]:
-    """Train one setting on the split's calibration runs and score it pseudo-online."""
+RECENTER = ('adaptive', 'fixed')
+
+
+def _figures(report: dict[str, Any]) -> dict[str, Any]:
+    return {'window_accuracy': report['window']['accuracy'],
+            'window_balanced_accuracy': report['window']['balanced_accuracy'],
+            'trial_accuracy': report['trial']['accuracy'],
+            'trial_balanced_accuracy': report['trial']['balanced_accuracy'],
+            'per_class_window': report['window']['per_class'],
+            'binary': report['binary'], 'calibration': report['calibration']}
+
+
+def measure(split: str, classes: str, pipeline: str, window: float) -> list[dict[str, Any]]:
+    """Train one setting on the split's calibration runs and score it pseudo-online, once per
+    re-centering of :data:`RECENTER`."""
+    import dataclasses
+
     from threadpoolctl import threadpool_limits
 
     from mindgrasp_classifier.data import load_inputs
-    from mindgrasp_classifier.pseudo_online import pseudo_online
+    from mindgrasp_classifier.pseudo_online import node_adaptation, pseudo_online
     from mindgrasp_classifier.training import TrainingConfig, train
 
     cal_runs, test_runs = SPLITS[split]
@@ -58,18 +75,15 @@ def measure(split: str, classes: str, pipeline: str, window: float) -> dict[str,
         cfg = TrainingConfig(pipeline=pipeline, classes=CLASS_SETS[classes], window=window,
                              tmin=EPOCH[0], tmax=EPOCH[1])
         model, cv = train(cal, cfg)
-        report, _ = pseudo_online(model, test, *EPOCH)
-    return {'split': split, 'classes': classes, 'pipeline': pipeline, 'window': window,
-            'temperature': model.temperature,
-            'cv': {k: cv.get(k) for k in ('scheme', 'accuracy', 'scored_classes')},
-            'cv_optimistic_accuracy': cv.get('optimistic', {}).get('accuracy'),
-            'window_accuracy': report['window']['accuracy'],
-            'window_balanced_accuracy': report['window']['balanced_accuracy'],
-            'trial_accuracy': report['trial']['accuracy'],
-            'trial_balanced_accuracy': report['trial']['balanced_accuracy'],
-            'per_class_window': report['window']['per_class'],
-            'binary': report['binary'], 'calibration': report['calibration'],
-            'seconds': time.perf_counter() - t0}
+        reports = {rc: pseudo_online(model, test, *EPOCH, adaptation=dataclasses.replace(
+            node_adaptation(), recenter=rc))[0] for rc in RECENTER}
+    seconds = time.perf_counter() - t0
+    return [{'split': split, 'classes': classes, 'pipeline': pipeline, 'window': window,
+             'recenter': rc, 'temperature': model.temperature,
+             'temperature_source': model.provenance['calibration']['source'],
+             'cv': {k: cv.get(k) for k in ('scheme', 'accuracy', 'scored_classes')},
+             'cv_optimistic_accuracy': cv.get('optimistic', {}).get('accuracy'),
+             **_figures(report), 'seconds': seconds} for rc, report in reports.items()]
 
 
 def _pct(v: float | None) -> str:
@@ -101,10 +115,11 @@ HEADER = ('| calibrate -> test | classes | pipeline | window | window acc / bal 
 
 
 def summary(rows: list[dict[str, Any]]) -> str:
-    """Mean over the two splits per setting, the controller's figures first."""
-    lines = ['| classes | pipeline | window | rest/hands AUC | rest/feet AUC | rest/hands bal % | '
-             'rest/feet bal % | H/F bal % | window bal % | ECE % |', '|' + '---|' * 10]
-    key = lambda r: (r['classes'], r['pipeline'], r['window'])  # noqa: E731
+    """Mean over the two splits per setting and re-centering, the controller's figures first."""
+    lines = ['| classes | pipeline | window | re-centering | rest/hands AUC | rest/feet AUC | '
+             'rest/hands bal % | rest/feet bal % | H/F bal % | window bal % | ECE % |',
+             '|' + '---|' * 11]
+    key = lambda r: (r['classes'], r['pipeline'], r['window'], r['recenter'])  # noqa: E731
     groups: dict[tuple, list[dict[str, Any]]] = {}
     for r in rows:
         groups.setdefault(key(r), []).append(r)
@@ -112,9 +127,9 @@ def summary(rows: list[dict[str, Any]]) -> str:
     def mean(rs: list[dict[str, Any]], f: Any) -> float:
         return float(np.mean([f(r) for r in rs]))
 
-    for (classes, pipeline, window), rs in groups.items():
+    for (classes, pipeline, window, recenter), rs in groups.items():
         lines.append(
-            f'| {classes} | {pipeline} | {window:g} s | '
+            f'| {classes} | {pipeline} | {window:g} s | {recenter} | '
             f"{mean(rs, lambda r: r['binary']['rest_vs_both_hands']['auc']):.2f} | "
             f"{mean(rs, lambda r: r['binary']['rest_vs_both_feet']['auc']):.2f} | "
             f"{_pct(mean(rs, lambda r: r['binary']['rest_vs_both_hands']['balanced_accuracy']))}"
@@ -133,14 +148,16 @@ def main(argv: list[str] | None = None) -> int:
     settings = list(itertools.product(SPLITS, CLASS_SETS, PIPELINES, WINDOWS))
     t0 = time.perf_counter()
     with ProcessPoolExecutor(max_workers=max(1, args.jobs)) as pool:
-        rows = list(pool.map(measure, *zip(*settings, strict=True)))
+        rows = [r for rs in pool.map(measure, *zip(*settings, strict=True)) for r in rs]
+    print(f'Re-centering {RECENTER[0]} (the classifier node\'s default):')
     print(HEADER)
     for r in rows:
-        print(row(r))
+        if r['recenter'] == RECENTER[0]:
+            print(row(r))
     print()
     print('Mean over both splits:')
-    print(summary(rows))
-    print(f'\n{len(rows)} settings in {time.perf_counter() - t0:.0f} s')
+    print(summary(sorted(rows, key=lambda r: (r['classes'], r['pipeline'], r['window']))))
+    print(f'\n{len(settings)} settings in {time.perf_counter() - t0:.0f} s')
     print(json.dumps(rows, separators=(',', ':')))
     return 0
 

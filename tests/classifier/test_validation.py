@@ -18,6 +18,7 @@ from mindgrasp_classifier.calibration import (
     nll,
     plot_reliability,
 )
+from mindgrasp_classifier.classifier_node import ClassifierParams
 from mindgrasp_classifier.data import add_rest_events
 from mindgrasp_classifier.errors import ClassifierError
 from mindgrasp_classifier.model import MiModel
@@ -25,6 +26,7 @@ from mindgrasp_classifier.pipelines import softmax
 from mindgrasp_classifier.pseudo_online import (
     format_pseudo_online,
     label_segments,
+    node_adaptation,
     pseudo_online,
     window_labels,
 )
@@ -193,6 +195,13 @@ def test_pseudo_online_report(rest_runs, tmp_path):
     # the trial figure is the offline evaluation's (one code path with the online decoder)
     assert report['trial']['accuracy'] == evaluate(model, [test])['accuracy']
     assert 'rest_vs_both_hands' in format_pseudo_online(report)
+    assert report['adaptation'] == {'mode': 'none', 'recenter': 'fixed'}
+    # as the classifier node decodes by default (its parameter defaults)
+    loop = node_adaptation()
+    assert (loop.recenter, loop.mode) == (ClassifierParams.recenter, ClassifierParams.adaptation)
+    rep_loop, _ = pseudo_online(model, [test], adaptation=loop)
+    assert rep_loop['adaptation']['recenter'] == loop.recenter
+    assert rep_loop['window']['n_windows'] == report['window']['n_windows']
     # a model without rest leaves rest windows out, and has no rest binaries
     no_rest, _ = train(rest_runs, TrainingConfig(channels='all', classes=[0, 1, 2, 3]))
     rep2, win2 = pseudo_online(no_rest, [test])

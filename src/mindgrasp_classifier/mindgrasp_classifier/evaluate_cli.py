@@ -31,6 +31,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              'every sliding window by the annotation it lies in (rest windows '
                              'too when the model knows rest): trial, window, per-class and binary '
                              'accuracies, calibration')
+    parser.add_argument('--online-recenter', choices=('fixed', 'adaptive'), default=None,
+                        help="re-centering of the decoder for --pseudo-online (default: the "
+                             "classifier node's default, so windows are decoded as in the loop)")
     parser.add_argument('--plots', metavar='DIR',
                         help='write reliability diagrams (PNG) of the window probabilities to DIR')
     parser.add_argument('--json', action='store_true',
@@ -65,9 +68,13 @@ def main(args: argparse.Namespace) -> int:
             plots.append(_plot(model, windows, args.plots, 'Offline epochs'))
         online = None
         if args.pseudo_online:
-            from mindgrasp_classifier.pseudo_online import pseudo_online
+            from mindgrasp_classifier.pseudo_online import node_adaptation, pseudo_online
 
-            online, online_windows = pseudo_online(model, recordings, args.tmin, args.tmax)
+            adaptation = node_adaptation()
+            if args.online_recenter:
+                adaptation.recenter = args.online_recenter
+            online, online_windows = pseudo_online(model, recordings, args.tmin, args.tmax,
+                                                   adaptation=adaptation)
             if args.plots:
                 plots.append(_plot(model, online_windows, args.plots, 'Pseudo-online'))
     except ClassifierError as exc:

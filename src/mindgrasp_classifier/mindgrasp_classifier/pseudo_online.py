@@ -16,6 +16,7 @@ balanced, binary decisions (:data:`BINARY_TASKS`) from the probabilities restric
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 from typing import Any
 
@@ -24,6 +25,7 @@ from sklearn.metrics import confusion_matrix, roc_auc_score
 
 from mindgrasp_classifier.calibration import calibration_summary, label_positions
 from mindgrasp_classifier.data import Recording
+from mindgrasp_classifier.decoder import AdaptationConfig
 from mindgrasp_classifier.errors import ClassifierError
 from mindgrasp_classifier.model import DECODER_CLASS_NAMES, MiModel
 from mindgrasp_classifier.preprocessing import window_samples
@@ -134,9 +136,22 @@ def _per_class(classes: Sequence[int], confusion: np.ndarray) -> dict[str, float
             for i, c in enumerate(classes)}
 
 
+def node_adaptation() -> AdaptationConfig:
+    """The classifier node's default adaptation and re-centering (its parameter defaults), so
+    a pseudo-online evaluation decodes as the loop does."""
+    from mindgrasp_classifier.classifier_node import ClassifierParams
+
+    defaults = {f.name: f.default for f in dataclasses.fields(ClassifierParams)}
+    return AdaptationConfig(mode=defaults['adaptation'], rate=defaults['adaptation_rate'],
+                            min_certainty=defaults['min_certainty'],
+                            recenter=defaults['recenter'],
+                            recenter_rate=defaults['recenter_rate'])
+
+
 def pseudo_online(model: MiModel, recordings: Sequence[Recording], tmin: float = 0.5,
-                  tmax: float = 2.5,
-                  chunk: float = 1.0 / 32.0) -> tuple[dict[str, Any], WindowPredictions]:
+                  tmax: float = 2.5, chunk: float = 1.0 / 32.0,
+                  adaptation: AdaptationConfig | None = None,
+                  ) -> tuple[dict[str, Any], WindowPredictions]:
     """Stream each recording through the online decoder and score every labelled window.
 
     Parameters
@@ -149,6 +164,10 @@ def pseudo_online(model: MiModel, recordings: Sequence[Recording], tmin: float =
         annotation.
     chunk : float
         Chunk length (s) fed to the decoder.
+    adaptation : AdaptationConfig, optional
+        Re-centering and class-mean adaptation of the decoder (default: none, the training
+        reference; :func:`node_adaptation` gives the classifier node's defaults). Each
+        recording starts a fresh decoder (a new session); supervised modes get no labels.
 
     Returns
     -------
@@ -163,7 +182,8 @@ def pseudo_online(model: MiModel, recordings: Sequence[Recording], tmin: float =
         The scored windows (``scheme='pseudo_online'``).
     """
     n_window = window_samples(model.rate, model.window)
-    streamed = [stream_recording(model, rec, chunk=chunk) for rec in recordings]
+    streamed = [stream_recording(model, rec, dataclasses.replace(adaptation or AdaptationConfig()),
+                                 chunk=chunk) for rec in recordings]
     trial = score_predictions(model, recordings, streamed, tmin, tmax)
     trial['per_class'] = _per_class(model.classes, trial['confusion'])
     dists, labels, n_left_out = [], [], 0
@@ -183,8 +203,10 @@ def pseudo_online(model: MiModel, recordings: Sequence[Recording], tmin: float =
     confusion = confusion_matrix(windows.labels, pred, labels=classes)
     probabilities = model.probabilities(windows.distances)
     logits = model.classifier.logits(windows.distances)
+    cfg = adaptation or AdaptationConfig()
     report = {
         'classes': model.class_names,
+        'adaptation': {'mode': cfg.mode, 'recenter': cfg.recenter},
         'n_predictions': int(sum(len(e) for e, _ in streamed)),
         'trial': trial,
         'window': {
@@ -214,9 +236,10 @@ def format_pseudo_online(report: dict[str, Any]) -> str:
     def pct(v: float | None) -> str:
         return '   -  ' if v is None else f'{100 * v:5.1f} %'
 
-    lines = [f"Pseudo-online ({report['n_predictions']} predictions; {win['n_windows']} windows "
-             f"inside a labelled stretch, {win['n_left_out']} left out; {trial['n_trials']} "
-             'trials):',
+    ada = report['adaptation']
+    lines = [f"Pseudo-online (re-centering {ada['recenter']}, adaptation {ada['mode']}; "
+             f"{report['n_predictions']} predictions; {win['n_windows']} windows inside a "
+             f"labelled stretch, {win['n_left_out']} left out; {trial['n_trials']} trials):",
              f"  {'':<{width}}{'trial':>9}{'window':>9}",
              f"  {'accuracy':<{width}}{pct(trial['accuracy']):>9}{pct(win['accuracy']):>9}",
              f"  {'balanced':<{width}}{pct(trial['balanced_accuracy']):>9}"
