@@ -171,3 +171,19 @@ def test_scan_subject_answers_by_where_the_arm_points():
     assert scan_class(target, 0.7, State.FINAL_APPROACH) == MiClass.BOTH_HANDS
     assert scan_class(target, 0.0, State.OBJECT_SEARCH, stopped=True) == MiClass.BOTH_HANDS
     assert scan_class(None, 0.0, State.CENTER_OBJECT, offered=True) is None
+
+
+def test_scan_final_approach_waits_for_go_on():
+    big = observation(64, 64, 0.2, 0.5)
+    for answer, end_state, words in ((HANDS, State.FINAL_APPROACH, 'fills'),
+                                     (UNIFORM, State.RETURN_TO_START, 'no go-on within 6.0 s')):
+        fsm = scan_fsm()
+        out, t = run_until(fsm, 0.0, 3.0, UNIFORM, stop=lambda o: o.offered)
+        out, t = run_until(fsm, t, 3.0, HANDS, stop=lambda o: o.state == State.INITIAL_APPROACH)
+        # the object is close at once: without a go-on the arm holds there
+        out, t = run_until(fsm, t, 0.3, UNIFORM, obs=big)
+        assert out.state == State.INITIAL_APPROACH and out.phase == 'waiting for go-on'
+        out, t = run_until(fsm, t, 8.0, answer, obs=big, stop=lambda o: o.locked)
+        assert out.locked and words in out.reason
+        out, t = run_until(fsm, t, 0.6, answer, obs=big)
+        assert out.state == end_state

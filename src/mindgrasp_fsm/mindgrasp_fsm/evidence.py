@@ -112,7 +112,7 @@ class Evidence:
     @property
     def fraction(self) -> float:
         """Evidence as a fraction of the threshold (0..1), for displays."""
-        return min(self.value / self.threshold, 1.0) if self.threshold > 0 else 1.0
+        return min(max(self.value / self.threshold, 0.0), 1.0) if self.threshold > 0 else 1.0
 
     def update(self, prediction: Prediction | None) -> bool:
         """Add ``prediction`` if it is newer than the last one counted; True once reached (see

@@ -35,9 +35,11 @@ autonomous mode and *offers* each object it centres; the person answers yes with
 imagery or no with both-feet imagery, the two classes real EEG tells apart best (0.93 on
 EEGMMIDB S001 against 0.60 for left/right hand). Yes commits to the object; no, or no answer
 within ``offer_timeout``, lets the arm turn on by ``scan_skip_angle`` to the next object. Once
-committed, the approach and grasp run by themselves; the person keeps imagining both hands, and
-both feet cancel them until the gripper closes (the arm returns to the start and scans on past
-that object). Both decisions are taken on evidence accumulated over decoder windows from the
+committed, the arm approaches by itself while the person keeps imagining both hands: a second
+yes ("go on", ``affirm_threshold``) must come before the final approach and grasp start (two
+decisions on different stretches of EEG, so that one misread stretch cannot grasp the wrong
+object), and both feet cancel until the gripper closes (the arm returns to the start and scans
+on past that object). Both decisions are taken on evidence accumulated over decoder windows from the
 calibrated class probabilities (:mod:`mindgrasp_fsm.evidence`); weak evidence means the arm
 waits.
 
@@ -162,9 +164,12 @@ class GraspFsm:
                                  threshold=self.params.confirm_threshold,
                                  clip=self.params.evidence_clip,
                                  reject_threshold=self.params.pass_threshold)
+        # cancel and go-on are the two answers of one test during the approach
         self._cancel = Evidence(MiClass.BOTH_FEET, [MiClass.BOTH_HANDS],
                                 threshold=self.params.cancel_threshold,
-                                clip=self.params.evidence_clip)
+                                clip=self.params.evidence_clip,
+                                reject_threshold=self.params.affirm_threshold)
+        self._affirmed = False
         self._attempt = 0
         self._outcome = ''
         self._gripper = GripperCommand(self.params.gripper_open_position, 0.0)
@@ -285,9 +290,15 @@ class GraspFsm:
 
         if self._cancellable():
             self._cancel.threshold, self._cancel.clip = p.cancel_threshold, p.evidence_clip
+            self._cancel.reject_threshold = p.affirm_threshold
             if self._cancel.update(inputs.prediction):
-                self._cancel_approach(q)
+                self._cancel_approach(q, f'cancelled the approach to the {self._ooi_label} '
+                                      f'(both-feet evidence {self._cancel.value:.2f} nat s)')
                 return self._output(np.zeros(6), phase='cancelled')
+            if self._cancel.rejected and not self._affirmed:
+                self._affirmed = True
+                self._events.append(f'go on with the {self._ooi_label} (both-hands evidence '
+                                    f'{-self._cancel.value:.2f} nat s)')
 
         handler = {
             State.OBJECT_SEARCH: self._search,
@@ -560,8 +571,10 @@ class GraspFsm:
         self._confirm.reject_threshold = p.pass_threshold
         if self._confirm.update(inputs.prediction):
             self._committed = True
+            self._affirmed = False
             self._offer_since = None
-            self._cancel.reset(self._now)
+            # the go-on decision counts windows after those of the confirmation only
+            self._cancel.reset(self._now + p.offer_delay)
             self._goto(self._center_next, f'confirmed the {ooi.label} (both-hands evidence '
                        f'{self._confirm.value:.2f} nat s)')
             return np.zeros(6), 'confirmed'
@@ -576,16 +589,14 @@ class GraspFsm:
             return np.zeros(6), 'passed'
         return v, f'offering the {ooi.label}: evidence {self._confirm.fraction:.0%}'
 
-    def _cancel_approach(self, q: np.ndarray) -> None:
-        """Scan: both-feet evidence backs out of the approach: return to the start, then scan
-        on past this object."""
-        label = self._ooi_label or 'object'
+    def _cancel_approach(self, q: np.ndarray, reason: str) -> None:
+        """Scan: back out of the approach (both-feet evidence, or no go-on in time): return to
+        the start, then scan on past this object. ``reason`` starts with 'cancelled'."""
         self._outcome = 'cancelled'
         self._committed = False
         self._ignore_from = float(q[0])
         self._ignore_angle = self.params.scan_skip_angle
-        self._goto(State.RETURN_TO_START, f'cancelled the approach to the {label} (both-feet '
-                   f'evidence {self._cancel.value:.2f} nat s)')
+        self._goto(State.RETURN_TO_START, reason)
 
     # ---------------------------------------------------------------------------- state 3
     def _initial_approach(self, t: float, q: np.ndarray, inputs: FsmInputs
@@ -606,6 +617,16 @@ class GraspFsm:
         j = p.approach_joint - 1
         near_limit = (p.approach_sign > 0 and q[j] >= p.joint_upper_limits[j] - 0.1) or \
             (p.approach_sign < 0 and q[j] <= p.joint_lower_limits[j] + 0.1)
+        close = ooi.pixel_fraction > p.final_approach_pixel_fraction or near_limit or (
+            math.isfinite(ooi.distance) and ooi.distance < p.final_approach_distance)
+        if close and self._scan and not self._affirmed:
+            # scan: the final approach and grasp wait for the person's go-on; none in time
+            # means the arm backs out, never that it grasps
+            if t - self._state_since > p.offer_timeout:
+                self._cancel_approach(q, f'cancelled the approach to the {ooi.label}: no go-on '
+                                      f'within {p.offer_timeout:.1f} s')
+                return v, 'cancelled'
+            return self._centring(ooi, inputs.vision, p.approach_center_gain), 'waiting for go-on'
         if ooi.pixel_fraction > p.final_approach_pixel_fraction:
             self._goto(State.FINAL_APPROACH, f'{ooi.label} fills {100 * ooi.pixel_fraction:.1f} %'
                        ' of the image')

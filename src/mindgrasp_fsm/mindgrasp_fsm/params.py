@@ -92,6 +92,9 @@ class FsmParams:
     pass_threshold: float = param(3.0, 'scan: evidence for both feet against both hands that '
                                   'passes the offered object at once', unit='nat s', min=0.01,
                                   max=100.0, live=True)
+    affirm_threshold: float = param(3.0, 'scan: evidence for both hands against both feet '
+                                    'during the approach (go on) before the final approach and '
+                                    'grasp start', unit='nat s', min=0.01, max=100.0, live=True)
     cancel_threshold: float = param(5.0, 'scan: evidence for both feet against both hands that '
                                     'cancels an approach before the gripper closes',
                                     unit='nat s', min=0.01, max=100.0, live=True)
