@@ -13,7 +13,7 @@ import pytest
 from mindgrasp_eeg import EEGError
 from mindgrasp_eeg.player import expand_sources, load_recording
 from mindgrasp_experiments.records import read_records
-from mindgrasp_experiments.subjects import replay_model
+from mindgrasp_experiments.subjects import REPLAY_TAG, replay_model
 from mindgrasp_testing import write_graz_xdf, write_recording_xdf
 
 from .test_sweep import mindgrasp
@@ -37,11 +37,12 @@ def test_the_model_is_calibrated_on_the_calibration_set_and_cached_by_its_digest
     subject = graz_subject(tmp_path)
     model = replay_model(str(subject), tmp_path / 'out')
     assert model.parent == tmp_path / 'out'
-    assert re.fullmatch(r'graz_classifier_[0-9a-f]{12}\.json', model.name), model.name
+    assert re.fullmatch(rf'graz_classifier_[0-9a-f]{{12}}_{REPLAY_TAG}\.json', model.name), \
+        model.name
     provenance = json.loads(model.read_text())['provenance']
     assert provenance['sources'] == [str(tmp_path / 'cal.xdf')]      # never the played file
     assert provenance['trials_per_class'] == {'left_hand': 5, 'right_hand': 5, 'both_hands': 5,
-                                              'both_feet': 5}
+                                              'both_feet': 5, 'rest': 20}
     mtime = model.stat().st_mtime_ns
     assert replay_model(str(subject), tmp_path / 'out') == model            # cached
     assert model.stat().st_mtime_ns == mtime
