@@ -137,11 +137,12 @@ def test_bad_input_is_one_clear_line_and_exit_2(tmp_path: Path, args: list[str],
 @pytest.mark.timeout(2400)   # 4 whole trials through the real nodes, on a loaded machine
 def test_a_small_sweep_writes_every_file_and_the_json(tmp_path: Path) -> None:
     """2 seeds x 2 accuracies x 2 trials (cut at 12 simulated s), with a swept parameter
-    column."""
+    column: the paper's paradigm, whose subject imagines from the first second (in the scan
+    paradigm it rests while the arm searches)."""
     out = tmp_path / 'sweep'
     result = mindgrasp('experiment', 'sweep', '--accuracy', '0.4,1.0', '--trials', '2',
                        '--seeds', '3,4', '--trial-timeout', '12', '--param',
-                       'fsm.certainty_threshold=0.5', '--out', str(out), '--json',
+                       'fsm.paradigm=paper', '--out', str(out), '--json',
                        '--no-progress')
     assert result.returncode == 0, result.stderr[-3000:]
     doc = json.loads(result.stdout.strip().splitlines()[-1])
@@ -150,7 +151,7 @@ def test_a_small_sweep_writes_every_file_and_the_json(tmp_path: Path) -> None:
                                                             (4, 1.0)]
     for p in points:
         assert all(k in p for k in JSON_KEYS), p
-        assert p['trials'] == 2 and p['fsm.certainty_threshold'] == 0.5
+        assert p['trials'] == 2 and p['fsm.paradigm'] == 'paper'
         assert 0.0 <= p['success_rate'] <= 1.0
         assert p['online_windows'] > 0 and 0.0 <= p['online_accuracy'] <= 1.0
         point_dir = out / 'points' / p['point']
@@ -169,10 +170,10 @@ def test_a_small_sweep_writes_every_file_and_the_json(tmp_path: Path) -> None:
     rows = list(csv.DictReader((out / 'sweep.csv').open(encoding='utf-8')))
     assert [(r['seed'], float(r['accuracy'])) for r in rows] == [('3', 0.4), ('3', 1.0),
                                                                   ('4', 0.4), ('4', 1.0)]
-    assert all(r['fsm.certainty_threshold'] == '0.5' for r in rows)
+    assert all(r['fsm.paradigm'] == 'paper' for r in rows)
     assert json.loads((out / 'sweep.json').read_text())['points'] == points
     report = (out / 'report.md').read_text()
-    assert '| accuracy | seed | fsm.certainty_threshold |' in report
+    assert '| accuracy | seed | fsm.paradigm |' in report
     assert 'success_vs_accuracy.png' in report
     assert all(math.isfinite(p['online_accuracy']) for p in points)
 

@@ -149,6 +149,32 @@ def check(args: argparse.Namespace, command: str) -> str | None:
     return None
 
 
+def add_param_argument(parser: argparse.ArgumentParser) -> None:
+    """``--param NODE.PARAM=V`` of an experiment: one value sets a node's parameter for every
+    trial; several values compare them, each as a point of a sweep."""
+    parser.add_argument('--param', action='append', default=[], metavar='NODE.PARAM=V1,V2,...',
+                        help='set a parameter of a node (names as in the profile\'s parameter '
+                             'files), e.g. fsm.paradigm=paper; several values, e.g. '
+                             'fsm.paradigm=paper,scan, run each as a point of a sweep '
+                             '(mindgrasp experiment sweep) and compare them; repeat for more')
+
+
+def compare_by_sweep(args: argparse.Namespace, command: str) -> int:
+    """``set-locations --param NODE.PARAM=V1,V2``: the comparison is a sweep over those values
+    at the subject's accuracy (``mindgrasp experiment sweep``, same records and report)."""
+    from mindgrasp_experiments.commands import sweep
+
+    subject = getattr(args, 'subject', 'virtual')
+    if subject in ('noise', 'oracle', 'autonomous'):
+        return fail(command, f'--param with several values compares them as a sweep, which '
+                             f'varies a pursuing subject; --subject {subject} takes one value '
+                             'per --param (run the command once per value).')
+    print(f'{command}: several values of --param: comparing them as a sweep at accuracy '
+          f'{args.accuracy:g}.', file=sys.stderr)
+    return sweep.main(argparse.Namespace(**{**vars(args), 'accuracy': str(args.accuracy),
+                                            'subject': subject, 'seeds': None}))
+
+
 def run_experiment(args: argparse.Namespace, protocol: str, command: str) -> int:
     """Run the protocol with ``args``; write the run directory; print the figures."""
     from tqdm import tqdm
@@ -160,12 +186,19 @@ def run_experiment(args: argparse.Namespace, protocol: str, command: str) -> int
     from mindgrasp_experiments.engine import lockstep_components
     from mindgrasp_experiments.records import write_records
     from mindgrasp_experiments.report import finite, write_run
+    from mindgrasp_experiments.sweep import apply_params, check_params, parse_param
     from mindgrasp_experiments.workers import run_trials
 
     problem = check(args, command)
     if problem:
         return fail(command, problem)
     subject = getattr(args, 'subject', 'autonomous')
+    try:
+        params = [parse_param(p) for p in getattr(args, 'param', [])]
+    except ExperimentError as exc:
+        return fail(command, str(exc))
+    if any(len(values) > 1 for _node, _name, values in params):
+        return compare_by_sweep(args, command)
     try:
         out = create_run_dir(protocol, args.out)
     except LaunchError as exc:
@@ -190,6 +223,12 @@ def run_experiment(args: argparse.Namespace, protocol: str, command: str) -> int
         if comp.module.endswith('trial_manager_node'):
             comp.ros_args += ['-p', f'stall_timeout:={args.stall_timeout}',
                               '-p', f'trial_timeout:={args.trial_timeout}']
+    try:
+        params = check_params(params, components)
+    except ExperimentError as exc:
+        return fail(command, str(exc))
+    components = apply_params(components, {f'{node}.{name}': values[0]
+                                           for node, name, values in params})
     trials = list(range(1, args.trials + 1))
     runs = []
     interrupted = False

@@ -160,6 +160,10 @@ class GraspFsm:
         # committed to the object of interest, and the evidence of each decision
         self._offer_since: float | None = None
         self._committed = False
+        # scan: bearings (joint-1 angle facing them, rad) of the objects passed or cancelled in
+        # this scan, and the ends of the joint-1 range reached since the first of them
+        self._passed: list[float] = []
+        self._limits_reached: set[float] = set()
         self._confirm = Evidence(MiClass.BOTH_HANDS, [MiClass.BOTH_FEET],
                                  threshold=self.params.confirm_threshold,
                                  clip=self.params.evidence_clip,
@@ -441,6 +445,10 @@ class GraspFsm:
                         if p.autonomous else 'turning on to the next object'
                 self._ignore_from = None
                 self._seen_since = None
+            if ooi is not None and self._scan and self._was_passed(ooi, q, inputs):
+                # offered (or cancelled) in this scan already: the others come first
+                self._seen_since = None
+                return self._sweep_step(q), f'turning on past the {ooi.label}'
             if ooi is not None and self._seen_since is not None \
                     and t - self._seen_since >= p.search_confirm_time:
                 self._center_next = State.INITIAL_APPROACH
@@ -487,6 +495,12 @@ class GraspFsm:
         if (self._sweep_dir > 0 and q[0] >= hi) or (self._sweep_dir < 0 and q[0] <= lo):
             self._sweep += 1
             self._sweep_dir = -self._sweep_dir
+            # scan: once both ends were reached since the first pass, every object has been
+            # offered once; the next sweep offers them all again
+            self._limits_reached.add(self._sweep_dir)
+            if len(self._limits_reached) == 2:
+                self._passed.clear()
+                self._limits_reached.clear()
         v[0] = self._sweep_dir * p.autonomous_search_velocity
         home = np.asarray(p.home_position)
         # keep the other joints at home, joint 5 at this sweep's tilt
@@ -581,21 +595,38 @@ class GraspFsm:
         declined = self._confirm.rejected
         if declined or t - self._offer_since > p.offer_timeout:
             self._offer_since = None
-            self._ignore_from = float(q[0])
-            self._ignore_angle = p.scan_skip_angle
+            self._remember_passed(q)
             why = (f'declined (both-feet evidence {-self._confirm.value:.2f} nat s)' if declined
                    else f'not confirmed in {p.offer_timeout:.1f} s')
             self._goto(State.OBJECT_SEARCH, f'passed the {ooi.label}: {why}')
             return np.zeros(6), 'passed'
         return v, f'offering the {ooi.label}: evidence {self._confirm.fraction:.0%}'
 
+    def _bearing(self, ooi: ObjectObservation, q: np.ndarray, inputs: FsmInputs) -> float:
+        """Joint-1 angle (rad) at which the arm would face ``ooi``: the current one plus the
+        object's horizontal angle in the image (pinhole camera; turning towards an object right
+        of centre is ``center_sign_joint1``)."""
+        cam = inputs.camera
+        if cam is None or inputs.vision is None:
+            return float(q[0])
+        off = math.atan2(ooi.centre_x - inputs.vision.image_width / 2.0, cam.fx)
+        return float(q[0]) + self.params.center_sign_joint1 * off
+
+    def _was_passed(self, ooi: ObjectObservation, q: np.ndarray, inputs: FsmInputs) -> bool:
+        bearing = self._bearing(ooi, q, inputs)
+        return any(abs(bearing - b) < self.params.scan_skip_angle for b in self._passed)
+
+    def _remember_passed(self, q: np.ndarray) -> None:
+        if not self._passed:
+            self._limits_reached.clear()
+        self._passed.append(float(q[0]))
+
     def _cancel_approach(self, q: np.ndarray, reason: str) -> None:
         """Scan: back out of the approach (both-feet evidence, or no go-on in time): return to
         the start, then scan on past this object. ``reason`` starts with 'cancelled'."""
         self._outcome = 'cancelled'
         self._committed = False
-        self._ignore_from = float(q[0])
-        self._ignore_angle = self.params.scan_skip_angle
+        self._remember_passed(q)
         self._goto(State.RETURN_TO_START, reason)
 
     # ---------------------------------------------------------------------------- state 3

@@ -108,9 +108,10 @@ class FsmParams:
                                'began are not counted (the person sees the offer and starts '
                                'to imagine; a 2 s window then still holds what came before)',
                                unit='s', min=0.0, max=10.0, live=True)
-    scan_skip_angle: float = param(0.45, 'scan: after passing an object, joint 1 turns this far '
-                                   'before the next object is offered', unit='rad', min=0.0,
-                                   max=6.3, live=True)
+    scan_skip_angle: float = param(0.35, 'scan: an object whose bearing lies this close to '
+                                   'one passed or cancelled in this scan is not offered again '
+                                   'until the scan has reached both ends of joint 1',
+                                   unit='rad', min=0.0, max=6.3, live=True)
     certainty_threshold: float = param(0.5, 'certainty below which state 3 uses the default '
                                        'slow approach', min=0.0, max=100.0, live=True)
     certainty_cap: float = param(2.0, 'certainty that gives full speed (certainty is unbounded, '

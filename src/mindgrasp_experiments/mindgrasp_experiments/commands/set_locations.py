@@ -6,13 +6,20 @@ trial, the subject drives the arm through EEG -> classifier -> controller (lock-
     mindgrasp experiment set-locations --trials 6 --subject oracle --json
     mindgrasp experiment set-locations --trials 10 --subject eegmmidb:1 --accuracy 0.9
     mindgrasp experiment set-locations --trials 90 --subject virtual --realism default
+    mindgrasp experiment set-locations --trials 18 --subject eegmmidb:1 \
+        --param fsm.paradigm=paper,scan
 """
 
 from __future__ import annotations
 
 import argparse
 
-from mindgrasp_experiments.cli import add_common_arguments, run_experiment, subject_type
+from mindgrasp_experiments.cli import (
+    add_common_arguments,
+    add_param_argument,
+    run_experiment,
+    subject_type,
+)
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -29,6 +36,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--accuracy', type=probability, default=0.8,
                         help='virtual subject: probability of imagining the right class '
                              '(default 0.8)')
+    add_param_argument(parser)
 
 
 def main(args: argparse.Namespace) -> int:
