@@ -187,3 +187,24 @@ def test_scan_final_approach_waits_for_go_on():
         assert out.locked and words in out.reason
         out, t = run_until(fsm, t, 0.6, answer, obs=big)
         assert out.state == end_state
+
+
+def test_scan_does_not_offer_a_passed_object_again_until_both_ends_were_reached():
+    fsm = scan_fsm()
+    out, t = run_until(fsm, 0.0, 3.0, UNIFORM, stop=lambda o: o.offered)
+    out, t = run_until(fsm, t, 3.0, FEET, stop=lambda o: o.state == State.OBJECT_SEARCH)
+    assert 'declined' in out.reason
+    # the same object still in view (the arm has not turned in this test): not offered again
+    out, t = run_until(fsm, t, 2.0, UNIFORM)
+    assert out.state == State.OBJECT_SEARCH and 'turning on past the red cube' in out.phase
+    assert out.joint_velocities[0] != 0.0
+    # the scan reaches one end, then the other: the object is offered again
+    p = fsm.params
+    lo, hi = p.joint_lower_limits[0], p.joint_upper_limits[0]
+    for end in (hi, lo):
+        q = HOME.copy()
+        q[0] = end
+        tick(fsm, t, UNIFORM, obs=None, q=q)
+        t += 0.02
+    out, t = run_until(fsm, t, 3.0, UNIFORM, stop=lambda o: o.state == State.CENTER_OBJECT)
+    assert out.state == State.CENTER_OBJECT
