@@ -198,7 +198,9 @@ def test_pseudo_online_report(rest_runs, tmp_path):
     assert report['adaptation'] == {'mode': 'none', 'recenter': 'fixed'}
     # as the classifier node decodes by default (its parameter defaults)
     loop = node_adaptation()
-    assert (loop.recenter, loop.mode) == (ClassifierParams.recenter, ClassifierParams.adaptation)
+    assert (loop.recenter, loop.mode, loop.recenter_rate, loop.recenter_prior) == (
+        ClassifierParams.recenter, ClassifierParams.adaptation, ClassifierParams.recenter_rate,
+        ClassifierParams.recenter_prior)
     rep_loop, _ = pseudo_online(model, [test], adaptation=loop)
     assert rep_loop['adaptation']['recenter'] == loop.recenter
     assert rep_loop['window']['n_windows'] == report['window']['n_windows']

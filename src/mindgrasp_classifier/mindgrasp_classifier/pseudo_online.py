@@ -141,11 +141,12 @@ def node_adaptation() -> AdaptationConfig:
     a pseudo-online evaluation decodes as the loop does."""
     from mindgrasp_classifier.classifier_node import ClassifierParams
 
-    defaults = {f.name: f.default for f in dataclasses.fields(ClassifierParams)}
-    return AdaptationConfig(mode=defaults['adaptation'], rate=defaults['adaptation_rate'],
-                            min_certainty=defaults['min_certainty'],
-                            recenter=defaults['recenter'],
-                            recenter_rate=defaults['recenter_rate'])
+    # node parameter -> AdaptationConfig field where the names differ; the others match
+    renamed = {'adaptation': 'mode', 'adaptation_rate': 'rate'}
+    wanted = {f.name for f in dataclasses.fields(AdaptationConfig)}
+    defaults = {renamed.get(f.name, f.name): f.default
+                for f in dataclasses.fields(ClassifierParams)}
+    return AdaptationConfig(**{k: v for k, v in defaults.items() if k in wanted})
 
 
 def pseudo_online(model: MiModel, recordings: Sequence[Recording], tmin: float = 0.5,
