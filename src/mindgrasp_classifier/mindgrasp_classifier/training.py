@@ -320,9 +320,10 @@ def train(recordings: Sequence[Recording], cfg: TrainingConfig | None = None,
         probability calibration (``calibration``); ``model.temperature`` is fitted on the
         held-out predictions (1.0 without cross-validation).
     report : dict
-        Cross-validation figures (:func:`cross_validate`, empty when ``cross_validate`` is
-        False) with ``calibration`` (:func:`~mindgrasp_classifier.calibration.calibration_summary`
-        plus the scheme its predictions came from).
+        Cross-validation figures (:func:`cross_validate_model`, empty when ``cross_validate``
+        is False) with ``calibration``
+        (:func:`~mindgrasp_classifier.calibration.calibration_summary` plus the scheme its
+        predictions came from).
     """
     cfg = cfg or TrainingConfig()
     cfg.check()
