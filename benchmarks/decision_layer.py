@@ -123,7 +123,7 @@ def main(argv: list[str] | None = None) -> int:
     d = FsmParams()
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument('--subject', default='docs/subjects/eegmmidb_s001_swapped.yaml')
-    parser.add_argument('--offers', type=int, default=60, help='episodes of each kind')
+    parser.add_argument('--offers', type=int, default=20, help='episodes per unit of --mix')
     parser.add_argument('--seed', type=int, default=0)
     parser.add_argument('--confirm', default=str(d.confirm_threshold),
                         help='confirm (and cancel) thresholds, nat s, comma-separated')
@@ -137,15 +137,32 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument('--recenter', default=ClassifierParams().recenter,
                         choices=['fixed', 'adaptive'],
                         help="the classifier's re-centering (its parameter recenter)")
+    parser.add_argument('--mix', default='1,4,1,1',
+                        help='episodes of each kind (target offer, other offer, wrong approach, '
+                             'right approach) per --offers: in a scan most offers are answered no')
+    parser.add_argument('--recenter-rate', type=float, default=None,
+                        help="(default: the classifier node's recenter_rate)")
+    parser.add_argument('--recenter-prior', type=float, default=None,
+                        help="s (default: the classifier node's recenter_prior)")
+    parser.add_argument('--trial-episodes', type=int, default=8,
+                        help='a fresh decoder every N episodes, as a lock-step experiment '
+                             'starts every trial with a fresh graph (0: one decoder)')
     parser.add_argument('--cache', default=str(Path(tempfile.gettempdir()) / 'mindgrasp_models'))
     args = parser.parse_args(argv)
     confirms = [float(x) for x in args.confirm.split(',')]
     passes = [float(x) for x in args.pass_.split(',')]
     generate, gen, model = source(args.subject, args.seed, Path(args.cache))
     node = ClassifierParams()       # the classifier node's defaults, as in the loop
-    decoder = MiDecoder(model, gen.channel_names, gen.sample_rate,
-                        AdaptationConfig(recenter=args.recenter, recenter_rate=node.recenter_rate,
-                                         recenter_prior=node.recenter_prior))
+    adaptation = AdaptationConfig(recenter=args.recenter,
+                                  recenter_rate=node.recenter_rate if args.recenter_rate is None
+                                  else args.recenter_rate,
+                                  recenter_prior=node.recenter_prior
+                                  if args.recenter_prior is None else args.recenter_prior)
+
+    def new_decoder() -> MiDecoder:
+        return MiDecoder(model, gen.channel_names, gen.sample_rate, adaptation)
+
+    decoder = new_decoder()
     rate = gen.sample_rate
     rng = np.random.default_rng(args.seed)
     yes, no = MiClass.BOTH_HANDS, MiClass.BOTH_FEET
@@ -154,16 +171,20 @@ def main(argv: list[str] | None = None) -> int:
     kinds = {'target offer': (yes, args.offer_timeout), 'other offer': (no, args.offer_timeout),
              'wrong approach': (no, args.approach), 'right approach': (yes, args.approach)}
     names = list(kinds)
-    order = rng.permutation(np.repeat(np.arange(len(kinds)), args.offers))
+    mix = [int(x) for x in args.mix.split(',')]
+    order = rng.permutation(np.repeat(np.arange(len(kinds)), [args.offers * m for m in mix]))
     episodes: dict[str, list[list[Prediction]]] = {k: [] for k in kinds}
     pos = 0
-    for i in order:
+    for n, i in enumerate(order):
+        if args.trial_episodes and n % args.trial_episodes == 0:
+            decoder = new_decoder()   # a lock-step trial starts a fresh graph
         intent, duration = kinds[names[i]]
         preds, pos = episode(generate, rate, decoder, pos, intent, duration, args.reaction, 0.0)
         episodes[names[i]].append(preds)
     print(f'{args.subject}: model {model.pipeline}, classes {model.class_names}, window '
           f'{model.window:g} s, temperature {model.temperature:.2f}, re-centering '
-          f'{args.recenter}; {args.offers} episodes of '
+          f'{args.recenter} (prior {adaptation.recenter_prior:g} s), a fresh decoder every '
+          f'{args.trial_episodes or "-"} episodes; {args.offers} episodes of '
           f'each kind, offer <= {args.offer_timeout:g} s, approach {args.approach:g} s, reaction '
           f'{args.reaction:g} s, clip {args.clip:g} nat')
     print(f'{"confirm":>7} {"pass":>5} | {"target: yes":>11} {"no":>5} {"s":>5} | '
