@@ -165,7 +165,8 @@ def test_a_small_sweep_writes_every_file_and_the_json(tmp_path: Path) -> None:
     assert points[1]['online_accuracy'] > points[0]['online_accuracy']
     assert points[3]['online_accuracy'] > points[2]['online_accuracy']
     for name in ('sweep.csv', 'sweep.json', 'report.md', 'success_vs_accuracy.png',
-                 'success_vs_accuracy.svg', 'time_vs_accuracy.png', 'time_vs_accuracy.svg'):
+                 'success_vs_accuracy.svg', 'time_vs_accuracy.png', 'time_vs_accuracy.svg',
+                 'outcomes_vs_online_accuracy.png', 'outcomes_vs_online_accuracy.svg'):
         assert (out / name).stat().st_size > 0, name
     rows = list(csv.DictReader((out / 'sweep.csv').open(encoding='utf-8')))
     assert [(r['seed'], float(r['accuracy'])) for r in rows] == [('3', 0.4), ('3', 1.0),

@@ -246,7 +246,8 @@ def _secs(value: float | None, ci: Sequence[float | None] | None = None) -> str:
 
 
 def _plots(points: Sequence[Mapping[str, Any]], varied: Sequence[str], out: Path) -> list[str]:
-    """success_vs_accuracy and time_vs_accuracy (PNG and SVG), one line per combination."""
+    """success_vs_accuracy and time_vs_accuracy (PNG and SVG), one line per combination, and
+    outcomes_vs_online_accuracy."""
     import matplotlib
 
     matplotlib.use('Agg')
@@ -293,6 +294,43 @@ def _plots(points: Sequence[Mapping[str, Any]], varied: Sequence[str], out: Path
             fig.savefig(out / f'{stem}.{ext}', dpi=120, bbox_inches='tight')
             written.append(f'{stem}.{ext}')
         plt.close(fig)
+    written += _outcomes_vs_online_accuracy(points, plt, out)
+    return written
+
+
+def _outcomes_vs_online_accuracy(points: Sequence[Mapping[str, Any]], plt: Any, out: Path
+                                 ) -> list[str]:
+    """outcomes_vs_online_accuracy (PNG, SVG): correct and wrong grasps against the decoder's
+    realised online accuracy (per window), one marker per subject, so the synthetic subject's
+    points and the replay subjects' (real EEG) lie on the same axes."""
+    fig, ax = plt.subplots(figsize=(6.5, 4.2))
+    subjects = sorted({str(p.get('subject', 'virtual')) for p in points})
+    markers = 'osD^v<>p'
+    for i, subject in enumerate(subjects):
+        group = [p for p in points if str(p.get('subject', 'virtual')) == subject
+                 and p.get('online_accuracy') is not None]
+        for field, colour, what in (('correct_and_successful_rate', 'tab:green', 'correct'),
+                                    ('wrong_grasp_rate', 'tab:red', 'wrong')):
+            xs = [p['online_accuracy'] for p in group]
+            ys = [p[field] if p[field] is not None else math.nan for p in group]
+            xerr = [[x - (p.get('online_accuracy_ci95') or [x, x])[0] for x, p in
+                     zip(xs, group, strict=True)],
+                    [(p.get('online_accuracy_ci95') or [x, x])[1] - x for x, p in
+                     zip(xs, group, strict=True)]]
+            ax.errorbar(xs, ys, xerr=xerr if xs else None, marker=markers[i % len(markers)],
+                        linestyle='none', color=colour, capsize=2,
+                        label=f'{what} grasp, {subject}')
+    ax.set_xlabel('decoder online accuracy against the intent (per window, 95 % CI)')
+    ax.set_ylabel('rate of trials')
+    ax.set_ylim(-0.02, 1.02)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7)
+    ax.set_title('Outcomes against the realised decoder accuracy')
+    written = []
+    for ext in ('png', 'svg'):
+        fig.savefig(out / f'outcomes_vs_online_accuracy.{ext}', dpi=120, bbox_inches='tight')
+        written.append(f'outcomes_vs_online_accuracy.{ext}')
+    plt.close(fig)
     return written
 
 
