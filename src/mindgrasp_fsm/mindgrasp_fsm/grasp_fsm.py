@@ -575,7 +575,8 @@ class GraspFsm:
     def _offer(self, t: float, q: np.ndarray, inputs: FsmInputs, ooi: ObjectObservation,
                v: np.ndarray) -> tuple[np.ndarray, str]:
         """Scan, state 2: the centred object is offered; commit on both-hands evidence, pass
-        on after ``offer_timeout``. The arm keeps the object centred meanwhile."""
+        on on both-feet evidence or after ``offer_timeout``. The arm keeps the object centred
+        meanwhile."""
         p = self.params
         if self._offer_since is None:
             self._offer_since = t
