@@ -16,7 +16,26 @@ constant ``erd_tau``). Sources sit under C4 (left hand), C3 (right hand), both (
 vertex Cz (feet), and reach the electrodes through a fixed dipole head model (:class:`HeadModel`),
 so each class changes the spatial covariance as real MI does.
 
-Every random source is seeded: ``seed`` drives the time series, ``head_seed`` the head model.
+How decodable the subject is, is set by four numbers (their defaults reproduce the original
+generator bit for bit; :mod:`~mindgrasp_eeg.decodability` measures and fits them):
+
+- ``separability`` scales the ERD depth of every class (1: ``erd_depth``, 0: imagery changes
+  nothing over the motor cortex, so no class can be told from another);
+- ``lateral_separability`` is how lateralised a one-hand ERD is (1: only the contralateral
+  hemisphere desynchronises; 0: both by half the depth, so left and right hand look the same,
+  yet unlike both hands, which desynchronise both hemispheres fully);
+- ``rest_separability``: any imagery also attenuates the occipital alpha by this times
+  ``erd_depth`` (attention to the task; in real EEG much of rest vs imagery is outside the
+  motor cortex), 0: not at all;
+- ``nonstationarity`` scales how much the statistics change over time. Per run (per ``seed``,
+  :class:`RunConditions`): the cap shifts (:data:`CAP_SHIFT_MM`), each rhythm, the background
+  and the ERD depth change in amplitude (:data:`RUN_LOG_SD`), so a classifier calibrated on
+  one run meets shifted class statistics in the next; per episode (each stretch of rest or of
+  one class): the rhythms wax and wane (:data:`EPISODE_LOG_SD`), so rest is as variable as in
+  real EEG. 0: stationary, every run alike.
+
+Every random source is seeded: ``seed`` drives the time series, the run's conditions and the
+episodes, ``head_seed`` the head model.
 """
 
 from __future__ import annotations
@@ -75,6 +94,67 @@ ERD_AREAS: dict[int, tuple[str, ...]] = {
 
 _BANDS_HZ = {'alpha': (8.0, 12.0), 'mu': (9.0, 13.0), 'beta': (18.0, 26.0)}
 
+#: the contralateral motor area of each one-hand class, and the ipsilateral one
+_LATERAL: dict[int, tuple[str, str]] = {LEFT_HAND: ('right_motor', 'left_motor'),
+                                        RIGHT_HAND: ('left_motor', 'right_motor')}
+#: RMS cap displacement per horizontal axis (mm) between runs at ``nonstationarity`` 1
+CAP_SHIFT_MM = 5.0
+#: SD of the natural log of the run-to-run amplitude factors at ``nonstationarity`` 1: each
+#: source rhythm (~30 %), the background (~20 %), the ERD depth (~30 %)
+RUN_LOG_SD: dict[str, float] = {'source': 0.3, 'background': 0.2, 'erd': 0.3}
+#: SD of the natural log of each rhythm's amplitude factor per episode (each stretch of rest or
+#: of one imagined class) at ``nonstationarity`` 1: rhythms wax and wane over seconds, which
+#: makes rest as variable as in real EEG (imagery, which suppresses them, less so)
+EPISODE_LOG_SD = 0.3
+
+
+@dataclass(frozen=True)
+class RunConditions:
+    """Random recording conditions of one run (``nonstationarity`` > 0).
+
+    Attributes
+    ----------
+    cap_shift_mm : ndarray, shape (3,)
+        Displacement of every electrode (mm, head coordinates; z stays 0).
+    source_gain : ndarray, shape (n_sources,)
+        Amplitude factor of each rhythmic source.
+    background_gain : float
+        Amplitude factor of the 1/f background.
+    erd_gain : float
+        Factor on the ERD depth of every class (how engaged the subject is in this run; one
+        factor for all, as a factor per class would make classes differ by chance within a run).
+    """
+
+    cap_shift_mm: np.ndarray
+    source_gain: np.ndarray
+    background_gain: float
+    erd_gain: float
+
+    #: standard normal draws that make one run's conditions
+    N_DRAWS = 2 + len(SOURCES) + 2
+
+    @classmethod
+    def draw(cls, nonstationarity: float, seed: int, head_seed: int = 0) -> RunConditions:
+        """Conditions of the run ``seed``; the same draws at every ``nonstationarity``, scaled by
+        it, so figures change smoothly with the setting (and 0 gives the nominal run)."""
+        rng = np.random.default_rng([seed, 2, head_seed])   # [seed, 1]: the artefacts
+        return cls.from_normals(nonstationarity, rng.standard_normal(cls.N_DRAWS))
+
+    @classmethod
+    def from_normals(cls, nonstationarity: float, z: np.ndarray) -> RunConditions:
+        """Conditions from ``N_DRAWS`` standard normal draws ``z`` (cap x/y, each source, the
+        background, the ERD depth), scaled by ``nonstationarity``."""
+        z = np.asarray(z, dtype=float)
+        if z.shape != (cls.N_DRAWS,):
+            msg = f'run_normals must have shape ({cls.N_DRAWS},); got {z.shape}.'
+            raise EEGError(msg)
+        z_cap, z_src, (z_bg, z_erd) = z[:2], z[2:-2], z[-2:]
+        ns = float(nonstationarity)
+        return cls(cap_shift_mm=np.array([*(ns * CAP_SHIFT_MM * z_cap), 0.0]),
+                   source_gain=np.exp(ns * RUN_LOG_SD['source'] * z_src),
+                   background_gain=float(np.exp(ns * RUN_LOG_SD['background'] * z_bg)),
+                   erd_gain=float(np.exp(ns * RUN_LOG_SD['erd'] * z_erd)))
+
 
 @dataclass(frozen=True)
 class HeadModel:
@@ -101,8 +181,13 @@ class HeadModel:
     emg_right: np.ndarray
 
     @classmethod
-    def build(cls, channel_names: tuple[str, ...] = NAUTILUS_32, seed: int = 0) -> HeadModel:
-        """Head model for ``channel_names`` (10-20 names) with a seeded 10 % gain scatter."""
+    def build(cls, channel_names: tuple[str, ...] = NAUTILUS_32, seed: int = 0,
+              cap_shift_mm: np.ndarray | None = None) -> HeadModel:
+        """Head model for ``channel_names`` (10-20 names) with a seeded 10 % gain scatter.
+
+        ``cap_shift_mm`` (shape (3,), mm) moves every electrode by that much: the same head and
+        sources (same ``seed``) seen through a cap put on differently.
+        """
         unknown = [c for c in channel_names if c not in ELECTRODE_POSITIONS_MM]
         if unknown:
             msg = (f'The synthetic head model has no position for channels {unknown}; use names '
@@ -110,6 +195,8 @@ class HeadModel:
             raise EEGError(msg)
         rng = np.random.default_rng(seed)
         pos = np.array([ELECTRODE_POSITIONS_MM[c] for c in channel_names]) / 1000.0  # (n_ch, 3) m
+        if cap_shift_mm is not None:
+            pos = pos + np.asarray(cap_shift_mm, dtype=float) / 1000.0
         centre = _HEAD_CENTRE_MM / 1000.0
         columns = []
         for electrode, depth, _band in SOURCES.values():
@@ -162,6 +249,27 @@ class SyntheticEEG:
         RMS amplitudes (V); rhythms at the electrode above their source.
     erd_depth : float
         Fractional amplitude drop of mu and beta during imagery (0..1; 0.5 = -75 % power).
+    separability : float
+        Scale on ``erd_depth`` for every class (>= 0; 1 = ``erd_depth``, 0 = no motor ERD;
+        depths are capped at 1). Sets how well classes, and imagery from rest, can be told
+        apart.
+    lateral_separability : float
+        0..1: how lateralised a one-hand ERD is. With ``x``, the contralateral hemisphere
+        desynchronises by ``(1 + x) / 2`` and the ipsilateral one by ``(1 - x) / 2`` of the
+        class depth: 1 = only contralateral (left vs right as easy as hands vs feet), 0 = both
+        alike (left and right hand indistinguishable); the other classes are unchanged.
+    rest_separability : float
+        >= 0: during any imagery the occipital alpha drops by ``rest_separability *
+        erd_depth`` (capped at 1): rest vs imagery gets easier, the classes stay as they are.
+        0 = imagery differs from rest by the motor ERD only.
+    nonstationarity : float
+        >= 0: size of the changes over time: this run's recording conditions, drawn from
+        ``seed`` (:class:`RunConditions`: at 1 a ~5 mm cap shift, ~30 % rhythm and ERD and
+        ~20 % background amplitude changes), and the rhythms' amplitudes per episode (~30 % at
+        1). 0 = stationary, every run alike.
+    run_normals : ndarray, shape (RunConditions.N_DRAWS,), optional
+        The run's standard normal draws instead of drawing them from ``seed`` (stratified
+        sampling over many runs, as :mod:`~mindgrasp_eeg.decodability` does).
     erd_tau : float
         Time constant of ERD onset and offset (s).
     blink_rate, emg_rate : float
@@ -179,7 +287,10 @@ class SyntheticEEG:
                  erd_depth: float = 0.5, erd_tau: float = 0.3,
                  blink_rate: float = 0.0, blink_amplitude: float = 100e-6,
                  emg_rate: float = 0.0, emg_rms: float = 20e-6,
-                 line_noise: float = 0.0, line_freq: float = 50.0) -> None:
+                 line_noise: float = 0.0, line_freq: float = 50.0,
+                 separability: float = 1.0, lateral_separability: float = 1.0,
+                 rest_separability: float = 0.0, nonstationarity: float = 0.0,
+                 run_normals: np.ndarray | None = None) -> None:
         if sample_rate < 60.0:
             msg = (f'The synthetic EEG needs a sample rate of at least 60 Hz to carry beta '
                    f'rhythms; {sample_rate} Hz is too low, use e.g. 250 Hz.')
@@ -187,9 +298,34 @@ class SyntheticEEG:
         if not 0.0 <= erd_depth <= 1.0:
             msg = f'erd_depth must be within 0..1 (fraction of amplitude); {erd_depth} is invalid.'
             raise EEGError(msg)
+        if not (np.isfinite(separability) and separability >= 0.0):
+            msg = (f'separability must be >= 0 (1 = erd_depth, 0 = no imagery signature); '
+                   f'{separability} is invalid.')
+            raise EEGError(msg)
+        if not 0.0 <= lateral_separability <= 1.0:
+            msg = (f'lateral_separability must be within 0..1 (1 = one-hand ERD only '
+                   f'contralateral); {lateral_separability} is invalid.')
+            raise EEGError(msg)
+        if not (np.isfinite(rest_separability) and rest_separability >= 0.0):
+            msg = (f'rest_separability must be >= 0 (occipital alpha drop during imagery, in '
+                   f'units of erd_depth); {rest_separability} is invalid.')
+            raise EEGError(msg)
+        if not (np.isfinite(nonstationarity) and nonstationarity >= 0.0):
+            msg = (f'nonstationarity must be >= 0 (0 = stationary, 1 = typical changes '
+                   f'between sessions); {nonstationarity} is invalid.')
+            raise EEGError(msg)
         self.channel_names = tuple(channel_names)
         self.sample_rate = float(sample_rate)
-        self.head = HeadModel.build(self.channel_names, head_seed)
+        self.separability, self.lateral_separability = separability, lateral_separability
+        self.rest_separability, self.nonstationarity = rest_separability, nonstationarity
+        # nonstationarity 0 draws nothing and changes nothing: the original output, bit for bit
+        self.run: RunConditions | None = None
+        if nonstationarity > 0:
+            self.run = (RunConditions.draw(nonstationarity, seed, head_seed)
+                        if run_normals is None
+                        else RunConditions.from_normals(nonstationarity, run_normals))
+        self.head = HeadModel.build(self.channel_names, head_seed,
+                                    None if self.run is None else self.run.cap_shift_mm)
         self.erd_depth = erd_depth
         self.blink_rate, self.blink_amplitude = blink_rate, blink_amplitude
         self.emg_rate, self.emg_rms = emg_rate, emg_rms
@@ -214,6 +350,8 @@ class SyntheticEEG:
                               for band, cols in self._band_cols.items()}
         rms = {'alpha': alpha_rms, 'mu': mu_rms, 'beta': beta_rms}
         self._src_rms = np.array([rms[b] for b in self._src_bands])
+        if self.run is not None:
+            self._src_rms = self._src_rms * self.run.source_gain
         self._src_area = [name.split('_', 1)[1] for name in SOURCES]
         self._gain = np.ones(n_src)                   # current (smoothed) ERD gain per source
         self._alpha_gain = float(np.exp(-1.0 / (erd_tau * fs))) if erd_tau > 0 else 0.0
@@ -222,16 +360,42 @@ class SyntheticEEG:
         self._next_onset = {kind: self._draw_onset(kind, 0) for kind in ('blink', 'emg')}
         self._events: list[tuple[int, np.ndarray, np.ndarray]] = []  # (onset, wave, topography)
         self.n_generated = 0                          # samples generated so far
+        # rhythm amplitudes of the current episode (nonstationarity > 0): drawn when the class
+        # changes, from their own stream, so chunking never changes them
+        self._episode_rng = np.random.default_rng([seed, 3, head_seed])
+        self._episode: object = 'none yet'
+        self._episode_rhythm = np.ones(n_src)
 
     @property
     def n_channels(self) -> int:
         """Number of channels."""
         return len(self.channel_names)
 
+    def erd_depths(self, mi_class: int | None) -> dict[str, float]:
+        """Fractional amplitude drop (0..1) of each desynchronised motor area for a class."""
+        if mi_class is None:
+            return {}
+        depth = self.erd_depth * self.separability
+        if self.run is not None:
+            depth = depth * self.run.erd_gain
+        depths = dict.fromkeys(ERD_AREAS.get(mi_class, ()), depth)
+        if mi_class in _LATERAL and self.lateral_separability < 1.0:
+            # the one-hand ERD spreads to the other hemisphere, its sum kept: left and right
+            # hand converge on each other, not on both hands (which desynchronise both fully)
+            contra, ipsi = _LATERAL[mi_class]
+            depths[contra] = depth * (1.0 + self.lateral_separability) / 2.0
+            depths[ipsi] = depth * (1.0 - self.lateral_separability) / 2.0
+        if self.rest_separability > 0.0:
+            # attention to the task: any imagery also blocks the occipital alpha (in real EEG
+            # much of rest vs imagery is there, not over the motor cortex)
+            alpha = self.erd_depth * self.rest_separability
+            depths['occipital'] = alpha * self.run.erd_gain if self.run is not None else alpha
+        return {area: min(d, 1.0) for area, d in depths.items()}
+
     def erd_target(self, mi_class: int | None) -> np.ndarray:
         """Target amplitude gain per source, shape (n_sources,), for an imagined class or None."""
-        areas = ERD_AREAS.get(mi_class, ()) if mi_class is not None else ()
-        return np.array([1.0 - self.erd_depth if area in areas else 1.0
+        depths = self.erd_depths(mi_class)
+        return np.array([1.0 - depths[area] if area in depths else 1.0
                          for area in self._src_area])
 
     def generate(self, n_samples: int, mi_class: int | None = None) -> np.ndarray:
@@ -257,9 +421,15 @@ class SyntheticEEG:
         noise = self._rng.standard_normal((n, 2 * self.n_channels + len(SOURCES)))
         white, src_white = noise[:, :self.n_channels], noise[:, self.n_channels:-self.n_channels]
         pink = self._pink(white)
-        data = self.background_rms * pink @ self.head.smoothing.T
-        # smoothed ERD gain, sample by sample (first-order low-pass towards the target)
+        background = (self.background_rms if self.run is None
+                      else self.background_rms * self.run.background_gain)
+        data = background * pink @ self.head.smoothing.T
         target = self.erd_target(mi_class)
+        if self.run is not None:                # this episode's rhythm amplitudes
+            if mi_class != self._episode:
+                self._new_episode(mi_class)
+            target = target * self._episode_rhythm
+        # smoothed ERD gain, sample by sample (first-order low-pass towards the target)
         decay = self._alpha_gain ** np.arange(1, n + 1)[:, None]
         gains = target + (self._gain - target) * decay          # (n, n_src)
         self._gain = gains[-1].copy()
@@ -274,6 +444,12 @@ class SyntheticEEG:
             data += self.line_noise * np.sin(2 * np.pi * self.line_freq * t)[:, None]
         self.n_generated += n
         return data
+
+    def _new_episode(self, mi_class: int | None) -> None:
+        """Draw the rhythm amplitudes of the episode (rest or a class) that starts now."""
+        self._episode = mi_class
+        z = self._episode_rng.standard_normal(len(SOURCES))
+        self._episode_rhythm = np.exp(self.nonstationarity * EPISODE_LOG_SD * z)
 
     def _draw_onset(self, kind: str, after: int) -> int:
         """Sample index of the next artefact of ``kind`` (Poisson process), or a huge number."""
