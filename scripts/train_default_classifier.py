@@ -69,9 +69,13 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument('--seed', type=int, default=100)
     parser.add_argument('--head-seed', type=int, default=0)
     parser.add_argument('--pipeline', default='mdm')
+    parser.add_argument('--window', type=float, default=1.0, help='decoder window (s)')
+    parser.add_argument('--tmax', type=float, default=2.5,
+                        help='training epoch end after the cue (s); > window + 0.5')
     args = parser.parse_args(argv)
     rec = calibration_session(args.trials_per_class, args.seed, args.head_seed)
-    model, report = train([rec], TrainingConfig(pipeline=args.pipeline, channels='motor'))
+    model, report = train([rec], TrainingConfig(pipeline=args.pipeline, channels='motor',
+                                                window=args.window, tmax=args.tmax))
     model.provenance['generator'] = 'scripts/train_default_classifier.py'
     path = model.save(args.out)
     print(format_report(report, f'Cross-validation on the calibration ({rec.source}):'))

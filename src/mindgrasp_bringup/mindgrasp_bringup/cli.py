@@ -48,7 +48,7 @@ COMMANDS: dict[str, str | dict[str, str]] = {
     'eeg': {
         'virtual-amp': 'mindgrasp_eeg.virtual_amp_cli',
         'play': 'mindgrasp_eeg.player_cli',
-        'fit-virtual': 'mindgrasp_eeg.fit_virtual_cli',
+        'fit-virtual': 'mindgrasp_experiments.fit_virtual_cli',
     },
     'train': {
         'classifier': 'mindgrasp_classifier.train_cli',

@@ -55,9 +55,11 @@ class ClassifierParams:
                                  max=1000.0)
     recenter: str = param('adaptive', 'Riemannian re-centering: the training reference or the '
                           "session's running mean", choices=RECENTER_MODES)
-    recenter_rate: float = param(0.005, 'smallest weight of a new window in the running session '
+    # slow forgetting (horizon ~2 min at 16 windows/s): a shorter memory follows the class mix of
+    # the last seconds (a scan answers 'no' far more often than 'yes') instead of the session
+    recenter_rate: float = param(0.0005, 'smallest weight of a new window in the running session '
                                  'mean', min=0.0, max=1.0)
-    recenter_prior: float = param(10.0, 'adaptive re-centering starts from the training '
+    recenter_prior: float = param(60.0, 'adaptive re-centering starts from the training '
                                   'reference weighted as this many seconds of windows',
                                   unit='s', min=0.0, max=3600.0)
     label_tmin: float = param(0.5, 'windows in [cue + label_tmin, cue + label_tmax] get the '

@@ -17,7 +17,7 @@ vertex Cz (feet), and reach the electrodes through a fixed dipole head model (:c
 so each class changes the spatial covariance as real MI does.
 
 How decodable the subject is, is set by four numbers (their defaults reproduce the original
-generator bit for bit; :mod:`~mindgrasp_eeg.decodability` measures and fits them):
+generator bit for bit; :mod:`~mindgrasp_experiments.decodability` measures and fits them):
 
 - ``separability`` scales the ERD depth of every class (1: ``erd_depth``, 0: imagery changes
   nothing over the motor cortex, so no class can be told from another);
@@ -269,7 +269,7 @@ class SyntheticEEG:
         1). 0 = stationary, every run alike.
     run_normals : ndarray, shape (RunConditions.N_DRAWS,), optional
         The run's standard normal draws instead of drawing them from ``seed`` (stratified
-        sampling over many runs, as :mod:`~mindgrasp_eeg.decodability` does).
+        sampling over many runs, as :mod:`~mindgrasp_experiments.decodability` does).
     erd_tau : float
         Time constant of ERD onset and offset (s).
     blink_rate, emg_rate : float

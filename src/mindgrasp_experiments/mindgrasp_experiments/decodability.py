@@ -60,9 +60,15 @@ import numpy as np
 
 from mindgrasp_common.mi import REST
 from mindgrasp_common.types import Recording
-
-from . import EEGError
-from .montage import BOTH_FEET, BOTH_HANDS, LEFT_HAND, NAUTILUS_32, NAUTILUS_RATE, RIGHT_HAND
+from mindgrasp_eeg import EEGError
+from mindgrasp_eeg.montage import (
+    BOTH_FEET,
+    BOTH_HANDS,
+    LEFT_HAND,
+    NAUTILUS_32,
+    NAUTILUS_RATE,
+    RIGHT_HAND,
+)
 
 __all__ = ['DEFAULT_SETTINGS', 'FIGURES', 'FIT_START', 'PARAMETER_BOUNDS', 'PIPELINES', 'REST',
            'Decodability', 'Figure', 'FitResult', 'MeasureConfig', 'RunSchedule', 'average',
@@ -202,7 +208,7 @@ def labelled(recording: Recording, events: Mapping[str, int | None]) -> Recordin
     """A copy of ``recording`` whose ``events`` are its annotations in ``events`` (annotation ->
     class 0..3, None = rest), rest as :data:`REST`; epochs as the replay subject cuts them
     (:func:`~mindgrasp_eeg.replay_eeg.segments`)."""
-    from .replay_eeg import segments
+    from mindgrasp_eeg.replay_eeg import segments
 
     rows = [(k0, REST if cls is None else int(cls)) for k0, _k1, cls in segments(recording, events)]
     return replace(recording, events=np.array(rows, dtype=int).reshape(-1, 2))
@@ -412,7 +418,7 @@ def average(results: Sequence[Decodability], source: str = '') -> Decodability:
 def replay_recordings(source: str) -> tuple[list[Recording], list[Recording], str]:
     """Labelled calibration and play recordings of a replay subject (``eegmmidb:<n>`` or a
     subject file), and its ``source``; raises :class:`EEGError` for a bad subject."""
-    from .subject_file import replay_subject
+    from mindgrasp_eeg.subject_file import replay_subject
 
     subject = replay_subject(source)
     sets = []
@@ -492,7 +498,7 @@ def synthetic_runs(schedules: Sequence[RunSchedule], *, seed: int = 0, repeat: i
         32 channels (:data:`NAUTILUS_32`) at ``rate`` Hz, volts; ``events`` as the schedule
         (:data:`REST` for rest).
     """
-    from .synthetic import SyntheticEEG
+    from mindgrasp_eeg.synthetic import SyntheticEEG
 
     out = []
     for i, sched in enumerate(schedules):
@@ -558,7 +564,7 @@ def _stratified_normals(seed: int, repeats: int, n_runs: int) -> np.ndarray:
     """
     from scipy.stats import norm, qmc
 
-    from .synthetic import RunConditions
+    from mindgrasp_eeg.synthetic import RunConditions
 
     n = RunConditions.N_DRAWS
     lhs = qmc.LatinHypercube(d=n_runs * n, seed=np.random.default_rng([seed, 4]))

@@ -1,6 +1,6 @@
 """Decodability of the virtual subject: the settings of SyntheticEEG (separability,
 lateral_separability, rest_separability, nonstationarity), the figures of
-mindgrasp_eeg.decodability, and ``mindgrasp eeg fit-virtual`` against real EEGMMIDB S001
+mindgrasp_experiments.decodability, and ``mindgrasp eeg fit-virtual`` against real EEGMMIDB S001
 (MNE_DATASETS_EEGBCI_PATH, ../shared/data)."""
 
 from __future__ import annotations
@@ -16,9 +16,9 @@ import yaml
 
 from mindgrasp_common.mi import REST
 from mindgrasp_eeg import EEGError
-from mindgrasp_eeg import decodability as dec
 from mindgrasp_eeg.montage import NAUTILUS_32
 from mindgrasp_eeg.synthetic import RunConditions, SyntheticEEG
+from mindgrasp_experiments import decodability as dec
 
 FS = 250.0
 #: the original subject, spelled out

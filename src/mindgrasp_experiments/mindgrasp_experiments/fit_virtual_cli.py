@@ -2,7 +2,7 @@
 
 Measures the real subject's decodability figures (4 classes, left vs right, hands vs feet, rest
 vs any imagery, rest vs both hands: calibrated on its calibration recordings, tested on its play
-recordings, :mod:`mindgrasp_eeg.decodability`), then searches the virtual subject's
+recordings, :mod:`mindgrasp_experiments.decodability`), then searches the virtual subject's
 ``separability``, ``lateral_separability``, ``rest_separability`` and ``nonstationarity`` so that
 synthetic sessions on the same cue schedules give the same figures. Prints real vs fitted per
 figure; ``--output`` writes the values as a ROS parameter file for the virtual amplifier.
@@ -25,11 +25,10 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from mindgrasp_common.cli_checks import non_negative_int, positive_int
-
-from . import EEGError
+from mindgrasp_eeg import EEGError
 
 if TYPE_CHECKING:
-    from .decodability import Decodability, FitResult
+    from mindgrasp_experiments.decodability import Decodability, FitResult
 
 PROG = 'mindgrasp eeg fit-virtual'
 
@@ -56,7 +55,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def format_table(result: FitResult, subject: str) -> str:
     """Real vs fitted virtual figures, one line per figure, then the fitted values."""
-    from .decodability import FIGURES
+    from mindgrasp_experiments.decodability import FIGURES
 
     real, syn, check = result.real, result.synthetic, result.check
     lines = [f'Decodability: {subject} (real) vs the fitted virtual subject',
@@ -99,14 +98,15 @@ def parameter_file(params: dict[str, float], subject: str, command: str, error: 
     they were fitted for)."""
     body = '\n'.join(f'    {k}: {v:g}' for k, v in {'head_seed': head_seed, **params}.items())
     return (f'# Virtual subject fitted to {subject}: `{command}`\n'
-            f'# (decodability figures of mindgrasp_eeg.decodability within {error:.3f} RMS of '
+            '# (decodability figures of mindgrasp_experiments.decodability within '
+            f'{error:.3f} RMS of '
             'the real ones).\n'
             f'virtual_amp:\n  ros__parameters:\n{body}\n')
 
 
 def main(args: argparse.Namespace) -> int:
     """Run the fit; 0, or 2 with one line on a bad subject or setting."""
-    from .decodability import (
+    from mindgrasp_experiments.decodability import (
         RunSchedule,
         common_channels,
         default_jobs,
