@@ -103,6 +103,16 @@ class VirtualAmpParams:
                                   min=-6.3, max=6.3)
     seed: int = param(0, 'seed of the EEG time series and the subject decisions', min=0)
     head_seed: int = param(0, 'seed of the head model (keep it for one virtual subject)', min=0)
+    # decodability (mindgrasp_eeg.synthetic; fitted to a real subject by `mindgrasp eeg
+    # fit-virtual`, which writes these as a parameter file); 1, 1, 0, 0 is the original head
+    separability: float = param(1.0, 'scale of every class ERD (0: classes indistinguishable)',
+                                min=0.0, max=10.0)
+    lateral_separability: float = param(1.0, 'how one-sided one-hand imagery is (0: left = '
+                                        'right)', min=0.0, max=1.0)
+    rest_separability: float = param(0.0, 'occipital alpha drop with any imagery, times '
+                                     'erd_depth', min=0.0, max=10.0)
+    nonstationarity: float = param(0.0, 'drift between runs and stretches (0: stationary)',
+                                   min=0.0, max=10.0)
     background_rms: float = param(10e-6, '1/f background', unit='V', min=0.0)
     alpha_rms: float = param(8e-6, 'alpha rhythm', unit='V', min=0.0)
     mu_rms: float = param(6e-6, 'mu rhythm', unit='V', min=0.0)

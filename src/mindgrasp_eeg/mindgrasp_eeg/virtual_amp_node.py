@@ -65,7 +65,9 @@ class VirtualAmpNode(rclpy.node.Node):
                 beta_rms=p.beta_rms, sensor_noise_rms=p.sensor_noise_rms,
                 erd_depth=p.erd_depth, erd_tau=p.erd_tau, blink_rate=p.blink_rate,
                 blink_amplitude=p.blink_amplitude, emg_rate=p.emg_rate, emg_rms=p.emg_rms,
-                line_noise=p.line_noise, line_freq=p.line_freq)
+                line_noise=p.line_noise, line_freq=p.line_freq, separability=p.separability,
+                lateral_separability=p.lateral_separability,
+                rest_separability=p.rest_separability, nonstationarity=p.nonstationarity)
         # the stream's layout: the parameters', or the recordings' with a replay eeg_source
         self.channel_names = list(gen.channel_names)
         self.sample_rate = float(gen.sample_rate)
