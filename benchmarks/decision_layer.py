@@ -184,9 +184,11 @@ def main(argv: list[str] | None = None) -> int:
     print(f'{args.subject}: model {model.pipeline}, classes {model.class_names}, window '
           f'{model.window:g} s, temperature {model.temperature:.2f}, re-centering '
           f'{args.recenter} (prior {adaptation.recenter_prior:g} s), a fresh decoder every '
-          f'{args.trial_episodes or "-"} episodes; {args.offers} episodes of '
-          f'each kind, offer <= {args.offer_timeout:g} s, approach {args.approach:g} s, reaction '
-          f'{args.reaction:g} s, clip {args.clip:g} nat')
+          f'{args.trial_episodes or "-"} episodes; {args.offers} x ({args.mix}) episodes '
+          f'(target offer, other offer, wrong approach, right approach), offer <= '
+          f'{args.offer_timeout:g} s, approach {args.approach:g} s, reaction '
+          f'{args.reaction:g} s, clip {args.clip:g} nat; the cancel threshold is the confirm '
+          'threshold of the row')
     print(f'{"confirm":>7} {"pass":>5} | {"target: yes":>11} {"no":>5} {"s":>5} | '
           f'{"other: yes":>10} {"no":>5} {"s":>5} | {"cancel wrong":>12} {"s":>5} | '
           f'{"cancel right":>12}')
