@@ -52,10 +52,11 @@ def is_replay(subject: str) -> bool:
 
 
 def replay_model(subject: str | SubjectFiles, directory: str | Path) -> Path:
-    """Calibrate (once) an MDM for a replay subject (``eegmmidb:<n>``, a subject file's path or
-    its :class:`~mindgrasp_eeg.subject_file.SubjectFiles`) on its calibration recordings, never
-    the ones played in the loop, and save it in ``directory`` as
-    ``<name>_classifier_<digest>.json`` (+ .npz); returns the .json path.
+    """Calibrate (once) the decoder (:data:`REPLAY_TRAINING`) of a replay subject
+    (``eegmmidb:<n>``, a subject file's path or its
+    :class:`~mindgrasp_eeg.subject_file.SubjectFiles`) on its calibration recordings, never the
+    ones played in the loop, and save it in ``directory`` as
+    ``<name>_classifier_<digest>_<REPLAY_TAG>.json`` (+ .npz); returns the .json path.
 
     The digest (12 hex digits of :meth:`SubjectFiles.calibration_digest`) changes with the
     calibration files, their event maps and the channel selection, so a cached model is reused
