@@ -194,3 +194,23 @@ def test_bad_subject_is_one_clear_line_and_exit_2(tmp_path: Path, command: str, 
     assert result.returncode == 2, result.stderr[-2000:]
     lines = [ln for ln in result.stderr.strip().splitlines() if not ln.startswith('Calibrating')]
     assert len(lines) == 1 and re.search(message, lines[0]), result.stderr
+
+
+def test_applied_params_are_the_ones_in_the_run_directory(tmp_path: Path) -> None:
+    """A point's params/<node>.yaml holds the values it ran with (issue 31, item 4)."""
+    from mindgrasp_bringup.launch_system import params as ros_params
+    from mindgrasp_experiments.engine import lockstep_components
+    from mindgrasp_experiments.sweep import apply_params
+
+    comps = lockstep_components('experiment', {'subject': 'virtual', 'protocol': 'set_locations',
+                                               'seed': '0', 'trials': '1'}, tmp_path,
+                                log=lambda *_: None)
+    before = (tmp_path / 'vision.yaml').read_text()
+    comps = apply_params(comps, {'fsm.paradigm': 'paper', 'fsm.confirm_threshold': 2.0},
+                         tmp_path)
+    fsm = ros_params.load_parameter_file(tmp_path / 'fsm.yaml')
+    values = next(iter(fsm.values()))
+    assert values['paradigm'] == 'paper' and values['confirm_threshold'] == 2.0
+    assert (tmp_path / 'vision.yaml').read_text() == before      # untouched nodes stay as written
+    fsm_comp = next(c for c in comps if c.label == 'fsm')
+    assert fsm_comp.ros_args[-4:] == ['-p', 'paradigm:=paper', '-p', 'confirm_threshold:=2.0']

@@ -228,7 +228,7 @@ def run_experiment(args: argparse.Namespace, protocol: str, command: str) -> int
     except ExperimentError as exc:
         return fail(command, str(exc))
     components = apply_params(components, {f'{node}.{name}': values[0]
-                                           for node, name, values in params})
+                                           for node, name, values in params}, out / 'params')
     trials = list(range(1, args.trials + 1))
     runs = []
     interrupted = False

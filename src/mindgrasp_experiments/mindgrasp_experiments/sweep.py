@@ -164,20 +164,33 @@ def combinations(params: Sequence[Param]) -> list[dict[str, Any]]:
             for combo in itertools.product(*(values for _, _, values in params))]
 
 
-def apply_params(components: Sequence[Any], combo: Mapping[str, Any]) -> list[Any]:
+def apply_params(components: Sequence[Any], combo: Mapping[str, Any],
+                 params_dir: str | Path | None = None) -> list[Any]:
     """Copies of ``components`` with the combination's parameters set (``-p name:=value`` after
-    the parameter file, so they win, as on a ``ros2 run`` command line)."""
+    the parameter file, so they win, as on a ``ros2 run`` command line). With ``params_dir``
+    (where :func:`~mindgrasp_experiments.engine.lockstep_components` wrote the run's parameter
+    files), each changed node's ``<node>.yaml`` there is written again with the values used."""
     import copy
+
+    from mindgrasp_bringup.launch_system import params as ros_params
+    from mindgrasp_bringup.launch_system import rundir
 
     out = []
     for comp in components:
         comp = copy.deepcopy(comp)
+        changed = []
         for full, value in combo.items():
             node, name = full.split('.', 1)
             if comp.label == node:
                 text = str(value).lower() if isinstance(value, bool) else str(value)
                 comp.ros_args += ['-p', f'{name}:={text}']
                 comp.parameters[name] = value
+                changed.append(f'{name}:={text}')
+        if changed and params_dir is not None:
+            rundir.write_yaml(Path(params_dir) / f'{comp.label}.yaml',
+                              ros_params.dump_parameters({'/**': dict(comp.parameters)}),
+                              header=f'parameters of {comp.label} (lock-step; set with --param '
+                                     f'{" ".join(changed)})')
         out.append(comp)
     return out
 

@@ -140,7 +140,7 @@ def main(args: argparse.Namespace) -> int:
             name = point_name(accuracy, {**axis, **combo})
             point_dir = out / 'points' / name
             comps = apply_params(components_at(accuracy, point_dir / 'params', subject,
-                                               seed), combo)
+                                               seed), combo, point_dir / 'params')
             bar.set_description(f'sweep {name}')
             runs = []
             wall_p = time.perf_counter()
