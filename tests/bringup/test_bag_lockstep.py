@@ -10,14 +10,17 @@ from pathlib import Path
 
 import pytest
 import yaml
+from mcap.reader import make_reader
 
 from mindgrasp_bringup.bag import BagReader
+from mindgrasp_bringup.launch_system.run_extras import DEFAULT_RECORD_EXCLUDE
 from mindgrasp_trainer.graz import GrazProtocol
 
-# short Graz timing: 2 trials take ~5 simulated seconds; no /trainer/display frames
+# short Graz timing: 2 trials take ~5 simulated seconds; a few /trainer/display frames, which
+# the default record_exclude_regex leaves out of the bag
 GRAZ_PARAMS = {'graz_prompter': {'ros__parameters': {
     'fixation': 0.3, 'cue': 0.5, 'imagery': 0.5, 'rest_min': 0.2, 'rest_max': 0.2,
-    'start_delay': 1.0, 'display_rate': 0.0}}}
+    'start_delay': 1.0, 'display_rate': 2.0}}}
 
 
 def test_intra_graph_and_raw_subscriptions_in_lockstep() -> None:
@@ -68,6 +71,10 @@ def test_lockstep_components_compose_the_launchs_recorder(tmp_path: Path) -> Non
     (rec,) = recorders({'record_topics': '/eeg/raw /trainer/prompt'}, tmp_path / 'bag')
     assert rec.parameters['output'] == str(tmp_path / 'bag')
     assert rec.parameters['topics'] == ['/eeg/raw', '/trainer/prompt']
+    # the runner's /clock beside the launch's exclusions (default: the display frames)
+    assert rec.parameters['exclude_regex'] == f'^/clock$|{DEFAULT_RECORD_EXCLUDE}'
+    assert rec.parameters['compression'] == 'zstd'
+    (rec,) = recorders({'record_exclude_regex': ''}, tmp_path / 'bag')
     assert rec.parameters['exclude_regex'] == '^/clock$'
     assert recorders({}, None) == []
     assert recorders({'record': 'false'}, tmp_path / 'bag') == []
@@ -111,6 +118,12 @@ def test_lockstep_launch_records_a_bag_on_sim_time(tmp_path: Path) -> None:
     for topic in ('/eeg/raw', '/trainer/prompt', '/virtual_subject/intent'):
         assert topic in info.stdout
     assert '/clock' not in info.stdout and '/trainer/display' not in info.stdout
+    # record_compression defaults to zstd: every chunk of the MCAP file is compressed
+    (mcap_file,) = runs[0].glob('*.mcap')
+    with mcap_file.open('rb') as stream:
+        summary = make_reader(stream).get_summary()
+    assert summary is not None and summary.chunk_indexes
+    assert {c.compression for c in summary.chunk_indexes} == {'zstd'}
     recorded = []
     for bag in runs:
         with BagReader(bag) as reader:

@@ -304,6 +304,9 @@ def test_recorder_is_first_and_gets_the_bag_and_topics() -> None:
     assert recorder.module == 'mindgrasp_bringup.bag.recorder_node'
     assert recorder.parameters['topics'] == ['/eeg/raw', '/fsm/state']
     assert recorder.parameters['regex'] == '^/camera/'
+    # the run's bag: zstd chunks, without the display frames drawn from recorded topics
+    assert recorder.parameters['compression'] == 'zstd'
+    assert recorder.parameters['exclude_regex'] == r'^/(display/image|trainer/display)$'
     assert p.record and p.arguments['record'] == 'true'
 
 

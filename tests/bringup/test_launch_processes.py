@@ -28,6 +28,7 @@ from mindgrasp_bringup.launch_system import (
     Shutdown,
 )
 from mindgrasp_bringup.launch_system.output import Printer
+from mindgrasp_bringup.launch_system.run_extras import DEFAULT_RECORD_EXCLUDE
 
 pytestmark = pytest.mark.slow
 
@@ -56,7 +57,9 @@ def test_two_processes_end_cleanly_and_fill_the_run_directory(tmp_path: Path) ->
         'ros__parameters': {'rate': 2.5, 'tag': 'one'}}
     arguments = read_yaml(run_dir / 'launch_arguments.yaml')
     assert arguments == {'count': '3', 'exit_code': '0', 'rate': '2.5', 'record': 'false',
-                         'record_topics': '', 'record_regex': '', 'duration': '0'}
+                         'record_topics': '', 'record_regex': '',
+                         'record_exclude_regex': DEFAULT_RECORD_EXCLUDE,
+                         'record_compression': 'zstd', 'duration': '0'}
     provenance = read_yaml(run_dir / 'provenance.yaml')
     assert re.fullmatch(r'[0-9a-f]{40}', provenance['git']['revision'])
     assert provenance['packages']['mindgrasp-ros'] and provenance['packages']['numpy']

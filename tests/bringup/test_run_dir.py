@@ -10,6 +10,7 @@ import yaml
 
 from mindgrasp_bringup.launch_system import LaunchError, rundir
 from mindgrasp_bringup.launch_system.run_extras import (
+    DEFAULT_RECORD_EXCLUDE,
     RunFiles,
     duration_limit,
     record_enabled,
@@ -64,9 +65,12 @@ def test_run_files_of_another_launcher_are_complete_whenever_it_stops(tmp_path) 
 
 
 @pytest.mark.parametrize(('arguments', 'record', 'duration', 'parameters'), [
-    ({}, True, None, {'output': 'B'}),
-    ({'record': 'false', 'duration': '30', 'record_topics': '/a, /b /c', 'record_regex': '/x.*'},
-     False, 30.0, {'output': 'B', 'topics': ['/a', '/b', '/c'], 'regex': '/x.*'}),
+    ({}, True, None, {'output': 'B', 'exclude_regex': DEFAULT_RECORD_EXCLUDE,
+                      'compression': 'zstd'}),
+    ({'record': 'false', 'duration': '30', 'record_topics': '/a, /b /c', 'record_regex': '/x.*',
+      'record_exclude_regex': '', 'record_compression': 'none'},
+     False, 30.0, {'output': 'B', 'topics': ['/a', '/b', '/c'], 'regex': '/x.*',
+                   'exclude_regex': '', 'compression': 'none'}),
 ])
 def test_both_launchers_read_the_common_arguments_alike(arguments, record, duration,
                                                          parameters) -> None:

@@ -12,9 +12,9 @@ otherwise, :func:`apply_lsl_scope` points ``LSLAPICFG`` at a file with::
 
 so stream discovery (queries and answers, UDP 16571) stays on the loopback interface: no other
 machine can find our streams, and the acquisition node finds only streams of this machine.
-liblsl 1.17 has no setting for the address of a stream's data connection (its TCP server and
-time service still bind 0.0.0.0 on ports from 16572 on); a firewall closes those when that
-matters.
+liblsl 1.18 (bundled by pylsl) has no setting for the address of an outlet's own sockets (its
+time service, UDP, and data server, TCP, still bind 0.0.0.0 on the first free ports from 16572
+on); a firewall closes those when that matters.
 
 Widening is one setting: ``MINDGRASP_LSL_SCOPE=network`` (e.g. the amplifier's LSL app runs on
 another computer). A user's own ``LSLAPICFG`` is always kept as it is.

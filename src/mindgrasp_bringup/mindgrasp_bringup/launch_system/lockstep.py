@@ -31,8 +31,8 @@ __all__ = ['LOCKSTEP_NODES', 'RECORDER_MODULE', 'LockstepComponent', 'check_eeg_
 LOCKSTEP_NODES: dict[str, str | dict[str, Any]] = {
     'mindgrasp_eeg.acquisition_node': 'LSL runs on wall time; the virtual amplifier publishes '
                                       '/eeg/raw itself in lock-step',
-    # the runner's own /clock is not a topic of the launch (a live run has none)
-    'mindgrasp_bringup.bag.recorder_node': {'exclude_regex': '^/clock$'},
+    # the runner's own /clock is not a topic of the launch (a live run has none): left out
+    # beside the launch's record_exclude_regex (_CLOCK_EXCLUDE)
     'mindgrasp_eeg.virtual_amp_node': {'output': 'ros'},
 }
 
@@ -40,6 +40,7 @@ LOCKSTEP_NODES: dict[str, str | dict[str, Any]] = {
 RECORDER_MODULE = 'mindgrasp_bringup.bag.recorder_node'
 #: the LSL acquisition node, and the node that replaces it in lock-step
 _ACQUISITION, _VIRTUAL_AMP = 'mindgrasp_eeg.acquisition_node', 'mindgrasp_eeg.virtual_amp_node'
+_CLOCK_EXCLUDE = '^/clock$'
 
 
 @dataclass
@@ -97,8 +98,11 @@ def lockstep_components(launch: str | Path, arguments: Sequence[str] | Mapping[s
         params = dict(spec.parameters)
         if isinstance(rule, dict):
             params.update(rule)
-        if spec.module == RECORDER_MODULE and bag is not None:
-            params['output'] = str(bag)
+        if spec.module == RECORDER_MODULE:
+            exclude = params.get('exclude_regex', '')
+            params['exclude_regex'] = f'{_CLOCK_EXCLUDE}|{exclude}' if exclude else _CLOCK_EXCLUDE
+            if bag is not None:
+                params['output'] = str(bag)
         path = params_dir / f'{spec.label}.yaml'
         rundir.write_yaml(path, ros_params.dump_parameters({'/**': params}),
                           header=f'parameters of {spec.label} (lock-step)')

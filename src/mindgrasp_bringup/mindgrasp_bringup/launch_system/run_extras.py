@@ -25,6 +25,11 @@ RECORDER_EXECUTABLE = 'recorder_node'
 RECORDER_NAME = 'recorder'
 
 #: arguments every launch accepts (the launcher handles them; profiles may read them too)
+#: Topics left out of a run's bag by default: the frames the participant display and the Graz
+#: prompter draw, from prompts, flips and states that the bag keeps. Uncompressed they were 99 %
+#: of a 22-s Graz bag (benchmarks/bag_size.py). ``record_exclude_regex:=''`` records them too.
+DEFAULT_RECORD_EXCLUDE = r'^/(display/image|trainer/display)$'
+
 COMMON_ARGUMENTS = (
     DeclareLaunchArgument(
         'record', default_value='true', choices=['true', 'false'],
@@ -37,6 +42,16 @@ COMMON_ARGUMENTS = (
     DeclareLaunchArgument(
         'record_regex', default_value='',
         description='record the topics matching this regular expression (empty: no filter)'),
+    DeclareLaunchArgument(
+        'record_exclude_regex', default_value=DEFAULT_RECORD_EXCLUDE,
+        description="do not record the topics matching this regular expression (default: the "
+                    "frames of the participant display and the Graz prompter, which are drawn "
+                    "from recorded prompts and states; empty: exclude nothing)"),
+    DeclareLaunchArgument(
+        'record_compression', default_value='zstd', choices=['none', 'zstd', 'lz4'],
+        description='MCAP chunk compression of the bag (as ros2 bag record '
+                    '--compression-format; zstd: about a third of the size for a few % of a '
+                    'core)'),
     DeclareLaunchArgument(
         'duration', default_value='0',
         description='end the launch after this many seconds (0: run until Ctrl-C or until '
@@ -65,8 +80,12 @@ def duration_limit(configurations: Mapping[str, str]) -> float | None:
 
 
 def recorder_parameters(configurations: Mapping[str, str], bag: str) -> dict[str, Any]:
-    """Parameters of the recorder node for ``record_topics:=`` / ``record_regex:=``."""
-    parameters: dict[str, Any] = {'output': bag}
+    """Parameters of the recorder node for ``record_topics:=``, ``record_regex:=``,
+    ``record_exclude_regex:=`` and ``record_compression:=``."""
+    parameters: dict[str, Any] = {
+        'output': bag,
+        'exclude_regex': configurations.get('record_exclude_regex', DEFAULT_RECORD_EXCLUDE),
+        'compression': configurations.get('record_compression', 'zstd')}
     topics = configurations.get('record_topics', '')
     if topics.strip():
         parameters['topics'] = [t for t in topics.replace(',', ' ').split() if t]
