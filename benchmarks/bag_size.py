@@ -1,7 +1,7 @@
 """Bag size and the recorder's CPU cost, with and without compression and the default exclusions.
 
 Run: ``.venv/bin/python benchmarks/bag_size.py [RUN_OR_BAG] [--duration 60] [--profile demo]
-[NAME:=VALUE ...]`` (e.g. ``--profile graz --duration 22 display:=headless``)
+[--live] [NAME:=VALUE ...]`` (e.g. ``--profile graz --duration 22 display:=headless``)
 
 Without a bag it records one first (``mindgrasp launch <profile> duration:=<duration>
 record_compression:=none record_exclude_regex:=`` into a temporary run directory, so every topic
@@ -10,12 +10,15 @@ is kept). The bag's messages are then read into memory once and written again by
 with every topic and without the topics the default ``record_exclude_regex`` leaves out. Printed
 per setting: bag size (MiB and MiB per recorded minute) and the writer's CPU time per recorded
 minute (``time.process_time`` around the writes only, so reading the source bag is not counted),
-then the largest topics.
+then the largest topics. ``--live`` instead launches the profile twice, recording everything
+uncompressed and then with the defaults, and prints each bag's size and the recorder process's CPU
+time per recorded minute.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 import re
 import shutil
@@ -26,21 +29,51 @@ import time
 from collections import defaultdict
 from pathlib import Path
 
+import psutil
+
 from mindgrasp_bringup.bag import BagReader, BagWriter
 from mindgrasp_bringup.launch_system.run_extras import DEFAULT_RECORD_EXCLUDE
 
 COMPRESSIONS = ('none', 'lz4', 'zstd')
 
 
-def record(profile: str, duration: float, runs: Path, arguments: list[str]) -> Path:
-    """Record ``profile`` for ``duration`` s with every topic and no compression; its bag."""
-    run_dir = runs / f'bag_size_{profile}'
+#: launch arguments of a recording that keeps every topic uncompressed
+EVERYTHING = ('record_compression:=none', 'record_exclude_regex:=')
+
+
+def record(profile: str, duration: float, run_dir: Path, arguments: list[str]
+           ) -> tuple[Path, float]:
+    """Launch ``profile`` for ``duration`` s; its bag and the recorder process's CPU seconds
+    (sampled every 0.2 s until it ends, so the last ~0.2 s of closing may be missed)."""
     cmd = [sys.executable, '-m', 'mindgrasp_bringup', 'launch', profile, f'duration:={duration}',
-           'record_compression:=none', 'record_exclude_regex:=', *arguments,
-           '--run-dir', str(run_dir)]
+           *arguments, '--run-dir', str(run_dir)]
     print(f'recording: {" ".join(cmd[2:])}', flush=True)
-    subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
-    return run_dir / 'bag'
+    launch = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    cpu: dict[int, float] = {}
+    while launch.poll() is None:
+        for child in psutil.Process(launch.pid).children(recursive=True):
+            with contextlib.suppress(psutil.Error):
+                if any('recorder_node' in part for part in child.cmdline()):
+                    times = child.cpu_times()
+                    cpu[child.pid] = times.user + times.system
+        time.sleep(0.2)
+    if launch.returncode != 0:
+        msg = f'the launch failed (exit code {launch.returncode}); see {run_dir}/logs'
+        raise SystemExit(msg)
+    return run_dir / 'bag', sum(cpu.values())
+
+
+def live(profile: str, duration: float, tmp: Path, arguments: list[str]) -> None:
+    """The same launch recorded both ways: everything uncompressed, and the defaults."""
+    print(f'{"recording":<22} {"MiB":>8} {"MiB/min":>8} {"recorder CPU s/min":>19}')
+    for label, extra in (('everything, none', EVERYTHING), ('defaults', ())):
+        bag, cpu = record(profile, duration, tmp / label.replace(' ', '_').replace(',', ''),
+                          [*arguments, *extra])
+        size = sum(f.stat().st_size for f in bag.rglob('*') if f.is_file())
+        with BagReader(bag) as reader:
+            minutes = max(reader.open().duration_ns / 60e9, 1e-9)
+        print(f'{label:<22} {size / 2**20:8.1f} {size / 2**20 / minutes:8.1f} '
+              f'{cpu / minutes:19.2f}', flush=True)
 
 
 def load(bag: Path) -> tuple[BagReader, list[tuple[str, int, bytes]]]:
@@ -76,14 +109,21 @@ def main(argv: list[str] | None = None) -> int:
                         help='launch arguments of the recording')
     parser.add_argument('--profile', default='demo', help='launch profile to record (demo)')
     parser.add_argument('--duration', type=float, default=60.0, help='seconds to record (60)')
+    parser.add_argument('--live', action='store_true',
+                        help='launch the profile twice (everything uncompressed; the defaults) '
+                             "and compare the bags and the recorder's CPU time")
     args = parser.parse_args(argv)
     with tempfile.TemporaryDirectory(prefix='bag_size_') as tmp:
         tmp_path = Path(tmp)
         if args.bag and ':=' in args.bag:
             args.arguments.insert(0, args.bag)
             args.bag = None
+        if args.live:
+            live(args.profile, args.duration, tmp_path, args.arguments)
+            return 0
         bag = (Path(args.bag) if args.bag
-               else record(args.profile, args.duration, tmp_path, args.arguments))
+               else record(args.profile, args.duration, tmp_path / 'run',
+                           [*args.arguments, *EVERYTHING])[0])
         if (bag / 'bag').is_dir():
             bag = bag / 'bag'
         reader, messages = load(bag)
