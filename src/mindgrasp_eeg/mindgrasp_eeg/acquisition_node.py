@@ -33,6 +33,7 @@ from mindgrasp_eeg.params import AcquisitionParams
 from mindgrasp_eeg.ros_conversions import ns_to_time_fields
 from mindgrasp_ros import rclpy
 from mindgrasp_ros.node_main import end_after, fail, run_node
+from mindgrasp_ros.node_traits import NodeTraits
 from mindgrasp_ros.params import declare_params
 from mindgrasp_ros.topics import EEG_RAW, EEG_STATUS
 
@@ -41,6 +42,16 @@ _LEVELS = {OK: DiagnosticStatus.OK, WARN: DiagnosticStatus.WARN, ERROR: Diagnost
 
 class AcquisitionNode(rclpy.node.Node):
     """Wires :class:`EEGAcquisition` to ``/eeg/raw`` and ``/eeg/status``."""
+
+    node_traits = NodeTraits(
+        provides=('eeg',),
+        lockstep_left_out='LSL runs on wall time; the virtual amplifier publishes /eeg/raw '
+                          'itself in lock-step',
+        lockstep_missing='lock-step cannot take EEG from an LSL stream: LSL runs on wall time, '
+                         'so the acquisition node is left out, and this launch has no virtual '
+                         'amplifier to publish /eeg/raw on simulated time. Start one '
+                         '(amp:=virtual; virtual_amp:=true in the eeg profile), or launch '
+                         'without --lockstep.')
 
     def __init__(self, **kwargs) -> None:
         super().__init__('eeg_acquisition', **kwargs)

@@ -36,6 +36,7 @@ from mindgrasp_eeg.synthetic import SyntheticEEG
 from mindgrasp_eeg.virtual_amp import VirtualAmplifier
 from mindgrasp_ros import rclpy
 from mindgrasp_ros.node_main import end_after, run_node
+from mindgrasp_ros.node_traits import NodeTraits
 from mindgrasp_ros.params import declare_params
 from mindgrasp_ros.topics import (
     EEG_RAW,
@@ -51,6 +52,10 @@ from mindgrasp_ros.topics import (
 
 class VirtualAmpNode(rclpy.node.Node):
     """Feeds the virtual subject from ROS topics and paces the virtual amplifier."""
+
+    # in lock-step there is no LSL (wall time): it publishes /eeg/raw itself
+    node_traits = NodeTraits(seed_parameters=('seed',), lockstep_parameters={'output': 'ros'},
+                             provides=('eeg',))
 
     def __init__(self, **kwargs) -> None:
         super().__init__('virtual_amp', **kwargs)

@@ -183,7 +183,7 @@ def run_experiment(args: argparse.Namespace, protocol: str, command: str) -> int
     from mindgrasp_bringup.launch_system.rundir import create_run_dir
     from mindgrasp_eeg import EEGError
     from mindgrasp_experiments import ExperimentError
-    from mindgrasp_experiments.engine import lockstep_components
+    from mindgrasp_experiments.engine import is_trial_manager, lockstep_components
     from mindgrasp_experiments.records import write_records
     from mindgrasp_experiments.report import finite, write_run
     from mindgrasp_experiments.sweep import apply_params, check_params, parse_param
@@ -220,7 +220,7 @@ def run_experiment(args: argparse.Namespace, protocol: str, command: str) -> int
     except ExperimentError as exc:
         return fail(command, str(exc))
     for comp in components:
-        if comp.module.endswith('trial_manager_node'):
+        if is_trial_manager(comp):
             comp.ros_args += ['-p', f'stall_timeout:={args.stall_timeout}',
                               '-p', f'trial_timeout:={args.trial_timeout}']
     try:

@@ -1,11 +1,13 @@
 """The experiment engine: a launch profile's own nodes, composed in one process on simulated time.
 
 :func:`lockstep_components` resolves a launch (profile or file, with its arguments) into the
-nodes to compose, as ``mindgrasp launch`` would start them, with the lock-step substitutions of
-:data:`LOCKSTEP_NODES`: LSL runs on wall time, so the virtual amplifier publishes ``/eeg/raw``
-itself (``output:=ros``) and the LSL acquisition node is left out. :func:`run_trial` builds a
-fresh :class:`~mindgrasp_ros.composition.LockstepRunner` graph for one trial (the trial manager
-told to run just that trial, every seed derived from ``(seed, trial)``), advances the clock in
+nodes to compose, as ``mindgrasp launch`` would start them, with the lock-step traits each node
+class declares (:class:`~mindgrasp_ros.node_traits.NodeTraits`): LSL runs on wall time, so the
+virtual amplifier publishes ``/eeg/raw`` itself (``output:=ros``) and the LSL acquisition node is
+left out. :func:`run_trial` builds a fresh :class:`~mindgrasp_ros.composition.LockstepRunner`
+graph for one trial (the trial manager, the node whose traits say so, told to run just that
+trial; every parameter a node's traits name as seeded set to a seed derived from
+``(seed, trial)``), advances the clock in
 steps of ``step_s`` until the trial manager is done, and returns the trial manager's record. A
 fresh graph per trial makes a trial's record depend on ``(seed, trial)`` only, whichever worker
 runs it.
@@ -24,7 +26,6 @@ from typing import Any
 
 from mindgrasp_bringup.launch_system import LaunchError
 from mindgrasp_bringup.launch_system.lockstep import (
-    LOCKSTEP_NODES,
     LockstepComponent,
     run_lockstep,
     set_log_level,
@@ -34,15 +35,20 @@ from mindgrasp_bringup.launch_system.lockstep import (
 )
 from mindgrasp_experiments import ExperimentError
 from mindgrasp_experiments.records import TrialRecord
+from mindgrasp_ros.composition import load_node_class
+from mindgrasp_ros.node_traits import NodeTraits, traits_of
 
-__all__ = ['LOCKSTEP_NODES', 'LockstepComponent', 'TrialRun', 'lockstep_components',
+__all__ = ['LockstepComponent', 'TrialRun', 'is_trial_manager', 'lockstep_components',
            'run_lockstep', 'run_trial', 'trial_seed']
 
-#: node module -> its parameters set to the trial's seed
-SEEDED_NODES = {'mindgrasp_eeg.virtual_amp_node': ('seed',),
-                'mindgrasp_experiments.oracle_subject_node': ('seed',),
-                'mindgrasp_sim.sim_node': ('seed', 'realism_seed')}
-TRIAL_MANAGER = 'mindgrasp_experiments.trial_manager_node'
+
+def _traits(component: LockstepComponent) -> NodeTraits:
+    return traits_of(load_node_class(component.module))
+
+
+def is_trial_manager(component: LockstepComponent) -> bool:
+    """Whether the component's node class is a trial manager (its traits say so)."""
+    return _traits(component).trial_manager
 
 
 def lockstep_components(launch: str | Path, arguments: Sequence[str] | Mapping[str, Any],
@@ -86,16 +92,16 @@ def run_trial(components: Sequence[LockstepComponent], trial: int, *, seed: int,
               ) -> TrialRun:
     """Run ``trial`` in a fresh lock-step graph of ``components``; returns its record.
 
-    The trial manager (``mindgrasp_experiments.trial_manager_node``) must be among the
-    components; it is told ``first_trial:=trial n_trials:=1``.
+    Exactly one component must be a trial manager (:func:`is_trial_manager`); it is told
+    ``first_trial:=trial n_trials:=1``.
     """
-    from mindgrasp_ros.composition import LockstepRunner, NodeCallbackError, load_node_class
+    from mindgrasp_ros.composition import LockstepRunner, NodeCallbackError
     from mindgrasp_ros.node_main import error_text, is_done
 
-    managers = [c for c in components if c.module == TRIAL_MANAGER]
+    managers = [c for c in components if is_trial_manager(c)]
     if len(managers) != 1:
-        msg = (f'A lock-step experiment needs exactly one trial manager ({TRIAL_MANAGER}); '
-               f'this launch has {len(managers)}.')
+        msg = ('A lock-step experiment needs exactly one trial manager (a node whose class '
+               f'declares NodeTraits(trial_manager=True)); this launch has {len(managers)}.')
         raise ExperimentError(msg)
     wall0, cpu0 = time.perf_counter(), time.process_time()
     set_log_level(log_level)
@@ -106,12 +112,12 @@ def run_trial(components: Sequence[LockstepComponent], trial: int, *, seed: int,
     try:
         for comp in components:
             extra: list[str] = []
-            if comp.module == TRIAL_MANAGER:
+            traits = _traits(comp)
+            if traits.trial_manager:
                 extra += ['-p', f'first_trial:={trial}', '-p', 'n_trials:=1', '-p',
                           "records_dir:=''"]
-            elif comp.module in SEEDED_NODES:
-                for name in SEEDED_NODES[comp.module]:
-                    extra += ['-p', f'{name}:={trial_seed(seed, trial)}']
+            for name in traits.seed_parameters:
+                extra += ['-p', f'{name}:={trial_seed(seed, trial)}']
             try:
                 node = runner.add(load_node_class(comp.module),
                                   ros_args=[*comp.ros_args, *extra])
@@ -123,7 +129,7 @@ def run_trial(components: Sequence[LockstepComponent], trial: int, *, seed: int,
                 record = _failed_record(trial, managers[0].parameters, 'node_error',
                                         f'{comp.label}: {type(exc).__name__}: {exc}')
                 break
-            if comp.module == TRIAL_MANAGER:
+            if traits.trial_manager:
                 manager = node
         build_s = time.perf_counter() - wall0
         if record is None:

@@ -27,6 +27,7 @@ from mindgrasp_eeg.ros_conversions import base_yaw_from_joint_state
 from mindgrasp_eeg.subject import VirtualSubject
 from mindgrasp_ros import rclpy
 from mindgrasp_ros.node_main import end_after, run_node
+from mindgrasp_ros.node_traits import NodeTraits
 from mindgrasp_ros.params import declare_params, param
 from mindgrasp_ros.topics import (
     BCI_PREDICTION,
@@ -59,6 +60,8 @@ class OracleParams:
 
 class OracleSubjectNode(rclpy.node.Node):
     """Publishes the pursuing subject's intended class as the prediction."""
+
+    node_traits = NodeTraits(seed_parameters=('seed',))
 
     def __init__(self, **kwargs) -> None:
         super().__init__('oracle_subject', **kwargs)

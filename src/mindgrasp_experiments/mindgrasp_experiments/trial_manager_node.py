@@ -47,6 +47,7 @@ from mindgrasp_experiments.records import TrialRecord, TrialTracker, write_recor
 from mindgrasp_experiments.summary import summarise
 from mindgrasp_ros import rclpy
 from mindgrasp_ros.node_main import fail, run_node
+from mindgrasp_ros.node_traits import NodeTraits
 from mindgrasp_ros.params import declare_params, param
 from mindgrasp_ros.topics import (
     BCI_PREDICTION,
@@ -100,6 +101,8 @@ class TrialManagerParams:
 
 class TrialManagerNode(rclpy.node.Node):
     """Trial loop of the grasp protocols (see the module docstring)."""
+
+    node_traits = NodeTraits(trial_manager=True)
 
     def __init__(self, **kwargs) -> None:
         super().__init__('trial_manager', **kwargs)

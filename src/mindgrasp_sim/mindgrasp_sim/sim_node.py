@@ -68,6 +68,7 @@ from mindgrasp_ros.interfaces.visualization_msgs.msg import MarkerArray
 
 from mindgrasp_ros import rclpy
 from mindgrasp_ros.node_main import run_node
+from mindgrasp_ros.node_traits import NodeTraits
 from mindgrasp_ros.params import declare_params, param
 from mindgrasp_ros.topics import (
     ARM_COMMANDS,
@@ -191,6 +192,8 @@ def _check_params(p: dict) -> None:
 
 class SimNode(rclpy.node.Node):
     """Thin ROS layer over :class:`Simulation` (see the module docstring for the contract)."""
+
+    node_traits = NodeTraits(seed_parameters=('seed', 'realism_seed'))
 
     def __init__(self, **kwargs) -> None:
         super().__init__('sim', **kwargs)

@@ -38,8 +38,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-import pybullet as pb
-from pybullet_utils.bullet_client import BulletClient
 from scipy.spatial.transform import Rotation
 
 from mindgrasp_common.geometry import top_down_quat
@@ -55,6 +53,7 @@ from mindgrasp_common.robot import (
 from mindgrasp_common.types import SceneObject
 from mindgrasp_sim.control import validate_velocities
 from mindgrasp_sim.errors import SimError
+from mindgrasp_sim.pybullet_quiet import BulletClient, pb
 from mindgrasp_sim.realism import Realism, RealismProfile
 from mindgrasp_sim.scene import ObjectSpec, SceneSpec, load_scene
 

@@ -96,13 +96,13 @@ def _run_lockstep(args: argparse.Namespace, service: LaunchService,
     ``duration:=S`` counts simulated seconds. Returns 1 when a node failed."""
     from mindgrasp_bringup.launch_system import rundir
     from mindgrasp_bringup.launch_system.lockstep import (
-        check_eeg_source,
+        check_left_out_nodes,
         lockstep_components,
         run_lockstep,
     )
 
     # argument problems are reported before anything is created
-    check_eeg_source(service.plan().processes)
+    check_left_out_nodes(service.plan().processes)
     run_dir = rundir.create_run_dir(service.name, args.run_dir, service.runs_root)
     given = dict(a.split(':=', 1) for a in launch_arguments)
     duration = float(given.pop('duration', 0) or 0)

@@ -2,12 +2,13 @@
 
 :func:`lockstep_components` resolves a launch (profile or file, with its arguments; plus an
 optional overlay launch file whose nodes replace same-named ones) into the nodes to compose, as
-``mindgrasp launch`` would start them, with the lock-step substitutions of
-:data:`LOCKSTEP_NODES`: LSL runs on wall time, so the virtual amplifier publishes ``/eeg/raw``
-itself (``output:=ros``) and the LSL acquisition node is left out. With a ``bag`` directory the
-launch's recorder is composed too (the same node, topics and arguments as in a live run; it
-discovers the topics from the in-process graph and stamps messages with simulated time);
-without one (the experiments, which write records) the launch runs with ``record:=false``.
+``mindgrasp launch`` would start them, with the lock-step traits each node class declares
+(:class:`mindgrasp_ros.node_traits.NodeTraits`): LSL runs on wall time, so the virtual amplifier
+publishes ``/eeg/raw`` itself (``output:=ros``) and the LSL acquisition node is left out. With a
+``bag`` directory the launch's recorder is composed too (the same node, topics and arguments as
+in a live run; it discovers the topics from the in-process graph and stamps messages with
+simulated time); without one (the experiments, which write records) the launch runs with
+``record:=false``.
 :func:`run_lockstep` steps them with :class:`mindgrasp_ros.composition.LockstepRunner` until a
 node is done. The experiments (:mod:`mindgrasp_experiments.engine`) build on these.
 """
@@ -23,23 +24,15 @@ from typing import Any
 
 from mindgrasp_bringup.launch_system import params as ros_params
 from mindgrasp_bringup.launch_system import rundir
+from mindgrasp_ros.node_traits import NodeTraits, traits_of
 
-__all__ = ['LOCKSTEP_NODES', 'RECORDER_MODULE', 'LockstepComponent', 'check_eeg_source',
-           'lockstep_components', 'run_lockstep', 'set_log_level']
-
-#: node module -> None (left out in lock-step, with the reason) or parameters set in lock-step
-LOCKSTEP_NODES: dict[str, str | dict[str, Any]] = {
-    'mindgrasp_eeg.acquisition_node': 'LSL runs on wall time; the virtual amplifier publishes '
-                                      '/eeg/raw itself in lock-step',
-    # the runner's own /clock is not a topic of the launch (a live run has none): left out
-    # beside the launch's record_exclude_regex (_CLOCK_EXCLUDE)
-    'mindgrasp_eeg.virtual_amp_node': {'output': 'ros'},
-}
+__all__ = ['RECORDER_MODULE', 'LockstepComponent', 'check_left_out_nodes', 'lockstep_components',
+           'node_traits', 'run_lockstep', 'set_log_level']
 
 #: the recorder's node module (its ``output`` is the bag directory)
 RECORDER_MODULE = 'mindgrasp_bringup.bag.recorder_node'
-#: the LSL acquisition node, and the node that replaces it in lock-step
-_ACQUISITION, _VIRTUAL_AMP = 'mindgrasp_eeg.acquisition_node', 'mindgrasp_eeg.virtual_amp_node'
+#: the runner's own /clock is not a topic of the launch (a live run has none): the recorder
+#: leaves it out beside the launch's record_exclude_regex
 _CLOCK_EXCLUDE = '^/clock$'
 
 
@@ -78,7 +71,7 @@ def lockstep_components(launch: str | Path, arguments: Sequence[str] | Mapping[s
         extra = user.plan().processes
         names = {p.label for p in extra}
         processes = [p for p in processes if p.label not in names] + list(extra)
-    check_eeg_source(processes)
+    check_left_out_nodes(processes)
     out = []
     for spec in processes:
         if not spec.is_node:
@@ -90,14 +83,12 @@ def lockstep_components(launch: str | Path, arguments: Sequence[str] | Mapping[s
                    'lock-step; give it as Node(package=..., executable=...) of a Python '
                    'package.')
             raise LaunchError(msg)
-        rule = LOCKSTEP_NODES.get(spec.module)
-        if isinstance(rule, str):
+        traits = node_traits(spec)
+        if traits.lockstep_left_out:
             if log is not None:
-                log(f"lock-step: '{spec.label}' left out ({rule}).")
+                log(f"lock-step: '{spec.label}' left out ({traits.lockstep_left_out}).")
             continue
-        params = dict(spec.parameters)
-        if isinstance(rule, dict):
-            params.update(rule)
+        params = {**spec.parameters, **traits.lockstep_parameters}
         if spec.module == RECORDER_MODULE:
             exclude = params.get('exclude_regex', '')
             params['exclude_regex'] = f'{_CLOCK_EXCLUDE}|{exclude}' if exclude else _CLOCK_EXCLUDE
@@ -120,18 +111,33 @@ def lockstep_components(launch: str | Path, arguments: Sequence[str] | Mapping[s
     return out
 
 
-def check_eeg_source(processes: Sequence[Any]) -> None:
-    """Raise :class:`LaunchError` when the launch's EEG comes from an LSL amplifier: lock-step
-    leaves the acquisition node out, and only the virtual amplifier can replace it."""
+def node_traits(spec: Any) -> NodeTraits:
+    """The traits the node class of a launch process declares (defaults for other programs);
+    :class:`LaunchError` when its module cannot be loaded."""
+    from mindgrasp_bringup.launch_system import LaunchError
+    from mindgrasp_ros.composition import CompositionError, load_node_class
+
+    if spec.module is None:
+        return traits_of(object)
+    try:
+        return traits_of(load_node_class(spec.module))
+    except CompositionError as exc:
+        msg = f"'{spec.label}' cannot be composed: {exc}"
+        raise LaunchError(msg) from None
+
+
+def check_left_out_nodes(processes: Sequence[Any]) -> None:
+    """Raise :class:`LaunchError` when a node that lock-step leaves out (the LSL acquisition
+    node) provides something that no composed node provides (EEG: the virtual amplifier)."""
     from mindgrasp_bringup.launch_system import LaunchError
 
-    modules = {spec.module for spec in processes}
-    if _ACQUISITION in modules and _VIRTUAL_AMP not in modules:
-        msg = ('lock-step cannot take EEG from an LSL stream: LSL runs on wall time, so the '
-               'acquisition node is left out, and this launch has no virtual amplifier to '
-               'publish /eeg/raw on simulated time. Start one (amp:=virtual; virtual_amp:=true '
-               'in the eeg profile), or launch without --lockstep.')
-        raise LaunchError(msg)
+    traits = [node_traits(spec) for spec in processes]
+    composed = {what for t in traits if not t.lockstep_left_out for what in t.provides}
+    for t in traits:
+        if t.lockstep_left_out and not set(t.provides) <= composed:
+            raise LaunchError(t.lockstep_missing or
+                              f'lock-step leaves a node out ({t.lockstep_left_out}) and nothing '
+                              'in this launch replaces it; launch without --lockstep.')
 
 
 def set_log_level(level: str) -> None:

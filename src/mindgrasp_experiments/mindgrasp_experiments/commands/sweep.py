@@ -54,7 +54,7 @@ def main(args: argparse.Namespace) -> int:
     from mindgrasp_eeg import EEGError
     from mindgrasp_experiments import ExperimentError
     from mindgrasp_experiments.cli import subject_launch_args
-    from mindgrasp_experiments.engine import lockstep_components
+    from mindgrasp_experiments.engine import is_trial_manager, lockstep_components
     from mindgrasp_experiments.records import write_records
     from mindgrasp_experiments.report import write_run
     from mindgrasp_experiments.subjects import is_replay
@@ -106,7 +106,7 @@ def main(args: argparse.Namespace) -> int:
         comps = lockstep_components('experiment', launch_args, params_dir, overlay=args.launch,
                                     log=log.append if log is not None else print)
         for comp in comps:
-            if comp.module.endswith('trial_manager_node'):
+            if is_trial_manager(comp):
                 comp.ros_args += ['-p', f'stall_timeout:={args.stall_timeout}',
                                   '-p', f'trial_timeout:={args.trial_timeout}']
         return comps

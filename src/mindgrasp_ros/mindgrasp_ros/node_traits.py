@@ -1,0 +1,60 @@
+"""What a graph host must know about a node, declared on the node class itself.
+
+A node class states its traits in a ``node_traits`` class attribute; the launcher, the lock-step
+runner and the experiment engine ask the class (:func:`traits_of`) instead of keeping tables of
+module names, so renaming a node or adding a seeded parameter is an edit in one file::
+
+    class SimNode(rclpy.node.Node):
+        node_traits = NodeTraits(seed_parameters=('seed', 'realism_seed'))
+
+A class without the attribute has the defaults: no seed, composed as it is, not a trial manager.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from types import MappingProxyType
+from typing import Any
+
+__all__ = ['NodeTraits', 'traits_of']
+
+
+@dataclass(frozen=True)
+class NodeTraits:
+    """Traits of a node class for the graph hosts.
+
+    Attributes:
+        seed_parameters: Parameters set to the trial's seed in an experiment (each trial of a
+            seed gets its own derived seed, so a record depends on ``(seed, trial)`` only).
+        lockstep_parameters: Parameters set when the graph runs lock-step on simulated time
+            (e.g. the virtual amplifier publishing ``/eeg/raw`` itself).
+        lockstep_left_out: Why the node is left out of a lock-step graph ('' = it is composed).
+        provides: What the node gives the graph (e.g. ``'eeg'``); a node left out in lock-step
+            must have a composed node that provides the same, or the launch is refused with
+            ``lockstep_missing``.
+        lockstep_missing: The one-line error when nothing composed provides what this left-out
+            node provides, naming the fix.
+        trial_manager: The node that runs an experiment's trials and keeps its records; the
+            engine tells it which trial to run and reads its records.
+    """
+
+    seed_parameters: tuple[str, ...] = ()
+    lockstep_parameters: Mapping[str, Any] = field(default_factory=lambda: MappingProxyType({}))
+    lockstep_left_out: str = ''
+    provides: tuple[str, ...] = ()
+    lockstep_missing: str = ''
+    trial_manager: bool = False
+
+
+_DEFAULT = NodeTraits()
+
+
+def traits_of(node_class: type) -> NodeTraits:
+    """The :class:`NodeTraits` a node class declares (the defaults when it declares none)."""
+    traits = getattr(node_class, 'node_traits', _DEFAULT)
+    if not isinstance(traits, NodeTraits):
+        msg = (f'{node_class.__module__}.{node_class.__qualname__}.node_traits must be a '
+               f'NodeTraits, not {type(traits).__name__}.')
+        raise TypeError(msg)
+    return traits
