@@ -46,6 +46,7 @@ from mindgrasp_bringup.launch_system.run_extras import (
     recorder_parameters,
 )
 from mindgrasp_bringup.launch_system.supervisor import ProcessResult, Supervisor
+from mindgrasp_common.safe_files import DeferredWriter
 
 logger = logging.getLogger('launch')
 
@@ -312,7 +313,7 @@ class LaunchService:
             remove_handlers(handlers)
 
     def _write_summary(self, run_dir: Path, code: int) -> None:
-        rundir.write_yaml(run_dir / 'summary.yaml', {
+        summary = {
             'ended_utc': dt.datetime.now(dt.timezone.utc).isoformat(timespec='seconds'),
             'exit_code': code,
             'clean': code == 0,
@@ -322,4 +323,10 @@ class LaunchService:
                            'clean': r.clean and not r.restarts, 'how': r.how,
                            'restarts': r.restarts, 'pid': r.pid}
                           for r in self.results],
-        })
+        }
+        # a full disk costs only this file: a copy goes to a fallback folder the log names
+        files = DeferredWriter(run_dir)
+        lines = files.write(run_dir, 'run summary',
+                            lambda folder: rundir.write_yaml(folder / 'summary.yaml', summary))
+        for line in lines:
+            logger.error(line)
