@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+from mcap.reader import make_reader
 from rosbags.rosbag2 import StoragePlugin
 from rosbags.rosbag2 import Writer as RosbagsWriter
 
@@ -149,3 +150,21 @@ try:
 except KeyboardInterrupt:
     pass
 '''
+
+
+def cut_in_half(path: Path) -> None:
+    """What a copy interrupted half way leaves: the first half of the file."""
+    data = path.read_bytes()
+    path.write_bytes(data[:len(data) // 2])
+
+
+def damage_chunks(path: Path, count: int = 3) -> list[int]:
+    """Flip a bit inside ``count`` chunks spread over the file; their byte offsets."""
+    with path.open('rb') as f:
+        chunks = make_reader(f).get_summary().chunk_indexes
+    picked = [chunks[round(i * (len(chunks) - 1) / (count + 1))] for i in range(1, count + 1)]
+    data = bytearray(path.read_bytes())
+    for chunk in picked:
+        data[chunk.chunk_start_offset + chunk.chunk_length - 40] ^= 0x04
+    path.write_bytes(bytes(data))
+    return [c.chunk_start_offset for c in picked]
