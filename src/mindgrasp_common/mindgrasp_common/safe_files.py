@@ -12,7 +12,8 @@ used to leave ``records.csv`` and ``summary.yaml`` at 0 bytes. Here every file i
 temporary name and renamed over the old one (as rosbag2 and atomic writers do), so a file is
 either the old one or the new one; and what cannot be written is kept in memory, retried at
 every later write, and copied to a fallback directory the log names
-(``$XDG_STATE_HOME/mindgrasp/unwritten/<run>``, else ``/tmp/mindgrasp-unwritten/<run>``).
+(``$XDG_STATE_HOME/mindgrasp/unwritten/<run path>``, else
+``/tmp/mindgrasp-unwritten/<run path>``, the path's slashes as underscores).
 """
 
 from __future__ import annotations
@@ -88,10 +89,12 @@ class DeferredWriter:
         self._reported: set[tuple[Path, str]] = set()   # faults logged already
 
     def _fallback_dir(self, directory: Path) -> Path:
-        run = self.run_dir
-        if run is not None and (directory == run or run in directory.parents):
-            return self.fallback / run.name / directory.relative_to(run)
-        return self.fallback / directory.name
+        # named after the whole path: two runs both called "run" must not share a fallback
+        run = self.run_dir if self.run_dir is not None else directory
+        name = str(run.absolute()).strip('/').replace('/', '_') or 'root'
+        if directory == run or run in directory.parents:
+            return self.fallback / name / directory.relative_to(run)
+        return self.fallback / name
 
     def write(self, directory: Path, what: str, write: Callable[[Path], object]) -> list[str]:
         """Write now, or keep for later; returns log lines (none when all went well).
