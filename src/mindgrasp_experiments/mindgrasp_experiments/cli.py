@@ -279,12 +279,13 @@ def run_experiment(args: argparse.Namespace, protocol: str, command: str) -> int
         'build_s': sum(r.build_s for r in runs), 'node_s': node_s,
     }
     written: dict[str, dict] = {}
-    lines = files.write(out, 'run report',
-                        lambda folder: written.update(doc=write_run(folder, records, info)))
+    calibration = calibration_accuracy_of(out)   # from the run's parameters, wherever it lands
+    lines = files.write(out, 'run report', lambda folder: written.update(
+        doc=write_run(folder, records, info, calibration)))
     lines += files.close()
     for line in lines:
         print(f'mindgrasp experiment {command}: {line}', file=sys.stderr)
-    doc = written.get('doc') or {'summary': summarise(records, calibration_accuracy_of(out))}
+    doc = written.get('doc') or {'summary': summarise(records, calibration)}
     s = doc['summary']
     cut = (f" (and {s['interrupted_trials']} interrupted, left out)"
            if s['interrupted_trials'] else '')
