@@ -37,6 +37,7 @@ sys.path.insert(0, str(REPO / 'tests' / 'bringup'))
 from conftest_bag import cut_in_half, damage_chunks  # noqa: E402
 
 from mindgrasp_bringup.bag import BagReader  # noqa: E402
+from mindgrasp_common.safe_files import fallback_folder  # noqa: E402
 from mindgrasp_experiments.records import read_records  # noqa: E402
 
 DAMAGES = {'cut in half': cut_in_half, 'three damaged chunks': damage_chunks}
@@ -88,7 +89,7 @@ def full_disk(size_mb: int, duration: float, workdir: Path) -> dict[str, Any]:
         run_dir = mount / 'run'
         result = _demo(run_dir, duration, XDG_STATE_HOME=str(state))
         out = result.stdout + result.stderr
-        copy = state / 'mindgrasp' / 'unwritten' / str(run_dir).strip('/').replace('/', '_')
+        copy = fallback_folder(run_dir, state / 'mindgrasp' / 'unwritten')
         finished = len(re.findall(r'\[trial_manager\]: Trial \d+ \(.*\): ', out))
         interrupted = len(re.findall(r'(\d+) interrupted, not counted', out))
         in_run = _records(run_dir / 'trials')

@@ -5,43 +5,16 @@ exit 1 unless ``--allow-damaged``; read-only tools write nothing; a missing bag 
 
 from __future__ import annotations
 
-import os
 import re
-import subprocess
-import sys
 from pathlib import Path
 
 import yaml
-from conftest_bag import EEG, STRING, cut_in_half, damage_chunks, eeg_chunk, string
+from conftest_bag import cut_in_half, damage_chunks, mindgrasp_cli, run_with_bag
 
-from mindgrasp_bringup.bag import BagReader, BagWriter
+from mindgrasp_bringup.bag import BagReader
 from mindgrasp_bringup.bag.damage import assess_bag
 
-N = 30          # messages per topic; 2 topics
-
-
-def _env() -> dict[str, str]:
-    env = dict(os.environ, PYTHONUNBUFFERED='1')
-    env.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
-    return env
-
-
-def _mindgrasp(*args: str, timeout: float = 300) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', *args],
-                          capture_output=True, text=True, env=_env(), timeout=timeout)
-
-
-def _run_with_bag(tmp_path: Path) -> Path:
-    """A run directory with a finished bag: EEG chunks and strings at 10 Hz, many MCAP chunks."""
-    run = tmp_path / 'run'
-    run.mkdir()
-    with BagWriter(run / 'bag', chunk_size=2000) as writer:
-        writer.add_topic('/eeg/raw', EEG)
-        writer.add_topic('/chatter', STRING)
-        for k in range(N):
-            writer.write('/eeg/raw', 1_000_000_000 + k * 100_000_000, eeg_chunk(25 * k))
-            writer.write('/chatter', 1_000_000_000 + k * 100_000_000 + 1, string(f'm {k}'))
-    return run
+N = 30          # messages per topic of run_with_bag; 2 topics
 
 
 def _files(run: Path) -> dict[str, bytes]:
@@ -50,18 +23,18 @@ def _files(run: Path) -> dict[str, bytes]:
 
 
 def test_bag_cut_in_half_reports_readable_and_recorded_counts_and_writes_nothing(tmp_path):
-    run = _run_with_bag(tmp_path)
+    run = run_with_bag(tmp_path)
     cut_in_half(run / 'bag' / 'bag_0.mcap')
     with BagReader(run / 'bag') as reader:
         readable = sum(1 for _ in reader.messages())
     assert 0 < readable < 2 * N
     before = _files(run)
-    info = _mindgrasp('bag', 'info', str(run))
+    info = mindgrasp_cli('bag', 'info', str(run))
     assert info.returncode == 1, info.stdout + info.stderr
     assert re.search(rf'Readable: +{readable} message\(s\) readable of {2 * N} recorded '
                      rf'\({2 * N - readable} lost\)', info.stdout), info.stdout
     assert 'cut off' in info.stdout
-    as_yaml = _mindgrasp('bag', 'info', '--yaml', '--allow-damaged', str(run))
+    as_yaml = mindgrasp_cli('bag', 'info', '--yaml', '--allow-damaged', str(run))
     assert as_yaml.returncode == 0, as_yaml.stderr
     damage = yaml.safe_load(as_yaml.stdout)['damage']
     assert damage['expected_messages'] == 2 * N and damage['readable_messages'] == readable
@@ -72,31 +45,31 @@ def test_bag_cut_in_half_reports_readable_and_recorded_counts_and_writes_nothing
 
 
 def test_three_damaged_chunks_are_skipped_counted_and_the_rest_is_played(tmp_path):
-    run = _run_with_bag(tmp_path)
+    run = run_with_bag(tmp_path)
     offsets = damage_chunks(run / 'bag' / 'bag_0.mcap')
     damage = assess_bag(run / 'bag')
     assert damage.skipped_records == 3 and damage.damaged
     assert 0 < damage.readable_messages < 2 * N == damage.expected_messages
     assert len(damage.lost_spans) == 3 and damage.lost_span_ns > 0
-    info = _mindgrasp('bag', 'info', str(run))
+    info = mindgrasp_cli('bag', 'info', str(run))
     assert info.returncode == 1
     for offset in offsets:
         assert f'record at byte {offset} (opcode 0x06' in info.stdout, info.stdout
-    play = _mindgrasp('bag', 'play', str(run), '--delay', '0', '--rate', '10', '--no-progress')
+    play = mindgrasp_cli('bag', 'play', str(run), '--delay', '0', '--rate', '10', '--no-progress')
     out = play.stdout + play.stderr
     assert play.returncode == 1, out
     # everything readable was played, not only what came before the first damaged chunk
     assert f'Published {damage.readable_messages} message(s)' in out, out
     assert f'{damage.readable_messages} message(s) readable of {2 * N} recorded' in out
     assert '--allow-damaged' in out and 'Traceback' not in out
-    allowed = _mindgrasp('bag', 'play', str(run), '--delay', '0', '--rate', '10',
+    allowed = mindgrasp_cli('bag', 'play', str(run), '--delay', '0', '--rate', '10',
                          '--no-progress', '--allow-damaged')
     assert allowed.returncode == 0, allowed.stdout + allowed.stderr
     assert f'Published {damage.readable_messages} message(s)' in allowed.stdout + allowed.stderr
 
 
 def test_a_sound_bag_reports_no_damage(tmp_path):
-    run = _run_with_bag(tmp_path)
+    run = run_with_bag(tmp_path)
     damage = assess_bag(run / 'bag')
     assert not damage.damaged and damage.readable_messages == damage.expected_messages == 2 * N
     assert damage.lines() == []
@@ -104,7 +77,7 @@ def test_a_sound_bag_reports_no_damage(tmp_path):
 
 def test_a_missing_bag_path_exits_2_with_one_line(tmp_path):
     for verb in ('info', 'reindex', 'play'):
-        done = _mindgrasp('bag', verb, str(tmp_path / 'nope'))
+        done = mindgrasp_cli('bag', verb, str(tmp_path / 'nope'))
         assert done.returncode == 2, (verb, done.stderr)
         lines = done.stderr.strip().splitlines()
         assert len(lines) == 1 and 'does not exist' in lines[0], (verb, done.stderr)

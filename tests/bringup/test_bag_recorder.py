@@ -20,6 +20,7 @@ from rosbags.rosbag2 import Reader as RosbagsReader
 
 from mindgrasp_bringup.bag import BagReader, BagWriter, Recorder
 from mindgrasp_bringup.cli import main as cli_main
+from mindgrasp_testing import small_tmpfs
 
 
 def test_messages_from_many_threads_are_all_written(tmp_path):
@@ -152,16 +153,8 @@ def test_sigkill_during_recording_leaves_a_readable_bag(tmp_path, capsys):
 @pytest.fixture
 def tiny_disk(tmp_path):
     """A 1 MiB tmpfs (needs root); skipped where mounting is not allowed."""
-    mount = tmp_path / f'tiny-{uuid.uuid4().hex[:6]}'
-    mount.mkdir()
-    result = subprocess.run(['mount', '-t', 'tmpfs', '-o', 'size=1m', 'tmpfs', str(mount)],
-                            capture_output=True, text=True)
-    if result.returncode != 0:
-        pytest.skip(f'cannot mount a 1 MiB tmpfs to fill (needs root): {result.stderr.strip()}')
-    try:
+    with small_tmpfs(tmp_path / f'tiny-{uuid.uuid4().hex[:6]}', '1m') as mount:
         yield mount
-    finally:
-        subprocess.run(['umount', '-l', str(mount)], check=False)
 
 
 def test_full_disk_stops_recording_with_an_error_and_keeps_what_was_written(tiny_disk):

@@ -16,23 +16,17 @@ import yaml
 from launch_fixtures.runner import launch_env, run_launch
 
 from mindgrasp_bringup.bag import BagReader
+from mindgrasp_common.safe_files import fallback_folder
 from mindgrasp_experiments.records import read_records
+from mindgrasp_testing import small_tmpfs
 
 pytestmark = pytest.mark.slow
 
 
 @pytest.fixture
 def small_disk(tmp_path):
-    mount = tmp_path / 'small'
-    mount.mkdir()
-    done = subprocess.run(['mount', '-t', 'tmpfs', '-o', 'size=3M', 'tmpfs', str(mount)],
-                          capture_output=True, text=True)
-    if done.returncode != 0:
-        pytest.skip(f'cannot mount a 3 MB tmpfs to fill (needs root): {done.stderr.strip()}')
-    try:
+    with small_tmpfs(tmp_path / 'small', '3M') as mount:
         yield mount
-    finally:
-        subprocess.run(['umount', '-l', str(mount)], check=False)
 
 
 @pytest.mark.timeout(1200)
@@ -49,7 +43,7 @@ def test_demo_on_a_full_disk_keeps_every_record_and_tells_the_truth(small_disk, 
     assert 'Traceback' not in out, out[-6000:]
     assert result.returncode == 1, out[-4000:]     # the recording failed: said, not hidden
     # the trial's record: in the fallback folder the log names, complete
-    copy = state / 'mindgrasp' / 'unwritten' / str(run_dir).strip('/').replace('/', '_')
+    copy = fallback_folder(run_dir, state / 'mindgrasp' / 'unwritten')
     line = next(x for x in out.splitlines() if 'Cannot write the trial records' in x)
     assert str(copy / 'trials') in line and 'No space left on device' in line
     (record,) = read_records(copy / 'trials')

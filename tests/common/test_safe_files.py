@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from mindgrasp_common.safe_files import DeferredWriter, write_atomic
+from mindgrasp_common.safe_files import DeferredWriter, fallback_folder, write_atomic
 
 
 class Disk:
@@ -42,10 +42,6 @@ def test_write_atomic_leaves_the_old_file_when_the_disk_is_full(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ['records.csv']   # no temp file left
 
 
-def _copy_dir(fallback: Path, run: Path) -> Path:
-    return fallback / str(run).strip('/').replace('/', '_')
-
-
 def test_records_go_to_the_fallback_then_home_when_space_returns(tmp_path):
     run, fallback = tmp_path / 'run', tmp_path / 'state'
     trials = run / 'trials'
@@ -55,13 +51,13 @@ def test_records_go_to_the_fallback_then_home_when_space_returns(tmp_path):
     disk.full_dirs.add(trials)
     lines = files.write(trials, 'trial records', disk.writer('a,b\n1,2\n3,4\n'))
     assert len(lines) == 1 and 'Cannot write the trial records' in lines[0]
-    copy = _copy_dir(fallback, run) / 'trials'
+    copy = fallback_folder(run, fallback) / 'trials'
     assert 'No space left on device' in lines[0] and str(copy) in lines[0]
     assert (trials / 'records.csv').read_text() == 'a,b\n1,2\n'    # old version intact
-    assert (_copy_dir(fallback, run) / 'trials' / 'records.csv').read_text() == 'a,b\n1,2\n3,4\n'
+    assert (copy / 'records.csv').read_text() == 'a,b\n1,2\n3,4\n'
     # still full: the next trial's write updates the copy and says nothing new
     assert files.write(trials, 'trial records', disk.writer('a,b\n1,2\n3,4\n5,6\n')) == []
-    assert (_copy_dir(fallback, run) / 'trials' / 'records.csv').read_text().endswith('5,6\n')
+    assert (copy / 'records.csv').read_text().endswith('5,6\n')
     disk.full_dirs.clear()                                  # space returns
     lines = files.close()
     assert len(lines) == 1 and 'written to' in lines[0] and 'now that it takes data' in lines[0]
@@ -76,13 +72,14 @@ def test_a_fault_that_lasts_to_the_end_is_one_line_naming_the_copy(tmp_path):
     files = DeferredWriter(run, fallback=fallback)
     assert len(files.write(run, 'run summary', disk.writer('exit_code: 0\n'))) == 1
     lines = files.close()
-    assert len(lines) == 1 and str(_copy_dir(fallback, run)) in lines[0] and 'complete' in lines[0]
+    copy = fallback_folder(run, fallback)
+    assert len(lines) == 1 and str(copy) in lines[0] and 'complete' in lines[0]
 
 
 def test_both_disks_full_keeps_the_records_in_memory(tmp_path):
     run, fallback = tmp_path / 'run', tmp_path / 'state'
     disk = Disk()
-    disk.full_dirs |= {run, _copy_dir(fallback, run)}
+    disk.full_dirs |= {run, fallback_folder(run, fallback)}
     files = DeferredWriter(run, fallback=fallback)
     lines = files.write(run, 'trial records', disk.writer('a\n1\n'))
     assert len(lines) == 1 and 'nor to the fallback' in lines[0] and 'kept in memory' in lines[0]

@@ -12,7 +12,9 @@ import sys
 
 import pytest
 
+from mindgrasp_common.safe_files import fallback_folder
 from mindgrasp_experiments.records import read_records
+from mindgrasp_testing import small_tmpfs
 
 pytestmark = pytest.mark.slow
 
@@ -21,18 +23,10 @@ FREE = 64 << 10     # bytes left on the disk when the experiment starts
 
 @pytest.fixture
 def nearly_full_disk(tmp_path):
-    mount = tmp_path / 'small'
-    mount.mkdir()
-    done = subprocess.run(['mount', '-t', 'tmpfs', '-o', 'size=1M', 'tmpfs', str(mount)],
-                          capture_output=True, text=True, check=False)
-    if done.returncode != 0:
-        pytest.skip(f'cannot mount a 1 MB tmpfs to fill (needs root): {done.stderr.strip()}')
-    try:
+    with small_tmpfs(tmp_path / 'small', '1M') as mount:
         stat = os.statvfs(mount)
         (mount / 'filler').write_bytes(b'\0' * (stat.f_bavail * stat.f_frsize - FREE))
         yield mount
-    finally:
-        subprocess.run(['umount', '-l', str(mount)], check=False)
 
 
 @pytest.mark.timeout(900)
@@ -45,7 +39,7 @@ def test_experiment_on_a_filling_disk_loses_no_record(nearly_full_disk, tmp_path
         env=dict(os.environ, XDG_STATE_HOME=str(state)))
     assert 'Traceback' not in done.stderr, done.stderr[-4000:]
     assert done.returncode == 1, done.stdout[-2000:] + done.stderr[-2000:]
-    copy = state / 'mindgrasp' / 'unwritten' / str(out).strip('/').replace('/', '_')
+    copy = fallback_folder(out, state / 'mindgrasp' / 'unwritten')
     faults = [line for line in done.stderr.splitlines() if 'Cannot write the' in line]
     assert faults and all(str(copy) in line and 'No space left on device' in line
                           for line in faults), done.stderr

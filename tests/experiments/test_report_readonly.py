@@ -7,9 +7,8 @@ import subprocess
 import sys
 from pathlib import Path
 
-import pytest
-
 from mindgrasp_experiments.records import TrialRecord, read_records, write_records
+from mindgrasp_testing import small_tmpfs
 
 
 def _records() -> list[TrialRecord]:
@@ -34,13 +33,7 @@ def test_report_rebuild_leaves_the_record_files_alone(tmp_path):
 
 
 def test_report_on_a_read_only_disk_is_one_line_and_keeps_the_records(tmp_path):
-    mount = tmp_path / 'ro'
-    mount.mkdir()
-    done = subprocess.run(['mount', '-t', 'tmpfs', '-o', 'size=4M', 'tmpfs', str(mount)],
-                          capture_output=True, text=True, check=False)
-    if done.returncode != 0:
-        pytest.skip(f'cannot mount a tmpfs (needs root): {done.stderr.strip()}')
-    try:
+    with small_tmpfs(tmp_path / 'ro', '4M') as mount:
         write_records(_records(), mount)
         subprocess.run(['mount', '-o', 'remount,ro', str(mount)], check=True)
         done = _report(mount)
@@ -49,5 +42,3 @@ def test_report_on_a_read_only_disk_is_one_line_and_keeps_the_records(tmp_path):
         assert len(lines) == 1 and 'cannot write the report into' in lines[0], done.stderr
         assert 'Read-only file system' in lines[0] and 'records are unchanged' in lines[0]
         assert [r.trial for r in read_records(mount)] == [1, 2, 3]
-    finally:
-        subprocess.run(['umount', '-l', str(mount)], check=False)

@@ -24,7 +24,7 @@ import os
 from collections.abc import Callable
 from pathlib import Path
 
-__all__ = ['DISK_ERRNOS', 'DeferredWriter', 'fallback_root', 'write_atomic']
+__all__ = ['DISK_ERRNOS', 'DeferredWriter', 'fallback_folder', 'fallback_root', 'write_atomic']
 
 #: errors of the disk rather than of the program: keep the data and go on
 DISK_ERRNOS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EROFS, errno.EIO, errno.EFBIG,
@@ -63,6 +63,13 @@ def fallback_root() -> Path:
     return Path('/tmp') / 'mindgrasp-unwritten'
 
 
+def fallback_folder(run_dir: Path, root: Path | None = None) -> Path:
+    """The fallback folder of ``run_dir``: named after its whole path (two runs both called
+    ``run`` must not share one), under ``root`` (default :func:`fallback_root`)."""
+    name = str(Path(run_dir).absolute()).strip('/').replace('/', '_') or 'root'
+    return (root if root is not None else fallback_root()) / name
+
+
 def _reason(exc: OSError) -> str:
     return exc.strerror or str(exc)
 
@@ -89,12 +96,10 @@ class DeferredWriter:
         self._reported: set[tuple[Path, str]] = set()   # faults logged already
 
     def _fallback_dir(self, directory: Path) -> Path:
-        # named after the whole path: two runs both called "run" must not share a fallback
         run = self.run_dir if self.run_dir is not None else directory
-        name = str(run.absolute()).strip('/').replace('/', '_') or 'root'
         if directory == run or run in directory.parents:
-            return self.fallback / name / directory.relative_to(run)
-        return self.fallback / name
+            return fallback_folder(run, self.fallback) / directory.relative_to(run)
+        return fallback_folder(directory, self.fallback)
 
     def write(self, directory: Path, what: str, write: Callable[[Path], object]) -> list[str]:
         """Write now, or keep for later; returns log lines (none when all went well).
