@@ -117,3 +117,24 @@ def test_summary_on_a_full_disk_keeps_the_old_file_and_goes_to_the_fallback(
     assert new['stop_reason'] == 'the duration ended'
     errors = [r.getMessage() for r in caplog.records if r.name == 'launch']
     assert len(errors) == 1 and str(copy) in errors[0] and 'No space left' in errors[0]
+
+
+def test_a_launch_on_a_full_disk_is_refused_in_one_line_before_anything_starts(tmp_path):
+    import contextlib
+
+    from launch_fixtures.runner import run_launch
+
+    from mindgrasp_testing import small_tmpfs
+
+    with small_tmpfs(tmp_path / 'full', '256k') as disk:
+        with (disk / 'filler').open('wb', buffering=0) as f, \
+                contextlib.suppress(OSError):      # until the disk is full
+            while True:
+                f.write(b'\0' * 4096)
+        result = run_launch('demo', 'duration:=5', '--run-dir', str(disk / 'run'), timeout=120)
+    assert result.returncode == 2, result.stderr
+    assert 'Traceback' not in result.stderr
+    errors = [line for line in result.stderr.splitlines() if 'error' in line.lower()]
+    assert len(errors) == 1 and 'cannot write the run directory' in errors[0], result.stderr
+    assert 'No space left on device' in errors[0] and '--run-dir' in errors[0]
+    assert 'process started' not in result.stderr

@@ -279,8 +279,13 @@ class LaunchService:
         handlers = configure_launch_logger(run_dir / 'logs' / 'launch.log')
         try:
             processes = plan.processes
-            commands = self.commands(plan, run_dir)
-            self._write_run_dir(plan, commands, run_dir)
+            try:
+                commands = self.commands(plan, run_dir)
+                self._write_run_dir(plan, commands, run_dir)
+            except OSError as exc:   # before anything starts: a run that cannot be redone
+                msg = (f'cannot write the run directory {run_dir} ({exc.strerror or exc}): free '
+                       'space on its disk or give --run-dir on another one.')
+                raise LaunchError(msg) from None
             logger.info("run directory: %s", run_dir)
             if self.composed:
                 from mindgrasp_bringup.launch_system.composed import compose
