@@ -5,6 +5,7 @@ exit 1 unless ``--allow-damaged``; read-only tools write nothing; a missing bag 
 
 from __future__ import annotations
 
+import contextlib
 import re
 from pathlib import Path
 
@@ -13,6 +14,7 @@ from conftest_bag import cut_in_half, damage_chunks, mindgrasp_cli, run_with_bag
 
 from mindgrasp_bringup.bag import BagReader
 from mindgrasp_bringup.bag.damage import assess_bag
+from mindgrasp_testing import small_tmpfs
 
 N = 30          # messages per topic of run_with_bag; 2 topics
 
@@ -81,3 +83,19 @@ def test_a_missing_bag_path_exits_2_with_one_line(tmp_path):
         assert done.returncode == 2, (verb, done.stderr)
         lines = done.stderr.strip().splitlines()
         assert len(lines) == 1 and 'does not exist' in lines[0], (verb, done.stderr)
+
+
+def test_reindex_on_a_full_disk_leaves_the_bag_as_it_was(tmp_path):
+    with small_tmpfs(tmp_path / 'disk', '512k') as disk:
+        run = run_with_bag(disk)
+        cut_in_half(run / 'bag' / 'bag_0.mcap')
+        with (disk / 'filler').open('wb', buffering=0) as f, \
+                contextlib.suppress(OSError):      # until the disk is full
+            while True:
+                f.write(b'\0' * 4096)
+        before = _files(run)
+        done = mindgrasp_cli('bag', 'reindex', str(run))
+        assert done.returncode == 1, done.stderr
+        lines = done.stderr.strip().splitlines()
+        assert len(lines) == 1 and 'No space left on device' in lines[0], done.stderr
+        assert _files(run) == before          # no partial copy, the original untouched

@@ -91,8 +91,7 @@ def _damaged_copy(demo_run: Path, tmp_path: Path, damage) -> Path:
 
 def test_replay_of_a_bag_cut_in_half_says_so_and_fails_its_check(demo_run, tmp_path):
     run = _damaged_copy(demo_run, tmp_path, cut_in_half)
-    done = _mindgrasp('replay', str(run), '--json', '--no-progress', '-o', str(tmp_path / 'r'),
-                      '--min-agreement', '0.9')
+    done = _mindgrasp('replay', str(run), '--json', '--no-progress', '-o', str(tmp_path / 'r'))
     assert done.returncode == 1, done.stdout[-3000:] + done.stderr[-3000:]
     summary = json.loads(done.stdout.strip().splitlines()[-1])
     damage = summary['damage']
@@ -101,7 +100,7 @@ def test_replay_of_a_bag_cut_in_half_says_so_and_fails_its_check(demo_run, tmp_p
     assert damage['lost_messages'] == damage['expected_messages'] - damage['readable_messages']
     assert damage['lost_span_s'] > 1.0
     assert any('Damaged bag' in n for n in summary['notes'])
-    assert summary['prediction_agreement'] == 1.0          # on the readable half
+    # the check fails even where the readable half agrees: its damage is not accepted
     assert 'pass --allow-damaged' in done.stderr and 'Traceback' not in done.stderr
 
 

@@ -11,7 +11,6 @@ incomplete or corrupt record, so everything before it is recovered.
 from __future__ import annotations
 
 import io
-import os
 import struct
 from collections import defaultdict
 from collections.abc import Iterator
@@ -22,6 +21,8 @@ from mcap.exceptions import EndOfFile, McapError
 from mcap.reader import make_reader
 from mcap.records import Channel, Chunk, Footer, Message, Schema, Statistics
 from mcap.stream_reader import StreamReader
+
+from mindgrasp_common.safe_files import write_atomic
 
 from .errors import BagError
 
@@ -244,31 +245,34 @@ def recover_mcap(path: Path) -> int:
     from mcap.writer import Writer as McapWriter
 
     path = Path(path)
-    tmp = path.with_name(path.name + '.recovering')
     contents = McapContents(path)
-    count = 0
-    with path.open('rb') as f, tmp.open('wb') as out:
-        size = path.stat().st_size
-        _check_magic(path, f.read(8))
-        writer = McapWriter(out, compression=CompressionType.NONE)
-        writer.start(profile='ros2', library='mindgrasp-ros bag recovery (mcap python)')
-        schema_ids: dict[int, int] = {}
-        channel_ids: dict[int, int] = {}
-        for record in _records(path, f, size, contents):
-            if isinstance(record, Schema) and record.id not in schema_ids:
-                schema_ids[record.id] = writer.register_schema(record.name, record.encoding,
-                                                               record.data)
-            elif isinstance(record, Channel) and record.id not in channel_ids:
-                channel_ids[record.id] = writer.register_channel(
-                    record.topic, record.message_encoding, schema_ids.get(record.schema_id, 0),
-                    dict(record.metadata))
-            elif isinstance(record, Message) and record.channel_id in channel_ids:
-                writer.add_message(channel_ids[record.channel_id], record.log_time,
-                                   record.data, record.publish_time, record.sequence)
-                count += 1
-        writer.finish()
-    os.replace(tmp, path)
-    return count
+    counted = [0]
+
+    def rewrite(tmp: Path) -> None:
+        with path.open('rb') as f, tmp.open('wb') as out:
+            size = path.stat().st_size
+            _check_magic(path, f.read(8))
+            writer = McapWriter(out, compression=CompressionType.NONE)
+            writer.start(profile='ros2', library='mindgrasp-ros bag recovery (mcap python)')
+            schema_ids: dict[int, int] = {}
+            channel_ids: dict[int, int] = {}
+            for record in _records(path, f, size, contents):
+                if isinstance(record, Schema) and record.id not in schema_ids:
+                    schema_ids[record.id] = writer.register_schema(record.name, record.encoding,
+                                                                   record.data)
+                elif isinstance(record, Channel) and record.id not in channel_ids:
+                    channel_ids[record.id] = writer.register_channel(
+                        record.topic, record.message_encoding,
+                        schema_ids.get(record.schema_id, 0), dict(record.metadata))
+                elif isinstance(record, Message) and record.channel_id in channel_ids:
+                    writer.add_message(channel_ids[record.channel_id], record.log_time,
+                                       record.data, record.publish_time, record.sequence)
+                    counted[0] += 1
+            writer.finish()
+
+    # a full disk leaves the original file as it was and no partial copy beside it
+    write_atomic(path, rewrite)
+    return counted[0]
 
 
 def verify_mcap(path: Path) -> list[str]:
