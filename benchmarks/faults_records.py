@@ -91,7 +91,7 @@ def full_disk(size_mb: int, duration: float, workdir: Path) -> dict[str, Any]:
         out = result.stdout + result.stderr
         copy = fallback_folder(run_dir, state / 'mindgrasp' / 'unwritten')
         finished = len(re.findall(r'\[trial_manager\]: Trial \d+ \(.*\): ', out))
-        interrupted = len(re.findall(r'(\d+) interrupted, not counted', out))
+        interrupted = sum(int(n) for n in re.findall(r'(\d+) interrupted, not counted', out))
         in_run = _records(run_dir / 'trials')
         in_fallback = _records(copy / 'trials')
         kept = max(in_run, in_fallback)
