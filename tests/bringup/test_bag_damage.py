@@ -99,3 +99,15 @@ def test_reindex_on_a_full_disk_leaves_the_bag_as_it_was(tmp_path):
         lines = done.stderr.strip().splitlines()
         assert len(lines) == 1 and 'No space left on device' in lines[0], done.stderr
         assert _files(run) == before          # no partial copy, the original untouched
+
+
+def test_the_reader_reads_on_past_damaged_chunks_in_order_without_repeats(tmp_path):
+    run = run_with_bag(tmp_path)
+    damage_chunks(run / 'bag' / 'bag_0.mcap')
+    with BagReader(run / 'bag') as reader:
+        got = list(reader.messages())
+        assert any('stopped the indexed reader' in n for n in reader.notes)
+    times = [t for _, t, _ in got]
+    assert times == sorted(times) and len(set(times)) == len(times)
+    assert len(got) == assess_bag(run / 'bag').readable_messages
+    assert got[-1][1] == 1_000_000_000 + (N - 1) * 100_000_000 + 1     # up to the end
