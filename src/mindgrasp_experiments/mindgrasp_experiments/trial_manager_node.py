@@ -273,21 +273,21 @@ class TrialManagerNode(rclpy.node.Node):
         return client.call_async(request)
 
     def _scene_file(self, scene: dict) -> Path:
+        """The scene as a file for /sim/load_scene, in the run directory (a hand-over to the
+        simulator: in the system's temporary folder when the run directory is full)."""
+        name = f"{scene['name']}.yaml"
         text = yaml.safe_dump(scene, sort_keys=False)
-        if self._scene_dir is None:
-            base = self.records_dir.parent if self.records_dir is not None else None
-            try:
-                self._scene_dir = Path(tempfile.mkdtemp(prefix='scenes_', dir=base))
-            except OSError:   # run directory full or gone: the scene file is only a hand-over
-                self._scene_dir = Path(tempfile.mkdtemp(prefix='mindgrasp_scenes_'))
-        path = self._scene_dir / f"{scene['name']}.yaml"
         try:
-            write_atomic(path, lambda tmp: tmp.write_text(text, encoding='utf-8'))
+            if self._scene_dir is None:
+                base = self.records_dir.parent if self.records_dir is not None else None
+                self._scene_dir = Path(tempfile.mkdtemp(prefix='scenes_', dir=base))
+            return write_atomic(self._scene_dir / name,
+                                lambda tmp: tmp.write_text(text, encoding='utf-8'))
         except OSError:
             self._scene_dir = Path(tempfile.mkdtemp(prefix='mindgrasp_scenes_'))
-            path = self._scene_dir / f"{scene['name']}.yaml"
+            path = self._scene_dir / name
             path.write_text(text, encoding='utf-8')
-        return path
+            return path
 
     def _wait_until_ready(self, now: float) -> None:
         missing = [t for t in self.p['wait_for']
