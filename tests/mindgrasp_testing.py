@@ -6,16 +6,19 @@ sys.path when several test folders have one.
 
 from __future__ import annotations
 
+import contextlib
 import struct
+import subprocess
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from mindgrasp_ros.node_process import NodeProcess
 
-__all__ = ['NodeProcess', 'spin_until', 'write_xdf']
+__all__ = ['NodeProcess', 'small_tmpfs', 'spin_until', 'write_xdf']
 
 
 def spin_until(node: object, predicate: Callable[[], bool], timeout: float = 10.0,
@@ -32,6 +35,21 @@ def spin_until(node: object, predicate: Callable[[], bool], timeout: float = 10.
         else:
             rclpy.spin_once(node, timeout_sec=0.05)
     return predicate()
+
+
+@contextlib.contextmanager
+def small_tmpfs(path: Path, size: str) -> Iterator[Path]:
+    """A real tmpfs of ``size`` (e.g. ``'3M'``) mounted at ``path`` for the block, to fill up;
+    the test is skipped with the reason where mounting is not allowed (not root)."""
+    path.mkdir(parents=True, exist_ok=True)
+    done = subprocess.run(['mount', '-t', 'tmpfs', '-o', f'size={size}', 'tmpfs', str(path)],
+                          capture_output=True, text=True, check=False)
+    if done.returncode != 0:
+        pytest.skip(f'cannot mount a {size} tmpfs to fill (needs root): {done.stderr.strip()}')
+    try:
+        yield path
+    finally:
+        subprocess.run(['umount', '-l', str(path)], check=False)
 
 
 def _chunk(tag: int, content: bytes) -> bytes:

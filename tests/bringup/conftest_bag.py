@@ -2,9 +2,13 @@
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
+from mcap.reader import make_reader
 from rosbags.rosbag2 import StoragePlugin
 from rosbags.rosbag2 import Writer as RosbagsWriter
 
@@ -149,3 +153,50 @@ try:
 except KeyboardInterrupt:
     pass
 '''
+
+
+def cut_in_half(path: Path) -> None:
+    """What a copy interrupted half way leaves: the first half of the file."""
+    data = path.read_bytes()
+    path.write_bytes(data[:len(data) // 2])
+
+
+def damage_chunks(path: Path, count: int = 3) -> list[int]:
+    """Flip a bit inside ``count`` chunks spread over the file; their byte offsets."""
+    with path.open('rb') as f:
+        chunks = make_reader(f).get_summary().chunk_indexes
+    picked = [chunks[round(i * (len(chunks) - 1) / (count + 1))] for i in range(1, count + 1)]
+    data = bytearray(path.read_bytes())
+    for chunk in picked:
+        data[chunk.chunk_start_offset + chunk.chunk_length - 40] ^= 0x04
+    path.write_bytes(bytes(data))
+    return [c.chunk_start_offset for c in picked]
+
+
+def cli_env() -> dict[str, str]:
+    """Environment of a ``mindgrasp`` child process: unbuffered, discovery on this host."""
+    env = dict(os.environ, PYTHONUNBUFFERED='1')
+    env.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
+    return env
+
+
+def mindgrasp_cli(*args: str, timeout: float = 300) -> subprocess.CompletedProcess:
+    """``mindgrasp ARGS`` in a child process, to its end (text stdout/stderr)."""
+    return subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', *args],
+                          capture_output=True, text=True, env=cli_env(), timeout=timeout)
+
+
+def run_with_bag(tmp_path: Path, n: int = 30, chunk_size: int = 2000) -> Path:
+    """A run directory with a finished bag of ``n`` EEG chunks and ``n`` strings at 10 Hz
+    (bag time 1.0-3.9 s), in several MCAP chunks."""
+    from mindgrasp_bringup.bag import BagWriter
+
+    run = tmp_path / 'run'
+    run.mkdir()
+    with BagWriter(run / 'bag', chunk_size=chunk_size) as writer:
+        writer.add_topic('/eeg/raw', EEG)
+        writer.add_topic('/chatter', STRING)
+        for k in range(n):
+            writer.write('/eeg/raw', 1_000_000_000 + k * 100_000_000, eeg_chunk(25 * k))
+            writer.write('/chatter', 1_000_000_000 + k * 100_000_000 + 1, string(f'm {k}'))
+    return run

@@ -216,8 +216,9 @@ def test_missing_and_corrupt_bags_give_clear_errors(tmp_path):
         BagReader(garbage).open()
     bag = _write(tmp_path / 'run', _messages(2))
     (bag / 'metadata.yaml').write_text('rosbag2_bagfile_information: {version: 9, storage_identi')
-    with pytest.raises(BagError, match=r'(?s)cannot be read: .* delete its metadata.yaml'):
-        BagReader(bag).open()
+    with BagReader(bag) as reader:       # read what can be read: the files, by a scan
+        assert any('cannot be read' in n and 'read by a scan instead' in n for n in reader.notes)
+        assert len(list(reader.messages())) == reader.message_count > 0
     bag2 = shutil.copytree(tmp_path / 'run', tmp_path / 'run2')
     (bag2 / 'run_0.mcap').unlink()
     with pytest.raises(BagError, match=r'is not a rosbag2 bag|cannot be read'):

@@ -4,7 +4,6 @@ recorder, ``bag info`` reporting damage with its byte offset, run directories ac
 
 from __future__ import annotations
 
-import os
 import re
 import signal
 import subprocess
@@ -15,44 +14,24 @@ import uuid
 from pathlib import Path
 
 import pytest
-from conftest_bag import EEG, PUBLISHER, STRING, eeg_chunk, string
+from conftest_bag import (
+    PUBLISHER,
+    cli_env,
+    mindgrasp_cli,
+    run_with_bag,
+)
 from mcap.reader import make_reader
 from rosbags.rosbag2 import Reader as RosbagsReader
 
-from mindgrasp_bringup.bag import BagWriter
 from mindgrasp_bringup.bag.mcap_scan import read_mcap_contents
 
 HERE = Path(__file__).parent
-
-
-def _env() -> dict[str, str]:
-    env = dict(os.environ, PYTHONUNBUFFERED='1')
-    env.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
-    return env
-
-
-def _mindgrasp(*args: str, timeout: float = 300) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', *args],
-                          capture_output=True, text=True, env=_env(), timeout=timeout)
 
 
 def _plain_mcap_count(path: Path) -> int:
     """Messages as the mcap library's default reader sees them (it needs the summary)."""
     with path.open('rb') as f:
         return sum(1 for _ in make_reader(f).iter_messages())
-
-
-def _run_with_bag(tmp_path: Path, n: int = 30, chunk_size: int = 2000) -> Path:
-    """A run directory with a finished bag of EEG chunks and strings, several MCAP chunks."""
-    run = tmp_path / 'run'
-    run.mkdir()
-    with BagWriter(run / 'bag', chunk_size=chunk_size) as writer:
-        writer.add_topic('/eeg/raw', EEG)
-        writer.add_topic('/chatter', STRING)
-        for k in range(n):
-            writer.write('/eeg/raw', 1_000_000_000 + k * 100_000_000, eeg_chunk(25 * k))
-            writer.write('/chatter', 1_000_000_000 + k * 100_000_000 + 1, string(f'm {k}'))
-    return run
 
 
 @pytest.mark.slow
@@ -63,10 +42,11 @@ def test_reindex_makes_a_sigkilled_recording_readable_by_the_plain_mcap_reader(t
     recorder = subprocess.Popen(
         [sys.executable, '-m', 'mindgrasp_bringup.bag.recorder_node', '--ros-args',
          '-p', f'output:={bag}', '-p', f'regex:="^{prefix}/"', '-p', 'discovery_period:=0.2',
-         '-p', 'flush_interval:=0.2'], env=_env(), stdout=subprocess.DEVNULL,
+         '-p', 'flush_interval:=0.2'], env=cli_env(), stdout=subprocess.DEVNULL,
         stderr=subprocess.DEVNULL)
     publisher = subprocess.Popen([sys.executable, '-c', PUBLISHER, str(HERE), prefix, '200'],
-                                 env=_env(), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+                                 env=cli_env(), stdout=subprocess.DEVNULL,
+                                 stderr=subprocess.DEVNULL)
     try:
         mcap = bag / 'bag_0.mcap'
         deadline = time.monotonic() + 90
@@ -85,7 +65,7 @@ def test_reindex_makes_a_sigkilled_recording_readable_by_the_plain_mcap_reader(t
     assert recovered >= 20
     with pytest.raises(Exception):  # noqa: B017 - the library raises several types
         _plain_mcap_count(mcap)
-    done = _mindgrasp('bag', 'reindex', str(run))
+    done = mindgrasp_cli('bag', 'reindex', str(run))
     assert done.returncode == 0, done.stdout + done.stderr
     assert 'bag_0.mcap has been rewritten with its summary' in done.stdout
     assert _plain_mcap_count(mcap) == recovered
@@ -93,12 +73,12 @@ def test_reindex_makes_a_sigkilled_recording_readable_by_the_plain_mcap_reader(t
     reader.open()
     assert reader.message_count == recovered
     reader.close()
-    info = _mindgrasp('bag', 'info', str(run))
+    info = mindgrasp_cli('bag', 'info', str(run))
     assert info.returncode == 0 and 'Damage' not in info.stdout, info.stdout + info.stderr
 
 
 def test_bag_info_reports_a_bit_flip_with_the_chunk_offset(tmp_path):
-    run = _run_with_bag(tmp_path)
+    run = run_with_bag(tmp_path)
     path = run / 'bag' / 'bag_0.mcap'
     with path.open('rb') as f:
         chunks = make_reader(f).get_summary().chunk_indexes
@@ -107,26 +87,26 @@ def test_bag_info_reports_a_bit_flip_with_the_chunk_offset(tmp_path):
     data = bytearray(path.read_bytes())
     data[target.chunk_start_offset + target.chunk_length - 40] ^= 0x04   # inside its records
     path.write_bytes(bytes(data))
-    info = _mindgrasp('bag', 'info', str(run))
+    info = mindgrasp_cli('bag', 'info', str(run))
     assert info.returncode == 1
     damage = [line for line in info.stdout.splitlines() if line.startswith('Damage:')]
     assert len(damage) == 1, info.stdout
     assert f'record at byte {target.chunk_start_offset} (opcode 0x06' in damage[0]
     assert 'crc validation failed' in damage[0]
     # reindex keeps every other chunk
-    done = _mindgrasp('bag', 'reindex', str(run / 'bag'))
+    done = mindgrasp_cli('bag', 'reindex', str(run / 'bag'))
     assert done.returncode == 0, done.stdout + done.stderr
     assert 0 < _plain_mcap_count(path) < 60
 
 
 def test_bag_info_reports_garbage_after_a_valid_header(tmp_path):
-    run = _run_with_bag(tmp_path)
+    run = run_with_bag(tmp_path)
     path = run / 'bag' / 'bag_0.mcap'
     data = path.read_bytes()
     header_end = 8 + 9 + int.from_bytes(data[9:17], 'little')
     path.write_bytes(data[:header_end] + bytes(range(256)) * 8)
     (run / 'bag' / 'metadata.yaml').unlink()
-    info = _mindgrasp('bag', 'info', str(run), '--no-rebuild')
+    info = mindgrasp_cli('bag', 'info', str(run), '--no-rebuild')
     assert info.returncode == 1
     assert (f'Damage: bag_0.mcap: bytes at {header_end} are not an MCAP record (opcode 0x00)'
             in info.stdout), info.stdout
@@ -134,15 +114,15 @@ def test_bag_info_reports_garbage_after_a_valid_header(tmp_path):
 
 @pytest.mark.slow
 def test_bag_info_and_play_accept_a_run_directory_and_play_shows_progress(tmp_path):
-    run = _run_with_bag(tmp_path, n=20)
-    by_run, by_bag = _mindgrasp('bag', 'info', str(run)), _mindgrasp('bag', 'info',
+    run = run_with_bag(tmp_path, n=20)
+    by_run, by_bag = mindgrasp_cli('bag', 'info', str(run)), mindgrasp_cli('bag', 'info',
                                                                       str(run / 'bag'))
     assert by_run.returncode == 0 and by_run.stdout == by_bag.stdout
     assert 'Count:      20' in by_run.stdout
     lines: list[str] = []
     proc = subprocess.Popen([sys.executable, '-m', 'mindgrasp_bringup', 'bag', 'play', str(run),
                              '--delay', '0.2'], stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                            text=True, env=_env())
+                            text=True, env=cli_env())
     reader = threading.Thread(target=lambda: lines.extend(proc.stdout), daemon=True)
     reader.start()
     assert proc.wait(120) == 0

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import errno
+import io
 import os
 import signal
 import subprocess
@@ -18,6 +20,7 @@ from rosbags.rosbag2 import Reader as RosbagsReader
 
 from mindgrasp_bringup.bag import BagReader, BagWriter, Recorder
 from mindgrasp_bringup.cli import main as cli_main
+from mindgrasp_testing import small_tmpfs
 
 
 def test_messages_from_many_threads_are_all_written(tmp_path):
@@ -130,13 +133,16 @@ def test_sigkill_during_recording_leaves_a_readable_bag(tmp_path, capsys):
               f'{len(lines) - len(got)} in the last flush interval)')
     assert len(got) >= flushed
     assert got == [image(k, 32, 24) for k in range(len(got))]
-    # bag info rebuilds metadata.yaml from the unfinished file, and reports the damage (exit 1)
+    # bag info reads the unfinished file, reports the damage (exit 1) and writes nothing
     capsys.readouterr()
+    before = sorted(p.name for p in bag.iterdir())
     assert cli_main(['bag', 'info', str(bag)]) == 1
     out = capsys.readouterr().out
     assert f'Messages:          {len(got)}' in out
-    assert 'rebuilt' in out and (bag / 'metadata.yaml').exists()
+    assert 'metadata.yaml is missing; run `mindgrasp bag reindex' in out
+    assert sorted(p.name for p in bag.iterdir()) == before      # read-only
     assert 'without a footer (the recorder was killed)' in out
+    assert cli_main(['bag', 'info', '--allow-damaged', str(bag)]) == 0
     # --fix finishes the file, so tools without a recovery path (rosbags) read it too.
     assert cli_main(['bag', 'info', '--fix', str(bag)]) == 0
     assert 'rewritten with its summary' in capsys.readouterr().out
@@ -147,16 +153,8 @@ def test_sigkill_during_recording_leaves_a_readable_bag(tmp_path, capsys):
 @pytest.fixture
 def tiny_disk(tmp_path):
     """A 1 MiB tmpfs (needs root); skipped where mounting is not allowed."""
-    mount = tmp_path / f'tiny-{uuid.uuid4().hex[:6]}'
-    mount.mkdir()
-    result = subprocess.run(['mount', '-t', 'tmpfs', '-o', 'size=1m', 'tmpfs', str(mount)],
-                            capture_output=True, text=True)
-    if result.returncode != 0:
-        pytest.skip(f'cannot mount a 1 MiB tmpfs to fill (needs root): {result.stderr.strip()}')
-    try:
+    with small_tmpfs(tmp_path / f'tiny-{uuid.uuid4().hex[:6]}', '1m') as mount:
         yield mount
-    finally:
-        subprocess.run(['umount', '-l', str(mount)], check=False)
 
 
 def test_full_disk_stops_recording_with_an_error_and_keeps_what_was_written(tiny_disk):
@@ -178,3 +176,60 @@ def test_full_disk_stops_recording_with_an_error_and_keeps_what_was_written(tiny
         got = [d for _, _, d in reader.messages()]
     assert 3 <= len(got) < len(frames)
     assert got == frames[:len(got)]
+
+
+class _FullDisk(io.RawIOBase):
+    """A file on a disk with ``budget`` bytes free: then ENOSPC, after a partial write."""
+
+    def __init__(self, path: Path, budget: int) -> None:
+        self._f = open(path, 'xb', buffering=0)  # noqa: SIM115 (closed by close())
+        self.budget = budget
+        self.name = str(path)
+
+    def writable(self) -> bool:
+        return True
+
+    def write(self, b) -> int:
+        if self.budget <= 0:
+            raise OSError(errno.ENOSPC, 'No space left on device')
+        n = self._f.write(bytes(b[:self.budget]))
+        self.budget -= n
+        return n
+
+    def tell(self) -> int:
+        return self._f.tell()
+
+    def close(self) -> None:
+        self._f.close()
+        super().close()
+
+
+def test_full_disk_counts_are_what_the_bag_really_holds(tmp_path, monkeypatch):
+    real_open = Path.open
+
+    def open_on_small_disk(self, mode='r', *args, **kwargs):
+        if mode == 'xb':
+            return io.BufferedWriter(_FullDisk(self, 40_000), 1 << 20)
+        return real_open(self, mode, *args, **kwargs)
+
+    monkeypatch.setattr(Path, 'open', open_on_small_disk)
+    errors = []
+    # chunks of ~8 KiB written out by size: some reach the disk between flushes, the last is cut
+    recorder = Recorder(BagWriter(tmp_path / 'bag', chunk_size=8_000, flush_interval=60.0),
+                        on_error=errors.append)
+    recorder.add_topic('/a', STRING)
+    recorder.start()
+    for i in range(200):
+        recorder.push('/a', string(f'{i:04d}' + 'x' * 500), 1_000 + i)
+        time.sleep(0.001)
+    counters = recorder.stop()['/a']
+    monkeypatch.undo()
+    assert recorder.error is not None and len(errors) == 1
+    with BagReader(tmp_path / 'bag') as reader:
+        readable = sum(1 for _ in reader.messages())
+    assert 0 < readable < 200
+    assert counters.written == readable          # the count is what can be recovered
+    assert counters.written + counters.lost_disk_fault == counters.received == 200
+    assert f'{readable} message(s) are on disk and recoverable' in errors[0]
+    assert f'{200 - readable - int(errors[0].split(" queued")[0].split()[-1])} written before ' \
+        'the fault did not reach the disk' in errors[0]

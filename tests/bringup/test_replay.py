@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import itertools
 import json
+import shutil
 import signal
 import subprocess
 import sys
@@ -15,7 +16,7 @@ import uuid
 from pathlib import Path
 
 import pytest
-from conftest_bag import EEG, eeg_chunk
+from conftest_bag import EEG, cut_in_half, damage_chunks, eeg_chunk
 from launch_fixtures.runner import launch_cmd, launch_env, run_launch
 
 from mindgrasp_bringup.bag import BagWriter
@@ -79,6 +80,40 @@ def test_replayed_predictions_equal_the_recorded_ones(demo_run, tmp_path):
         assert (out / name).exists(), name
     assert 'Replayed classifier: predictions' in done.stdout
     assert '100.0 %' in (out / 'report.md').read_text()
+
+
+def _damaged_copy(demo_run: Path, tmp_path: Path, damage) -> Path:
+    run = tmp_path / 'run'
+    shutil.copytree(demo_run, run, ignore=shutil.ignore_patterns('replays'))
+    damage(run / 'bag' / 'bag_0.mcap')
+    return run
+
+
+def test_replay_of_a_bag_cut_in_half_says_so_and_fails_its_check(demo_run, tmp_path):
+    run = _damaged_copy(demo_run, tmp_path, cut_in_half)
+    done = _mindgrasp('replay', str(run), '--json', '--no-progress', '-o', str(tmp_path / 'r'))
+    assert done.returncode == 1, done.stdout[-3000:] + done.stderr[-3000:]
+    summary = json.loads(done.stdout.strip().splitlines()[-1])
+    damage = summary['damage']
+    assert damage['damaged'] and damage['cut_files'] == 1
+    assert 0 < damage['readable_messages'] < damage['expected_messages']
+    assert damage['lost_messages'] == damage['expected_messages'] - damage['readable_messages']
+    assert damage['lost_span_s'] > 1.0
+    assert any('Damaged bag' in n for n in summary['notes'])
+    # the check fails even where the readable half agrees: its damage is not accepted
+    assert 'pass --allow-damaged' in done.stderr and 'Traceback' not in done.stderr
+
+
+def test_replay_of_a_bag_with_three_damaged_chunks_reads_the_rest(demo_run, tmp_path):
+    run = _damaged_copy(demo_run, tmp_path, damage_chunks)
+    done = _mindgrasp('replay', str(run), '--json', '--no-progress', '-o', str(tmp_path / 'r'),
+                      '--allow-damaged')
+    assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-3000:]
+    summary = json.loads(done.stdout.strip().splitlines()[-1])
+    assert summary['damage']['skipped_records'] == 3
+    assert summary['damage']['lost_messages'] > 0
+    assert summary['fed']['/eeg/raw'] > 0
+    assert 'The agreement covers the readable part only.' in done.stderr
 
 
 def test_launch_replay_with_the_controller_reports_it_open_loop(demo_run, tmp_path):

@@ -87,3 +87,58 @@ def test_both_launchers_read_the_common_arguments_alike(arguments, record, durat
 def test_a_bad_common_argument_is_one_clear_error(name, value, problem) -> None:
     with pytest.raises(LaunchError, match=re.escape(problem)):
         record_enabled({name: value}) if name == 'record' else duration_limit({name: value})
+
+
+def test_summary_on_a_full_disk_keeps_the_old_file_and_goes_to_the_fallback(
+        tmp_path, monkeypatch, caplog) -> None:
+    """ENOSPC at the file layer: the summary is never truncated, and it is not lost."""
+    import errno
+    from pathlib import Path
+
+    from mindgrasp_common.safe_files import fallback_folder
+
+    monkeypatch.setenv('XDG_STATE_HOME', str(tmp_path / 'state'))
+    path = rundir.create_run_dir('demo', None, tmp_path / 'runs')
+    files = RunFiles(path)
+    files.process_ended('sim-1', 40, 0)
+    real_write_text = Path.write_text
+
+    def full_disk(self: Path, text: str, *args, **kwargs) -> int:
+        if path in self.parents:          # the run directory's disk is full
+            real_write_text(self, text[:10], *args, **kwargs)
+            raise OSError(errno.ENOSPC, 'No space left on device')
+        return real_write_text(self, text, *args, **kwargs)
+
+    monkeypatch.setattr(Path, 'write_text', full_disk)
+    files.process_ended('fsm-2', 41, 0)
+    files.stopping('the duration ended')          # still full: no second line
+    monkeypatch.undo()
+    old = yaml.safe_load((path / 'summary.yaml').read_text())
+    assert [p['label'] for p in old['processes']] == ['sim-1']       # intact, not truncated
+    copy = fallback_folder(path, tmp_path / 'state' / 'mindgrasp' / 'unwritten')
+    new = yaml.safe_load((copy / 'summary.yaml').read_text())
+    assert [p['label'] for p in new['processes']] == ['sim-1', 'fsm-2']
+    assert new['stop_reason'] == 'the duration ended'
+    errors = [r.getMessage() for r in caplog.records if r.name == 'launch']
+    assert len(errors) == 1 and str(copy) in errors[0] and 'No space left' in errors[0]
+
+
+def test_a_launch_on_a_full_disk_is_refused_in_one_line_before_anything_starts(tmp_path):
+    import contextlib
+
+    from launch_fixtures.runner import run_launch
+
+    from mindgrasp_testing import small_tmpfs
+
+    with small_tmpfs(tmp_path / 'full', '256k') as disk:
+        with (disk / 'filler').open('wb', buffering=0) as f, \
+                contextlib.suppress(OSError):      # until the disk is full
+            while True:
+                f.write(b'\0' * 4096)
+        result = run_launch('demo', 'duration:=5', '--run-dir', str(disk / 'run'), timeout=120)
+    assert result.returncode == 2, result.stderr
+    assert 'Traceback' not in result.stderr
+    errors = [line for line in result.stderr.splitlines() if 'error' in line.lower()]
+    assert len(errors) == 1 and 'cannot write the run directory' in errors[0], result.stderr
+    assert 'No space left on device' in errors[0] and '--run-dir' in errors[0]
+    assert 'process started' not in result.stderr

@@ -181,11 +181,13 @@ def run_experiment(args: argparse.Namespace, protocol: str, command: str) -> int
 
     from mindgrasp_bringup.launch_system import LaunchError
     from mindgrasp_bringup.launch_system.rundir import create_run_dir
+    from mindgrasp_common.safe_files import DeferredWriter
     from mindgrasp_eeg import EEGError
     from mindgrasp_experiments import ExperimentError
     from mindgrasp_experiments.engine import is_trial_manager, lockstep_components
     from mindgrasp_experiments.records import write_records
     from mindgrasp_experiments.report import finite, write_run
+    from mindgrasp_experiments.summary import calibration_accuracy_of, summarise
     from mindgrasp_experiments.sweep import apply_params, check_params, parse_param
     from mindgrasp_experiments.workers import run_trials
 
@@ -235,12 +237,17 @@ def run_experiment(args: argparse.Namespace, protocol: str, command: str) -> int
     wall0, cpu0 = time.perf_counter(), time.process_time()
     bar = tqdm(total=len(trials), unit='trial', disable=args.no_progress, file=sys.stderr,
                desc=f'{protocol} ({subject})', dynamic_ncols=True)
+    # on disk as they finish: nothing is lost on a crash; a full disk costs one line, the
+    # records stay in memory and in a fallback copy until the run directory takes them
+    files = DeferredWriter(out)
     try:
         for run in run_trials(components, trials, seed=args.seed, workers=args.workers,
                               step_s=args.step, ray=args.ray):
             runs.append(run)
             done = [r.record for r in runs]
-            write_records(done, out)      # on disk as they finish: nothing is lost on a crash
+            for line in files.write(out, 'trial records',
+                                    lambda folder, done=done: write_records(done, folder)):
+                bar.write(f'mindgrasp experiment {command}: {line}', file=sys.stderr)
             bar.update(1)
             bar.set_postfix(success=f'{sum(r.success for r in done)}/{len(done)}',
                             rtf=f'{sum(r.sim_s for r in runs) / (time.perf_counter() - wall0):.1f}')
@@ -271,7 +278,14 @@ def run_experiment(args: argparse.Namespace, protocol: str, command: str) -> int
         'cpu_s_per_sim_s': cpu / sim if sim > 0 else math.nan,
         'build_s': sum(r.build_s for r in runs), 'node_s': node_s,
     }
-    doc = write_run(out, records, info)
+    written: dict[str, dict] = {}
+    calibration = calibration_accuracy_of(out)   # from the run's parameters, wherever it lands
+    lines = files.write(out, 'run report', lambda folder: written.update(
+        doc=write_run(folder, records, info, calibration)))
+    lines += files.close()
+    for line in lines:
+        print(f'mindgrasp experiment {command}: {line}', file=sys.stderr)
+    doc = written.get('doc') or {'summary': summarise(records, calibration)}
     s = doc['summary']
     cut = (f" (and {s['interrupted_trials']} interrupted, left out)"
            if s['interrupted_trials'] else '')
@@ -294,7 +308,7 @@ def run_experiment(args: argparse.Namespace, protocol: str, command: str) -> int
                                  'real_time_factor': info['real_time_factor'],
                                  'cpu_s_per_sim_s': info['cpu_s_per_sim_s'],
                                  'wall_s': wall, 'sim_s': sim, 'interrupted': interrupted})))
-    return 130 if interrupted else 0
+    return 130 if interrupted else 1 if files.pending else 0
 
 
 def _pct(rate: float) -> str:

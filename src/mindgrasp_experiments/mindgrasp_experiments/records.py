@@ -28,6 +28,7 @@ from dataclasses import asdict, dataclass, fields
 from pathlib import Path
 
 from mindgrasp_common.mi import CLASS_NAMES, DECODER_CLASS_NAMES, REST
+from mindgrasp_common.safe_files import write_atomic
 from mindgrasp_common.states import State
 from mindgrasp_sim.task import SUCCESS_HEIGHT
 
@@ -337,7 +338,14 @@ def shape_of(label: str) -> str:
 
 def write_records(records: Iterable[TrialRecord], directory: str | Path,
                   stem: str = 'records') -> tuple[Path, Path]:
-    """Write ``<directory>/<stem>.csv`` and ``.parquet`` (one row per trial, in trial order)."""
+    """Write ``<directory>/<stem>.csv`` and ``.parquet`` (one row per trial, in trial order).
+
+    Each file is written to a temporary name and renamed, so a full disk leaves the previous
+    version intact, never a truncated file.
+
+    Raises:
+        OSError: a file could not be written (its previous version is unchanged).
+    """
     import pyarrow as pa
     import pyarrow.parquet as pq
 
@@ -345,15 +353,18 @@ def write_records(records: Iterable[TrialRecord], directory: str | Path,
     directory.mkdir(parents=True, exist_ok=True)
     rows = [r.to_row() for r in sorted(records, key=lambda r: r.trial)]
     columns = TrialRecord.columns()
-    csv_path = directory / f'{stem}.csv'
-    with csv_path.open('w', newline='', encoding='utf-8') as f:
-        writer = csv.DictWriter(f, fieldnames=columns, lineterminator='\n')
-        writer.writeheader()
-        for row in rows:
-            writer.writerow({k: _csv_value(v) for k, v in row.items()})
+
+    def write_csv(path: Path) -> None:
+        with path.open('w', newline='', encoding='utf-8') as f:
+            writer = csv.DictWriter(f, fieldnames=columns, lineterminator='\n')
+            writer.writeheader()
+            for row in rows:
+                writer.writerow({k: _csv_value(v) for k, v in row.items()})
+
     table = pa.Table.from_pylist(rows, schema=_schema()) if rows else _schema().empty_table()
-    parquet_path = directory / f'{stem}.parquet'
-    pq.write_table(table, parquet_path)
+    csv_path = write_atomic(directory / f'{stem}.csv', write_csv)
+    parquet_path = write_atomic(directory / f'{stem}.parquet',
+                                lambda path: pq.write_table(table, path))
     return csv_path, parquet_path
 
 

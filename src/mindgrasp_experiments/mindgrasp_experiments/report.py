@@ -15,6 +15,7 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from mindgrasp_common.safe_files import write_atomic
 from mindgrasp_experiments.records import TrialRecord, read_records, write_records
 from mindgrasp_experiments.summary import PAPER, calibration_accuracy_of, summarise
 
@@ -146,8 +147,11 @@ def render_report(summary: Mapping[str, Any], run: Mapping[str, Any]) -> str:
 
 
 def write_run(run_dir: str | Path, records: Sequence[TrialRecord],
-              run: Mapping[str, Any], calibration_accuracy: float | None = None) -> dict:
+              run: Mapping[str, Any], calibration_accuracy: float | None = None, *,
+              with_records: bool = True) -> dict:
     """Write records, summary.json, report.md and the plots; returns the summary document.
+
+    ``with_records=False`` leaves the record files as they are (a rebuild from them).
 
     ``calibration_accuracy``: the classifier's cross-validated accuracy, shown beside its
     online accuracy; by default ``run['calibration_accuracy']``, else read from the model the
@@ -156,7 +160,8 @@ def write_run(run_dir: str | Path, records: Sequence[TrialRecord],
 
     run_dir = Path(run_dir)
     run_dir.mkdir(parents=True, exist_ok=True)
-    write_records(records, run_dir)
+    if with_records:
+        write_records(records, run_dir)
     run = dict(run)
     run['plots'] = [p.name for p in write_plots(records, run_dir, run.get('protocol', ''))]
     if calibration_accuracy is None:
@@ -165,14 +170,16 @@ def write_run(run_dir: str | Path, records: Sequence[TrialRecord],
         calibration_accuracy = calibration_accuracy_of(run_dir)
     summary = summarise(records, calibration_accuracy)
     doc = {'summary': summary, 'run': run, 'paper': PAPER.get(run.get('protocol', ''), {})}
-    (run_dir / 'summary.json').write_text(json.dumps(finite(doc), indent=2) + '\n',
-                                          encoding='utf-8')
-    (run_dir / 'report.md').write_text(render_report(summary, run), encoding='utf-8')
+    text = json.dumps(finite(doc), indent=2) + '\n'
+    write_atomic(run_dir / 'summary.json', lambda tmp: tmp.write_text(text, encoding='utf-8'))
+    report = render_report(summary, run)
+    write_atomic(run_dir / 'report.md', lambda tmp: tmp.write_text(report, encoding='utf-8'))
     return doc
 
 
 def rebuild(run_dir: str | Path) -> dict:
-    """Rebuild summary.json, report.md and the plots of ``run_dir`` from its records."""
+    """Rebuild summary.json, report.md and the plots of ``run_dir`` from its records (which
+    are read, never rewritten)."""
     run_dir = Path(run_dir)
     records = read_records(run_dir)
     run: dict = {}
@@ -181,4 +188,4 @@ def rebuild(run_dir: str | Path) -> dict:
     if not run.get('protocol') and records:
         run['protocol'] = records[0].protocol
         run['subject'] = records[0].subject
-    return write_run(run_dir, records, run)
+    return write_run(run_dir, records, run, with_records=False)

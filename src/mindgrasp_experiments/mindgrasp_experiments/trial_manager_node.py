@@ -38,6 +38,7 @@ from mindgrasp_ros.interfaces.std_msgs.msg import String
 from mindgrasp_ros.interfaces.visualization_msgs.msg import MarkerArray
 
 from mindgrasp_common.markers import objects_from_markers
+from mindgrasp_common.safe_files import DeferredWriter, write_atomic
 from mindgrasp_experiments.protocols import (
     PROTOCOLS,
     random_locations_trial,
@@ -117,6 +118,9 @@ class TrialManagerNode(rclpy.node.Node):
             str(Path(os.environ['MINDGRASP_RUN_DIR']) / 'trials')
             if os.environ.get('MINDGRASP_RUN_DIR') else '')
         self.records_dir = Path(records_dir) if records_dir else None
+        # a full disk costs only what cannot be written: records stay in memory, go to a
+        # fallback folder the log names, and land in records_dir when space returns
+        self.record_files = DeferredWriter(self.records_dir.parent if self.records_dir else None)
         self.target_pub = self.create_publisher(TaskTarget, TASK_TARGET.name, TASK_TARGET.qos)
         self.create_subscription(MarkerArray, SIM_OBJECTS.name, self.objects_callback,
                                  SIM_OBJECTS.qos)
@@ -272,12 +276,21 @@ class TrialManagerNode(rclpy.node.Node):
         return client.call_async(request)
 
     def _scene_file(self, scene: dict) -> Path:
-        if self._scene_dir is None:
-            base = self.records_dir.parent if self.records_dir is not None else None
-            self._scene_dir = Path(tempfile.mkdtemp(prefix='scenes_', dir=base))
-        path = self._scene_dir / f"{scene['name']}.yaml"
-        path.write_text(yaml.safe_dump(scene, sort_keys=False), encoding='utf-8')
-        return path
+        """The scene as a file for /sim/load_scene, in the run directory (a hand-over to the
+        simulator: in the system's temporary folder when the run directory is full)."""
+        name = f"{scene['name']}.yaml"
+        text = yaml.safe_dump(scene, sort_keys=False)
+        try:
+            if self._scene_dir is None:
+                base = self.records_dir.parent if self.records_dir is not None else None
+                self._scene_dir = Path(tempfile.mkdtemp(prefix='scenes_', dir=base))
+            return write_atomic(self._scene_dir / name,
+                                lambda tmp: tmp.write_text(text, encoding='utf-8'))
+        except OSError:
+            self._scene_dir = Path(tempfile.mkdtemp(prefix='mindgrasp_scenes_'))
+            path = self._scene_dir / name
+            path.write_text(text, encoding='utf-8')
+            return path
 
     def _wait_until_ready(self, now: float) -> None:
         missing = [t for t in self.p['wait_for']
@@ -354,8 +367,7 @@ class TrialManagerNode(rclpy.node.Node):
                    f'failed ({rec.failure}: {rec.reason})')
         self.get_logger().info(f'Trial {rec.trial} ({rec.desired}): {verdict} after '
                                f"{rec.duration_s:.1f} s: {rec.outcome.replace('_', ' ')}.")
-        if self.records_dir is not None:
-            write_records(self.records, self.records_dir)
+        self._save_records()
         last = self.p['n_trials'] and self.n_done >= self.p['n_trials']
         if last:
             self._begin_trial()          # ends the node
@@ -368,6 +380,8 @@ class TrialManagerNode(rclpy.node.Node):
         if self.tracker.active:
             self.finish_interrupted('stopped before the trial ended')
             self._report()
+        for line in self.record_files.close():
+            self.get_logger().error(line)
         super().destroy_node()
 
     def finish_interrupted(self, reason: str, failure: str = 'interrupted') -> None:
@@ -376,8 +390,16 @@ class TrialManagerNode(rclpy.node.Node):
         if self.tracker.active:
             rec = self.tracker.finish(self.now_s(), failure, reason)
             self.records.append(rec)
-            if self.records_dir is not None:
-                write_records(self.records, self.records_dir)
+            self._save_records()
+
+    def _save_records(self) -> None:
+        """Write records.csv/.parquet; a disk fault is one warning, never a crash."""
+        if self.records_dir is None:
+            return
+        records = list(self.records)
+        for line in self.record_files.write(self.records_dir, 'trial records',
+                                            lambda folder: write_records(records, folder)):
+            self.get_logger().warning(line)
 
     def fail(self, reason: str) -> None:
         """Stop the trials with an error (the node ends, exit code 1)."""

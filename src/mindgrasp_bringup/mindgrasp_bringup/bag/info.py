@@ -70,5 +70,8 @@ def format_info(summary: dict[str, Any]) -> str:
     if not summary['topics']:
         lines.append('Topic information: (no topics)')
     lines += [f'Note: {note}' for note in summary['notes']]
-    lines += [f'Damage: {damage}' for damage in summary.get('damage', [])]
+    damage = summary.get('damage') or {}
+    lines += [f'Damage: {problem}' for problem in damage.get('problems', [])]
+    if damage.get('damaged'):
+        lines.append(f'Readable:          {damage["summary"]}')
     return '\n'.join(lines)

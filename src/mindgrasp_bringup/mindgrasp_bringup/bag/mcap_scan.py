@@ -11,7 +11,6 @@ incomplete or corrupt record, so everything before it is recovered.
 from __future__ import annotations
 
 import io
-import os
 import struct
 from collections import defaultdict
 from collections.abc import Iterator
@@ -23,10 +22,12 @@ from mcap.reader import make_reader
 from mcap.records import Channel, Chunk, Footer, Message, Schema, Statistics
 from mcap.stream_reader import StreamReader
 
+from mindgrasp_common.safe_files import write_atomic
+
 from .errors import BagError
 
-__all__ = ['ChannelInfo', 'McapContents', 'is_finished', 'iter_mcap_messages', 'read_mcap_contents',
-           'recover_mcap', 'verify_mcap']
+__all__ = ['ChannelInfo', 'McapContents', 'damage_sentences', 'is_finished', 'iter_mcap_messages',
+           'read_mcap_contents', 'recover_mcap', 'verify_mcap']
 
 MAGIC = b'\x89MCAP0\r\n'
 _RECORD_HEADER = struct.Struct('<BQ')
@@ -59,6 +60,10 @@ class McapContents:
     stopped_at: str = ''         # why a scan stopped before the end of the file
     damaged: list[str] = field(default_factory=list)  # corrupt records skipped by a scan
     compression: str = ''
+    #: per skipped record: (last message time before it, first after it) in ns; None at an end
+    gaps: list[tuple[int | None, int | None]] = field(default_factory=list)
+    footer: bool = False         # a scan reached the footer
+    last_ns: int | None = None   # log time of the last readable message in file order (scan)
 
 
 def _check_magic(path: Path, head: bytes) -> None:
@@ -121,8 +126,13 @@ def _records(path: Path, f: io.BufferedReader, size: int,
             return
 
 
-def read_mcap_contents(path: Path) -> McapContents:
+def read_mcap_contents(path: Path, *, scan: bool = False) -> McapContents:
     """Channels, counts and time range of one MCAP file: its summary, else a scan.
+
+    Args:
+        path: The .mcap file.
+        scan: Read every record even when the file has a summary (finds what a summary hides:
+            chunks whose CRC fails, records cut off); the counts are then what is readable.
 
     Raises:
         BagError: the file does not exist or is not MCAP.
@@ -137,7 +147,7 @@ def read_mcap_contents(path: Path) -> McapContents:
     with f:
         size = path.stat().st_size
         _check_magic(path, f.read(8))
-        if _is_finished(f, size):
+        if not scan and _is_finished(f, size):
             f.seek(0)
             try:
                 summary = make_reader(f).get_summary()
@@ -154,12 +164,17 @@ def read_mcap_contents(path: Path) -> McapContents:
                     contents.end_ns = stats.message_end_time
                 contents.compression = next(
                     (c.compression for c in summary.chunk_indexes if c.compression), '')
+                contents.footer = True
                 return contents
         contents.complete = False
         schemas: dict[int, Schema] = {}
         counts: dict[int, int] = defaultdict(int)
         start, end = 2**63 - 1, 0
+        open_gaps = 0
         for record in _records(path, f, size, contents):
+            for _ in range(len(contents.damaged) - len(contents.gaps)):
+                contents.gaps.append((contents.last_ns, None))   # closed by the next message
+                open_gaps += 1
             if isinstance(record, Schema):
                 schemas[record.id] = record
             elif isinstance(record, Channel):
@@ -168,10 +183,17 @@ def read_mcap_contents(path: Path) -> McapContents:
                 counts[record.channel_id] += 1
                 start = min(start, record.log_time)
                 end = max(end, record.log_time)
+                contents.last_ns = record.log_time
+                while open_gaps:
+                    k = len(contents.gaps) - open_gaps
+                    contents.gaps[k] = (contents.gaps[k][0], record.log_time)
+                    open_gaps -= 1
             elif isinstance(record, Chunk) and record.compression:
                 contents.compression = record.compression
             elif isinstance(record, Footer):
-                contents.complete = True
+                contents.complete = contents.footer = True
+        for _ in range(len(contents.damaged) - len(contents.gaps)):
+            contents.gaps.append((contents.last_ns, None))
         contents.channel_counts = dict(counts)
         contents.message_count = sum(counts.values())
         if contents.message_count:
@@ -223,31 +245,34 @@ def recover_mcap(path: Path) -> int:
     from mcap.writer import Writer as McapWriter
 
     path = Path(path)
-    tmp = path.with_name(path.name + '.recovering')
     contents = McapContents(path)
-    count = 0
-    with path.open('rb') as f, tmp.open('wb') as out:
-        size = path.stat().st_size
-        _check_magic(path, f.read(8))
-        writer = McapWriter(out, compression=CompressionType.NONE)
-        writer.start(profile='ros2', library='mindgrasp-ros bag recovery (mcap python)')
-        schema_ids: dict[int, int] = {}
-        channel_ids: dict[int, int] = {}
-        for record in _records(path, f, size, contents):
-            if isinstance(record, Schema) and record.id not in schema_ids:
-                schema_ids[record.id] = writer.register_schema(record.name, record.encoding,
-                                                               record.data)
-            elif isinstance(record, Channel) and record.id not in channel_ids:
-                channel_ids[record.id] = writer.register_channel(
-                    record.topic, record.message_encoding, schema_ids.get(record.schema_id, 0),
-                    dict(record.metadata))
-            elif isinstance(record, Message) and record.channel_id in channel_ids:
-                writer.add_message(channel_ids[record.channel_id], record.log_time,
-                                   record.data, record.publish_time, record.sequence)
-                count += 1
-        writer.finish()
-    os.replace(tmp, path)
-    return count
+    counted = [0]
+
+    def rewrite(tmp: Path) -> None:
+        with path.open('rb') as f, tmp.open('wb') as out:
+            size = path.stat().st_size
+            _check_magic(path, f.read(8))
+            writer = McapWriter(out, compression=CompressionType.NONE)
+            writer.start(profile='ros2', library='mindgrasp-ros bag recovery (mcap python)')
+            schema_ids: dict[int, int] = {}
+            channel_ids: dict[int, int] = {}
+            for record in _records(path, f, size, contents):
+                if isinstance(record, Schema) and record.id not in schema_ids:
+                    schema_ids[record.id] = writer.register_schema(record.name, record.encoding,
+                                                                   record.data)
+                elif isinstance(record, Channel) and record.id not in channel_ids:
+                    channel_ids[record.id] = writer.register_channel(
+                        record.topic, record.message_encoding,
+                        schema_ids.get(record.schema_id, 0), dict(record.metadata))
+                elif isinstance(record, Message) and record.channel_id in channel_ids:
+                    writer.add_message(channel_ids[record.channel_id], record.log_time,
+                                       record.data, record.publish_time, record.sequence)
+                    counted[0] += 1
+            writer.finish()
+
+    # a full disk leaves the original file as it was and no partial copy beside it
+    write_atomic(path, rewrite)
+    return counted[0]
 
 
 def verify_mcap(path: Path) -> list[str]:
@@ -257,21 +282,22 @@ def verify_mcap(path: Path) -> list[str]:
     (bit flips), and that the file ends with its footer and closing magic. [] when sound.
     """
     path = Path(path)
-    contents = McapContents(path)
-    footer = False
-    with path.open('rb') as f:
-        size = path.stat().st_size
-        head = f.read(8)
-        if head[:8] != MAGIC:
-            return [f'{path.name}: not an MCAP file (bad magic bytes at byte 0).']
-        for record in _records(path, f, size, contents):
-            if isinstance(record, Footer):
-                footer = True
-    problems = [f'{path.name}: {d}; it was skipped.' for d in contents.damaged]
+    try:
+        contents = read_mcap_contents(path, scan=True)
+    except BagError:
+        return [f'{path.name}: not an MCAP file (bad magic bytes at byte 0).']
+    return damage_sentences(contents)
+
+
+def damage_sentences(contents: McapContents) -> list[str]:
+    """What a scan (:func:`read_mcap_contents` with ``scan=True``) found wrong, as sentences."""
+    name = contents.path.name
+    problems = [f'{name}: {d}; it was skipped.' for d in contents.damaged]
     if contents.stopped_at:
-        problems.append(f'{path.name}: {contents.stopped_at}; the records before it are '
+        problems.append(f'{name}: {contents.stopped_at}; the records before it are '
                         'readable (`mindgrasp bag reindex` keeps them).')
-    elif not footer:
-        problems.append(f'{path.name}: ends at byte {size} without a footer (the recorder was '
+    elif not contents.footer:
+        size = contents.path.stat().st_size
+        problems.append(f'{name}: ends at byte {size} without a footer (the recorder was '
                         'killed); run `mindgrasp bag reindex` to finish it.')
     return problems

@@ -11,13 +11,14 @@ the ``mcap`` library and bags rebuilt from files. The layout follows rosbag2 Jaz
 
 from __future__ import annotations
 
-import os
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import yaml
+
+from mindgrasp_common.safe_files import write_atomic
 
 from .errors import BagError
 from .mcap_scan import McapContents, read_mcap_contents
@@ -105,11 +106,9 @@ def dump_metadata(metadata: dict[str, Any]) -> str:
 
 def write_metadata(bag_dir: Path, metadata: dict[str, Any]) -> Path:
     """Write ``metadata.yaml`` atomically (temporary file + rename), so it is never half written."""
-    path = Path(bag_dir) / METADATA_FILE
-    tmp = path.with_name(METADATA_FILE + '.tmp')
-    tmp.write_text(dump_metadata(metadata), encoding='utf-8')
-    os.replace(tmp, path)
-    return path
+    text = dump_metadata(metadata)
+    return write_atomic(Path(bag_dir) / METADATA_FILE,
+                        lambda tmp: tmp.write_text(text, encoding='utf-8'))
 
 
 def load_metadata(bag_dir: Path) -> dict[str, Any]:
@@ -118,16 +117,16 @@ def load_metadata(bag_dir: Path) -> dict[str, Any]:
     try:
         data = yaml.safe_load(path.read_text(encoding='utf-8'))
     except FileNotFoundError:
-        msg = f'{path} does not exist; run `mindgrasp bag info {bag_dir}` to rebuild it.'
+        msg = f'{path} does not exist; run `mindgrasp bag reindex {bag_dir}` to rebuild it.'
         raise BagError(msg) from None
     except yaml.YAMLError as exc:
         msg = (f'{path} is not valid YAML ({exc}); delete it and run '
-               f'`mindgrasp bag info {bag_dir}` to rebuild it from the storage files.')
+               f'`mindgrasp bag reindex {bag_dir}` to rebuild it from the storage files.')
         raise BagError(msg) from None
     info = data.get('rosbag2_bagfile_information') if isinstance(data, dict) else None
     if not isinstance(info, dict):
         msg = (f'{path} has no rosbag2_bagfile_information section; delete it and run '
-               f'`mindgrasp bag info {bag_dir}` to rebuild it from the storage files.')
+               f'`mindgrasp bag reindex {bag_dir}` to rebuild it from the storage files.')
         raise BagError(msg)
     return info
 

@@ -7,7 +7,9 @@ publish are skipped and named.
 
 The playback runs in its own thread on the bag's schedule; the node ends when it has played the
 bag (exit 0), on Ctrl-C/SIGTERM (0, within the current wait), on a bag error while playing (1),
-or refuses to start on a bad parameter or an unreadable bag (2).
+or refuses to start on a bad parameter or an unreadable bag (2). A damaged bag (see
+:mod:`.damage`) is played as far as it is readable, what was lost is logged before the first
+message, and the node ends with exit code 1 unless ``allow_damaged`` is true.
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ import traceback
 from dataclasses import dataclass
 from typing import Any
 
+from mindgrasp_bringup.bag.damage import assess_bag
 from mindgrasp_bringup.bag.errors import BagError
 from mindgrasp_bringup.bag.paths import resolve_bag
 from mindgrasp_bringup.bag.player import Player, PlayStats, parse_remaps, type_problem
@@ -53,6 +56,8 @@ class PlayerParams:
     priority: int = param(0, 'real-time (SCHED_FIFO) priority of the playback thread (0: '
                           'normal; needs root or CAP_SYS_NICE)', min=0, max=99)
     progress: bool = param(False, 'show a progress bar on stderr')
+    allow_damaged: bool = param(False, 'end with exit code 0 after playing the readable part '
+                                'of a damaged bag (default: 1, after playing it)')
 
     def __post_init__(self) -> None:
         if not self.rate > 0:
@@ -73,6 +78,9 @@ class PlayerNode(rclpy.node.Node):
         self.reader = BagReader(resolve_bag(p.bag)).open()  # a run directory or its bag
         for note in self.reader.notes:
             self.get_logger().warning(note)
+        self.damage = assess_bag(self.reader.path)   # said before anything is published
+        for line in self.damage.lines():
+            self.get_logger().warning(f'Damaged bag: {line}')
         self.remap = parse_remaps([r for r in p.remap if r])
         self.publishers_: dict[str, Any] = {}
         self.player = Player(
@@ -114,6 +122,11 @@ class PlayerNode(rclpy.node.Node):
         try:
             if not (self.params.delay > 0 and self.stop_event.wait(self.params.delay)):
                 self._play_bag()
+            if self.damage.damaged and not self.params.allow_damaged and not self.done.done():
+                fail(self, f'The bag is damaged; its readable part was played. '
+                           f'{self.damage.count_line()} Pass --allow-damaged (-p '
+                           'allow_damaged:=true) to accept it, or repair it with `mindgrasp '
+                           'bag reindex`.')
         finally:
             if not self.done.done():
                 self.done.set_result(0)

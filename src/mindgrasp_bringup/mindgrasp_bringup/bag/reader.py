@@ -90,7 +90,15 @@ class BagReader:
                 raise BagError(msg)
             unfinished = [p for p in self.files if not is_finished(p)]
             if has_metadata and not unfinished:
-                self._open_rosbags(self.path)
+                try:
+                    self._open_rosbags(self.path)
+                except BagError as exc:
+                    if not self.files:
+                        raise
+                    # read what can be read: a damaged summary or metadata.yaml does not
+                    # make the records unreadable
+                    self.notes.append(f'{exc} The files were read by a scan instead.')
+                    self._open_scan(self.files, [], has_metadata)
             else:
                 self._open_scan(self.files, unfinished, has_metadata)
         elif self.path.suffix == '.mcap':
@@ -114,7 +122,7 @@ class BagReader:
             reader.open()
         except (ReaderError, FileNotFoundError, OSError, KeyError, ValueError) as exc:
             msg = (f'The bag {path} cannot be read: {exc} It is corrupt or incomplete; for an '
-                   f'MCAP bag, delete its metadata.yaml and run `mindgrasp bag info {path}` to '
+                   f'MCAP bag, delete its metadata.yaml and run `mindgrasp bag reindex {path}` to '
                    'rebuild it from the files.')
             raise BagError(msg) from exc
         self._reader = reader
@@ -179,7 +187,7 @@ class BagReader:
         if self.message_count:
             self.start_ns, self.end_ns = start, end
         if metadata is None and self.path.is_dir():
-            self.notes.append(f'metadata.yaml was missing; run `mindgrasp bag info {self.path}` '
+            self.notes.append(f'metadata.yaml is missing; run `mindgrasp bag reindex {self.path}` '
                               'to write it.')
 
     def rebuild_metadata(self) -> Path:
@@ -200,19 +208,40 @@ class BagReader:
             conns = [c for c in self._reader.connections if wanted is None or c.topic in wanted]
             if not conns:
                 return
+            last: int | None = None
+            at_last: set[tuple[str, int, bytes]] = set()   # yielded at time ``last``
             try:
                 for conn, timestamp, data in self._reader.messages(conns, start=start_ns):
+                    if timestamp != last:
+                        last, at_last = timestamp, set()
+                    at_last.add(_key(conn.topic, data))
                     yield conn.topic, timestamp, data
             except ReaderError as exc:
-                msg = (f'The bag {self.path} is corrupt: {exc} Messages up to this point were '
-                       'read; the rest cannot be.')
-                raise BagError(msg) from exc
+                mcap = [f for f in self.files if f.suffix == '.mcap']
+                if not mcap:
+                    msg = (f'The bag {self.path} is corrupt: {exc} Messages up to this point '
+                           'were read; the rest cannot be.')
+                    raise BagError(msg) from exc
+                # read what can be read: the rest comes from a scan, which skips damaged records
+                self.notes.append(f'A damaged record stopped the indexed reader ({exc}); the '
+                                  'messages after it were read by a scan that skips it.')
+                for topic, timestamp, data in self._scan(mcap, wanted, start_ns):
+                    if last is not None and (timestamp < last or (timestamp == last
+                                             and _key(topic, data) in at_last)):
+                        continue
+                    yield topic, timestamp, data
             return
         if not self._scan_files:
             msg = f'The bag {self.path} is not open; call open() first.'
             raise BagError(msg)
+        yield from self._scan(self._scan_files, wanted, start_ns)
+
+    @staticmethod
+    def _scan(files: list[Path], wanted: set[str] | None,
+              start_ns: int | None) -> Iterator[tuple[str, int, bytes]]:
+        """Every readable message of ``files`` in file order (damaged records skipped)."""
         for channel, timestamp, data in itertools.chain.from_iterable(
-                iter_mcap_messages(p) for p in self._scan_files):
+                iter_mcap_messages(p) for p in files):
             if wanted is not None and channel.topic not in wanted:
                 continue
             if start_ns is not None and timestamp < start_ns:
@@ -232,6 +261,11 @@ class BagReader:
     def __exit__(self, exc_type: type[BaseException] | None, exc: BaseException | None,
                  tb: TracebackType | None) -> None:
         self.close()
+
+
+def _key(topic: str, data: bytes | memoryview) -> tuple[str, int, bytes]:
+    """Tells apart messages of one timestamp, cheaply (no hash of a whole image)."""
+    return topic, len(data), bytes(data[:64])
 
 
 def _rosbags_qos(qos: Any) -> dict[str, Any]:

@@ -33,6 +33,8 @@ class TopicCounters:
     written: int = 0
     bytes_written: int = 0
     dropped_queue_full: int = 0      # messages dropped because the write queue was full
+    lost_disk_fault: int = 0         # messages lost to a write error: not on disk when it came,
+                                     # queued then, or received after it
     samples_missing: int = 0         # EEG samples missing between chunks (sequence gaps)
     gaps: int = 0                    # number of sequence gaps seen
 
@@ -105,7 +107,10 @@ class Recorder:
         with self._lock:
             counters = self.counters[topic]
             counters.received += 1
-            if self._stopping or self.error is not None:
+            if self.error is not None:
+                counters.lost_disk_fault += 1
+                return False
+            if self._stopping:
                 return False
             if self._queued_bytes + size > self.max_queue_bytes:
                 counters.dropped_queue_full += 1
@@ -192,12 +197,27 @@ class Recorder:
             self.error = (f'Recording stopped: {exc}' + (
                 '' if full or isinstance(exc, BagError) else
                 ' This is a bug in the recorder; please report it with the bag.'))
-            dropped = sum(1 for item in self._queue if item[0] == 'msg')
+            queued = 0
+            for item in self._queue:
+                if item[0] == 'msg':
+                    self.counters[item[1]].lost_disk_fault += 1
+                    queued += 1
             self._queue.clear()
             self._queued_bytes = 0
-        self.writer.abort()
-        self.error += (f' {dropped} queued message(s) were not written; everything written '
-                       f'before is kept in {self.writer.path}.')
+        self.writer.abort()     # reads back what reached the disk
+        unwritten = 0
+        for topic, counters in self.counters.items():
+            stats = self.writer.topics.get(topic)
+            on_disk = stats.stats.message_count if stats is not None else 0
+            lost = max(0, counters.written - on_disk)
+            unwritten += lost
+            counters.lost_disk_fault += lost
+            counters.written = on_disk
+        kept = sum(c.written for c in self.counters.values())
+        self.error += (f' {kept} message(s) are on disk and recoverable in {self.writer.path}; '
+                       f'{unwritten} written before the fault did not reach the disk and '
+                       f'{queued} queued were not written (`mindgrasp bag reindex` finishes '
+                       'the bag once there is space).')
         if self.on_error is not None:
             self.on_error(self.error)
 

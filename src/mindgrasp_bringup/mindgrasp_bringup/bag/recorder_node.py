@@ -257,9 +257,11 @@ class RecorderNode(rclpy.node.Node):
             self.get_logger().warning(line)
         total = sum(c.written for c in counters.values())
         dropped = sum(c.dropped_queue_full for c in counters.values())
+        lost = sum(c.lost_disk_fault for c in counters.values())
         recorded = sum(1 for c in counters.values() if c.written)
+        fault = f', {lost} lost to the write error' if self.recorder.error is not None else ''
         self.get_logger().info(f'Recorded {total} message(s) on {recorded} topic(s) to '
-                               f'{self.recorder.writer.path}; {dropped} dropped; '
+                               f'{self.recorder.writer.path}; {dropped} dropped{fault}; '
                                f'{len(missing)} topic(s) not recorded.')
         for topic, why in missing.items():
             self.get_logger().warning(f'Not recorded: {topic}: {why}')

@@ -21,6 +21,7 @@ from mcap.writer import CompressionType
 from mcap.writer import Writer as McapWriter
 
 from .errors import BagError
+from .mcap_scan import read_mcap_contents
 from .metadata import FileStats, TopicStats, build_metadata, dump_metadata, write_metadata
 from .qos import dump_offered_qos, qos_to_dict
 from .typestore import typestore as default_typestore
@@ -89,6 +90,7 @@ class BagWriter:
         self._channel_ids: dict[str, int] = {}
         self._unflushed = 0
         self._last_flush = time.monotonic()
+        self._counts_before_file: dict[str, int] = {}
         self._opened = False
         self._closed = False
 
@@ -127,6 +129,9 @@ class BagWriter:
                                 compression=_COMPRESSION[self.compression])
         self._mcap.start(profile='ros2', library=_LIBRARY)
         self.files.append(FileStats(name))
+        # per-topic counts in the finished files: abort() adds what the current file holds
+        self._counts_before_file = {t: topic.stats.message_count
+                                    for t, topic in self.topics.items()}
         self._schema_ids = {}
         self._channel_ids = {}
         for topic in self.topics.values():
@@ -262,14 +267,19 @@ class BagWriter:
         try:
             self._io(self._finish_file)
             self._io(write_metadata, self.path, self._metadata())
-        finally:
-            self._closed = True
+        except BaseException:
+            self.abort()        # counts made true, what reached the disk kept
+            raise
+        self._closed = True
 
     def abort(self) -> None:
-        """Stop after an error: keep the flushed data, try to leave a metadata.yaml.
+        """Stop after an error: keep the flushed data, make the counts true, try to leave a
+        metadata.yaml.
 
-        The file gets no summary, so readers scan it (:mod:`.mcap_scan`); ``mindgrasp bag info``
-        rebuilds metadata.yaml if writing it here fails too (disk still full).
+        Messages handed to the MCAP writer but not on disk when the error came (a chunk cut by
+        a full disk) are not in the bag: the current file is read back, so ``files``, the topic
+        counts and metadata.yaml say what is recoverable. The file gets no summary, so readers
+        scan it (:mod:`.mcap_scan`); ``mindgrasp bag reindex`` finishes it once there is space.
         """
         if self._closed:
             return
@@ -278,8 +288,30 @@ class BagWriter:
             with suppress(OSError, ValueError):
                 self._stream.close()
         self._mcap = self._stream = None
+        if self.files:
+            self._recount(self.path / self.files[-1].path)
         with suppress(OSError):
             write_metadata(self.path, self._metadata())
+
+    def _recount(self, path: Path) -> None:
+        """Set the current file's and the topics' counts to what ``path`` really holds."""
+        try:
+            contents = read_mcap_contents(path)
+        except BagError:        # not even the header reached the disk
+            contents = None
+        current = self.files[-1]
+        by_topic: dict[str, int] = {}
+        if contents is not None:
+            current.message_count = contents.message_count
+            current.start_ns, current.end_ns = contents.start_ns, contents.end_ns
+            for cid, channel in contents.channels.items():
+                by_topic[channel.topic] = (by_topic.get(channel.topic, 0)
+                                           + contents.channel_counts.get(cid, 0))
+        else:
+            current.message_count = current.start_ns = current.end_ns = 0
+        for name, topic in self.topics.items():
+            topic.stats.message_count = self._counts_before_file.get(name, 0) + \
+                by_topic.get(name, 0)
 
     @property
     def is_open(self) -> bool:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
+from mindgrasp_bringup.bag.damage import ALLOW_DAMAGED_HELP
 from mindgrasp_bringup.bag.ros_glue import param_args
 from mindgrasp_common.cli_checks import non_negative_float, positive_float
 
@@ -35,6 +36,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              'match before the first message (default: 0.5)')
     parser.add_argument('--no-progress', action='store_true',
                         help='no progress bar (the summary line is printed at the end)')
+    parser.add_argument('--allow-damaged', action='store_true', help=ALLOW_DAMAGED_HELP)
 
 
 def main(args: argparse.Namespace) -> int:
@@ -58,5 +60,6 @@ def main(args: argparse.Namespace) -> int:
         'regex': args.regex, 'exclude_regex': args.exclude_regex,
         'remap': list(args.remap) or [''], 'clock': args.clock > 0,
         'clock_frequency': float(args.clock or 40.0), 'delay': float(args.delay),
-        'priority': int(args.priority), 'progress': not args.no_progress}
+        'priority': int(args.priority), 'progress': not args.no_progress,
+        'allow_damaged': bool(args.allow_damaged)}
     return player_node.main(['mindgrasp-bag-play', *param_args(params)])

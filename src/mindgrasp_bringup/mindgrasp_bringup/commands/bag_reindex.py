@@ -19,13 +19,17 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
-    """Reindex; 1 when the path is not an MCAP bag."""
+    """Reindex; 2 when the path does not exist, 1 when it is not an MCAP bag."""
     from mindgrasp_bringup.bag import BagError
     from mindgrasp_bringup.bag.integrity import reindex, verify_bag
     from mindgrasp_bringup.bag.paths import resolve_bag
 
     try:
         bag = resolve_bag(args.bag)
+    except BagError as exc:     # a missing path is a usage error, as in `ros2 bag` (exit 2)
+        print(f'mindgrasp bag reindex: {exc}', file=sys.stderr)
+        return 2
+    try:
         done = reindex(bag)
         left = verify_bag(bag)
     except (BagError, OSError) as exc:

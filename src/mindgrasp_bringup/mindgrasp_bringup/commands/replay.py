@@ -18,6 +18,7 @@ import sys
 
 import yaml
 
+from mindgrasp_bringup.bag.damage import ALLOW_DAMAGED_HELP
 from mindgrasp_common.cli_checks import probability
 
 
@@ -40,6 +41,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--json', action='store_true',
                         help='print the comparison as one JSON object on the last line')
     parser.add_argument('--no-progress', action='store_true', help='no progress bar')
+    parser.add_argument('--allow-damaged', action='store_true', help=ALLOW_DAMAGED_HELP)
 
 
 def parse_params(items: list[str]) -> dict[str, dict[str, object]]:
@@ -62,7 +64,7 @@ def parse_params(items: list[str]) -> dict[str, dict[str, object]]:
 def main(args: argparse.Namespace) -> int:
     """Replay, write the report, print the summary line; 2 on bad arguments."""
     from mindgrasp_bringup.bag import BagError
-    from mindgrasp_bringup.replay import ReplayConfig, run_replay, summary_line
+    from mindgrasp_bringup.replay import ReplayConfig, damage_lines, run_replay, summary_line
 
     try:
         if not 0.0 <= args.min_agreement <= 1.0:
@@ -79,12 +81,20 @@ def main(args: argparse.Namespace) -> int:
     except BagError as exc:
         print(f'mindgrasp replay: {exc}', file=sys.stderr)
         return 2
+    except OSError as exc:      # the report cannot be written (full disk, read-only run)
+        print(f'mindgrasp replay: cannot write the report to {exc.filename or cfg.output} '
+              f'({exc.strerror or exc}); pass -o DIR on a disk with space.', file=sys.stderr)
+        return 1
     print(summary_line(result), flush=True)
     if args.json:
         print(json.dumps(result.summary), flush=True)
+    lines = damage_lines(result, args.allow_damaged)
+    for line in lines:
+        print(f'mindgrasp replay: {line}', file=sys.stderr)
+    code = 1 if lines and not args.allow_damaged else 0
     agreement = result.summary['prediction_agreement'] or 0.0
     if agreement < args.min_agreement:
         print(f'mindgrasp replay: prediction agreement {agreement:.3f} is below '
               f'--min-agreement {args.min_agreement:.3f}.', file=sys.stderr)
-        return 1
-    return 0
+        code = 1
+    return code

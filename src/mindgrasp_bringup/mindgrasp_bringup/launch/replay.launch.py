@@ -35,11 +35,17 @@ def generate_launch_description() -> LaunchDescription:
                                   'classifier); empty: the one the run used'),
         DeclareLaunchArgument('output', default_value='',
                               description='report directory; empty: <run>/replays/<time>'),
+        DeclareLaunchArgument('allow_damaged', default_value='false',
+                              choices=['true', 'false'],
+                              description='accept a damaged bag (its readable part is '
+                                          'replayed either way; without this the replay ends '
+                                          'with exit code 1)'),
         *run_directory_actions(),  # ros2 launch: run directory, recorder, duration
         Node(package='mindgrasp_bringup', executable='replay_node', name='replay',
              parameters=[{'bag': LaunchConfiguration('bag'),
                           'controller': LaunchConfiguration('controller'),
                           'model': LaunchConfiguration('model'),
-                          'output': LaunchConfiguration('output')}],
+                          'output': LaunchConfiguration('output'),
+                          'allow_damaged': LaunchConfiguration('allow_damaged')}],
              on_exit=Shutdown(reason='the replay ended')),
     ])

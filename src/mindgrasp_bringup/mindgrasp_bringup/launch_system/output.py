@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import os
 import sys
@@ -67,6 +68,28 @@ class LaunchLogFormatter(logging.Formatter):
         return text
 
 
+class _LaunchFileHandler(logging.FileHandler):
+    """``logs/launch.log``: a full disk stops the file with one line on stderr, not a traceback
+    per message (the console keeps every message)."""
+
+    def handleError(self, record: logging.LogRecord) -> None:  # noqa: N802 (logging's name)
+        exc = sys.exc_info()[1]
+        if not isinstance(exc, OSError):
+            super().handleError(record)
+            return
+        logging.getLogger('launch').removeHandler(self)
+        with contextlib.suppress(OSError, ValueError):
+            self.close()
+        with contextlib.suppress(OSError, ValueError):
+            sys.stderr.write(f'[ERROR] [launch]: cannot write {self.baseFilename} '
+                             f'({exc.strerror or exc}); launcher messages go to the console '
+                             'only from here.\n')
+
+    def close(self) -> None:
+        with contextlib.suppress(OSError, ValueError):   # flush of a full disk at the end
+            super().close()
+
+
 def configure_launch_logger(log_file: Path | None) -> list[logging.Handler]:
     """Send the launcher's own messages to stderr and ``log_file``; returns the handlers added."""
     logger = logging.getLogger('launch')
@@ -78,7 +101,7 @@ def configure_launch_logger(log_file: Path | None) -> list[logging.Handler]:
     handlers.append(console)
     if log_file is not None:
         log_file.parent.mkdir(parents=True, exist_ok=True)
-        file_handler = logging.FileHandler(log_file, encoding='utf-8')
+        file_handler = _LaunchFileHandler(log_file, encoding='utf-8')
         file_handler.setFormatter(logging.Formatter('%(asctime)s [%(levelname)s] %(message)s'))
         handlers.append(file_handler)
     for handler in handlers:

@@ -10,6 +10,7 @@ through the functions here, so ``record_topics:=...`` or ``duration:=30`` mean t
 from __future__ import annotations
 
 import datetime as dt
+import logging
 import math
 from collections.abc import Mapping, Sequence
 from pathlib import Path
@@ -19,6 +20,7 @@ from mindgrasp_bringup.launch_system import rundir
 from mindgrasp_bringup.launch_system.actions.declare_launch_argument import DeclareLaunchArgument
 from mindgrasp_bringup.launch_system.conditions import evaluate_bool
 from mindgrasp_bringup.launch_system.errors import LaunchError
+from mindgrasp_common.safe_files import DeferredWriter
 
 RECORDER_PACKAGE = 'mindgrasp_bringup'
 RECORDER_EXECUTABLE = 'recorder_node'
@@ -113,6 +115,8 @@ class RunFiles:
     def __init__(self, path: Path) -> None:
         self.path = path
         self.summary: dict[str, Any] = {'ended_utc': None, 'stop_reason': None, 'processes': []}
+        # a full disk costs only this file: kept, copied to a fallback folder the log names
+        self.files = DeferredWriter(path)
 
     def write_start(self, *, profile: str, launch_file: str | None, launcher: str,
                     command_line: Sequence[str], arguments: Mapping[str, str], record: bool,
@@ -139,5 +143,7 @@ class RunFiles:
 
     def _write_summary(self) -> None:
         self.summary['ended_utc'] = _now()
-        rundir.write_yaml(self.path / 'summary.yaml', self.summary,
-                          header='rewritten as each process ends')
+        summary = dict(self.summary)
+        for line in self.files.write(self.path, 'run summary', lambda folder: rundir.write_yaml(
+                folder / 'summary.yaml', summary, header='rewritten as each process ends')):
+            logging.getLogger('launch').error(line)

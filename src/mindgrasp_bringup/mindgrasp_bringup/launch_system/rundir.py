@@ -30,6 +30,7 @@ import yaml
 
 from mindgrasp_bringup.launch_system.errors import LaunchError
 from mindgrasp_common.resources import resource_path
+from mindgrasp_common.safe_files import write_atomic
 
 DIST_NAME = 'mindgrasp-ros'
 _ENV_KEYS = ('ROS_DOMAIN_ID', 'ROS_AUTOMATIC_DISCOVERY_RANGE', 'ROS_STATIC_PEERS',
@@ -141,10 +142,17 @@ def provenance() -> dict[str, Any]:
 
 
 def write_yaml(path: Path, data: Mapping[str, Any] | str, header: str = '') -> None:
-    """Write YAML (a mapping or ready text) with an optional ``#`` comment header."""
+    """Write YAML (a mapping or ready text) with an optional ``#`` comment header.
+
+    Atomic (temporary file + rename): a full disk leaves the previous version, never a
+    truncated file.
+
+    Raises:
+        OSError: the file could not be written.
+    """
     text = data if isinstance(data, str) else yaml.safe_dump(dict(data), sort_keys=False,
                                                              width=100)
     if header:
         text = ''.join(f'# {line}\n' for line in header.splitlines()) + text
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(text, encoding='utf-8')
+    write_atomic(path, lambda tmp: tmp.write_text(text, encoding='utf-8'))

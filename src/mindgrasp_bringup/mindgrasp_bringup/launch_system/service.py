@@ -46,6 +46,7 @@ from mindgrasp_bringup.launch_system.run_extras import (
     recorder_parameters,
 )
 from mindgrasp_bringup.launch_system.supervisor import ProcessResult, Supervisor
+from mindgrasp_common.safe_files import DeferredWriter
 
 logger = logging.getLogger('launch')
 
@@ -278,8 +279,13 @@ class LaunchService:
         handlers = configure_launch_logger(run_dir / 'logs' / 'launch.log')
         try:
             processes = plan.processes
-            commands = self.commands(plan, run_dir)
-            self._write_run_dir(plan, commands, run_dir)
+            try:
+                commands = self.commands(plan, run_dir)
+                self._write_run_dir(plan, commands, run_dir)
+            except OSError as exc:   # before anything starts: a run that cannot be redone
+                msg = (f'cannot write the run directory {run_dir} ({exc.strerror or exc}): free '
+                       'space on its disk or give --run-dir on another one.')
+                raise LaunchError(msg) from None
             logger.info("run directory: %s", run_dir)
             if self.composed:
                 from mindgrasp_bringup.launch_system.composed import compose
@@ -312,7 +318,7 @@ class LaunchService:
             remove_handlers(handlers)
 
     def _write_summary(self, run_dir: Path, code: int) -> None:
-        rundir.write_yaml(run_dir / 'summary.yaml', {
+        summary = {
             'ended_utc': dt.datetime.now(dt.timezone.utc).isoformat(timespec='seconds'),
             'exit_code': code,
             'clean': code == 0,
@@ -322,4 +328,10 @@ class LaunchService:
                            'clean': r.clean and not r.restarts, 'how': r.how,
                            'restarts': r.restarts, 'pid': r.pid}
                           for r in self.results],
-        })
+        }
+        # a full disk costs only this file: a copy goes to a fallback folder the log names
+        files = DeferredWriter(run_dir)
+        lines = files.write(run_dir, 'run summary',
+                            lambda folder: rundir.write_yaml(folder / 'summary.yaml', summary))
+        for line in lines:
+            logger.error(line)

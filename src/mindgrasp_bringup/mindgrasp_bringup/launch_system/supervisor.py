@@ -210,7 +210,8 @@ class Supervisor:
                         proc.log_file.write(text + '\n')
                         proc.log_file.flush()
                     except OSError as exc:  # disk full: keep draining the pipe, say it once
-                        proc.log_file.close()
+                        with contextlib.suppress(OSError):  # its buffer cannot be flushed
+                            proc.log_file.close()
                         logger.error("cannot write the log of '%s' any more (%s); its output "
                                      "still goes to the terminal. Free disk space.",
                                      proc.label, exc)

@@ -10,7 +10,8 @@ from mindgrasp_ros.topics import BCI_PREDICTION, FSM_STATE
 from .engine import ReplayConfig, ReplayResult, replay
 from .report import compare, write_report
 
-__all__ = ['ReplayConfig', 'ReplayResult', 'compare', 'replay', 'run_replay', 'write_report']
+__all__ = ['ReplayConfig', 'ReplayResult', 'compare', 'damage_lines', 'replay', 'run_replay',
+           'write_report']
 
 
 def run_replay(cfg: ReplayConfig) -> ReplayResult:
@@ -33,3 +34,14 @@ def summary_line(result: ReplayResult) -> str:
         parts.append(f'controller states {100 * (state["agreement"] or 0):.1f} % (open loop)')
     return f'Replayed {", ".join(result.nodes)}: ' + '; '.join(parts) + \
         f'; report: {result.report_path}'
+
+
+def damage_lines(result: ReplayResult, allow_damaged: bool) -> list[str]:
+    """What a damaged bag cost the replay, one line per problem then the counts ([] when the
+    bag is sound). Without ``allow_damaged`` the caller exits 1 (the bag tools' policy)."""
+    damage = result.damage
+    if not damage.get('damaged'):
+        return []
+    end = '.' if allow_damaged else '; pass --allow-damaged (allow_damaged:=true) to accept it.'
+    return [*(f'damaged bag: {p}' for p in damage['problems']),
+            f'damaged bag: {damage["summary"]} The agreement covers the readable part only{end}']

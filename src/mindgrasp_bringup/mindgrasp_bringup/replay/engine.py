@@ -28,6 +28,7 @@ from typing import Any
 
 import yaml
 
+from mindgrasp_bringup.bag.damage import assess_bag
 from mindgrasp_bringup.bag.errors import BagError
 from mindgrasp_bringup.bag.paths import resolve_bag, run_dir_of
 from mindgrasp_bringup.bag.qos import adapted_qos
@@ -93,6 +94,7 @@ class ReplayResult:
     start_ns: int
     end_ns: int
     notes: list[str] = field(default_factory=list)
+    damage: dict[str, Any] = field(default_factory=dict)   # :meth:`BagDamage.as_dict`
     report_path: Path | None = None
     summary: dict[str, Any] = field(default_factory=dict)
 
@@ -148,6 +150,8 @@ def replay(cfg: ReplayConfig) -> ReplayResult:
     base = run_dir if run_dir is not None else bag.resolve().parent
     output = Path(cfg.output) if cfg.output else base / 'replays' / stamp
     reader = BagReader(bag).open()
+    # one damage policy for every bag tool: replay what can be read, say and count what cannot
+    damage = assess_bag(bag)
     try:
         if EEG_TOPIC not in reader.topics or not reader.topics[EEG_TOPIC].message_count:
             msg = (f'The bag {bag} has no {EEG_TOPIC} messages, so the classifier has nothing to '
@@ -217,13 +221,15 @@ def replay(cfg: ReplayConfig) -> ReplayResult:
             starts = _segment_starts(statuses, store)
             result = ReplayResult(bag, run_dir, output, keys, recorded, replayed,
                                   dict.fromkeys(feed, 0), 0, None, None, reader.start_ns,
-                                  reader.end_ns)
+                                  reader.end_ns, damage=damage.as_dict())
+            result.notes += [f'Damaged bag: {line}' for line in damage.lines()]
             max_step = cfg.max_step_s or (0.01 if cfg.controller else 0.1)
             _feed(runner, inputs, pubs, store, starts, result, max_step, cfg.progress)
         finally:
             runner.close()
     finally:
         reader.close()
+    result.notes += [n for n in reader.notes if n not in result.notes]
     if not starts:
         result.notes.append('The recording has no classifier filter start (/bci/status '
                             'segment_start_sample, recorded by newer classifiers); the replayed '

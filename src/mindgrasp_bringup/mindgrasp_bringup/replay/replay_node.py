@@ -6,7 +6,8 @@
 Parameters: :class:`ReplayParams`. The re-run nodes run lock-step on the bag's clock in this
 process (see :mod:`mindgrasp_bringup.replay.engine`); the node ends when the report is written
 (exit 0) and logs the summary line. A missing bag or one the replay cannot use ends it with exit
-code 2 and one line; Ctrl-C stops it (0).
+code 2 and one line; a damaged bag is replayed as far as it is readable and ends it with exit
+code 1 unless ``allow_damaged:=true``; Ctrl-C stops it (0).
 """
 
 from __future__ import annotations
@@ -15,9 +16,9 @@ from dataclasses import dataclass
 
 from mindgrasp_bringup.bag.errors import BagError
 from mindgrasp_bringup.bag.paths import resolve_bag
-from mindgrasp_bringup.replay import ReplayConfig, run_replay, summary_line
+from mindgrasp_bringup.replay import ReplayConfig, damage_lines, run_replay, summary_line
 from mindgrasp_ros import rclpy
-from mindgrasp_ros.node_main import EXIT_OK, EXIT_REFUSED, run_node
+from mindgrasp_ros.node_main import EXIT_OK, EXIT_REFUSED, fail, run_node
 from mindgrasp_ros.params import ParameterError, declare_params, param
 
 
@@ -30,6 +31,8 @@ class ReplayParams:
     model: str = param('', "classifier model (.json); '': the one the run used")
     output: str = param('', "report directory; '': <run>/replays/<time>")
     progress: bool = param(True, 'show a progress bar on stderr')
+    allow_damaged: bool = param(False, 'end with exit code 0 after replaying the readable part '
+                                'of a damaged bag (default: 1)')
 
 
 class ReplayNode(rclpy.node.Node):
@@ -57,6 +60,12 @@ class ReplayNode(rclpy.node.Node):
             self.done.set_result(EXIT_REFUSED)
             return
         self.get_logger().info(summary_line(result))
+        lines = damage_lines(result, p.allow_damaged)
+        for line in lines:
+            self.get_logger().warning(line)
+        if lines and not p.allow_damaged:
+            fail(self, 'The bag is damaged (see above); the report covers its readable part.')
+            return
         self.done.set_result(EXIT_OK)
 
 

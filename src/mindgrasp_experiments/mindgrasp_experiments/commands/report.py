@@ -28,6 +28,11 @@ def main(args: argparse.Namespace) -> int:
     except FileNotFoundError as exc:
         print(f'mindgrasp experiment report: {exc}', file=sys.stderr)
         return 2
+    except OSError as exc:      # a full or read-only disk: the records are untouched
+        print(f'mindgrasp experiment report: cannot write the report into {run_dir} '
+              f'({exc.strerror or exc}); the records are unchanged. Free space, or copy the '
+              'run directory to a writable disk and run the command there.', file=sys.stderr)
+        return 1
     s = doc['summary']
     cut = f" (and {s['interrupted_trials']} interrupted)" if s['interrupted_trials'] else ''
     print(f"{s['trials']} trials{cut}: report {run_dir / 'report.md'}")

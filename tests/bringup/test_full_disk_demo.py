@@ -1,0 +1,70 @@
+"""A full disk costs only what cannot be written (issue 31, item 1), end to end: the demo runs
+with its run directory on a 3 MB tmpfs (real processes, DDS, LSL, PyBullet, MCAP). The recorder
+stops when the disk fills; the trial still ends and its record goes to the fallback folder the
+log names; no file is left truncated; the recorder's count is what the bag holds; ``bag info``
+reads the bag on the full disk without writing; no traceback anywhere."""
+
+from __future__ import annotations
+
+import re
+import subprocess
+import sys
+import uuid
+
+import pytest
+import yaml
+from launch_fixtures.runner import launch_env, run_launch
+
+from mindgrasp_bringup.bag import BagReader
+from mindgrasp_common.safe_files import fallback_folder
+from mindgrasp_experiments.records import read_records
+from mindgrasp_testing import small_tmpfs
+
+pytestmark = pytest.mark.slow
+
+
+@pytest.fixture
+def small_disk(tmp_path):
+    with small_tmpfs(tmp_path / 'small', '3M') as mount:
+        yield mount
+
+
+@pytest.mark.timeout(1200)
+def test_demo_on_a_full_disk_keeps_every_record_and_tells_the_truth(small_disk, tmp_path):
+    run_dir, state = small_disk / 'run', tmp_path / 'state'
+    params = tmp_path / 'test_params.yaml'      # a deadline for the trial on a loaded machine
+    params.write_text(yaml.safe_dump({'trial_manager': {'ros__parameters': {
+        'trial_timeout': 300.0}}}), encoding='utf-8')
+    result = run_launch('demo', 'duration:=500', 'trials:=1', 'targets:=red cube',
+                        'live_view_port:=0', f'eeg_stream:=mg-full-{uuid.uuid4().hex[:8]}',
+                        '--sigint-timeout', '20', '--run-dir', str(run_dir), timeout=900,
+                        MINDGRASP_PARAMS_FILES=str(params), XDG_STATE_HOME=str(state))
+    out = result.stdout + result.stderr
+    assert 'Traceback' not in out, out[-6000:]
+    assert result.returncode == 1, out[-4000:]     # the recording failed: said, not hidden
+    # the trial's record: in the fallback folder the log names, complete
+    copy = fallback_folder(run_dir, state / 'mindgrasp' / 'unwritten')
+    line = next(x for x in out.splitlines() if 'Cannot write the trial records' in x)
+    assert str(copy / 'trials') in line and 'No space left on device' in line
+    (record,) = read_records(copy / 'trials')
+    assert record.desired == 'red cube'
+    # nothing truncated: every file of the run directory is either absent or whole
+    for name in ('summary.yaml', 'trials/records.csv', 'trials/records.parquet'):
+        path = run_dir / name
+        assert not path.exists() or path.stat().st_size > 0, name
+    summary = run_dir / 'summary.yaml' if (run_dir / 'summary.yaml').exists() \
+        else copy / 'summary.yaml'
+    assert yaml.safe_load(summary.read_text())['exit_code'] == 1
+    # the recorder's count is what can be recovered
+    kept = re.search(r'(\d+) message\(s\) are on disk and recoverable', out)
+    assert kept, out[-4000:]
+    with BagReader(run_dir / 'bag') as reader:
+        assert sum(1 for _ in reader.messages()) == int(kept.group(1)) > 0
+    # bag info on the full disk: reads, reports the cut file, writes nothing
+    before = sorted(p.name for p in (run_dir / 'bag').iterdir())
+    info = subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', 'bag', 'info', str(run_dir)],
+                          capture_output=True, text=True, env=launch_env(), timeout=300)
+    assert info.returncode == 1 and 'cut off' in info.stdout, info.stdout + info.stderr
+    assert f'Readable:          {kept.group(1)} message(s) readable' in info.stdout
+    assert 'Traceback' not in info.stderr
+    assert sorted(p.name for p in (run_dir / 'bag').iterdir()) == before
