@@ -12,15 +12,16 @@ Prints figures, asserts nothing. The same trials give the same figures (lock-ste
 from __future__ import annotations
 
 import argparse
+import itertools
 import sys
 import tempfile
 from pathlib import Path
 
 import numpy as np
-
-from mindgrasp_ros import rclpy
 from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import FsmState
 from mindgrasp_ros.interfaces.std_msgs.msg import Float64MultiArray
+
+from mindgrasp_ros import rclpy
 from mindgrasp_ros.topics import ARM_COMMANDS, FSM_STATE
 
 #: (time s, joint velocities (6,) rad/s, controller state 1..6) of every command heard
@@ -49,7 +50,7 @@ def accelerations(heard: list[tuple[float, np.ndarray, int]]) -> dict[str, float
     """Largest speed-up and braking (rad/s^2) between consecutive commands, overall and in
     state 6; a reversal counts as braking to zero and speeding up from it."""
     out = {'speed_up': 0.0, 'braking': 0.0, 'speed_up_return': 0.0, 'braking_return': 0.0}
-    for (t0, v0, _s0), (t1, v1, s1) in zip(heard, heard[1:], strict=False):
+    for (t0, v0, _s0), (t1, v1, s1) in itertools.pairwise(heard):
         dt = t1 - t0
         if dt <= 0:
             continue
