@@ -99,6 +99,25 @@ def test_a_dying_node_is_reported_and_stops_the_launch(tmp_path: Path) -> None:
                                                                      'crasher': False}
 
 
+def test_an_arm_driver_that_exits_0_at_once_stops_the_hardware_launch(tmp_path: Path) -> None:
+    """Issue 31, item 9: a driver that ended with exit code 0 left the launch running without
+    an arm and ending with exit 0. A driver is a required node: its end stops every process,
+    says so in one line, and the launch fails."""
+    result = run_launch('hardware', 'eeg_stream:=nobody', 'arm_driver:=true', 'record:=false',
+                        'model:=package://mindgrasp_classifier/models/default_classifier.json',
+                        '--run-dir', str(tmp_path / 'run'), timeout=120.0)
+    assert result.returncode == 1, result.stderr
+    err = result.stderr
+    assert re.search(r"required process 'arm_driver' \(pid \d+\) ended \(exit code 0\) while "
+                     r'the launch was running; stopping every process\.', err), err
+    assert "stopping the launch: required process 'arm_driver' ended" in err
+    summary = read_yaml(tmp_path / 'run' / 'summary.yaml')
+    assert summary['exit_code'] == 1
+    ended = {p['label']: p for p in summary['processes']}
+    assert not ended['arm_driver']['clean']
+    assert all(p['returncode'] is not None for p in summary['processes'])   # none left running
+
+
 def test_respawn_restarts_a_dead_node(tmp_path: Path) -> None:
     marker = tmp_path / 'crashed-once'
     result = run_launch(fixture('respawn.launch.py'), 'record:=false', f'marker:={marker}',

@@ -43,32 +43,43 @@ def test_hardware_has_drivers_and_no_simulator(tmp_path, monkeypatch) -> None:
     (tmp_path / 'models').mkdir()
     (tmp_path / 'models' / 'alice.json').write_text('{}')
     procs = processes('hardware', 'eeg_stream:=gNautilus', 'arm_driver:=true',
-                      'arm_driver_args:=--ip "10.0.0.2" --rate 100')
+                      'arm_driver_args:=--ip "10.0.0.2" --rate 100', 'model:=models/alice.json')
     assert 'sim' not in procs and 'virtual_amp' not in procs and 'camera_driver' not in procs
     driver = procs['arm_driver']
     assert driver.program[0].endswith('/true') and driver.node_name == 'arm_driver'
     assert driver.arguments == ['--ip', '10.0.0.2', '--rate', '100']
+    assert driver.required and driver.shutdown_on_exit     # its end stops the launch
     assert procs['eeg_acquisition'].parameters['stream_name'] == 'gNautilus'
-    from mindgrasp_bringup.launch_system import config_files
-    from mindgrasp_bringup.launch_system.params import load_parameter_file
-
-    file_model = {}
-    for f in config_files('classifier'):
-        file_model.update(load_parameter_file(f).get('classifier', {}))
-    assert procs['classifier'].parameters.get('model') == file_model.get('model')
+    assert procs['classifier'].parameters['model'] == 'models/alice.json'
     procs = processes('hardware', 'eeg_stream:=a', 'arm_driver:=true', 'camera_driver:=true',
                       'model:=models/alice.json')
-    assert 'camera_driver' in procs
-    assert procs['classifier'].parameters['model'] == 'models/alice.json'
+    assert 'camera_driver' in procs and procs['camera_driver'].required
     # package/executable: our module, else `ros2 run package executable`
-    procs = processes('hardware', 'eeg_stream:=a', 'arm_driver:=mindgrasp_sim/sim_node')
+    procs = processes('hardware', 'eeg_stream:=a', 'arm_driver:=mindgrasp_sim/sim_node',
+                      'model:=models/alice.json')
     assert procs['arm_driver'].module == 'mindgrasp_sim.sim_node'
     with pytest.raises(LaunchError, match=r"needs these arguments, which were not given: "
                                           r"eeg_stream:=<value>.*; arm_driver:=<value>"):
         LaunchService('hardware').plan()
     with pytest.raises(LaunchError, match="'no-such-arm-driver' was found neither on PATH"):
         LaunchService('hardware', ['eeg_stream:=a', 'arm_driver:=no-such-arm-driver',
-                                   'record:=false']).plan()
+                                   'model:=models/alice.json', 'record:=false']).plan()
+
+
+def test_hardware_never_decodes_a_person_with_the_simulated_head_silently(tmp_path,
+                                                                         monkeypatch) -> None:
+    """Issue 31, item 9: without model:= the hardware profile used the classifier trained on
+    the simulated head, without a word. Now it refuses in one line naming both fixes; a bench
+    test names that model on purpose."""
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(LaunchError, match=r"launch argument 'model' is required and was not "
+                                          r"given: add model:=<value> \(the person's classifier "
+                                          r'.*model:=package://mindgrasp_classifier/models/'
+                                          r'default_classifier\.json\)'):
+        LaunchService('hardware', ['eeg_stream:=a', 'arm_driver:=true']).plan()
+    bench = 'package://mindgrasp_classifier/models/default_classifier.json'
+    procs = processes('hardware', 'eeg_stream:=a', 'arm_driver:=true', f'model:={bench}')
+    assert procs['classifier'].parameters['model'] == bench
 
 
 def test_replay_runs_the_lockstep_replay_process_with_its_arguments(tmp_path, monkeypatch) -> None:

@@ -100,8 +100,10 @@ def project(fsm: GraspFsm, q: np.ndarray, obj: PointObject, t: float) -> VisionF
 
 @pytest.fixture
 def params() -> FsmParams:
-    """Default parameters with a short lock (faster tests)."""
-    return FsmParams(lock_duration=0.5, paradigm='paper')
+    """Default parameters with a short lock (faster tests) and no practical acceleration
+    limit, so that each tick's command shows the gains alone (the limiter is tested with the
+    defaults in test_grasp_fsm.py)."""
+    return FsmParams(lock_duration=0.5, paradigm='paper', max_joint_acceleration=[1e6] * 6)
 
 
 @pytest.fixture

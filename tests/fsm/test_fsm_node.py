@@ -184,3 +184,88 @@ def test_fsm_bad_parameter_refuses_to_start(spawn_node) -> None:
     out = proc.output()
     assert "'recenter_threshold' (0.01) must exceed 'center_tolerance'" in out, out
     assert 'Traceback' not in out
+
+
+def test_nan_joint_states_from_a_second_publisher_latch_a_stop(rclpy_ctx, spawn_node) -> None:
+    """Issue 31, item 6: beside the arm driver's clean joint states (50 Hz) a second publisher
+    sends NaN ones at 20 Hz. The controller used to alternate stop and move (20 times in 3.2 s);
+    now the first NaN latches a stop (one warning line) that holds while the NaN publisher runs,
+    is released (one line) once the joint states were clean for sensor_clean_time, and the arm
+    moves again only after a fresh decision."""
+    rclpy = rclpy_ctx
+    from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import DetectionArray, MIPrediction
+    from mindgrasp_ros.interfaces.sensor_msgs.msg import JointState
+    from mindgrasp_ros.interfaces.std_msgs.msg import Float64MultiArray
+
+    proc = spawn_node('mindgrasp_fsm.fsm_node', '--ros-args', '-p', 'duration:=300.0',
+                      '-p', 'search_gain:=0.4', '-p', 'paradigm:=paper')
+    assert proc.wait_for_output('Grasp controller ready', 60.0), proc.output()
+    node = rclpy.node.Node('fsm_fault_driver')
+    faulty = rclpy.node.Node('nan_joint_states')     # the second publisher, its own node
+    commands: list[np.ndarray] = []
+    node.create_subscription(Float64MultiArray, '/arm_controller/commands',
+                             lambda m: commands.append(np.array(m.data)), 100)
+    js_pub = node.create_publisher(JointState, '/joint_states', 10)
+    nan_pub = faulty.create_publisher(JointState, '/joint_states', 10)
+    det_pub = node.create_publisher(DetectionArray, '/vision/detections', 10)
+    pred_pub = node.create_publisher(MIPrediction, '/bci/prediction', 10)
+    names = [f'joint_{i}' for i in range(1, 7)]
+
+    def publish() -> None:
+        stamp = node.get_clock().now().to_msg()
+        js = JointState(name=names, position=np.array(HOME), velocity=np.zeros(6))
+        js.header.stamp = stamp
+        js_pub.publish(js)
+        det = DetectionArray(image_width=128, image_height=128, object_of_interest=-1)
+        det.header.stamp = stamp
+        det_pub.publish(det)
+        pred = MIPrediction(class_index=MIPrediction.LEFT_HAND, certainty=1.0)
+        pred.header.stamp = stamp
+        pred_pub.publish(pred)
+
+    nan_sent = [0]
+    sending = [False]
+
+    def publish_nan() -> None:
+        if sending[0]:
+            js = JointState(name=names, position=np.full(6, np.nan), velocity=np.zeros(6))
+            js.header.stamp = faulty.get_clock().now().to_msg()
+            nan_pub.publish(js)
+            nan_sent[0] += 1
+
+    node.create_timer(0.02, publish)
+    faulty.create_timer(0.05, publish_nan)
+    executor = rclpy.executors.SingleThreadedExecutor()
+    executor.add_node(node)
+    executor.add_node(faulty)
+
+    def spin(predicate, timeout: float = 60.0) -> bool:
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline and not predicate():
+            executor.spin_once(timeout_sec=0.02)
+        return predicate()
+
+    assert spin(lambda: bool(commands) and abs(commands[-1][0] - 0.4) < 1e-9), proc.output()
+    # (a start-up hiccup of this test's publishers may have latched and released once already)
+    latches = proc.output().count('sensor fault:')
+    sending[0] = True
+    assert spin(lambda: 'sensor fault: joint states contain NaN' in proc.output()), \
+        proc.output()
+    assert spin(lambda: bool(np.all(commands[-1] == 0)))
+    n = len(commands)
+    assert spin(lambda: nan_sent[0] >= 40)            # 2 s of NaN at 20 Hz
+    assert all(np.all(c == 0) for c in commands[n:]), 'moved while the NaN publisher ran'
+    assert proc.output().count('sensor fault:') == latches + 1, proc.output()
+    # the NaN publisher stops: released after 1 s clean, then a fresh decision (1 s of left
+    # hand decoded after the release) restarts the arm
+    sending[0] = False
+    released = proc.output().count('sensor fault released')
+    assert spin(lambda: proc.output().count('sensor fault released') > released), proc.output()
+    assert all(np.all(c == 0) for c in commands[n:])
+    assert spin(lambda: abs(commands[-1][0] - 0.4) < 1e-9), proc.output()
+    assert spin(lambda: proc.output().count('fresh decision after the sensor fault: left hand')
+                > released), proc.output()
+    executor.shutdown()
+    faulty.destroy_node()
+    node.destroy_node()
+    assert proc.stop() in (0, -2, 130), proc.output()

@@ -328,10 +328,102 @@ def test_watchdog_stops_every_joint(fsm: GraspFsm, kw: dict, match: str) -> None
     assert out.stopped
     assert np.all(out.joint_velocities == 0)
     assert re.search(match, out.reason), out.reason
-    # recovers when the inputs are good again (after a prediction loss: a fresh decision first)
-    if 'prediction' in kw and kw['prediction'] == 'stale':
+    # recovers when the inputs are good again (after a prediction loss or a joint-state fault,
+    # which latches: a fresh decision first, tested below)
+    if 'joints' in kw and kw['joints'] is not None:
+        fsm.params.sensor_clean_time = 0.0
+    if kw in ({'prediction': 'stale'}, {'joints': 'stale'}, {'joints': 'nan'}):
         fsm.params.resume_after_stale = 'resume'
     assert not fsm.tick(inputs(t + 0.02, cls=MiClass.LEFT_HAND, obs=None)).stopped
+
+
+@pytest.mark.parametrize('fault', ['nan', 'inf', 'stale', 'refused'])
+def test_a_joint_state_fault_latches_a_stop_until_clean_and_a_fresh_decision(
+        fsm: GraspFsm, fault: str) -> None:
+    """A NaN publisher beside the arm driver (issue 31, item 6): clean and faulty joint states
+    alternate; the arm stays stopped until they were clean for sensor_clean_time (1 s) and then
+    until a fresh decision, as after a prediction loss. One event when the latch starts, one
+    when it is released."""
+    outs, t = run(fsm, 0.0, 0.3, cls=MiClass.LEFT_HAND, obs=None)
+    assert outs[-1].joint_velocities[0] > 0
+    outs = []
+    for k in range(80):                  # 1.6 s: every 3rd joint state is faulty
+        t += 0.02
+        inp = inputs(t, cls=MiClass.LEFT_HAND, obs=None)
+        if k % 3 == 0 and fault in ('nan', 'inf'):
+            q = HOME.copy()
+            q[1] = np.nan if fault == 'nan' else np.inf
+            inp.joints = JointStateIn(q, np.zeros(6), t)
+        elif k % 3 == 0 and fault == 'stale':
+            inp.joints = JointStateIn(HOME, np.zeros(6), t - 0.5)
+        elif fault == 'refused':       # the node refused a message (wrong names or sizes)
+            inp.joint_fault = (t - 0.02 * (k % 3), '/joint_states has 5 names')
+        outs.append(fsm.tick(inp))
+    assert all(o.stopped and not o.joint_velocities.any() for o in outs)
+    events = [e for o in outs for e in o.events]
+    assert len([e for e in events if e.startswith('sensor fault:')]) == 1, events
+    # clean from now on, the person still imagines left hand: no move for sensor_clean_time,
+    # then the release, then a fresh decision (resume_hold 1 s of predictions after it)
+    outs, t = run(fsm, t + 0.02, 3.0, cls=MiClass.LEFT_HAND, obs=None)
+    first = next(i for i, o in enumerate(outs) if not o.stopped)
+    released = next(i for i, o in enumerate(outs)
+                    if any(e.startswith('sensor fault released') for e in o.events))
+    assert 0.9 <= released * 0.02 <= 1.1, released
+    assert 'waiting for a new command' in outs[released + 1].reason
+    assert 1.9 <= first * 0.02 <= 2.2, first
+    assert any('fresh decision after the sensor fault' in e for e in outs[first].events)
+    assert outs[-1].joint_velocities[0] > 0
+
+
+def test_autonomous_mode_resumes_after_a_clean_sensor_time(params: FsmParams) -> None:
+    params.autonomous = True
+    fsm = GraspFsm.from_params(params)
+    run(fsm, 0.0, 0.2, cls=None, obs=None)
+    bad = inputs(0.22, cls=None, obs=None)
+    bad.joint_fault = (0.21, '/joint_states has 5 names')
+    assert fsm.tick(bad).stopped
+    outs, _ = run(fsm, 0.24, 1.2, cls=None, obs=None)
+    first = next(i for i, o in enumerate(outs) if not o.stopped)
+    assert 0.9 <= 0.24 + first * 0.02 - 0.21 <= 1.05
+
+
+@pytest.mark.parametrize(('state', 'outcome'), [(State.OBJECT_SEARCH, ''),
+                                                 (State.RETURN_TO_START, 'holding'),
+                                                 (State.RETURN_TO_START, 'failed')])
+def test_every_velocity_profile_respects_the_acceleration_limits(state: State,
+                                                                 outcome: str) -> None:
+    """Issue 31, item 7: no command speeds a joint up faster than max_joint_acceleration, nor
+    than return_acceleration in state 6 (the return used to jump 0.02 -> 0.5 rad/s in a tick
+    after the lift), on a kinematic arm that follows the commands."""
+    params = FsmParams(lock_duration=0.5, paradigm='paper', autonomous=True)
+    fsm = GraspFsm.from_params(params)
+    fsm._outcome = outcome
+    fsm.force_state(state)
+    q = HOME.copy()
+    q[1] += 0.6
+    q[2] -= 0.5
+    prev, t, worst = np.zeros(6), 0.0, 0.0
+    for _ in range(400):
+        out = fsm.tick(inputs(t, q=q, cls=None, obs=None,
+                              gripper=HOLDING if outcome == 'holding' else None))
+        v = out.joint_velocities
+        limit = params.return_acceleration if out.state == State.RETURN_TO_START else \
+            max(params.max_joint_acceleration)
+        speed_up = np.where(prev * v >= 0, np.abs(v) - np.abs(prev), np.abs(v))
+        worst = max(worst, float(np.max(speed_up)) / 0.02 / limit)
+        q = q + 0.02 * v
+        prev, t = v, t + 0.02
+    assert 0.5 < worst <= 1.0 + 1e-9
+
+
+def test_acceleration_limiter_brakes_at_once_and_ramps_after_a_reversal() -> None:
+    from mindgrasp_fsm.acceleration import AccelerationLimiter
+
+    lim = AccelerationLimiter(2)
+    np.testing.assert_allclose(lim.limit(np.array([1.0, -1.0]), 0.1, 2.0), [0.2, -0.2])
+    np.testing.assert_allclose(lim.limit(np.array([1.0, -0.1]), 0.1, [2.0, 2.0]), [0.4, -0.1])
+    np.testing.assert_allclose(lim.limit(np.array([-1.0, 0.0]), 0.1, 2.0), [-0.2, 0.0])
+    np.testing.assert_allclose(lim.limit(np.array([-1.0, 0.0]), 0.0, 2.0), [-0.2, 0.0])
 
 
 def test_after_a_prediction_loss_the_arm_waits_for_a_fresh_decision(fsm: GraspFsm) -> None:

@@ -13,7 +13,7 @@ from typing import Any
 
 import launch.logging
 from launch.action import Action
-from launch.actions import RegisterEventHandler, Shutdown, TimerAction
+from launch.actions import LogInfo, RegisterEventHandler, Shutdown, TimerAction
 from launch.event_handlers import OnProcessExit, OnShutdown
 from launch.launch_context import LaunchContext
 from launch.some_substitutions_type import SomeSubstitutionsType
@@ -187,4 +187,7 @@ def driver_node(context: LaunchContext, role: str) -> list[Any]:
     except ValueError as exc:
         msg = f'{role}_driver_args:={text!r} cannot be split into arguments ({exc}): check quotes.'
         raise LaunchError(msg) from None
-    return [Node(executable=executable, name=f'{role}_driver', arguments=arguments)]
+    # a required node, launch's way: its end shuts the launch down
+    return [Node(executable=executable, name=f'{role}_driver', arguments=arguments,
+                 on_exit=[LogInfo(msg=f'the {role} driver ended; stopping the launch'),
+                          Shutdown(reason=f'the {role} driver ended')])]

@@ -27,7 +27,7 @@ from mindgrasp_common.errors import CommonError
 from mindgrasp_common.mi import decoder_class_index
 from mindgrasp_fsm.conversions import gripper_from_fingers, vision_frame_from_msg
 from mindgrasp_fsm.errors import FsmError
-from mindgrasp_fsm.grasp_fsm import GraspFsm
+from mindgrasp_fsm.grasp_fsm import SENSOR_FAULT, GraspFsm
 from mindgrasp_fsm.params import FsmParams
 from mindgrasp_fsm.types import (
     STATE_NAMES,
@@ -124,24 +124,26 @@ class FsmNode(rclpy.node.Node):
         self.inputs.vision = vision_frame_from_msg(msg, self._stamp_or_now(msg.header))
 
     def joint_state_callback(self, msg: JointState) -> None:
+        """Keep a good joint state; a bad one is handed to the controller as a sensor fault
+        (it latches a stop and says why), never used as a position."""
         names = list(msg.name)
-        try:
-            idx = [names.index(n) for n in self.params.joint_names]
-        except ValueError:
-            self.get_logger().error(f'/joint_states names {names} lack one of the controller '
-                                    f'joints {self.params.joint_names}; set joint_names to '
-                                    'match the arm.', throttle_duration_sec=5.0)
-            return
         pos = np.asarray(msg.position, dtype=float)
         vel = np.asarray(msg.velocity, dtype=float)
-        if pos.size != len(names):
-            self.get_logger().error(f'/joint_states has {len(names)} names but {pos.size} '
-                                    'positions; the arm driver must send one position per '
-                                    'joint.', throttle_duration_sec=5.0)
-            return
-        v = vel[idx] if vel.size == len(names) else np.zeros(len(idx))
-        # NaN positions are passed on: the controller's watchdog stops the arm and says why
-        self.inputs.joints = JointStateIn(pos[idx], v, self._stamp_or_now(msg.header))
+        missing = [n for n in self.params.joint_names if n not in names]
+        if missing:
+            fault = (f'/joint_states names {names} lack the controller joints {missing}; set '
+                     'joint_names to match the arm')
+        elif pos.size != len(names) or vel.size not in (0, len(names)):
+            fault = (f'/joint_states has {len(names)} names but {pos.size} positions and '
+                     f'{vel.size} velocities; the arm driver must send one per joint')
+        else:
+            idx = [names.index(n) for n in self.params.joint_names]
+            v = vel[idx] if vel.size else np.zeros(len(idx))
+            if np.isfinite(pos[idx]).all() and np.isfinite(v).all():
+                self.inputs.joints = JointStateIn(pos[idx], v, self._stamp_or_now(msg.header))
+                return
+            fault = 'joint states contain NaN or infinite values; check the arm driver'
+        self.inputs.joint_fault = (self._now(), fault)
 
     def finger_callback(self, msg: JointState) -> None:
         self._fingers = np.asarray(msg.position, dtype=float)
@@ -180,7 +182,10 @@ class FsmNode(rclpy.node.Node):
         self.gripper_pub.publish(Float64MultiArray(data=np.array([out.gripper.position])))
         self._publish_state(out, now)
         for event in out.events:
-            self.get_logger().info(f'State: {event}')
+            # a sensor fault's latch and release are the lines a user must see
+            log = self.get_logger().warning if event.startswith(f'{SENSOR_FAULT}:') else \
+                self.get_logger().info
+            log(f'State: {event}')
 
     def _publish_state(self, out: FsmOutput, now: float) -> None:
         """/fsm/state on every change, else at most once per second. A stop reason carries a
@@ -191,8 +196,10 @@ class FsmNode(rclpy.node.Node):
                out.offered)
         if key == self._last_state_msg and now - self._last_state_pub < 1.0:
             return
-        if out.stopped and (self._last_state_msg is None or not self._last_state_msg[2]):
-            self.get_logger().warning(out.reason)
+        latched = any(e.startswith(f'{SENSOR_FAULT}:') for e in out.events)
+        if out.stopped and not latched and (self._last_state_msg is None or
+                                            not self._last_state_msg[2]):
+            self.get_logger().warning(out.reason)   # a latch said why in its own line
         self._last_state_msg, self._last_state_pub = key, now
         msg = FsmState(state=int(out.state), state_name=STATE_NAMES[out.state],
                        previous_state=int(out.previous_state),

@@ -26,7 +26,14 @@ BCI input is used in states 1-3 only; its velocities scale with the certainty. C
 proportional on the pixel error, joint 1 from x and joint 5 from y. A watchdog stops every joint
 when predictions (BCI mode) or joint states are older than ``watchdog_timeout``, when joint states
 hold NaN, or when no camera frames arrive; the output says why. Commands never drive a joint past
-its limits.
+its limits, and no joint speeds up faster than ``max_joint_acceleration`` (``return_acceleration``
+in state 6); slowing down is never limited, so stops and locks act at once.
+
+A sensor fault (joint states stale, with NaN/inf, or refused by the node for wrong names or
+sizes, ``FsmInputs.joint_fault``) latches the stop: the arm holds until the joint states have been
+clean for ``sensor_clean_time`` and then, as after a prediction loss, until a fresh decision. The
+output's events say when the latch starts and when it is released (both start with
+:data:`SENSOR_FAULT`).
 
 Two BCI paradigms (``paradigm``). ``paper``: the person steers with four classes as in the
 paper (left/right hand turn, both hands select and approach, both feet back off). ``scan``
@@ -57,6 +64,7 @@ import math
 import numpy as np
 
 from mindgrasp_common.mi import REST
+from mindgrasp_fsm.acceleration import AccelerationLimiter
 from mindgrasp_fsm.errors import FsmError
 from mindgrasp_fsm.evidence import Evidence
 from mindgrasp_fsm.grasp_policy import GraspPolicy, PolicyStep, fingers_loaded
@@ -72,6 +80,8 @@ from mindgrasp_fsm.types import (
     VisionFrame,
 )
 
+#: how the events of a sensor-fault latch begin (the node logs them as warnings)
+SENSOR_FAULT = 'sensor fault'
 _CLASS_WORDS = {0: 'left hand', 1: 'right hand', 2: 'both hands', 3: 'both feet', REST: 'rest'}
 
 
@@ -89,6 +99,13 @@ def clamp_to_limits(q: np.ndarray, v: np.ndarray, params: FsmParams) -> np.ndarr
     up_room = np.maximum(hi - q, 0.0) / dt
     down_room = np.maximum(q - lo, 0.0) / dt
     return np.minimum(np.maximum(v, -down_room), up_room)
+
+
+def _cap(v: np.ndarray, vmax: np.ndarray | float) -> np.ndarray:
+    """Joint velocities (6,) scaled down as one vector so that none exceeds ``vmax`` (rad/s):
+    the direction of motion in joint space is kept."""
+    scale = float(np.max(np.abs(v) / vmax))
+    return v / scale if scale > 1.0 else v
 
 
 class GraspFsm:
@@ -155,6 +172,12 @@ class GraspFsm:
         self._stale_pred = False
         self._back_at: float | None = None
         self._fresh: tuple[int, float] | None = None
+        self._loss = 'prediction loss'
+        # sensor-fault latch: time (s) of the latest joint-state fault seen (None: not latched)
+        self._fault_at: float | None = None
+        self._fault_why = ''
+        self._dt = 0.0
+        self._limiter = AccelerationLimiter()
         self._return_lift: bool | None = None
         # scan paradigm: when the current offer began (None: no offer), whether the person
         # committed to the object of interest, and the evidence of each decision
@@ -236,8 +259,13 @@ class GraspFsm:
         events, self._events = self._events, []
         if reason is None and self._pending is not None:
             reason = f'locked: {self._pending[1]}'
+        p = self.params
+        accel = np.asarray(p.max_joint_acceleration, dtype=float)
+        if self.state == State.RETURN_TO_START:
+            accel = np.minimum(accel, p.return_acceleration)
+        v = self._limiter.limit(v, self._dt, accel)
         return FsmOutput(
-            joint_velocities=np.asarray(v, dtype=float), gripper=self._gripper, state=self.state,
+            joint_velocities=v, gripper=self._gripper, state=self.state,
             previous_state=self.previous_state, locked=self._lock_until is not None,
             stopped=stopped, reason=self.reason if reason is None else reason,
             object_of_interest=self._ooi_label, phase=phase, grasp_attempts=self._attempt,
@@ -267,9 +295,13 @@ class GraspFsm:
         if not math.isfinite(now):
             msg = f'The controller time must be finite seconds, got {now}; pass the clock time.'
             raise FsmError(msg)
-        dt = 0.0 if self._last_time is None else max(now - self._last_time, 0.0)
+        first = self._last_time is None
+        dt = 0.0 if first else max(now - self._last_time, 0.0)
         self._last_time = now
         self._now = now
+        # the speed-up allowed this tick: one control period at most, so that a late tick (a
+        # loaded machine) cannot step the velocity further than a punctual one
+        self._dt = p.control_period if first else min(dt, p.control_period)
 
         # --- watchdog: nothing moves on stale or broken inputs -------------------------------
         why = self._watchdog(inputs, now) or self._await_fresh_decision(inputs)
@@ -319,18 +351,11 @@ class GraspFsm:
 
     def _watchdog(self, inputs: FsmInputs, now: float) -> str:
         p = self.params
-        joints = inputs.joints
-        if joints is None:
+        if inputs.joints is None:
             return 'stopped: no joint states received yet'
-        age = now - joints.stamp
-        if age > p.watchdog_timeout:
-            return (f'stopped: joint states are {age:.2f} s old (limit {p.watchdog_timeout:.2f} s);'
-                    ' check the arm driver')
-        pos = np.asarray(joints.position, dtype=float)
-        if pos.shape != (6,):
-            return f'stopped: joint states hold {pos.size} positions, 6 expected'
-        if not np.isfinite(pos).all() or not np.isfinite(np.asarray(joints.velocity)).all():
-            return 'stopped: joint states contain NaN or infinite values; check the arm driver'
+        why = self._sensor_latch(inputs, now)
+        if why:
+            return why
         if not p.autonomous:
             pred = inputs.prediction
             if pred is None:
@@ -339,6 +364,7 @@ class GraspFsm:
             if age > p.watchdog_timeout:
                 self._stale_pred = True
                 self._back_at = self._fresh = None
+                self._loss = 'prediction loss'
                 return (f'stopped: the latest MI prediction is {age:.2f} s old (limit '
                         f'{p.watchdog_timeout:.2f} s); check the classifier and EEG stream')
         if inputs.vision is None:
@@ -347,6 +373,58 @@ class GraspFsm:
         if age > p.camera_timeout:
             return (f'stopped: no camera images for {age:.2f} s (limit {p.camera_timeout:.2f} s);'
                     ' holding still')
+        return ''
+
+    def _joint_fault(self, inputs: FsmInputs, now: float) -> str:
+        """What is wrong with the joint states at ``now`` (s), '' when nothing."""
+        p = self.params
+        joints = inputs.joints
+        assert joints is not None
+        age = now - joints.stamp
+        if age > p.watchdog_timeout:
+            return (f'joint states are {age:.2f} s old (limit {p.watchdog_timeout:.2f} s); '
+                    'check the arm driver')
+        pos = np.asarray(joints.position, dtype=float)
+        if pos.shape != (6,):
+            return f'joint states hold {pos.size} positions, 6 expected'
+        if not np.isfinite(pos).all() or not np.isfinite(np.asarray(joints.velocity)).all():
+            return 'joint states contain NaN or infinite values; check the arm driver'
+        return ''
+
+    def _sensor_latch(self, inputs: FsmInputs, now: float) -> str:
+        """'' when the joint states may be used, else why the arm holds (a latched stop).
+
+        A fault now, or a faulty message received since the last one seen, (re)starts the
+        latch; it is released once nothing was wrong for ``sensor_clean_time`` s, and the arm
+        then waits for a fresh decision, by the mechanism of a prediction loss.
+        """
+        p = self.params
+        why = self._joint_fault(inputs, now)
+        fault_at = now if why else None
+        received = inputs.joint_fault
+        if received is not None and (self._fault_at is None or received[0] > self._fault_at) \
+                and now - received[0] < p.sensor_clean_time:
+            fault_at, why = (fault_at or received[0]), why or received[1]
+        if fault_at is not None:
+            if self._fault_at is None:
+                self._events.append(f'{SENSOR_FAULT}: {why}; the arm holds until the joint states'
+                                    f' are clean for {p.sensor_clean_time:.1f} s and a new '
+                                    'command is given')
+            self._fault_at, self._fault_why = fault_at, why
+        if self._fault_at is None:
+            return ''
+        clean = now - self._fault_at
+        if clean < p.sensor_clean_time:
+            return (f'stopped: {SENSOR_FAULT} ({self._fault_why}); clean for {clean:.2f} of '
+                    f'{p.sensor_clean_time:.2f} s, then a new command restarts the arm')
+        self._fault_at = None
+        self._events.append(f'{SENSOR_FAULT} released: joint states clean for {clean:.2f} s'
+                            + ('' if p.autonomous else '; waiting for a new command'))
+        # the person restarts the arm as after a prediction loss, with decisions stamped after
+        # the release only
+        self._stale_pred = True
+        self._back_at, self._fresh = now, None
+        self._loss = SENSOR_FAULT
         return ''
 
     def _await_fresh_decision(self, inputs: FsmInputs) -> str:
@@ -375,10 +453,12 @@ class GraspFsm:
         if held >= p.resume_hold:
             self._stale_pred = False
             self._back_at = self._fresh = None
-            self._events.append('fresh decision after the prediction loss: '
+            self._events.append(f'fresh decision after the {self._loss}: '
                                 f'{_CLASS_WORDS.get(pred.class_index, pred.class_index)}')
             return ''
-        return ('stopped: the MI predictions are back after a loss; waiting for a new command '
+        back = ('the joint states are clean again after a fault' if self._loss == SENSOR_FAULT
+                else 'the MI predictions are back after a loss')
+        return (f'stopped: {back}; waiting for a new command '
                 f'(one class for {p.resume_hold:.1f} s, resume_after_stale)')
 
     def _observe(self, vision: VisionFrame | None, t: float) -> None:
@@ -737,7 +817,7 @@ class GraspFsm:
             # carrying: rise straight up first, so the object clears the table and the arm
             v, done = self.policy.lift_step(t, q)
             if not done:
-                return self._ramp(t, v, p.return_velocity_holding), 'lifting'
+                return _cap(v, p.return_velocity_holding), 'lifting'
             self._return_lift = False
         err = np.asarray(p.home_position) - q
         if np.max(np.abs(err)) < p.return_tolerance:
@@ -750,16 +830,8 @@ class GraspFsm:
         vmax = np.asarray(p.max_joint_velocity)
         if holding:
             vmax = np.minimum(vmax, p.return_velocity_holding)
-        scale = float(np.max(np.abs(v) / vmax))
-        if scale > 1.0:
-            v = v / scale
-        return self._ramp(t, v, float(np.max(vmax))), 'returning'
-
-    def _ramp(self, t: float, v: np.ndarray, vmax: float) -> np.ndarray:
-        """Limit the speed to ``return_acceleration`` * time in state (a smooth start)."""
-        limit = min(vmax, self.params.return_acceleration * (t - self._state_since) + 0.02)
-        peak = float(np.max(np.abs(v)))
-        return v * (limit / peak) if peak > limit else v
+        # the speed-up to this is ramped by the acceleration limiter (_output)
+        return _cap(v, vmax), 'returning'
 
     # ---------------------------------------------------------------------------- info
     @property

@@ -59,6 +59,9 @@ class FsmParams:
                                       min=0.0, max=0.5, live=True)
     max_joint_velocity: list[float] = param(list(ARM_MAX_VELOCITY), 'velocity limit per joint',
                                             unit='rad/s')
+    # no profile may step a joint from slow to fast in one tick (braking is never limited)
+    max_joint_acceleration: list[float] = param([2.0] * 6, 'speed-up limit per joint for every '
+                                                'velocity command', unit='rad/s^2', live=True)
     control_period: float = param(0.02, 'control tick (the node ticks at 1 / control_period)',
                                   unit='s', min=0.001, max=1.0)
     lock_duration: float = param(1.0, 'all joints held between states (paper: locks)', unit='s',
@@ -76,6 +79,12 @@ class FsmParams:
                                     'or resume', choices=RESUME_MODES, live=True)
     resume_hold: float = param(1.0, 'a fresh decision after a loss: one class decoded without '
                                'a break for this long', unit='s', min=0.0, max=10.0, live=True)
+    # a sensor fault (joint states with NaN/inf, wrong names or sizes, stale) latches a stop as
+    # a prediction loss does: released once the joint states were clean this long, then the
+    # person's fresh decision (resume_after_stale) restarts the arm
+    sensor_clean_time: float = param(1.0, 'after a joint-state fault the arm holds until the '
+                                     'joint states were clean this long', unit='s', min=0.0,
+                                     max=60.0, live=True)
     # --- BCI -----------------------------------------------------------------------------------
     # paper: the person steers with 4 classes (left/right turn, both hands select and approach,
     # both feet back off). scan: the arm turns from object to object itself and offers each one;
@@ -302,7 +311,8 @@ class FsmParams:
                                   live=True)
     return_velocity_holding: float = param(0.5, 'per-joint velocity limit while carrying an '
                                            'object', unit='rad/s', min=0.01, max=3.0, live=True)
-    return_acceleration: float = param(1.0, 'ramp at the start of the return (no jerk)',
+    return_acceleration: float = param(1.0, 'speed-up limit per joint during the return (no '
+                                       'jerk; lower of this and max_joint_acceleration)',
                                        unit='rad/s^2', min=0.01, max=100.0, live=True)
     return_lift_height: float = param(0.25, 'carrying, the hand first rises straight to this '
                                       'height', unit='m', min=0.0, max=2.0, live=True)
@@ -319,7 +329,7 @@ class FsmParams:
     def validate(self) -> None:
         """Raise :class:`FsmError` naming the first bad parameter and how to fix it."""
         for name in ('joint_names', 'home_position', 'joint_lower_limits', 'joint_upper_limits',
-                     'max_joint_velocity'):
+                     'max_joint_velocity', 'max_joint_acceleration'):
             values = getattr(self, name)
             if len(values) != 6:
                 msg = (f"The parameter '{name}' must have 6 entries (one per arm joint), got "
@@ -339,10 +349,12 @@ class FsmParams:
             if not (isinstance(value, int | float) and math.isfinite(value) and value > 0):
                 msg = f"The parameter '{name}' must be a positive number, {value!r} is invalid."
                 raise FsmError(msg)
-        if any(v <= 0 for v in self.max_joint_velocity):
-            msg = (f"Every entry of 'max_joint_velocity' must be > 0 rad/s, got "
-                   f'{self.max_joint_velocity}.')
-            raise FsmError(msg)
+        for name, unit in (('max_joint_velocity', 'rad/s'), ('max_joint_acceleration',
+                                                             'rad/s^2')):
+            values = getattr(self, name)
+            if not all(math.isfinite(v) and v > 0 for v in values):
+                msg = f"Every entry of '{name}' must be > 0 {unit}, got {values}."
+                raise FsmError(msg)
         if not 1 <= self.approach_joint <= 6:
             msg = (f"The parameter 'approach_joint' must be a joint number 1..6, got "
                    f'{self.approach_joint}.')

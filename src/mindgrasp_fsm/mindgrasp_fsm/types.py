@@ -80,6 +80,9 @@ class FsmInputs:
     vision: VisionFrame | None = None
     gripper: GripperState | None = None
     camera: CameraModel | None = None
+    # the latest joint-state message that was refused (NaN/inf, wrong names or sizes): its time
+    # of receipt (s, controller clock) and what was wrong; ``joints`` keeps the last good one
+    joint_fault: tuple[float, str] | None = None
 
 
 @dataclass(frozen=True)

@@ -89,9 +89,41 @@ class CommandGate:
         self.timed_out = True
 
 
+class CommandBursts:
+    """Bad commands come in bursts (a faulty publisher at its own rate beside the controller):
+    one warning at the start of each burst, not one per message, and after a refused command
+    (NaN/inf, wrong length) the arm holds until no refused command came for ``hold`` s.
+
+    A burst of one ``kind`` ends when no command of that kind came for ``hold`` s. Times in s.
+    """
+
+    def __init__(self, hold: float = 1.0) -> None:
+        self.hold = float(hold)
+        self._last: dict[str, float] = {}
+        self.count: dict[str, int] = {}
+
+    def bad(self, kind: str, now: float) -> bool:
+        """Note a bad command of ``kind`` at ``now``; True when it starts a burst (warn now)."""
+        last = self._last.get(kind)
+        self._last[kind] = now
+        start = last is None or now - last >= self.hold
+        self.count[kind] = 1 if start else self.count.get(kind, 0) + 1
+        return start
+
+    def holding(self, kind: str, now: float) -> bool:
+        """True while a burst of ``kind`` lasts (its latest command less than ``hold`` s ago)."""
+        last = self._last.get(kind)
+        return last is not None and now - last < self.hold
+
+    def clear(self) -> None:
+        """Forget every burst (e.g. after a reset)."""
+        self._last.clear()
+        self.count.clear()
+
+
 def _read_only(a: np.ndarray) -> np.ndarray:
     a.flags.writeable = False
     return a
 
 
-__all__ = ['CommandGate', 'gripper_closure', 'validate_velocities']
+__all__ = ['CommandBursts', 'CommandGate', 'gripper_closure', 'validate_velocities']

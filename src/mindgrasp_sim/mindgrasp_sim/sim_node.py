@@ -7,7 +7,9 @@ RGB-D camera driver, served by :class:`~mindgrasp_sim.simulation.Simulation`.
         --params-file src/mindgrasp_sim/mindgrasp_sim/param/sim.yaml
 
 Subscribes ``/arm_controller/commands`` (std_msgs/Float64MultiArray, 6 joint velocities, rad/s;
-older than ``command_timeout`` s means zero), ``/gripper_controller/commands``
+older than ``command_timeout`` s means zero; clipped to the velocity limits of the loaded URDF;
+NaN/inf or a wrong length is refused and holds the arm until no refused command came for
+``bad_command_hold`` s; one warning per burst of bad commands), ``/gripper_controller/commands``
 (Float64MultiArray: [closure] 0 open .. 1 closed, or [thumb, left, right]) and ``/task/target``.
 Publishes ``/joint_states`` (6 arm joints), ``/gripper/joint_states`` (3 fingers: angles, efforts
 in N m), ``/gripper/contacts`` (std_msgs/UInt8MultiArray, 1 = finger touches an object; with
@@ -93,7 +95,7 @@ from mindgrasp_ros.topics import (
     TRAINER_ROBOT,
 )
 from mindgrasp_sim import messages as msgs
-from mindgrasp_sim.control import CommandGate, gripper_closure
+from mindgrasp_sim.control import CommandBursts, CommandGate, gripper_closure, validate_velocities
 from mindgrasp_sim.errors import SimError
 from mindgrasp_sim.simulation import CameraConfig, Simulation
 from mindgrasp_sim.task import TaskMonitor
@@ -131,6 +133,10 @@ class SimParams:
                            '(/sim/step)')
     command_timeout: float = param(0.25, 'a velocity command older than this means zero '
                                    'velocity', unit='s', min=0.001, max=60.0)
+    bad_command_hold: float = param(1.0, 'after a refused velocity command (NaN/inf, wrong '
+                                    'length) the arm holds until none came for this long; also '
+                                    'the gap that ends a burst of bad commands (one warning '
+                                    'each)', unit='s', min=0.0, max=60.0)
     trainer_robot: bool = param(False, 'also simulate the green training robot under '
                                 '/trainer_robot/')
     gui: bool = param(False, 'PyBullet window (needs a display)')
@@ -166,6 +172,7 @@ class _RobotIO:
     name: str
     prefix: str
     gate: CommandGate
+    bursts: CommandBursts
     pubs: dict = field(default_factory=dict)
     applied: np.ndarray = field(default_factory=lambda: np.zeros(6))
 
@@ -247,7 +254,8 @@ class SimNode(rclpy.node.Node):
         self.robots: dict[str, _RobotIO] = {}
         for name in self.sim.robots:
             prefix = '' if name == 'user' else TRAINER_ROBOT
-            io = _RobotIO(name, prefix, CommandGate(float(p['command_timeout'])))
+            io = _RobotIO(name, prefix, CommandGate(float(p['command_timeout'])),
+                          CommandBursts(float(p['bad_command_hold'])))
             js, fingers, contacts, ee, arm, gripper = (t.in_namespace(prefix) for t in (
                 JOINT_STATES, GRIPPER_JOINT_STATES, GRIPPER_CONTACTS, EE_POSE, ARM_COMMANDS,
                 GRIPPER_COMMANDS))
@@ -395,25 +403,41 @@ class SimNode(rclpy.node.Node):
             self._finish()
 
     # ------------------------------------------------------------------ commands
-    def _warn_bad(self, text: str) -> None:
-        """A bad command: at most one warning per second for all of them (one call site)."""
-        self.get_logger().warning(text, throttle_duration_sec=1.0)
-
     def arm_command_callback(self, msg: Float64MultiArray, io: _RobotIO) -> None:
-        """Joint velocities (rad/s); a bad command stops the arm and is reported."""
+        """Joint velocities (rad/s). A refused command stops the arm, which then holds until
+        the commands were valid for ``bad_command_hold`` s; a command beyond the URDF's velocity
+        limits is clipped to them. One warning per burst of each."""
+        now = self.sim_now()
+        topic = f'{io.prefix}/arm_controller/commands'
+        hold = io.bursts.hold
         try:
-            io.gate.command(msg.data, self.sim_now())
+            v = validate_velocities(msg.data, io.gate.n_joints)
         except SimError as err:
             io.gate.clear()
-            self._warn_bad(f'Rejected {io.prefix}/arm_controller/commands: {err} The arm holds '
-                           'still.')
+            if io.bursts.bad('refused', now):
+                self.get_logger().warning(
+                    f'Rejected {topic}: {err} The arm holds still until the commands are valid '
+                    f'for {hold:.1f} s (one warning per burst).')
+            return
+        if io.bursts.holding('refused', now):
+            return                  # a burst of refused commands: the arm keeps holding
+        if io.bursts.count.pop('refused', 0):
+            self.get_logger().info(f'{topic} valid for {hold:.1f} s again; the arm follows them.')
+        limits = self.sim.max_velocity
+        if (np.abs(v) > limits).any() and io.bursts.bad('clipped', now):
+            self.get_logger().warning(
+                f'Clipped {topic} {np.round(v, 3).tolist()} rad/s to the velocity limits of the '
+                f'URDF {limits.tolist()} rad/s (one warning per burst); command at most those.')
+        io.gate.command(v, now)
 
     def gripper_command_callback(self, msg: Float64MultiArray, io: _RobotIO) -> None:
         """Gripper closure target(s)."""
         try:
             self.sim.set_gripper(gripper_closure(msg.data), robot=io.name)
         except SimError as err:
-            self._warn_bad(f'Rejected {io.prefix}/gripper_controller/commands: {err}')
+            if io.bursts.bad('gripper', self.sim_now()):
+                self.get_logger().warning(f'Rejected {io.prefix}/gripper_controller/commands: '
+                                          f'{err} (one warning per burst)')
 
     def target_callback(self, msg: TaskTarget) -> None:
         self.desired = f'{msg.colour} {msg.shape}'.strip()

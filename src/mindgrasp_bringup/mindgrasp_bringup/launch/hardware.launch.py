@@ -1,11 +1,18 @@
 """Real hardware: an LSL amplifier and an external arm driver (no simulator), with acquisition,
 classifier, vision and the grasp controller.
 
-    mindgrasp launch hardware eeg_stream:=gNautilus arm_driver:=my_arm_driver
+    mindgrasp launch hardware eeg_stream:=gNautilus arm_driver:=my_arm_driver \\
+        model:=models/alice.json               # her classifier (mindgrasp train classifier)
     mindgrasp launch hardware eeg_stream:=gNautilus arm_driver:=/opt/arm/bin/driver \\
-        arm_driver_args:="--ip 192.168.1.10" camera_driver:=my_camera_node
+        arm_driver_args:="--ip 192.168.1.10" camera_driver:=my_camera_node \\
+        model:=models/alice.json
     mindgrasp launch hardware eeg_stream:=gNautilus arm_driver:=my_ros_pkg/arm_node \\
-        model:=models/alice.json               # ros2 run my_ros_pkg arm_node; her classifier
+        model:=package://mindgrasp_classifier/models/default_classifier.json   # bench test only
+
+``model:=`` is required: a real person's EEG is never decoded by the classifier trained on the
+simulated head unless it is named on purpose (the last line, for a bench test without a person).
+The drivers are required nodes: if one ends, even with exit code 0, the launch stops every node and
+ends with a non-zero exit code (``mindgrasp launch``; ``ros2 launch`` shuts down with its own code).
 
 The arm driver must serve the arm contract of ros2_control's forward velocity controller:
 subscribe /arm_controller/commands and /gripper_controller/commands (std_msgs/Float64MultiArray,
@@ -42,10 +49,12 @@ def generate_launch_description() -> LaunchDescription:
         DeclareLaunchArgument('arm_driver_args', default_value='',
                               description='command-line arguments of the arm driver (shell '
                                           'quoting)'),
-        file_argument('model', default_value='',
-                      description='classifier model (.json written by mindgrasp train '
-                                  'classifier); empty: the one in '
-                                  'mindgrasp_classifier/param/classifier.yaml'),
+        # no default: the simulated head's classifier must never decode a person silently
+        file_argument('model', default_value=None,
+                      description="the person's classifier model (.json written by mindgrasp "
+                                  'train classifier); for a bench test without a person, name '
+                                  'the simulated head\'s on purpose: model:=package://'
+                                  'mindgrasp_classifier/models/default_classifier.json'),
         DeclareLaunchArgument('camera_driver', default_value='',
                               description='camera driver started like arm_driver (empty: the '
                                           'arm driver or another system publishes the camera)'),

@@ -167,7 +167,11 @@ def driver_nodes(role: str, condition: Any = None) -> list[Any]:
     """The ``<role>_driver`` node of a real arm or camera: the program ``<role>_driver:=`` names
     (on PATH, a path, ``package/executable``; under ``mindgrasp launch`` also a Python module)
     with ``<role>_driver_args:=`` split by shell rules into its arguments. Declare both launch
-    arguments in the profile."""
+    arguments in the profile.
+
+    A driver is a required node: its end, even with exit code 0, stops the launch, which then
+    ends with a non-zero exit code under ``mindgrasp launch`` (``ros2 launch`` shuts down
+    through ``on_exit=Shutdown()``, with its own exit code 0)."""
     if la.using_real_launch():
         from launch.actions import OpaqueFunction
 
@@ -178,4 +182,4 @@ def driver_nodes(role: str, condition: Any = None) -> list[Any]:
 
     return [la.Node(executable=la.LaunchConfiguration(f'{role}_driver'), name=f'{role}_driver',
                     arguments=[SplitArguments(la.LaunchConfiguration(f'{role}_driver_args'))],
-                    condition=condition)]
+                    condition=condition, required=True)]

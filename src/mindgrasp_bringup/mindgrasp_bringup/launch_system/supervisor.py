@@ -273,6 +273,12 @@ class Supervisor:
             proc.restart_at = now + spec.respawn_delay
             proc.how = 'respawning'
             return
+        if rc == 0 and spec.required:
+            proc.how, proc.clean = 'ended', False
+            logger.error("required process '%s' (pid %d) ended (exit code 0) while the launch "
+                         'was running; stopping every process.', spec.label, proc.popen.pid)
+            self.request_shutdown(f"required process '{spec.label}' ended")
+            return
         if rc == 0:
             proc.how, proc.clean = 'finished', True
             logger.info("process has finished cleanly [pid %d]: %s", proc.popen.pid, spec.label)

@@ -54,6 +54,9 @@ class ProcessSpec:
     respawn_delay: float = 0.0             #: s
     respawn_max_retries: int = -1          #: -1: no limit
     shutdown_on_exit: bool = False
+    #: its end stops the launch as a failure, whatever its exit code (ROS 1's required="true"):
+    #: a driver that exits 0 at once must not leave a run without an arm
+    required: bool = False
     sigterm_timeout: float | None = None   #: s after SIGINT before SIGTERM (None: launcher's)
     sigkill_timeout: float | None = None   #: s after SIGTERM before SIGKILL (None: launcher's)
     problem: str | None = None             #: why it cannot start (e.g. missing module)
@@ -129,7 +132,8 @@ class ExecuteProcess(Action):
                  respawn: bool | SomeSubstitutions = False,
                  respawn_delay: float | SomeSubstitutions = 0.0, respawn_max_retries: int = -1,
                  on_exit: Shutdown | None = None, sigterm_timeout: float | None = None,
-                 sigkill_timeout: float | None = None, **kwargs: object) -> None:
+                 sigkill_timeout: float | None = None, required: bool = False,
+                 **kwargs: object) -> None:
         super().__init__(**kwargs)  # type: ignore[arg-type]
         self.cmd = list(cmd)
         if not self.cmd:
@@ -146,6 +150,7 @@ class ExecuteProcess(Action):
         if on_exit is not None and not isinstance(on_exit, Shutdown):
             raise LaunchError('on_exit: only on_exit=Shutdown() is supported.')
         self.on_exit = on_exit
+        self.required = bool(required)
         self.sigterm_timeout = sigterm_timeout
         self.sigkill_timeout = sigkill_timeout
 
@@ -161,7 +166,8 @@ class ExecuteProcess(Action):
                                            'respawn')),
             'respawn_delay': self._delay(context),
             'respawn_max_retries': self.respawn_max_retries,
-            'shutdown_on_exit': self.on_exit is not None,
+            'shutdown_on_exit': self.on_exit is not None or self.required,
+            'required': self.required,
             'sigterm_timeout': self.sigterm_timeout, 'sigkill_timeout': self.sigkill_timeout,
         }
 
