@@ -183,6 +183,27 @@ def parse_replay_source(text: str) -> int:
     return number
 
 
+#: what the virtual amplifier's ``eeg_source`` may be, for messages
+EEG_SOURCE_FORMS = ('synthetic (the head model), eegmmidb:<subject> (EEGMMIDB subjects 1-109) or '
+                    'the path of a subject file (.yaml)')
+
+
+def check_eeg_source(text: str) -> None:
+    """Raise :class:`EEGError` unless ``text`` is a valid ``eeg_source`` (:data:`EEG_SOURCE_FORMS`):
+    launch profiles check it before any node starts. Reads no recording."""
+    if text == 'synthetic':
+        return
+    if text.lower().endswith(SUBJECT_SUFFIXES):
+        if not Path(text).expanduser().is_file():
+            msg = f'the subject file {text!r} does not exist; give {EEG_SOURCE_FORMS}.'
+            raise EEGError(msg)
+        return
+    if not text.lower().startswith('eegmmidb:'):
+        msg = f'{text!r} is not an EEG source; give {EEG_SOURCE_FORMS}.'
+        raise EEGError(msg)
+    parse_replay_source(text)   # its message names the subject range
+
+
 def is_replay_source(text: str) -> bool:
     """A replay subject (``eegmmidb:<n>`` or a subject file ``*.yaml``/``*.yml``)?"""
     return text.lower().startswith('eegmmidb:') or text.lower().endswith(SUBJECT_SUFFIXES)

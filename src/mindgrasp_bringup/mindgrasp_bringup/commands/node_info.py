@@ -4,11 +4,11 @@ from __future__ import annotations
 
 import argparse
 
-from mindgrasp_bringup.ros_cli import cli_node, print_error, wait_for_graph
+from mindgrasp_bringup.ros_cli import cli_node, node_name, print_error, wait_for_graph
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument('node', help='fully qualified node name, e.g. /sim')
+    parser.add_argument('node', type=node_name, help='fully qualified node name, e.g. /sim')
 
 
 def main(args: argparse.Namespace) -> int:
