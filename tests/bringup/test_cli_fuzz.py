@@ -189,6 +189,17 @@ SEMANTIC = [
     (['run', 'mindgrasp_fsm', 'no_such_node'], "'mindgrasp_fsm.no_such_node' does not exist"),
     (['eeg', 'virtual-amp', '--no-ros', '--ros-args', '-p', 'seed:=1'], '--ros-args needs'),
     (['topic'], 'a verb is required: list, echo'),
+    # files and parameters of the offline commands
+    (['experiment', 'report', '/no/such/run'], '/no/such/run'),
+    (['experiment', 'set-locations', '--trials', '1', '--param', 'no_equals'], 'no_equals'),
+    (['experiment', 'set-locations', '--trials', '1', '--launch', '/no/such.launch.py'],
+     '/no/such.launch.py'),
+    (['export', 'eeg', '/no/such/run'], '/no/such/run'),
+    (['eeg', 'play', '/no/such.edf'], '/no/such.edf'),
+    (['replay', '/no/such/run'], '/no/such/run'),
+    (['evaluate', 'classifier', '--model', 'package://no_such_package/m', '--eegbci', '1'],
+     'no_such_package'),
+    (['train', 'vision', '--n-images', '1'], '--n-images must be >= 30'),
 ]
 
 
