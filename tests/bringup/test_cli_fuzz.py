@@ -262,7 +262,7 @@ def _mindgrasp(*argv: str) -> subprocess.CompletedProcess:
      "[FsmNode] ERROR: Invalid parameter 'bogus': write it as -p name:=value."),
     # the options reach the node: its own range check refuses the value
     (['eeg', 'virtual-amp', '--ros-args', '-p', 'accuracy:=7'], "'accuracy'"),
-    (['train', 'classifier', '--edf', 'x.edf'], 'required: -o/--out'),
+    (['topic', 'hz', '/x', '--window', '0'], 'argument -w/--window: must be >= 1, got 0'),
 ])
 def test_real_processes(argv, message):
     done = _mindgrasp(*argv)
