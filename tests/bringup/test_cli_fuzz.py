@@ -281,3 +281,13 @@ def test_virtual_amp_passes_ros_args_on():
     ros = _ros_argv(args)
     assert ros[0] == '--ros-args' and ros[-4:] == ['-p', 'seed:=1', '-r', '__node:=amp2']
     assert ros.index('seed:=3') < ros.index('seed:=1')   # the later -p wins, as in rcl
+
+
+def test_an_unknown_node_is_one_line_without_the_cli_itself():
+    """A valid name nobody has: one line listing the nodes there are, not the command's own
+    hidden node (it listed /_mindgrasp_cli_<pid>)."""
+    done = _mindgrasp('node', 'info', '/no_such_node')
+    lines = [line for line in done.stderr.splitlines() if line.strip()]
+    assert done.returncode == 1 and len(lines) == 1, done.stderr
+    assert "Node '/no_such_node' was not found. Nodes: " in lines[0]
+    assert '_mindgrasp_cli' not in lines[0] and 'Traceback' not in done.stderr
