@@ -209,6 +209,8 @@ def test_bad_values_are_one_line(argv, message, capsys):
     code = _run_cli(argv)
     line = _one_line_error(capsys, code)
     assert message in line, line
+    if argv[:2] in (['topic', 'pub'], ['param', 'set']):
+        assert code == 2, line   # a value that does not fit: a usage error, nothing was sent
 
 
 # -- every node's argument parser: --ros-args rules and parameter files ---------------------------

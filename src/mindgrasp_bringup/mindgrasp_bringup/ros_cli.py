@@ -17,8 +17,9 @@ from typing import Any
 import numpy as np
 import yaml
 
-__all__ = ['CliError', 'cli_node', 'find_topic_type', 'message_to_yaml', 'message_type',
-           'node_name', 'resolve_field', 'set_fields', 'topic_name', 'wait_for_graph']
+__all__ = ['CliError', 'UsageError', 'cli_node', 'find_topic_type', 'message_to_yaml',
+           'message_type', 'node_name', 'resolve_field', 'set_fields', 'topic_name',
+           'wait_for_graph']
 
 
 class CliError(Exception):
@@ -167,13 +168,13 @@ def set_fields(msg: Any, values: dict[str, Any]) -> Any:
         if key not in fields:
             text = (f'{msg.__msgtype__} has no field {key!r}; its fields are: '
                     f'{", ".join(fields)}.')
-            raise CliError(text)
+            raise UsageError(text)
         current = getattr(msg, key)
         if hasattr(current, '_fields'):
             if not isinstance(value, dict):
                 text = (f'Field {key!r} is a {fields[key]} message: give its fields as a mapping, '
                         f'e.g. "{{{key}: {{...}}}}"; {value!r} is not one.')
-                raise CliError(text)
+                raise UsageError(text)
             set_fields(current, value)
         elif isinstance(current, list) and isinstance(value, list) and value and \
                 isinstance(value[0], dict):
@@ -186,10 +187,17 @@ def set_fields(msg: Any, values: dict[str, Any]) -> Any:
                 check_value(f'{msg.__msgtype__} field {key!r}', fields[key], value)
                 setattr(msg, key, value)
             except (TypeError, ValueError, OverflowError) as exc:
-                raise CliError(str(exc)) from None
+                raise UsageError(str(exc)) from None
     return msg
 
 
+class UsageError(CliError):
+    """Bad input found before anything is sent (a value that does not fit its field): exit
+    code 2, as argparse gives for a bad value."""
+
+
 def print_error(exc: Exception) -> int:
+    """Print ``exc`` as the command's one error line; the exit code (2 for a
+    :class:`UsageError`, else 1)."""
     print(f'mindgrasp: {exc}', file=sys.stderr)
-    return 1
+    return 2 if isinstance(exc, UsageError) else 1

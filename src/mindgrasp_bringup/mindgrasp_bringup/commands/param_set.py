@@ -7,7 +7,7 @@ import argparse
 import yaml
 
 from mindgrasp_bringup.commands._param_client import call
-from mindgrasp_bringup.ros_cli import CliError, cli_node, node_name, print_error
+from mindgrasp_bringup.ros_cli import CliError, UsageError, cli_node, node_name, print_error
 from mindgrasp_common.cli_checks import yaml_error_text
 
 
@@ -39,12 +39,12 @@ def main(args: argparse.Namespace) -> int:
         except yaml.YAMLError as exc:
             msg = (f'{args.value!r} is not a parameter value ({yaml_error_text(exc)}); write it '
                    'as YAML, e.g. 0.5, true, "[C3, C4]".')
-            raise CliError(msg) from None
+            raise UsageError(msg) from None
         try:
             param = Parameter(args.name, value=value)
             _check_range(args.name, param)
         except (TypeError, ValueError) as exc:
-            raise CliError(f'{args.value!r} is not a parameter value: {exc}') from None
+            raise UsageError(f'{args.value!r} is not a parameter value: {exc}') from None
         with cli_node('param') as node:
             res = call(node, args.node, 'set_parameters',
                        lambda srv: srv.Request(parameters=[param.to_parameter_msg()]))

@@ -9,6 +9,7 @@ import yaml
 
 from mindgrasp_bringup.ros_cli import (
     CliError,
+    UsageError,
     cli_node,
     message_type,
     print_error,
@@ -48,10 +49,10 @@ def main(args: argparse.Namespace) -> int:
         try:
             values = yaml.safe_load(args.values) or {}
         except yaml.YAMLError as exc:
-            raise CliError(f'The values are not valid YAML ({yaml_error_text(exc)}); write '
-                           'them as a mapping, e.g. "{data: 1.0}".') from None
+            raise UsageError(f'The values are not valid YAML ({yaml_error_text(exc)}); write '
+                             'them as a mapping, e.g. "{data: 1.0}".') from None
         if not isinstance(values, dict):
-            raise CliError('The values must be a YAML mapping, e.g. "{data: 1.0}".')
+            raise UsageError('The values must be a YAML mapping, e.g. "{data: 1.0}".')
         msg = set_fields(cls(), values)
         qos = rclpy.qos.QoSProfile(
             depth=10,
