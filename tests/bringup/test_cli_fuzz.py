@@ -22,6 +22,14 @@ from pathlib import Path
 import pytest
 
 from mindgrasp_bringup import cli
+from mindgrasp_common.cli_checks import (
+    finite_float,
+    non_negative_float,
+    non_negative_int,
+    positive_float,
+    positive_int,
+    probability,
+)
 from mindgrasp_testing import console_scripts
 
 REPO = Path(__file__).resolve().parents[2]
@@ -29,6 +37,11 @@ REPO = Path(__file__).resolve().parents[2]
 #: a harmless value for a required positional argument, by its dest
 SAMPLES = {'topic': '/fuzz', 'type': 'std_msgs/msg/String', 'node': '/fuzz',
            'package': 'mindgrasp_fsm', 'executable': 'fsm_node', 'name': 'x', 'value': '1'}
+
+
+#: a value outside the range of each number check (plain ``float`` takes nan: no option should)
+OUT_OF_RANGE = {non_negative_int: '-1', positive_int: '0', non_negative_float: '-0.5',
+                positive_float: '0', probability: '1.5', finite_float: 'nan', float: 'nan'}
 
 
 def _verbs() -> list[tuple[str, ...]]:
@@ -95,6 +108,14 @@ def _usage_cases() -> list:
             if action.choices or (action.type not in (None, str)):
                 cases.append(pytest.param([*prefix, *tail, flag, 'no-such-value', 'x'], flag,
                                           id=f'{label} {flag} no-such-value'))
+            if action.type in OUT_OF_RANGE:
+                value = OUT_OF_RANGE[action.type]
+                count = action.nargs if isinstance(action.nargs, int) else 1
+                # --x=-1, not --x -1: argparse takes '-1' alone for an option when a parser
+                # has options that look like negative numbers
+                words = [f'{flag}={value}'] if count == 1 else [flag, *[value] * count]
+                cases.append(pytest.param([*prefix, *tail, *words], flag,
+                                          id=f'{label} {flag}={value}'))
     return cases
 
 

@@ -15,8 +15,8 @@ import argparse
 import math
 from typing import NoReturn
 
-__all__ = ['OneLineParser', 'non_negative_float', 'non_negative_int', 'positive_float',
-           'positive_int', 'probability', 'yaml_error_text']
+__all__ = ['OneLineParser', 'finite_float', 'non_negative_float', 'non_negative_int',
+           'positive_float', 'positive_int', 'probability', 'yaml_error_text']
 
 
 class OneLineParser(argparse.ArgumentParser):
@@ -50,6 +50,12 @@ def _float(text: str) -> float:
         msg = f'{text!r} is not a finite number'
         raise argparse.ArgumentTypeError(msg)
     return value
+
+
+def finite_float(text: str) -> float:
+    """Any finite number (times that may be negative, e.g. an epoch start before its cue);
+    ``float`` alone took ``nan``, which ended in a traceback further on."""
+    return _float(text)
 
 
 def non_negative_int(text: str) -> int:
