@@ -234,6 +234,23 @@ def test_bad_values_are_one_line(argv, message, capsys):
         assert code == 2, line   # a value that does not fit: a usage error, nothing was sent
 
 
+@pytest.mark.parametrize(('argv', 'message'), [
+    (['experiment', 'random-locations', '--trials', '1', '--realism', '{bad}/broken.yaml'],
+     'is not valid YAML (line 2, column 1'),
+    (['train', 'vision', '--n-images', '30', '--realism', '{bad}/broken.yaml'],
+     'is not valid YAML (line 2, column 1'),
+    (['session', 'run', '--subject', 's1', '--plan', '{bad}/broken.yaml', '--root', '{bad}'],
+     'is not valid YAML: line 2, column 1'),
+    (['experiment', 'set-locations', '--trials', '1', '--subject', '{bad}/broken.yaml'],
+     'line 2, column 1'),
+    (['eeg', 'play', 'eegbci:999:4'], 'EEGMMIDB has subjects 1-109 and runs 1-14'),
+], ids=lambda v: ' '.join(v)[:50] if isinstance(v, list) else None)
+def test_bad_files_are_one_line(argv, message, bad_files, capsys):
+    code = _run_cli([a.format(bad=bad_files) for a in argv])
+    line = _one_line_error(capsys, code)
+    assert message in line, line
+
+
 # -- every node's argument parser: --ros-args rules and parameter files ---------------------------
 
 def _node_mains() -> list:
