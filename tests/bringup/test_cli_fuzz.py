@@ -262,20 +262,21 @@ def _node_mains() -> list:
             if name != 'mindgrasp']
 
 
-BAD_ROS_ARGS = [
-    (['-p', 'bogus'], "Invalid parameter 'bogus': write it as -p name:=value"),
-    (['-p'], '-p needs a value'),
-    (['-p', ':=3'], 'the name is missing'),
-    (['-r', 'bad'], "Invalid remapping 'bad'"),
-    (['-r', '__node:=9bad'], "Invalid node name '9bad'"),
-    (['-r', '__ns:=/a//b'], 'Invalid namespace'),
-    (['--log-level', 'loud'], "Unknown log level 'loud'"),
-    (['--bogus'], "Unknown ROS argument '--bogus'"),
-    (['--params-file', '/no/such/params.yaml'], 'does not exist'),
-    (['--params-file', '{bad}/broken.yaml'], 'is not valid YAML (line 2, column 1'),
-    (['--params-file', '{bad}/not_ros.yaml'], 'must be a mapping of node names to'),
-    (['--params-file', '{bad}/scalar.yaml'], 'must be a mapping'),
-]
+#: ``--ros-args`` rules a node must refuse: the words, then a part of its one error line
+BAD_ROS_ARGS = [(words.split(), message.strip()) for words, message in (
+    row.split(' | ') for row in """\
+-p bogus | Invalid parameter 'bogus': write it as -p name:=value
+-p | -p needs a value
+-p :=3 | the name is missing
+-r bad | Invalid remapping 'bad'
+-r __node:=9bad | Invalid node name '9bad'
+-r __ns:=/a//b | Invalid namespace
+--log-level loud | Unknown log level 'loud'
+--bogus | Unknown ROS argument '--bogus'
+--params-file /no/such/params.yaml | does not exist
+--params-file {bad}/broken.yaml | is not valid YAML (line 2, column 1
+--params-file {bad}/not_ros.yaml | must be a mapping of node names to
+--params-file {bad}/scalar.yaml | must be a mapping""".splitlines())]
 
 
 @pytest.mark.parametrize('target', _node_mains())
