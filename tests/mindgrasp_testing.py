@@ -6,6 +6,7 @@ sys.path when several test folders have one.
 
 from __future__ import annotations
 
+import ast
 import contextlib
 import struct
 import subprocess
@@ -18,7 +19,7 @@ import pytest
 
 from mindgrasp_ros.node_process import NodeProcess
 
-__all__ = ['NodeProcess', 'small_tmpfs', 'spin_until', 'write_xdf']
+__all__ = ['NodeProcess', 'console_scripts', 'small_tmpfs', 'spin_until', 'write_xdf']
 
 
 def spin_until(node: object, predicate: Callable[[], bool], timeout: float = 10.0,
@@ -50,6 +51,20 @@ def small_tmpfs(path: Path, size: str) -> Iterator[Path]:
         yield path
     finally:
         subprocess.run(['umount', '-l', str(path)], check=False)
+
+
+def console_scripts(package_dir: Path) -> dict[str, str]:
+    """``{executable: 'module:function'}`` of a package's setup.py (read, not executed)."""
+    tree = ast.parse((package_dir / 'setup.py').read_text(encoding='utf-8'))
+    scripts: dict[str, str] = {}
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Dict):
+            for key, value in zip(node.keys, node.values, strict=True):
+                if isinstance(key, ast.Constant) and key.value == 'console_scripts':
+                    for item in ast.literal_eval(value):
+                        name, _, target = (s.strip() for s in item.partition('='))
+                        scripts[name] = target
+    return scripts
 
 
 def _chunk(tag: int, content: bytes) -> bytes:

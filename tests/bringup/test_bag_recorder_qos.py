@@ -226,5 +226,10 @@ def test_a_subscribed_only_topic_is_reported_not_recorded(tmp_path):
         listener.stop()
         if recorder is not None:
             recorder.stop()
+    # a topic only listened to (as /trainer/prompt in every demo) is info, not a warning; a
+    # topic the user named and never saw stays a warning
     assert any(f'Not recorded: {topic}: it had subscribers but no publisher' in line
+               and '[INFO]' in line for line in recorder.lines), recorder.lines
+    assert any(f'Not recorded: {prefix}/unused: no node published' in line and '[WARN]' in line
                for line in recorder.lines), recorder.lines
+    assert not any('[WARN]' in line for line in recorder.lines if topic in line), recorder.lines

@@ -7,7 +7,6 @@ console scripts for their nodes, and a real ``colcon build`` whose installed exe
 
 from __future__ import annotations
 
-import ast
 import configparser
 import os
 import re
@@ -20,7 +19,7 @@ import pytest
 from catkin_pkg.package import parse_package
 
 from mindgrasp_bringup.launch_system.actions.node import node_module
-from mindgrasp_testing import spin_until
+from mindgrasp_testing import console_scripts, spin_until
 
 REPO = Path(__file__).resolve().parents[2]
 SRC = REPO / 'src'
@@ -29,20 +28,6 @@ PYTHON_PACKAGES = [p for p in PACKAGES if p.name != 'mindgrasp_msgs']
 #: imports that package.xml cannot declare: colcon refuses dependency cycles
 UNDECLARED = {('mindgrasp_trainer', 'mindgrasp_bringup'):
               'session.py reads bags with BagReader lazily; bringup depends on the trainer'}
-
-
-def console_scripts(package_dir: Path) -> dict[str, str]:
-    """``{executable: 'module:function'}`` of a package's setup.py (read, not executed)."""
-    tree = ast.parse((package_dir / 'setup.py').read_text(encoding='utf-8'))
-    scripts: dict[str, str] = {}
-    for node in ast.walk(tree):
-        if isinstance(node, ast.Dict):
-            for key, value in zip(node.keys, node.values, strict=True):
-                if isinstance(key, ast.Constant) and key.value == 'console_scripts':
-                    for item in ast.literal_eval(value):
-                        name, _, target = (s.strip() for s in item.partition('='))
-                        scripts[name] = target
-    return scripts
 
 
 def test_every_package_folder_is_a_ros_package() -> None:

@@ -13,6 +13,7 @@ from rosbags.rosbag2 import StoragePlugin, Writer
 
 from mindgrasp_eeg import EEGError
 from mindgrasp_eeg.export import _typestore, export_session, read_session
+from mindgrasp_eeg.montage import standard_montage
 
 FS, NAMES = 250.0, ['C3', 'Cz', 'C4']
 T0_NS = 1_700_000_000_000_000_000
@@ -89,9 +90,11 @@ def test_session_from_bag(run_dir) -> None:
 
 
 @pytest.mark.parametrize('fmt', ['fif', 'edf'])
-def test_export_round_trip_through_mne(run_dir, fmt: str) -> None:
+def test_export_round_trip_through_mne(run_dir, fmt: str, recwarn) -> None:
     path, data = run_dir
     out = export_session(path, fmt=fmt)
+    # MNE 1.13 deprecated the 'standard_1020' name: every export printed its FutureWarning
+    assert [str(w.message) for w in recwarn if issubclass(w.category, FutureWarning)] == []
     assert out.parent == path and out.is_file()
     reader = mne.io.read_raw_fif if fmt == 'fif' else mne.io.read_raw_edf
     raw = reader(out, preload=True, verbose='error')
@@ -115,9 +118,9 @@ def test_export_round_trip_through_mne(run_dir, fmt: str) -> None:
     _events, ids = mne.events_from_annotations(raw, verbose='error')
     assert 'prompt/cue/left_hand' in ids and 'result/success/red cube' in ids
     if fmt == 'edf':      # EDF stores no electrode positions: the reader sets the montage
-        raw.set_montage('standard_1020')
+        raw.set_montage(standard_montage())
     positions = raw.get_montage().get_positions()['ch_pos']
-    assert set(positions) == set(NAMES)                     # standard_1020 positions
+    assert set(positions) == set(NAMES)                     # standard 10-20 positions
     assert positions['C3'][0] < 0 < positions['C4'][0]      # left and right of the head
 
 

@@ -723,3 +723,15 @@ def test_a_measurement_is_the_median_of_several_frames(params: FsmParams) -> Non
     np.testing.assert_allclose(noisy[:2], single[:2], atol=0.01)
     repeated = measured([good, good, good])
     np.testing.assert_allclose(repeated, single)
+
+
+def test_an_object_of_unknown_shape_is_named_by_its_colour() -> None:
+    """Before the depth CNN names the shape, logs and /fsm/state said "yellow unknown"."""
+    fsm = GraspFsm.from_params(FsmParams())       # the default paradigm scans for objects
+    outs, _ = run(fsm, 0.0, 3.0, cls=MiClass.BOTH_HANDS,
+                  obs=observation(shape='unknown', colour='yellow'))
+    reasons = [o.reason for o in outs]
+    assert any('yellow object seen by the' in r for r in reasons), reasons
+    assert not any('unknown' in r for r in reasons), reasons
+    assert 'yellow object' in {o.object_of_interest for o in outs}
+    assert observation(shape='cylinder', colour='red').label == 'red cylinder'

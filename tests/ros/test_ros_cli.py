@@ -45,7 +45,7 @@ def test_topic_pub_reaches_a_subscriber(spawn_node):
                     '--times', '3', '--rate', '5')
     assert pub.returncode == 0, pub.stderr
     bad = mindgrasp('topic', 'pub', '/chatter', 'std_msgs/msg/String', '{text: x}', '--once')
-    assert bad.returncode == 1 and "has no field 'text'" in bad.stderr
+    assert bad.returncode == 2 and "has no field 'text'" in bad.stderr   # usage error
 
 
 def test_param_commands(spawn_node):

@@ -466,3 +466,16 @@ def test_a_nan_publisher_beside_the_controller_holds_the_arm(rclpy_ctx, spawn_no
     assert spin_until(rclpy, node, lambda: probe.joints[-1].velocity[0] > 0.25, 60)
     assert 'valid for 1.0 s again' in proc.output()
     assert proc.stop() == 0
+
+
+def test_a_stop_before_the_first_step_reports_no_rate(capfd):
+    """Stopped before it stepped, the node said "real-time factor 0.00x"; now it says what
+    happened, and a run that stepped keeps its factor (test_fast_mode_...)."""
+    from mindgrasp_ros.composition import LockstepRunner
+    from mindgrasp_sim.sim_node import SimNode
+
+    with LockstepRunner(start_time_s=0.0) as runner:
+        runner.add(SimNode, ros_args=['-p', 'camera_width:=32', '-p', 'camera_height:=32'])
+    out, err = capfd.readouterr()
+    assert 'before the first simulation step' in out + err, out + err
+    assert 'real-time factor' not in out + err

@@ -364,3 +364,15 @@ def test_egl_renderer_sees_the_same_scene():
         assert 0.5 < float(np.median(depth[ys, xs])) < 0.7
     finally:
         s.close()
+
+
+def test_connecting_prints_nothing(capfd):
+    """pybullet printed ``argv[0]=`` (C stdout) twice per Simulation, so once per trial and
+    client in every experiment log; the caller's own output stays as it was."""
+    print('before', flush=True)
+    for _ in range(2):
+        Simulation('set_locations', seed=0, camera=CameraConfig(64, 64, 10.0)).close()
+    print('after', flush=True)
+    out, err = capfd.readouterr()
+    assert 'argv[0]' not in out + err
+    assert out == 'before\nafter\n'

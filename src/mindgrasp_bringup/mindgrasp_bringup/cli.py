@@ -10,11 +10,13 @@ does not break the others.
 from __future__ import annotations
 
 import argparse
+import functools
 import importlib
 import importlib.util
 import sys
 from collections.abc import Sequence
 
+from mindgrasp_common.cli_checks import OneLineParser
 from mindgrasp_ros.process import handle_stop_signals
 
 #: command -> module, or command -> {verb: module}
@@ -77,8 +79,10 @@ COMMANDS: dict[str, str | dict[str, str]] = {
 }
 
 
+@functools.cache
 def _module_doc(module_name: str) -> str:
-    """Docstring of a command module, without importing heavy packages on --help."""
+    """Docstring of a command module, without importing heavy packages on --help (read once
+    per process: in-process callers such as tests build the parser many times)."""
     try:
         spec = importlib.util.find_spec(module_name)
     except (ImportError, ValueError):
@@ -121,7 +125,7 @@ def _import(module_name: str):
 
 def build_parser(argv: Sequence[str]) -> argparse.ArgumentParser:
     """Build the parser; only the command named in ``argv`` imports its module."""
-    parser = argparse.ArgumentParser(
+    parser = OneLineParser(
         prog='mindgrasp',
         description='MIndGrasp-ROS: motor-imagery EEG control of an assistive arm on ROS 2.')
     sub = parser.add_subparsers(dest='command', metavar='<command>')
@@ -150,8 +154,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parser.parse_args(argv)
     module_name = getattr(args, '_module', None)
     if module_name is None:
-        parser.print_help()
-        return 0 if not argv else 2
+        if not argv:
+            parser.print_help()
+            return 0
+        verbs = COMMANDS.get(args.command, {})  # a command given without its verb
+        print(f'mindgrasp {args.command}: error: a verb is required: {", ".join(verbs)} '
+              f'(see mindgrasp {args.command} --help)', file=sys.stderr)
+        return 2
     handle_stop_signals()    # Ctrl-C and SIGTERM stop every command, even one run in the background
     module = _import(module_name)
     if module is None:

@@ -18,8 +18,9 @@ waking for each message (benchmarks/live_view.py); with the real rclpy, or ``pol
 each message is sent on as it arrives. A slow client loses its oldest messages beyond
 ``message_backlog_size``, and the node warns about it; the graph never waits for it. Listens on
 loopback only unless ``address`` says otherwise. A port in use ends the node with exit code 2 and
-one line naming the fix; with ``port_in_use:=any`` (the launch profiles) it serves on a free port
-instead and says which.
+one line naming the port and the fix (``port:=``), as foxglove_bridge; with ``port_in_use:=skip``
+(the launch profiles) the line is an error log and the node ends with 0, so the rest of a launch
+runs on without its live view.
 """
 
 from __future__ import annotations
@@ -48,10 +49,10 @@ class BridgeParams:
     port: int = param(DEFAULT_PORT, 'TCP port of the WebSocket server (0: any free port)',
                       min=0, max=65535)
     address: str = param('127.0.0.1', 'address to listen on (loopback: this machine only)')
-    # the launch profiles say 'any': a second demo on this machine must not stop for its view
+    # the launch profiles say 'skip': a second demo on this machine must not stop for its view
     port_in_use: str = param('fail', "when the port is taken: 'fail' (exit 2, as "
-                             "foxglove_bridge) or 'any' (serve on a free port, with a warning)",
-                             choices=('fail', 'any'))
+                             "foxglove_bridge) or 'skip' (log the error and end with 0: the rest "
+                             'of a launch runs on without the view)', choices=('fail', 'skip'))
     # param() returns a dataclasses.field with a default_factory for lists
     topic_whitelist: list[str] = param(['.*'], 'regexes of the topics to serve')
     message_backlog_size: int = param(
@@ -89,12 +90,13 @@ class FoxgloveBridgeNode(rclpy.node.Node):
         try:
             self.server = FoxgloveServer(self.params.address, self.params.port, **server_options)
         except LiveViewError as exc:
-            if self.params.port_in_use != 'any' or 'in use' not in str(exc):
+            if self.params.port_in_use != 'skip' or 'in use' not in str(exc):
                 raise
-            self.server = FoxgloveServer(self.params.address, 0, **server_options)
-            self.get_logger().warning(
-                f'The live view port {self.params.port} is in use (another live view?); '
-                f'serving on port {self.server.port} instead.')
+            # not a free port instead: a view on a port nobody asked for is one nobody finds
+            self.server = None
+            self.get_logger().error(f'{exc} The live view is off; the rest runs on.')
+            self.done.set_result(0)
+            return
         self._types: dict[str, str] = {}                   # advertised topic -> type
         self._subscriptions: dict[str, Any] = {}           # watched topic -> subscription
         self._requested: dict[str, dict[str, Any]] = {}    # watched topic -> QoS
@@ -194,6 +196,9 @@ class FoxgloveBridgeNode(rclpy.node.Node):
                 self.server.log(topic, data, info.get('source_timestamp') or now)
 
     def destroy_node(self) -> None:
+        if self.server is None:     # never served (port_in_use:=skip)
+            super().destroy_node()
+            return
         sent = sum(t.messages for t in self.server.topics.values())
         slow = ', '.join(f'{client} ({n})' for client, n in self.server.drop_reports.items())
         self.get_logger().info(f'Live view served {len(self.server.topics)} topic(s), '

@@ -65,6 +65,7 @@ _HELPERS = {
     'config_files': 'mindgrasp_bringup.launch_system.params',
     'number_argument': 'mindgrasp_bringup.launch_system.number_argument',
     'file_argument': 'mindgrasp_bringup.launch_system.number_argument',
+    'checked_argument': 'mindgrasp_bringup.launch_system.number_argument',
     'classifier_nodes': 'mindgrasp_bringup.launch_system.common',
     'eeg_source_arguments': 'mindgrasp_bringup.launch_system.common',
     'eeg_source_nodes': 'mindgrasp_bringup.launch_system.common',

@@ -6,6 +6,7 @@ names from ``ros_discovery_info`` (see :mod:`mindgrasp_ros.runtime.graph`).
 
 from __future__ import annotations
 
+import argparse
 import contextlib
 import os
 import sys
@@ -16,12 +17,55 @@ from typing import Any
 import numpy as np
 import yaml
 
-__all__ = ['CliError', 'cli_node', 'find_topic_type', 'message_to_yaml', 'resolve_field',
-           'set_fields', 'wait_for_graph']
+__all__ = ['CliError', 'UsageError', 'cli_node', 'find_topic_type', 'message_to_yaml',
+           'message_type', 'node_name', 'resolve_field', 'set_fields', 'topic_name',
+           'wait_for_graph']
 
 
 class CliError(Exception):
     """A command-line error with a message for the user."""
+
+
+# argparse ``type=`` checks of names and types: a bad one is a usage error (one line, exit 2)
+# before any DDS traffic, instead of a traceback from the node that would have used it
+
+def topic_name(text: str) -> str:
+    """A valid ROS topic name (``/eeg/raw``, ``eeg/raw``, ``~/out``)."""
+    from mindgrasp_ros.runtime.exceptions import InvalidNameError
+    from mindgrasp_ros.runtime.names import validate_topic_name
+
+    try:
+        return validate_topic_name(text)
+    except InvalidNameError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
+def node_name(text: str) -> str:
+    """A valid node name, fully qualified (``/fsm``, ``/trainer_robot/sim``) or relative."""
+    from mindgrasp_ros.runtime.exceptions import InvalidNameError
+    from mindgrasp_ros.runtime.names import validate_namespace, validate_node_name
+
+    namespace, _, name = text.rpartition('/')
+    try:
+        if '//' in text:
+            raise InvalidNameError(f'Invalid node name {text!r}: it must not contain "//".')
+        validate_namespace(namespace)
+        validate_node_name(name)
+    except InvalidNameError as exc:
+        msg = f'{exc} Node names look like /fsm or /trainer_robot/sim (mindgrasp node list).'
+        raise argparse.ArgumentTypeError(msg) from None
+    return text
+
+
+def message_type(text: str) -> str:
+    """A message type the runtime knows (``std_msgs/msg/String`` or ``std_msgs/String``)."""
+    from mindgrasp_ros.typesupport import MessageTypeError, get_message_class
+
+    try:
+        get_message_class(text)
+    except MessageTypeError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+    return text
 
 
 @contextlib.contextmanager
@@ -117,15 +161,20 @@ def resolve_field(msg: Any, path: str) -> Any:
 def set_fields(msg: Any, values: dict[str, Any]) -> Any:
     """Fill a message from a dict (YAML of ``topic pub``), recursively, naming bad fields."""
     from mindgrasp_ros.typesupport import get_message_class
+    from mindgrasp_ros.value_ranges import check_value
 
     fields = msg.get_fields_and_field_types()
     for key, value in values.items():
         if key not in fields:
             text = (f'{msg.__msgtype__} has no field {key!r}; its fields are: '
                     f'{", ".join(fields)}.')
-            raise CliError(text)
+            raise UsageError(text)
         current = getattr(msg, key)
-        if hasattr(current, '_fields') and isinstance(value, dict):
+        if hasattr(current, '_fields'):
+            if not isinstance(value, dict):
+                text = (f'Field {key!r} is a {fields[key]} message: give its fields as a mapping, '
+                        f'e.g. "{{{key}: {{...}}}}"; {value!r} is not one.')
+                raise UsageError(text)
             set_fields(current, value)
         elif isinstance(current, list) and isinstance(value, list) and value and \
                 isinstance(value[0], dict):
@@ -135,12 +184,20 @@ def set_fields(msg: Any, values: dict[str, Any]) -> Any:
             setattr(msg, key, [set_fields(cls(), v) for v in value])
         else:
             try:
+                check_value(f'{msg.__msgtype__} field {key!r}', fields[key], value)
                 setattr(msg, key, value)
-            except (TypeError, ValueError) as exc:
-                raise CliError(f'Field {key!r}: {exc}') from None
+            except (TypeError, ValueError, OverflowError) as exc:
+                raise UsageError(str(exc)) from None
     return msg
 
 
+class UsageError(CliError):
+    """Bad input found before anything is sent (a value that does not fit its field): exit
+    code 2, as argparse gives for a bad value."""
+
+
 def print_error(exc: Exception) -> int:
+    """Print ``exc`` as the command's one error line; the exit code (2 for a
+    :class:`UsageError`, else 1)."""
     print(f'mindgrasp: {exc}', file=sys.stderr)
-    return 1
+    return 2 if isinstance(exc, UsageError) else 1

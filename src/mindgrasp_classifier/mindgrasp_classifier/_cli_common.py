@@ -7,6 +7,7 @@ import json
 from typing import Any
 
 from mindgrasp_classifier.data import Recording, load_inputs
+from mindgrasp_common.cli_checks import finite_float
 from mindgrasp_ros.topics import EEG_RAW, TRAINER_PROMPT, VIRTUAL_SUBJECT_INTENT
 
 
@@ -41,8 +42,10 @@ def add_data_arguments(parser: argparse.ArgumentParser) -> None:
     g.add_argument('--rest', action='store_true',
                    help="label rest epochs as class 'rest' (EEGMMIDB: the T0 annotations; other "
                         'files: map their rest annotation in --event-map, e.g. T0=rest)')
-    g.add_argument('--tmin', type=float, default=0.5, help='epoch start after the cue (s, 0.5)')
-    g.add_argument('--tmax', type=float, default=2.5, help='epoch end after the cue (s, 2.5)')
+    g.add_argument('--tmin', type=finite_float, default=0.5,
+                   help='epoch start after the cue (s, 0.5)')
+    g.add_argument('--tmax', type=finite_float, default=2.5,
+                   help='epoch end after the cue (s, 2.5)')
 
 
 def load_from_args(args: argparse.Namespace, rest: bool = False) -> list[Recording]:

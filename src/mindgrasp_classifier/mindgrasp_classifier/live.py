@@ -24,7 +24,7 @@ import numpy as np
 
 from mindgrasp_classifier.data import Recording
 from mindgrasp_classifier.errors import ClassifierError
-from mindgrasp_classifier.model import MiModel
+from mindgrasp_classifier.model import MiModel, resolve_model_path
 from mindgrasp_classifier.training import score_predictions
 from mindgrasp_ros.node_process import NodeProcess
 from mindgrasp_ros.topics import BCI_PREDICTION, EEG_RAW
@@ -174,7 +174,7 @@ def evaluate_live(model_path: str, recordings: Sequence[Recording], tmin: float 
         for i, rec in enumerate(recordings):
             work = Path(tmp) / f'rec{i}'
             work.mkdir()
-            results.append(stream_live(str(Path(model_path).resolve()), rec, work,
+            results.append(stream_live(str(resolve_model_path(model_path)), rec, work,
                                        progress=progress,
                                        desc=f'live {i + 1}/{len(recordings)}'))
     report = score_predictions(model, recordings, results, tmin, tmax)

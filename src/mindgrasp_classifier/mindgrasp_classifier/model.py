@@ -188,12 +188,7 @@ class MiModel:
         ``path``: the .json (or its stem), relative to the working directory, or a data file of
         this package (``models/default_classifier.json``), or ``package://<package>/<path>``.
         """
-        try:
-            path = resolve_path(path, 'mindgrasp_classifier', ('.json',))
-        except ResourceNotFoundError as exc:
-            msg = f'{exc} Give the path of a model written by `mindgrasp train classifier`.'
-            raise ClassifierError(msg) from None
-        json_path, _ = model_paths(path)
+        json_path = resolve_model_path(path)
         if not json_path.is_file():
             msg = (f'The model file {json_path} does not exist; train one with '
                    '`mindgrasp train classifier` or give the path of an existing model.')
@@ -256,6 +251,25 @@ class MiModel:
                    f'{model.reference.shape}; the files are inconsistent, retrain the model.')
             raise ClassifierError(msg)
         return model
+
+
+def resolve_model_path(path: str | Path) -> Path:
+    """The absolute path of a model's .json, for a path a user gave: with or without the suffix,
+    relative to the working directory, a data file of this package (``models/...``) or a
+    ``package://<package>/<path>`` URI. The one resolver of model paths: the CLI, the live
+    evaluation (which hands the path to a node in another working directory) and the nodes.
+
+    Raises
+    ------
+    ClassifierError
+        A ``package://`` URI whose package or file does not exist.
+    """
+    try:
+        resolved = resolve_path(path, 'mindgrasp_classifier', ('.json',))
+    except ResourceNotFoundError as exc:
+        msg = f'{exc} Give the path of a model written by `mindgrasp train classifier`.'
+        raise ClassifierError(msg) from None
+    return model_paths(resolved)[0].absolute()
 
 
 def model_paths(path: str | Path) -> tuple[Path, Path]:

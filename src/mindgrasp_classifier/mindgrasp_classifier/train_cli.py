@@ -14,8 +14,13 @@ from mindgrasp_classifier._cli_common import (
 from mindgrasp_classifier.errors import ClassifierError
 from mindgrasp_classifier.model import class_index, model_paths
 from mindgrasp_classifier.pipelines import PIPELINES
-from mindgrasp_classifier.training import TrainingConfig, train
-from mindgrasp_common.cli_checks import non_negative_int, positive_float, positive_int
+from mindgrasp_classifier.training import COVARIANCE_ESTIMATORS, TrainingConfig, train
+from mindgrasp_common.cli_checks import (
+    finite_float,
+    non_negative_int,
+    positive_float,
+    positive_int,
+)
 from mindgrasp_common.mi import REST
 
 
@@ -31,15 +36,16 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     g.add_argument('--classes', default=None,
                    help='classes to keep, e.g. left_hand,right_hand or rest,both_hands,both_feet '
                         '(default: all in the data; rest implies --rest)')
-    g.add_argument('--band', type=float, nargs=2, default=(8.0, 30.0), metavar=('LOW', 'HIGH'),
-                   help='band-pass (Hz, 8 30)')
+    g.add_argument('--band', type=finite_float, nargs=2, default=(8.0, 30.0),
+                   metavar=('LOW', 'HIGH'), help='band-pass (Hz, 8 30)')
     g.add_argument('--filter-order', type=positive_int, default=4, help='Butterworth order (4)')
     g.add_argument('--window', type=positive_float, default=1.0, help='window length (s, 1.0)')
     g.add_argument('--step', type=positive_float, default=1 / 16,
                    help='online window step (s, 0.0625)')
     g.add_argument('--train-step', type=positive_float, default=1 / 16,
                    help='step of training windows inside an epoch (s, 0.0625)')
-    g.add_argument('--estimator', default='oas', help='pyRiemann covariance estimator (oas)')
+    g.add_argument('--estimator', default='oas', choices=COVARIANCE_ESTIMATORS,
+                   help='pyRiemann covariance estimator (oas)')
     g.add_argument('--cv', type=non_negative_int, default=5,
                    help='folds of the trial-grouped k-fold, 0 for no cross-validation (5); several '
                         'recordings are cross-validated leave-one-run-out')

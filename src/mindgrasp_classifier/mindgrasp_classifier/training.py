@@ -50,6 +50,10 @@ from mindgrasp_common.mi import REST
 LORO, KFOLD = 'leave_one_run_out', 'trial_grouped_kfold'
 
 
+#: pyRiemann's covariance estimators (``Covariances(estimator=...)``; its list is private)
+COVARIANCE_ESTIMATORS = ('corr', 'cov', 'hub', 'lwf', 'mcd', 'oas', 'sch', 'scm', 'stu', 'tyl')
+
+
 @dataclass
 class TrainingConfig:
     """Settings of a model (all times in seconds, frequencies in Hz).
@@ -106,6 +110,10 @@ class TrainingConfig:
         """Raise :class:`ClassifierError` on an invalid setting."""
         if self.pipeline not in PIPELINES:
             msg = f'Unknown pipeline {self.pipeline!r}; choose one of {list(PIPELINES)}.'
+            raise ClassifierError(msg)
+        if self.estimator not in COVARIANCE_ESTIMATORS:
+            msg = (f'Unknown covariance estimator {self.estimator!r}; choose one of '
+                   f'{list(COVARIANCE_ESTIMATORS)}.')
             raise ClassifierError(msg)
         if self.tmax - self.tmin < self.window:
             msg = (f'The epoch {self.tmin}-{self.tmax} s is shorter than the window '

@@ -18,9 +18,10 @@ Annotations (onset in seconds from the first sample, from the message header sta
   next change.
 
 MNE selects annotations by their ``/``-separated tags, so ``epochs['success']`` or
-``epochs['target']`` epoch by trial outcome or target. The raw data get the ``standard_1020``
-montage (positions of the channels it knows; others stay without position); FIF keeps it, EDF has
-no field for positions (``raw.set_montage('standard_1020')`` after reading).
+``epochs['target']`` epoch by trial outcome or target. The raw data get the standard 10-20
+montage (:func:`~.montage.standard_montage`: positions of the channels it knows; others stay
+without position); FIF keeps it, EDF has no field for positions
+(``raw.set_montage(standard_montage())`` after reading).
 
 Units: EEGChunk data are volts; MNE keeps volts (FIF float32; EDF scales to 16-bit per channel).
 """
@@ -43,7 +44,7 @@ from mindgrasp_ros.topics import (
 )
 
 from . import EEGError
-from .montage import class_name
+from .montage import class_name, standard_montage
 
 FORMATS = ('fif', 'edf')
 
@@ -184,8 +185,7 @@ def to_raw(recording: Recording):
     raw = mne.io.RawArray(np.nan_to_num(recording.data, nan=0.0).T, info, verbose='error')
     raw.set_meas_date(dt.datetime.fromtimestamp(recording.start_ns * 1e-9, tz=dt.timezone.utc))
     # electrode positions for topographies and source analysis; channels outside 10-20 keep none
-    raw.set_montage(mne.channels.make_standard_montage('standard_1020'), on_missing='ignore',
-                    match_case=False, verbose='error')
+    raw.set_montage(standard_montage(), on_missing='ignore', match_case=False, verbose='error')
     if recording.annotations:
         onset, duration, desc = zip(*recording.annotations, strict=True)
         raw.set_annotations(mne.Annotations(onset, duration, desc,

@@ -50,7 +50,15 @@ def expand_sources(sources: Sequence[str]) -> list[str]:
         import mne
 
         # MNE finds the data itself: $MNE_DATASETS_EEGBCI_PATH, else its config, else ~/mne_data
-        paths = mne.datasets.eegbci.load_data(subj, run_list, update_path=False, verbose='error')
+        try:
+            paths = mne.datasets.eegbci.load_data(subj, run_list, update_path=False,
+                                                  verbose='error')
+        except Exception as exc:    # download or registry errors of MNE/pooch (S999 is unknown)
+            problem = ' '.join(str(exc).split())
+            msg = (f'MNE could not provide the EEGMMIDB recording {src} ({type(exc).__name__}: '
+                   f'{problem}); EEGMMIDB has subjects 1-109 and runs 1-14. Set '
+                   'MNE_DATASETS_EEGBCI_PATH to a folder that holds it, or allow the download.')
+            raise EEGError(msg) from None
         out.extend(str(p) for p in paths)
     return out
 

@@ -48,6 +48,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+from mindgrasp_common.cli_checks import yaml_error_text
 from mindgrasp_common.errors import CommonError
 from mindgrasp_common.mi import CLASS_NAMES, class_index
 from mindgrasp_common.types import Recording
@@ -183,6 +184,27 @@ def parse_replay_source(text: str) -> int:
     return number
 
 
+#: what the virtual amplifier's ``eeg_source`` may be, for messages
+EEG_SOURCE_FORMS = ('synthetic (the head model), eegmmidb:<subject> (EEGMMIDB subjects 1-109) or '
+                    'the path of a subject file (.yaml)')
+
+
+def check_eeg_source(text: str) -> None:
+    """Raise :class:`EEGError` unless ``text`` is a valid ``eeg_source`` (:data:`EEG_SOURCE_FORMS`):
+    launch profiles check it before any node starts. Reads no recording."""
+    if text == 'synthetic':
+        return
+    if text.lower().endswith(SUBJECT_SUFFIXES):
+        if not Path(text).expanduser().is_file():
+            msg = f'the subject file {text!r} does not exist; give {EEG_SOURCE_FORMS}.'
+            raise EEGError(msg)
+        return
+    if not text.lower().startswith('eegmmidb:'):
+        msg = f'{text!r} is not an EEG source; give {EEG_SOURCE_FORMS}.'
+        raise EEGError(msg)
+    parse_replay_source(text)   # its message names the subject range
+
+
 def is_replay_source(text: str) -> bool:
     """A replay subject (``eegmmidb:<n>`` or a subject file ``*.yaml``/``*.yml``)?"""
     return text.lower().startswith('eegmmidb:') or text.lower().endswith(SUBJECT_SUFFIXES)
@@ -210,16 +232,7 @@ def _eegbci_paths(reference: str) -> list[Path]:
     """Files of ``eegbci:<subject>:<run>[,<run>]`` through MNE's loader (errors as EEGError)."""
     from .player import expand_sources
 
-    try:
-        return [Path(p).resolve() for p in expand_sources([reference])]
-    except EEGError:
-        raise
-    except Exception as exc:    # download or file errors from MNE/pooch
-        problem = ' '.join(str(exc).split())
-        msg = (f'MNE could not provide the EEGMMIDB recording {reference} ({type(exc).__name__}: '
-               f'{problem}); set MNE_DATASETS_EEGBCI_PATH to a folder that holds it, or allow '
-               'the download.')
-        raise EEGError(msg) from None
+    return [Path(p).resolve() for p in expand_sources([reference])]
 
 
 def load_subject_file(path: str | Path) -> SubjectFiles:
@@ -241,7 +254,7 @@ def load_subject_file(path: str | Path) -> SubjectFiles:
     try:
         doc = yaml.safe_load(path.read_text())
     except (yaml.YAMLError, UnicodeDecodeError) as exc:
-        problem = ' '.join(str(exc).split())
+        problem = yaml_error_text(exc)
         msg = f'The subject file {path} is not valid YAML ({problem}); fix its syntax.'
         raise EEGError(msg) from None
     where = str(path)

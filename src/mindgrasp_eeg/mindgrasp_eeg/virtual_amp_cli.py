@@ -44,8 +44,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help='stream without ROS (internal cue schedule with --cues)')
     parser.add_argument('--cues', type=non_negative_int, default=0,
                         help='--no-ros: number of cued trials (0 = none, the subject rests)')
-    parser.add_argument('ros_args', nargs=argparse.REMAINDER,
-                        help='--ros-args ... passed to the node')
+    # an option, not a REMAINDER positional: argparse hands a positional REMAINDER nothing that
+    # starts with '-' when no positional comes before it, so '--ros-args ...' was refused
+    parser.add_argument('--ros-args', dest='ros_args', nargs=argparse.REMAINDER, default=[],
+                        metavar='ARG', help='ROS arguments passed on to the node, e.g. '
+                                            '--ros-args -p seed:=1 -r __node:=amp2 (last)')
 
 
 def _ros_argv(args: argparse.Namespace) -> list[str]:
@@ -56,10 +59,7 @@ def _ros_argv(args: argparse.Namespace) -> list[str]:
     argv = ['--ros-args']
     for key, value in params.items():
         argv += ['-p', f'{key}:={value}']
-    extra = list(args.ros_args or [])
-    if extra[:1] == ['--ros-args']:
-        extra = extra[1:]
-    return argv + extra
+    return argv + list(args.ros_args)  # after ours: a -p given here wins
 
 
 def run_without_ros(args: argparse.Namespace) -> int:
@@ -111,6 +111,10 @@ def main(args: argparse.Namespace) -> int:
     parameter), or 1 with a message when the ROS-free loop cannot start."""
     try:
         if args.no_ros:
+            if args.ros_args:
+                print('mindgrasp eeg virtual-amp: error: --ros-args needs the ROS node; leave '
+                      'out --no-ros or the ROS arguments.', file=sys.stderr)
+                return 2
             return run_without_ros(args)
         from .virtual_amp_node import main as node_main
 

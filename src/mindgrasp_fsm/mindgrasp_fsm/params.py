@@ -14,6 +14,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from mindgrasp_common.cli_checks import yaml_error_text
 from mindgrasp_common.resources import resource_path
 from mindgrasp_common.robot import (
     ARM_JOINTS,
@@ -421,7 +422,8 @@ class FsmParams:
         try:
             data = yaml.safe_load(path.read_text(encoding='utf-8')) or {}
         except (OSError, yaml.YAMLError) as exc:
-            msg = f'Cannot read the controller parameter file {path}: {exc}. Give a ROS YAML file.'
+            msg = (f'Cannot read the controller parameter file {path}: '
+                   f'{yaml_error_text(exc)}. Give a ROS YAML file.')
             raise FsmError(msg) from exc
         for key in (node_name, f'/{node_name}', '/**'):
             section = data.get(key)

@@ -34,8 +34,10 @@ class ObjectObservation:
 
     @property
     def label(self) -> str:
-        """``"<colour> <shape>"``."""
-        return f'{self.colour} {self.shape}'.strip()
+        """``"<colour> <shape>"``, or ``"<colour> object"`` while the shape is unknown (not yet
+        classified): the log said "selected the yellow unknown"."""
+        shape = 'object' if self.shape in ('', 'unknown') else self.shape
+        return f'{self.colour} {shape}'.strip()
 
 
 @dataclass(frozen=True)

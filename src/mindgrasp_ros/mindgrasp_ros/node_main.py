@@ -29,7 +29,8 @@ Exit codes (one convention for every node, as the launcher reports them):
   (Ctrl-C, SIGTERM, ``rclpy.shutdown()`` from elsewhere);
 - ``1`` the node failed while running: ``done`` completed with an exception (its message is printed
   as one line ``[node] ERROR: ...``) or with a non-zero exit code;
-- ``2`` the node refused to start: its constructor raised a parameter error (rclpy's
+- ``2`` the node refused to start: its ``--ros-args`` are malformed (``-p bogus``, a missing or
+  bad ``--params-file``), or its constructor raised a parameter error (rclpy's
   ``ParameterException`` family, :class:`~mindgrasp_ros.params.ParameterError`) or one of the
   ``errors`` the caller names (the package's own error class); one line, no traceback.
 
@@ -82,6 +83,23 @@ def _parameter_errors() -> tuple[type[BaseException], ...]:
     for name in ('InvalidParameterTypeException', 'InvalidParameterValueException',
                  'ParameterUninitializedException'):
         cls = getattr(exceptions, name, None)
+        if isinstance(cls, type):
+            errors.append(cls)
+    return tuple(errors)
+
+
+def _argument_errors() -> tuple[type[BaseException], ...]:
+    """What ``rclpy.init`` raises for a malformed ``--ros-args`` section: ours, and the real
+    rclpy's ``RCLInvalidROSArgsError`` / ``UnknownROSArgsError`` when it is in use."""
+    from mindgrasp_ros.runtime.arguments import RosArgumentError
+
+    errors: list[type[BaseException]] = [RosArgumentError]
+    try:
+        from rclpy.impl.implementation_singleton import rclpy_implementation as impl
+    except ImportError:
+        return tuple(errors)
+    for name in ('RCLInvalidROSArgsError', 'UnknownROSArgsError'):  # pragma: no cover - ROS 2
+        cls = getattr(impl, name, None)
         if isinstance(cls, type):
             errors.append(cls)
     return tuple(errors)
@@ -212,9 +230,14 @@ def run_node(node_class: Callable[[], Any], args: list[str] | None = None, *,
         print(help_text(node_class))
         exit_if_main_program(EXIT_OK, getattr(node_class, '__module__', ''))
         return EXIT_OK
-    rclpy.init(args=argv)
-    node = None
     label = getattr(node_class, '__name__', 'node')
+    try:
+        rclpy.init(args=argv)
+    except _argument_errors() as exc:
+        print(f'[{label}] ERROR: {exc}', file=sys.stderr, flush=True)
+        exit_if_main_program(EXIT_REFUSED, getattr(node_class, '__module__', ''))
+        return EXIT_REFUSED
+    node = None
     try:
         try:
             node = node_class()

@@ -301,11 +301,14 @@ def read_yaml_section(path: str | Path, node_name: str) -> dict[str, Any]:
     """The ``<node_name>: ros__parameters:`` (or ``/**``) mapping of a ROS parameter file."""
     import yaml
 
+    from mindgrasp_common.cli_checks import yaml_error_text
+
     path = Path(path)
     try:
         data = yaml.safe_load(path.read_text(encoding='utf-8')) or {}
     except (OSError, yaml.YAMLError) as exc:
-        msg = f'Cannot read the parameter file {path}: {exc}. Give a ROS parameter YAML file.'
+        msg = (f'Cannot read the parameter file {path}: {yaml_error_text(exc)}. Give a ROS '
+               'parameter YAML file.')
         raise ParameterError(msg) from exc
     for key in (node_name, f'/{node_name}', '/**'):
         section = data.get(key)

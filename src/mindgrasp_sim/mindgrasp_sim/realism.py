@@ -49,6 +49,7 @@ from typing import Any
 import numpy as np
 import yaml
 
+from mindgrasp_common.cli_checks import yaml_error_text
 from mindgrasp_common.resources import resource_path
 from mindgrasp_sim.errors import SimError
 
@@ -324,7 +325,8 @@ class RealismProfile:
         try:
             data = yaml.safe_load(path.read_text(encoding='utf-8'))
         except yaml.YAMLError as exc:
-            msg = f'Realism profile {str(path)!r} is not valid YAML ({exc}); fix its syntax.'
+            msg = (f'Realism profile {str(path)!r} is not valid YAML '
+                   f'({yaml_error_text(exc)}); fix its syntax.')
             raise SimError(msg) from None
         return cls.from_dict(data or {}, name=path.stem)
 

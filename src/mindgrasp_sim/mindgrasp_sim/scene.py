@@ -35,6 +35,7 @@ from typing import Any
 import numpy as np
 import yaml
 
+from mindgrasp_common.cli_checks import yaml_error_text
 from mindgrasp_common.resources import resource_path
 from mindgrasp_sim.errors import SimError
 
@@ -294,7 +295,8 @@ def load_scene(scene: str | Path | dict) -> SceneSpec:
         try:
             data = yaml.safe_load(path.read_text(encoding='utf-8'))
         except yaml.YAMLError as exc:
-            msg = f'Scene file {source!r} is not valid YAML ({exc}); fix its syntax.'
+            msg = (f'Scene file {source!r} is not valid YAML ({yaml_error_text(exc)}); fix its '
+                   'syntax.')
             raise SimError(msg) from None
     if not isinstance(data, dict):
         msg = f'Scene {source!r} must be a mapping with an objects: and/or random: section.'

@@ -622,10 +622,14 @@ class SimNode(rclpy.node.Node):
         wall = time.monotonic() - self._wall_start
         simulated = self.total_steps * self.sim.dt
         cpu = time.process_time() - self._cpu_start
-        self.get_logger().info(
-            f'Simulated {simulated:.2f} s in {wall:.2f} s wall time: real-time factor '
-            f'{simulated / max(wall, 1e-9):.2f}x ({simulated / max(cpu, 1e-9):.2f}x per CPU '
-            'second of this process).')
+        if simulated > 0:
+            self.get_logger().info(
+                f'Simulated {simulated:.2f} s in {wall:.2f} s wall time: real-time factor '
+                f'{simulated / max(wall, 1e-9):.2f}x ({simulated / max(cpu, 1e-9):.2f}x per CPU '
+                'second of this process).')
+        else:   # stopped before the first step: a factor of 0.00x says nothing
+            self.get_logger().info(f'Stopped after {wall:.2f} s wall time, before the first '
+                                   'simulation step.')
         self.sim.close()
         super().destroy_node()
 

@@ -79,6 +79,14 @@ class _Client(BulletClient):
     new ``functools.partial`` (after an ``inspect`` check) on every call, thousands per simulated
     second in the physics loop."""
 
+    def __init__(self, connection_mode: int) -> None:
+        # BulletClient connects with options='', and pybullet's C code prints "argv[0]=" for any
+        # options string: two lines per Simulation, per trial in an experiment. pb.connect
+        # without options prints nothing. (The attributes are the ones BulletClient sets.)
+        self._shapes: dict = {}
+        self._pid = os.getpid()
+        self._client = pb.connect(connection_mode)
+
     def __getattr__(self, name: str) -> object:
         attribute = super().__getattr__(name)
         if name != 'disconnect' and isinstance(attribute, functools.partial):
@@ -88,8 +96,8 @@ class _Client(BulletClient):
 
 @contextlib.contextmanager
 def _c_stdout_to_stderr() -> Iterator[None]:
-    """PyBullet's C code prints ``argv[0]=`` to stdout on every connect; send it to stderr so
-    stdout stays the caller's (e.g. a command's --json line)."""
+    """PyBullet's C code may print to stdout while it connects (the GUI's OpenGL report); send it
+    to stderr so stdout stays the caller's (e.g. a command's --json line)."""
     libc = ctypes.CDLL(None)
     sys.stdout.flush()
     saved = os.dup(1)

@@ -15,7 +15,12 @@ import csv
 import json
 import sys
 
-from mindgrasp_common.cli_checks import non_negative_float, non_negative_int, positive_int
+from mindgrasp_common.cli_checks import (
+    OneLineParser,
+    non_negative_float,
+    non_negative_int,
+    positive_int,
+)
 from mindgrasp_trainer.graz import GrazProtocol
 from mindgrasp_trainer.protocol import CLASS_NAMES, NO_CLASS, PromptEvent, TrainerError
 from mindgrasp_trainer.trainer import TrainerProtocol
@@ -88,6 +93,6 @@ def main(args: argparse.Namespace) -> int:
 
 
 if __name__ == '__main__':
-    parser = argparse.ArgumentParser(prog='mindgrasp trainer schedule', description=__doc__)
+    parser = OneLineParser(prog='mindgrasp trainer schedule', description=__doc__)
     add_arguments(parser)
     sys.exit(main(parser.parse_args()))

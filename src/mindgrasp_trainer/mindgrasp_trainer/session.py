@@ -50,6 +50,7 @@ from typing import Any
 
 import yaml
 
+from mindgrasp_common.cli_checks import yaml_error_text
 from mindgrasp_common.resources import resource_path
 from mindgrasp_ros.topics import DISPLAY_FLIP, TASK_RESULT, TASK_TARGET, TRAINER_PROMPT
 from mindgrasp_trainer.protocol import TrainerError
@@ -119,7 +120,7 @@ def load_plan(plan: str) -> Plan:
     try:
         data = yaml.safe_load(path.read_text(encoding='utf-8')) or {}
     except yaml.YAMLError as err:
-        msg = f'The plan {path} is not valid YAML: {err}'.replace('\n', ' ')
+        msg = f'The plan {path} is not valid YAML: {yaml_error_text(err)}'
         raise SessionError(msg) from None
     where = f'plan {path.name}'
     if not isinstance(data, dict) or not isinstance(data.get('phases'), list) or \

@@ -202,6 +202,17 @@ class RecorderNode(rclpy.node.Node):
                               'topic name).')
         return out
 
+    def _idle(self, topic: str) -> bool:
+        """A topic nobody named that carried nothing in this run: its publishers had nothing to
+        say, or it only had subscribers (``/trainer/prompt`` in a demo without a trainer). Not a
+        fault, so its "not recorded" line is info (still in metadata.yaml); a topic named in
+        ``topics``, a QoS that never matched and an unknown type stay warnings."""
+        if topic in self.topics:
+            return False
+        matched_but_silent = topic in self._requested and topic in self._matched
+        listened_only = topic in self._unpublished and topic not in self._requested
+        return matched_but_silent or listened_only
+
     def _make_callback(self, topic: str) -> Any:
         push = self.recorder.push
         clock = self.get_clock()
@@ -264,7 +275,8 @@ class RecorderNode(rclpy.node.Node):
                                f'{self.recorder.writer.path}; {dropped} dropped{fault}; '
                                f'{len(missing)} topic(s) not recorded.')
         for topic, why in missing.items():
-            self.get_logger().warning(f'Not recorded: {topic}: {why}')
+            log = self.get_logger().info if self._idle(topic) else self.get_logger().warning
+            log(f'Not recorded: {topic}: {why}')
         return self.recorder.error
 
 

@@ -10,7 +10,7 @@ import sys
 from mindgrasp_bringup.launch_system import LaunchError, LaunchService, profiles
 from mindgrasp_bringup.launch_system.description import LAUNCH_SUFFIX, PROFILE_DIR
 from mindgrasp_bringup.launch_system.service import format_arguments
-from mindgrasp_common.cli_checks import non_negative_float, positive_float
+from mindgrasp_common.cli_checks import OneLineParser, non_negative_float, positive_float
 
 EPILOG = """examples:
   mindgrasp launch demo                      headless demo, recorded to runs/<UTC time>_demo/
@@ -64,7 +64,7 @@ def _split_remainder(args: argparse.Namespace) -> argparse.Namespace:
         (options if item.startswith('-') or (options and options[-1] in _TAKES_VALUE
                                              and ':=' not in item) else given).append(item)
     if options:
-        parser = argparse.ArgumentParser(prog='mindgrasp launch')
+        parser = OneLineParser(prog='mindgrasp launch')
         _options(parser)
         parser.parse_args(options, namespace=args)  # keeps what is set, adds the rest
     args.launch_arguments = given

@@ -9,7 +9,7 @@ from __future__ import annotations
 import argparse
 
 from mindgrasp_bringup.commands._param_client import call
-from mindgrasp_bringup.ros_cli import CliError, cli_node, print_error
+from mindgrasp_bringup.ros_cli import CliError, cli_node, node_name, print_error
 
 TYPE_NAMES = {0: 'not set', 1: 'boolean', 2: 'integer', 3: 'double', 4: 'string',
               5: 'byte array', 6: 'boolean array', 7: 'integer array', 8: 'double array',
@@ -17,7 +17,7 @@ TYPE_NAMES = {0: 'not set', 1: 'boolean', 2: 'integer', 3: 'double', 4: 'string'
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument('node', help='fully qualified node name, e.g. /fsm')
+    parser.add_argument('node', type=node_name, help='fully qualified node name, e.g. /fsm')
     parser.add_argument('names', nargs='+', help='parameter names')
 
 

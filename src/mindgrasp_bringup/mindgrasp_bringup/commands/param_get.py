@@ -5,14 +5,14 @@ from __future__ import annotations
 import argparse
 
 from mindgrasp_bringup.commands._param_client import call
-from mindgrasp_bringup.ros_cli import CliError, cli_node, print_error
+from mindgrasp_bringup.ros_cli import CliError, cli_node, node_name, print_error
 
 TYPE_LABELS = {1: 'Boolean', 2: 'Integer', 3: 'Double', 4: 'String', 5: 'Byte array',
                6: 'Boolean array', 7: 'Integer array', 8: 'Double array', 9: 'String array'}
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument('node', help='fully qualified node name')
+    parser.add_argument('node', type=node_name, help='fully qualified node name')
     parser.add_argument('name', help='parameter name, e.g. window_length')
     parser.add_argument('--hide-type', action='store_true', help='print the value only')
 

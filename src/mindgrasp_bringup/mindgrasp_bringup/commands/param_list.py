@@ -5,11 +5,11 @@ from __future__ import annotations
 import argparse
 
 from mindgrasp_bringup.commands._param_client import call
-from mindgrasp_bringup.ros_cli import CliError, cli_node, print_error
+from mindgrasp_bringup.ros_cli import CliError, cli_node, node_name, print_error
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument('node', help='fully qualified node name, e.g. /classifier')
+    parser.add_argument('node', type=node_name, help='fully qualified node name, e.g. /classifier')
     parser.add_argument('--param-prefixes', nargs='*', default=[], help='only these prefixes')
 
 

@@ -13,8 +13,9 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+from pathlib import Path
 
-from mindgrasp_bringup.launch_system.actions.node import resolve_program
+from mindgrasp_bringup.launch_system.actions.node import find_module, resolve_program
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -24,7 +25,21 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help='arguments of the node (e.g. --ros-args -p name:=value)')
 
 
+def _package_exists(package: str) -> bool:
+    """``package`` is one of our Python packages or in a sourced ROS 2 workspace's index."""
+    if find_module(package):
+        return True
+    return any(Path(prefix, 'share', 'ament_index', 'resource_index', 'packages', package).is_file()
+               for prefix in os.environ.get('AMENT_PREFIX_PATH', '').split(os.pathsep) if prefix)
+
+
 def main(args: argparse.Namespace) -> int:
+    if not _package_exists(args.package):
+        # as ros2 run: without this, any program on PATH named like the executable ran
+        print(f"mindgrasp run: error: package '{args.package}' not found; check the name (our "
+              "packages are mindgrasp_*) or source the ROS 2 workspace that has it.",
+              file=sys.stderr)
+        return 2
     program, _module, problem = resolve_program(args.package, args.executable)
     if problem is not None:
         print(f'mindgrasp run: {problem}', file=sys.stderr)

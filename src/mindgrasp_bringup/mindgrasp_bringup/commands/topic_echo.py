@@ -10,15 +10,18 @@ from mindgrasp_bringup.ros_cli import (
     cli_node,
     find_topic_type,
     message_to_yaml,
+    message_type,
     print_error,
     resolve_field,
+    topic_name,
 )
 from mindgrasp_common.cli_checks import non_negative_float, non_negative_int
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument('topic', help='topic name, e.g. /joint_states')
-    parser.add_argument('type', nargs='?', help='message type (default: as discovered)')
+    parser.add_argument('topic', type=topic_name, help='topic name, e.g. /joint_states')
+    parser.add_argument('type', nargs='?', type=message_type,
+                        help='message type (default: as discovered)')
     parser.add_argument('--once', action='store_true', help='print one message and exit')
     parser.add_argument('--times', type=non_negative_int, default=0, help='exit after N messages')
     parser.add_argument('--field', help='print only this field, e.g. header.stamp')

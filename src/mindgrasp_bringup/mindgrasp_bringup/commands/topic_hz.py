@@ -8,17 +8,24 @@ from collections import deque
 
 import numpy as np
 
-from mindgrasp_bringup.ros_cli import CliError, cli_node, find_topic_type, print_error
+from mindgrasp_bringup.ros_cli import (
+    CliError,
+    cli_node,
+    find_topic_type,
+    message_type,
+    print_error,
+    topic_name,
+)
 from mindgrasp_common.cli_checks import non_negative_float, positive_int
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument('topic', help='topic name, e.g. /camera/color/image_raw')
+    parser.add_argument('topic', type=topic_name, help='topic name, e.g. /camera/color/image_raw')
     parser.add_argument('-w', '--window', type=positive_int, default=100,
                         help='number of intervals in the statistics window (default 100)')
     parser.add_argument('--duration', type=non_negative_float, default=0.0,
                         help='stop after this many seconds (0: until Ctrl-C)')
-    parser.add_argument('--type', help='message type (default: as discovered)')
+    parser.add_argument('--type', type=message_type, help='message type (default: as discovered)')
 
 
 def stats(stamps: deque) -> tuple[float, float, float, float] | None:

@@ -5,11 +5,11 @@ from __future__ import annotations
 import argparse
 import time
 
-from mindgrasp_bringup.ros_cli import CliError, cli_node, find_topic_type, print_error
+from mindgrasp_bringup.ros_cli import CliError, cli_node, find_topic_type, print_error, topic_name
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument('topic', help='topic name')
+    parser.add_argument('topic', type=topic_name, help='topic name')
     parser.add_argument('-v', '--verbose', action='store_true',
                         help='list every endpoint with node name, GID and QoS')
 

@@ -7,13 +7,22 @@ import time
 
 import yaml
 
-from mindgrasp_bringup.ros_cli import CliError, cli_node, print_error, set_fields
-from mindgrasp_common.cli_checks import non_negative_int, positive_float
+from mindgrasp_bringup.ros_cli import (
+    CliError,
+    UsageError,
+    cli_node,
+    message_type,
+    print_error,
+    set_fields,
+    topic_name,
+)
+from mindgrasp_common.cli_checks import non_negative_int, positive_float, yaml_error_text
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument('topic', help='topic name, e.g. /arm_controller/commands')
-    parser.add_argument('type', help='message type, e.g. std_msgs/msg/Float64MultiArray')
+    parser.add_argument('topic', type=topic_name, help='topic name, e.g. /arm_controller/commands')
+    parser.add_argument('type', type=message_type,
+                        help='message type, e.g. std_msgs/msg/Float64MultiArray')
     parser.add_argument('values', nargs='?', default='{}',
                         help='YAML of the fields, e.g. "{data: [0.1, 0, 0, 0, 0, 0]}"')
     parser.add_argument('-r', '--rate', type=positive_float, default=1.0, help='Hz (default 1)')
@@ -40,9 +49,10 @@ def main(args: argparse.Namespace) -> int:
         try:
             values = yaml.safe_load(args.values) or {}
         except yaml.YAMLError as exc:
-            raise CliError(f'The values are not valid YAML: {exc}') from None
+            raise UsageError(f'The values are not valid YAML ({yaml_error_text(exc)}); write '
+                             'them as a mapping, e.g. "{data: 1.0}".') from None
         if not isinstance(values, dict):
-            raise CliError('The values must be a YAML mapping, e.g. "{data: 1.0}".')
+            raise UsageError('The values must be a YAML mapping, e.g. "{data: 1.0}".')
         msg = set_fields(cls(), values)
         qos = rclpy.qos.QoSProfile(
             depth=10,

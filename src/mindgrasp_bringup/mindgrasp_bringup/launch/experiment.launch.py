@@ -27,11 +27,13 @@ from mindgrasp_bringup.launch_api import (
     Node,
     NotEqualsSubstitution,
     Shutdown,
+    checked_argument,
     config_files,
     file_argument,
     number_argument,
     run_directory_actions,
 )
+from mindgrasp_eeg.subject_file import check_eeg_source
 
 
 def _when(subject: str) -> IfCondition:
@@ -65,11 +67,11 @@ def generate_launch_description() -> LaunchDescription:
         number_argument('accuracy', default_value='0.8', kind=float, minimum=0, maximum=1,
                         description='virtual subject: probability (0-1) that a decision '
                                     'is the right class'),
-        DeclareLaunchArgument('eeg_source', default_value='synthetic',
-                              description='EEG of the virtual subject: synthetic (head model), '
-                                          'eegmmidb:<subject> or path/to/subject.yaml (a replay '
-                                          'subject: real imagery epochs of the intended class; '
-                                          'give the calibrated model:=)'),
+        checked_argument('eeg_source', check=check_eeg_source, default_value='synthetic',
+                         description='EEG of the virtual subject: synthetic (head model), '
+                                     'eegmmidb:<subject> or path/to/subject.yaml (a replay '
+                                     'subject: real imagery epochs of the intended class; '
+                                     'give the calibrated model:=)'),
         number_argument('trials', default_value='3', minimum=0,
                         description='trials before the launch ends (0: until Ctrl-C)'),
         number_argument('first_trial', default_value='1', minimum=1,

@@ -116,9 +116,9 @@ def live_view_arguments() -> list[Any]:
                                  description='serve the topics to Foxglove on '
                                              'ws://localhost:<live_view_port> (loopback only)'),
         la.DeclareLaunchArgument('live_view_port', default_value='8765',
-                                 description='TCP port of the live view (0: any free port; '
-                                             'a port in use gives a free one; both are '
-                                             'printed in its log)'),
+                                 description='TCP port of the live view (0: any free port, '
+                                             'printed in its log; a port in use turns the view '
+                                             'off with one error line, the rest runs on)'),
     ]
 
 
@@ -131,7 +131,7 @@ def live_view_nodes() -> list[Any]:
                 # no parameter file of its own; $MINDGRASP_PARAMS_FILES reach it like any node
                 parameters=[*la.config_files('live_view'),
                             {'port': la.LaunchConfiguration('live_view_port'),
-                             'port_in_use': 'any'}],
+                             'port_in_use': 'skip'}],
                 condition=la.IfCondition(la.LaunchConfiguration('live_view'))),
     ]
 

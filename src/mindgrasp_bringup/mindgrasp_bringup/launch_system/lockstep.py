@@ -198,7 +198,11 @@ def run_lockstep(components: Sequence[LockstepComponent], *, step_s: float = 0.0
         wall = time.perf_counter() - wall0
         sim = runner.time_s
         cpu = time.process_time() - cpu0
-        log(f'lock-step: simulated {sim:.1f} s in {wall:.1f} s wall time (real-time factor '
-            f'{sim / max(wall, 1e-9):.1f}, {cpu / max(sim, 1e-9):.3f} CPU s per simulated s).')
+        if sim > 0:
+            log(f'lock-step: simulated {sim:.1f} s in {wall:.1f} s wall time (real-time factor '
+                f'{sim / max(wall, 1e-9):.1f}, {cpu / sim:.3f} CPU s per simulated s).')
+        else:   # stopped (Ctrl-C) while composing: no rate to report (it read 8e8 CPU s per s)
+            log(f'lock-step: stopped after {wall:.1f} s wall time, before the first simulated '
+                'step.')
         runner.close()
     return code

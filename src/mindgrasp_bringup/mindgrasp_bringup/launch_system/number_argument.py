@@ -8,6 +8,8 @@ line naming the argument, the value and an example, exit 2, nothing started::
     number_argument('seed', default_value='0', description='layout seed', minimum=0)
 
 :func:`file_argument` does the same for a file (``model:=``): when given, it must exist.
+:func:`checked_argument` takes the check from the package that reads the value (``eeg_source:=``
+is checked by ``mindgrasp_eeg``'s own parser of it).
 
 Under ``ros2 launch`` they are plain ``DeclareLaunchArgument`` s (the nodes' parameter descriptors
 check the value there).
@@ -16,6 +18,7 @@ check the value there).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from typing import Any
 
 from mindgrasp_bringup.launch_system.actions.declare_launch_argument import (
@@ -24,8 +27,8 @@ from mindgrasp_bringup.launch_system.actions.declare_launch_argument import (
 from mindgrasp_bringup.launch_system.errors import LaunchError
 from mindgrasp_common.resources import ResourceNotFoundError, resolve_path
 
-__all__ = ['FileLaunchArgument', 'NumberLaunchArgument', 'check_number', 'file_argument',
-           'number_argument']
+__all__ = ['CheckedLaunchArgument', 'FileLaunchArgument', 'NumberLaunchArgument',
+           'check_number', 'checked_argument', 'file_argument', 'number_argument']
 
 
 def check_number(name: str, text: str, kind: type, minimum: float | None,
@@ -111,3 +114,34 @@ def file_argument(name: str, *, default_value: str, description: str) -> Any:
         return launch_api.DeclareLaunchArgument(name, default_value=default_value,
                                                 description=description)
     return FileLaunchArgument(name, default_value=default_value, description=description)
+
+
+class CheckedLaunchArgument(DeclareLaunchArgument):
+    """A :class:`DeclareLaunchArgument` whose value ``check(text)`` accepts; whatever the check
+    raises becomes a :class:`LaunchError` naming the argument (before any process starts)."""
+
+    def __init__(self, name: str, *, check: Callable[[str], object], **kwargs: Any) -> None:
+        super().__init__(name, **kwargs)
+        self.check = check
+
+    def execute(self, context: Any) -> None:
+        super().execute(context)
+        text = context.launch_configurations[self.name]
+        try:
+            self.check(text)
+        except Exception as exc:  # the check's own error class; its message says what is valid
+            msg = f"launch argument '{self.name}' is {text!r}: {exc}"
+            raise LaunchError(msg) from None
+
+
+def checked_argument(name: str, *, check: Callable[[str], object], default_value: str,
+                     description: str) -> Any:
+    """Declare ``name`` with a value check (see the module docstring): ``check(text)`` raises
+    with a message naming the valid values when ``text`` is not one."""
+    from mindgrasp_bringup import launch_api
+
+    if launch_api.using_real_launch():
+        return launch_api.DeclareLaunchArgument(name, default_value=default_value,
+                                                description=description)
+    return CheckedLaunchArgument(name, check=check, default_value=default_value,
+                                 description=description)

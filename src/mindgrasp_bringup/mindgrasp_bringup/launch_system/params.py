@@ -21,6 +21,7 @@ from typing import Any
 import yaml
 
 from mindgrasp_bringup.launch_system.errors import LaunchError
+from mindgrasp_common.cli_checks import yaml_error_text
 from mindgrasp_common.resources import ResourceNotFoundError, resource_path
 
 PARAMS_KEY = 'ros__parameters'
@@ -39,7 +40,7 @@ def load_parameter_file(path: str | Path) -> dict[str, dict[str, Any]]:
     try:
         data = yaml.safe_load(path.read_text(encoding='utf-8'))
     except yaml.YAMLError as exc:
-        msg = f'parameter file {path} is not valid YAML ({exc}); fix the file.'
+        msg = f'parameter file {path} is not valid YAML ({yaml_error_text(exc)}); fix the file.'
         raise LaunchError(msg) from exc
     if data is None:
         return {}

@@ -18,14 +18,21 @@ from typing import Any
 
 import yaml
 
-from mindgrasp_ros.runtime.exceptions import RCLError
-from mindgrasp_ros.runtime.names import RemapRule
+from mindgrasp_common.cli_checks import yaml_error_text
+from mindgrasp_ros.runtime.exceptions import InvalidNameError, RCLError
+from mindgrasp_ros.runtime.logging import parse_severity
+from mindgrasp_ros.runtime.names import RemapRule, validate_namespace, validate_node_name
 
-__all__ = ['ParamsFileError', 'RosArguments', 'load_params_file', 'parse_ros_args',
-           'remove_ros_args']
+__all__ = ['ParamsFileError', 'RosArgumentError', 'RosArguments', 'load_params_file',
+           'parse_ros_args', 'remove_ros_args']
 
 
-class ParamsFileError(RCLError):
+class RosArgumentError(RCLError):
+    """A malformed ``--ros-args`` section (rcl's ``RCL_RET_INVALID_ROS_ARGS``): the message
+    names the argument and the form it must take. A node given one refuses to start (exit 2)."""
+
+
+class ParamsFileError(RosArgumentError):
     """A parameter file that is missing or not ROS YAML."""
 
 
@@ -100,21 +107,24 @@ def parse_ros_args(args: list[str]) -> RosArguments:
         def need_value(flag: str, index: int) -> str:
             if index + 1 >= len(args):
                 msg = f'{flag} needs a value after it (--ros-args {flag} ...).'
-                raise RCLError(msg)
+                raise RosArgumentError(msg)
             return args[index + 1]
 
         if arg in ('-r', '--remap'):
-            out.remaps.append(RemapRule.parse(need_value(arg, i)))
+            out.remaps.append(_parse_remap(need_value(arg, i)))
             i += 2
         elif arg in ('-p', '--param'):
             text = need_value(arg, i)
             if ':=' not in text:
                 msg = f'Invalid parameter {text!r}: write it as -p name:=value.'
-                raise RCLError(msg)
+                raise RosArgumentError(msg)
             lhs, value = text.split(':=', 1)
             node = None
             if ':' in lhs:
                 node, lhs = lhs.split(':', 1)
+            if not lhs:
+                msg = f'Invalid parameter {text!r}: the name is missing; write -p name:=value.'
+                raise RosArgumentError(msg)
             out.params.append((node, lhs, _parse_value(value)))
             i += 2
         elif arg == '--params-file':
@@ -125,6 +135,11 @@ def parse_ros_args(args: list[str]) -> RosArguments:
         elif arg == '--log-level':
             text = need_value(arg, i)
             logger, _, level = text.rpartition(':=')  # "level" or "logger_name:=level"
+            try:
+                parse_severity(level)
+            except ValueError as exc:
+                msg = f'--log-level {text!r}: {exc}'
+                raise RosArgumentError(msg) from None
             out.log_levels.append((logger, level))
             i += 2
         elif arg in ('-e', '--enclave'):
@@ -137,8 +152,22 @@ def parse_ros_args(args: list[str]) -> RosArguments:
         else:
             msg = (f'Unknown ROS argument {arg!r}. Valid: -r from:=to, -p name:=value, '
                    '--params-file FILE, --log-level [logger:=]LEVEL, -e ENCLAVE.')
-            raise RCLError(msg)
+            raise RosArgumentError(msg)
     return out
+
+
+def _parse_remap(text: str) -> RemapRule:
+    """``-r`` rule -> :class:`RemapRule`; a new node name (``__node:=``) or namespace
+    (``__ns:=``) is validated here, so a bad one is an argument error, not a crash later."""
+    try:
+        rule = RemapRule.parse(text)
+        if rule.from_ in ('__node', '__name'):
+            validate_node_name(rule.to)
+        elif rule.from_ == '__ns':
+            validate_namespace(rule.to)
+    except InvalidNameError as exc:
+        raise RosArgumentError(f'-r {text}: {exc}') from None
+    return rule
 
 
 def remove_ros_args(args: list[str]) -> list[str]:
@@ -202,7 +231,8 @@ def _read_params_file(path: Path) -> list[tuple[str, dict]]:
         try:
             data = yaml.load(path.read_text(encoding='utf-8'), Loader=_ParamsFileLoader)
         except yaml.YAMLError as exc:
-            msg = f'Parameter file {path} is not valid YAML: {exc}'
+            msg = (f'Parameter file {path} is not valid YAML ({yaml_error_text(exc)}); fix its '
+                   'syntax.')
             raise ParamsFileError(msg) from None
         if data is None:
             data = {}
