@@ -27,6 +27,7 @@ COMMANDS: dict[str, str | dict[str, str]] = {
         'play': 'mindgrasp_bringup.commands.bag_play',
         'info': 'mindgrasp_bringup.commands.bag_info',
         'reindex': 'mindgrasp_bringup.commands.bag_reindex',
+        'latency': 'mindgrasp_bringup.commands.bag_latency',
     },
     'topic': {
         'list': 'mindgrasp_bringup.commands.topic_list',
