@@ -16,9 +16,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest_bag import EEG, JOINTS, eeg_chunk, joints
 from launch_fixtures.runner import fixture, launch_env, run_launch
 
+from mindgrasp_bringup.bag import BagWriter
 from mindgrasp_bringup.bag.latency import LatencyError, RunStamps, latency_report
+from mindgrasp_bringup.launch_system.run_report import write_run_report
 
 MS = 1_000_000
 T0 = 1_795_000_000_000_000_000   # a wall-clock time (ns)
@@ -164,17 +167,37 @@ def test_bag_latency_json_prints_one_object_on_the_last_line(loop_run: Path) -> 
     assert text.returncode == 0 and 'end to end (EEG sample -> command)' in text.stdout
 
 
-@pytest.mark.slow
-def test_a_run_without_eeg_says_so_in_its_report_and_in_one_line(tmp_path: Path) -> None:
-    run_dir = tmp_path / 'run'
-    result = run_launch(fixture('talk.launch.py'), 'count:=20', '--run-dir', str(run_dir),
-                        timeout=120)
-    assert result.returncode == 0, result.stderr[-4000:]
-    assert 'No latency figures: The run has no /eeg/raw messages' in \
-        (run_dir / 'report.md').read_text(encoding='utf-8')
-    assert not (run_dir / 'latency.json').exists()
+def _bag_run(run_dir: Path, messages: list[tuple[str, str, bytes]]) -> Path:
+    """A run directory whose bag (written by our BagWriter, real MCAP) holds ``messages``."""
+    with BagWriter(run_dir / 'bag') as writer:
+        for topic, msgtype, _ in messages:
+            writer.add_topic(topic, msgtype)
+        for i, (topic, _, data) in enumerate(messages):
+            writer.write(topic, T0 + i * 10 * MS, data, T0 + i * 10 * MS)
+    return run_dir
+
+
+@pytest.mark.parametrize(('messages', 'line'), [
+    ([('/joint_states', JOINTS, joints(i)) for i in range(5)],
+     'The run has no /eeg/raw messages, so there is no EEG sample to time; record a live run '
+     'with EEG (e.g. `mindgrasp launch demo`).'),
+    # a lock-step run: header stamps on simulated time (from 0 s), DDS stamps on the wall clock
+    ([('/eeg/raw', EEG, eeg_chunk(25 * i, stamp_ns=i * 10**8)) for i in range(5)],
+     "The run's /eeg/raw stamps are not on the wall clock (a lock-step run on simulated time); "
+     'latencies need a live run (`mindgrasp launch demo`).'),
+])
+def test_a_run_without_latencies_says_why_in_one_line_and_in_its_report(
+        tmp_path: Path, messages: list, line: str) -> None:
+    run_dir = _bag_run(tmp_path / 'run', messages)
     cli = _latency_cli(run_dir)
     assert cli.returncode == 1 and cli.stdout == ''
-    assert cli.stderr.splitlines() == [
-        'mindgrasp bag latency: The run has no /eeg/raw messages, so there is no EEG sample to '
-        'time; record a live run with EEG (e.g. `mindgrasp launch demo`).']
+    assert cli.stderr.splitlines() == [f'mindgrasp bag latency: {line}']
+    write_run_report(run_dir, 'test')
+    assert f'No latency figures: {line}' in (run_dir / 'report.md').read_text(encoding='utf-8')
+    assert not (run_dir / 'latency.json').exists()
+
+
+def test_a_run_without_a_bag_says_so_in_its_report(tmp_path: Path) -> None:
+    write_run_report(tmp_path, 'test')
+    assert 'No latency figures: The run has no bag (record:=false, or the recorder ended ' \
+        'before it opened one)' in (tmp_path / 'report.md').read_text(encoding='utf-8')

@@ -31,8 +31,8 @@ def write_run_report(run_dir: Path, title: str) -> Path:
     lines = [f'# Run {run_dir.name}: {title}', '']
     try:
         if not bag.is_dir():
-            msg = ('The run recorded no bag (record:=false), so it has no timing report; record '
-                   'the run to get one.')
+            msg = ('The run has no bag (record:=false, or the recorder ended before it opened '
+                   'one), so it has no timing report; record the run to get one.')
             raise LatencyError(msg)
         report = latency_report(read_run_stamps(bag))
     except (BagError, LatencyError, OSError) as exc:
