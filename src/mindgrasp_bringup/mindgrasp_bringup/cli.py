@@ -66,6 +66,7 @@ COMMANDS: dict[str, str | dict[str, str]] = {
     },
     'export': {
         'eeg': 'mindgrasp_eeg.export_cli',
+        'bids': 'mindgrasp_eeg.bids_cli',
     },
     'trainer': {
         'schedule': 'mindgrasp_trainer.schedule_cli',

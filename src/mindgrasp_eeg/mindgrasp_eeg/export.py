@@ -97,7 +97,9 @@ def read_session(path: str | Path, eeg_topic: str = EEG_RAW.name) -> Recording:
             wanted = {eeg_topic, TRAINER_PROMPT.name, TASK_TARGET.name,
                       VIRTUAL_SUBJECT_INTENT.name, TASK_RESULT.name, FSM_STATE.name}
             conns = [c for c in reader.connections if c.topic in wanted]
-            for conn, t_log, raw in reader.messages(connections=conns):
+            if not any(c.topic == eeg_topic for c in conns):
+                conns = []    # no EEG: reported below (rosbags reads every topic for [])
+            for conn, t_log, raw in (reader.messages(connections=conns) if conns else ()):
                 msg = store.deserialize_cdr(raw, conn.msgtype)
                 if conn.topic == eeg_topic:
                     this = (float(msg.sample_rate), tuple(msg.channel_names))
