@@ -79,6 +79,10 @@ def display_arguments() -> list[Any]:
                               description='display layout; auto follows the prompts'),
         la.DeclareLaunchArgument('display_label', default_value='',
                               description="phase name in the display's banner"),
+        la.DeclareLaunchArgument('markers', default_value='true', choices=['true', 'false'],
+                              description='mirror prompts (at the display flip when a display '
+                                          'runs), targets, results and controller states to the '
+                                          'LSL marker stream MIndGrasp-Markers, for LabRecorder'),
     ]
 
 
@@ -94,7 +98,13 @@ def display_nodes(files: list[Path], n_trials: object = 0) -> list[Any]:
                                   'fullscreen': mode == 'fullscreen'}],
              condition=_if_equal('display', mode))
         for mode in DISPLAY_MODES[1:]
-    ]
+    ] + [la.GroupAction([
+        la.Node(package='mindgrasp_eeg', executable='marker_node', name='lsl_markers',
+                parameters=[*la.config_files('eeg'), {'cue_topic': cues}], condition=condition)
+        # what the participant saw, when: the display's flips; else the prompts as sent
+        for condition, cues in ((_if_equal('display', 'off'), '/trainer/prompt'),
+                                (_if_differs('display', 'off'), '/display/flip'))],
+        condition=_if_equal('markers', 'true'))]
 
 
 def sim_scene_camera(display_rate: float = 3.0) -> list[tuple[object, dict]]:

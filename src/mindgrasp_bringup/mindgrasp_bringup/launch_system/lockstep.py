@@ -34,6 +34,7 @@ LOCKSTEP_NODES: dict[str, str | dict[str, Any]] = {
     # the runner's own /clock is not a topic of the launch (a live run has none)
     'mindgrasp_bringup.bag.recorder_node': {'exclude_regex': '^/clock$'},
     'mindgrasp_eeg.virtual_amp_node': {'output': 'ros'},
+    'mindgrasp_eeg.marker_node': 'LSL runs on wall time; the bag keeps the events',
 }
 
 #: the recorder's node module (its ``output`` is the bag directory)
