@@ -24,13 +24,7 @@ import pylsl
 from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import FsmState, GraspResult, Prompt, TaskTarget
 
 from mindgrasp_eeg import EEGError
-from mindgrasp_eeg.event_markers import (
-    lsl_time,
-    prompt_marker,
-    result_marker,
-    state_marker,
-    target_marker,
-)
+from mindgrasp_eeg import event_markers as em
 from mindgrasp_eeg.lsl import MarkerOutlet
 from mindgrasp_eeg.params import MarkerParams
 from mindgrasp_ros import rclpy
@@ -63,23 +57,23 @@ class MarkerNode(rclpy.node.Node):
         """Push ``marker`` at the LSL time of ``stamp`` (a header stamp; now when unset)."""
         stamp_ns = int(stamp.sec) * 1_000_000_000 + int(stamp.nanosec)
         now_ns = self.get_clock().now().nanoseconds
-        at = lsl_time(stamp_ns, now_ns, pylsl.local_clock()) if stamp_ns else 0.0
+        at = em.lsl_time(stamp_ns, now_ns, pylsl.local_clock()) if stamp_ns else 0.0
         self.outlet.push(marker, at)
         self.count += 1
 
     def prompt_callback(self, msg: Prompt) -> None:
-        self.push(prompt_marker(msg.phase, msg.class_index), msg.header.stamp)
+        self.push(em.prompt_marker(msg.phase, msg.class_index), msg.header.stamp)
 
     def target_callback(self, msg: TaskTarget) -> None:
-        self.push(target_marker(msg.colour, msg.shape), msg.header.stamp)
+        self.push(em.target_marker(msg.colour, msg.shape), msg.header.stamp)
 
     def result_callback(self, msg: GraspResult) -> None:
-        self.push(result_marker(msg.success, msg.desired_object), msg.header.stamp)
+        self.push(em.result_marker(msg.success, msg.desired_object), msg.header.stamp)
 
     def state_callback(self, msg: FsmState) -> None:
         if msg.state != self.state:       # /fsm/state repeats itself once a second
             self.state = int(msg.state)
-            self.push(state_marker(msg.state, msg.state_name), msg.header.stamp)
+            self.push(em.state_marker(msg.state, msg.state_name), msg.header.stamp)
 
     def destroy_node(self) -> None:
         """Say how many markers went out, then withdraw the stream."""
