@@ -96,6 +96,11 @@ def test_predictions_without_their_chunk_are_left_out_with_a_note() -> None:
     ({'chunk_first_ns': np.arange(40, dtype=np.int64) * 32 * MS,
       'chunk_last_ns': np.arange(40, dtype=np.int64) * 32 * MS + 28 * MS},
      r"^The run's /eeg/raw stamps are not on the wall clock \(a lock-step run on simulated "),
+    # a lock-step bag: every stamp on simulated time, from 0
+    ({name: getattr(_loop(), name) - T0 for name in ('chunk_first_ns', 'chunk_last_ns',
+                                                     'chunk_pub_ns', 'pred_stamp_ns',
+                                                     'pred_pub_ns', 'command_pub_ns')},
+     r"^The run's /eeg/raw stamps are not on the wall clock \(a lock-step run on simulated "),
     ({'pred_stamp_ns': np.full(40, T0 - 3600 * 10**9, np.int64)},
      r"^None of the run's 40 predictions pairs with a recorded /eeg/raw chunk"),
 ])
@@ -201,3 +206,15 @@ def test_a_run_without_a_bag_says_so_in_its_report(tmp_path: Path) -> None:
     write_run_report(tmp_path, 'test')
     assert 'No latency figures: The run has no bag (record:=false, or the recorder ended ' \
         'before it opened one)' in (tmp_path / 'report.md').read_text(encoding='utf-8')
+
+
+@pytest.mark.slow
+def test_a_lock_step_run_has_a_report_that_says_why_it_has_no_latencies(tmp_path: Path) -> None:
+    run_dir = tmp_path / 'run'
+    res = subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', 'launch', 'graz',
+                          'trials:=1', '--lockstep', '--run-dir', str(run_dir)],
+                         capture_output=True, text=True, timeout=300, env=launch_env(),
+                         check=False)
+    assert res.returncode == 0, res.stderr[-3000:]
+    assert "No latency figures: The run's /eeg/raw stamps are not on the wall clock (a " \
+        'lock-step run on simulated time)' in (run_dir / 'report.md').read_text(encoding='utf-8')

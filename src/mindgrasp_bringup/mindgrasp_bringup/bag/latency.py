@@ -47,6 +47,9 @@ HOPS: dict[str, tuple[str, str]] = {
 # stamps further apart than this from their publication are not on the same clock (a lock-step
 # run stamps messages with simulated time while DDS stamps them with the wall clock)
 _SAME_CLOCK_NS = 60 * 10**9
+# publication times before 2001 are simulated time (a lock-step run's clock starts at 0): its
+# "latencies" would be the simulation's step, not the machine's
+_WALL_CLOCK_MIN_NS = 10**18
 
 
 class LatencyError(ValueError):
@@ -114,7 +117,7 @@ def latency_report(stamps: RunStamps) -> dict[str, Any]:
                'live run with EEG (e.g. `mindgrasp launch demo`).')
         raise LatencyError(msg)
     lag = np.median(np.abs(s.chunk_pub_ns - s.chunk_last_ns))
-    if lag > _SAME_CLOCK_NS:
+    if lag > _SAME_CLOCK_NS or np.median(s.chunk_pub_ns) < _WALL_CLOCK_MIN_NS:
         msg = ('The run\'s /eeg/raw stamps are not on the wall clock (a lock-step run on '
                'simulated time); latencies need a live run (`mindgrasp launch demo`).')
         raise LatencyError(msg)
