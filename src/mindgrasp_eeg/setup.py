@@ -49,6 +49,7 @@ setup(
         'console_scripts': [
             'acquisition_node = mindgrasp_eeg.acquisition_node:main',
             'virtual_amp_node = mindgrasp_eeg.virtual_amp_node:main',
+            'marker_node = mindgrasp_eeg.marker_node:main',
         ],
     },
 )

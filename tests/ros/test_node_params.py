@@ -26,6 +26,7 @@ NODES = [
      'trainer.yaml'),
     ('eeg_acquisition', 'mindgrasp_eeg.params', 'AcquisitionParams', 'mindgrasp_eeg', 'eeg.yaml'),
     ('virtual_amp', 'mindgrasp_eeg.params', 'VirtualAmpParams', 'mindgrasp_eeg', 'eeg.yaml'),
+    ('lsl_markers', 'mindgrasp_eeg.params', 'MarkerParams', 'mindgrasp_eeg', 'eeg.yaml'),
 ]
 IDS = [n[0] for n in NODES]
 

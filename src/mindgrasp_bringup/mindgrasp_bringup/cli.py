@@ -29,6 +29,7 @@ COMMANDS: dict[str, str | dict[str, str]] = {
         'play': 'mindgrasp_bringup.commands.bag_play',
         'info': 'mindgrasp_bringup.commands.bag_info',
         'reindex': 'mindgrasp_bringup.commands.bag_reindex',
+        'latency': 'mindgrasp_bringup.commands.bag_latency',
     },
     'topic': {
         'list': 'mindgrasp_bringup.commands.topic_list',
@@ -67,6 +68,7 @@ COMMANDS: dict[str, str | dict[str, str]] = {
     },
     'export': {
         'eeg': 'mindgrasp_eeg.export_cli',
+        'bids': 'mindgrasp_eeg.bids_cli',
     },
     'trainer': {
         'schedule': 'mindgrasp_trainer.schedule_cli',

@@ -17,6 +17,9 @@ def add_data_arguments(parser: argparse.ArgumentParser) -> None:
     g.add_argument('--edf', nargs='+', default=[], metavar='FILE',
                    help='EEG files with annotations (EDF/BDF/GDF); EEGMMIDB SxxxRyy.edf files are '
                         'labelled automatically')
+    g.add_argument('--xdf', nargs='+', default=[], metavar='FILE',
+                   help='XDF recordings (LabRecorder: the EEG and the MIndGrasp-Markers stream; '
+                        'cues are its prompt markers, or those named in --event-map)')
     g.add_argument('--bag', nargs='+', default=[], metavar='RUN',
                    help='recorded runs (rosbag2 folders or run directories) with /eeg/raw and '
                         '/trainer/prompt')
@@ -56,7 +59,7 @@ def load_from_args(args: argparse.Namespace, rest: bool = False) -> list[Recordi
                              eeg_topic=args.eeg_topic, prompt_topic=args.prompt_topic,
                              labels=args.labels, keep_aborted=args.keep_aborted,
                              intent_topic=args.intent_topic, tmin=args.tmin, tmax=args.tmax,
-                             rest=rest or args.rest)
+                             rest=rest or args.rest, xdf=args.xdf)
     aborted = sum(r.n_aborted for r in recordings)
     if aborted:
         print(f"{'Kept' if args.keep_aborted else 'Left out'} {aborted} aborted trial(s) "

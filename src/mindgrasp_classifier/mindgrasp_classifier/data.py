@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import dataclasses
 import itertools
+import logging
 import os
 import re
 from collections.abc import Iterable, Sequence
@@ -327,12 +328,61 @@ def _find_bag_dir(path: Path) -> Path:
     raise ClassifierError(msg)
 
 
+def load_xdf(path: str | Path, event_map: dict[str, int] | None = None) -> Recording:
+    """Load an XDF recording (LabRecorder: the amplifier's EEG and a marker stream) with cues.
+
+    Without ``event_map`` the cues are MIndGrasp's LSL markers (``prompt/<phase>/<class>``, from
+    the ``lsl_markers`` node), labelled as :func:`load_bag` labels prompts: each trial's first
+    class-bearing ``cue`` or ``move`` prompt. With ``event_map`` (marker -> class) the markers it
+    names are the cues (stimulus software of another lab). EEG in volts; the markers are kept
+    in ``Recording.annotations``.
+    """
+    from mindgrasp_eeg import EEGError
+    from mindgrasp_eeg.player import load_recording
+
+    path = Path(path)
+    if not path.is_file():
+        msg = f'The XDF file {path} does not exist; check the path.'
+        raise ClassifierError(msg)
+    # pyxdf logs a warning per stream of a file without clock offsets (nothing to correct): not
+    # a problem of the recording, and no line for the user
+    logging.getLogger('pyxdf').setLevel(logging.ERROR)
+    try:
+        rec = load_recording(path)
+    except EEGError as exc:
+        raise ClassifierError(str(exc)) from None
+    if not rec.annotations:
+        msg = (f'{path.name} has no marker stream (an LSL stream of type Markers); record '
+               'MIndGrasp-Markers (or your stimulus software\'s markers) beside the EEG, as '
+               'LabRecorder does.')
+        raise ClassifierError(msg)
+    events, in_cue = [], False
+    for onset, _duration, marker in rec.annotations:
+        if event_map is not None:
+            k = event_map.get(marker)
+        else:
+            parts = marker.split('/')
+            if len(parts) != 3 or parts[0] != 'prompt':
+                continue
+            cue = parts[1] in ('cue', 'move') and parts[2] in CLASS_NAMES
+            k, in_cue = (class_index(parts[2]) if cue and not in_cue else None), cue
+        if k is not None:
+            events.append((round(onset * rec.rate), k))
+    if not events:
+        msg = (f'{path.name} has markers but no cues: expected MIndGrasp prompt markers '
+               '(prompt/cue/<class>); for other marker names pass --event-map, e.g. '
+               'T1=left_hand,T2=right_hand.')
+        raise ClassifierError(msg)
+    return dataclasses.replace(rec, events=np.array(events, dtype=int).reshape(-1, 2))
+
+
 def load_inputs(edf: Iterable[str] = (), bags: Iterable[str] = (), event_map: str | None = None,
                 eegbci_subject: int | None = None, eegbci_runs: Sequence[int] = (),
                 eeg_topic: str = EEG_RAW.name,
                 prompt_topic: str = TRAINER_PROMPT.name, *, labels: str = 'prompt',
                 keep_aborted: bool = False, intent_topic: str = VIRTUAL_SUBJECT_INTENT.name,
-                tmin: float = 0.5, tmax: float = 2.5, rest: bool = False) -> list[Recording]:
+                tmin: float = 0.5, tmax: float = 2.5, rest: bool = False,
+                xdf: Iterable[str] = ()) -> list[Recording]:
     """Load every input named on a command line; raises if none is given.
 
     ``rest`` labels rest epochs of EDF files (:func:`load_edf`); recorded runs have no rest
@@ -346,12 +396,13 @@ def load_inputs(edf: Iterable[str] = (), bags: Iterable[str] = (), event_map: st
         raise ClassifierError(msg)
     emap = parse_event_map(event_map) if event_map else None
     recs = [load_edf(p, emap, rest=rest) for p in edf]
+    recs += [load_xdf(p, emap) for p in xdf]
     if eegbci_subject is not None:
         recs += [load_edf(p, rest=rest)
                  for p in eegbci_files(eegbci_subject, eegbci_runs or (4, 6, 8, 10))]
     recs += [load_bag(p, eeg_topic, prompt_topic, labels=labels, keep_aborted=keep_aborted,
                       intent_topic=intent_topic, tmin=tmin, tmax=tmax) for p in bags]
     if not recs:
-        msg = 'No input data; give --edf FILES, --bag RUNS or --eegbci SUBJECT.'
+        msg = 'No input data; give --edf FILES, --xdf FILES, --bag RUNS or --eegbci SUBJECT.'
         raise ClassifierError(msg)
     return recs

@@ -15,10 +15,13 @@ Layers (ROS-free unless the module name ends in ``_node``):
 - :mod:`~mindgrasp_eeg.subject_file`: replay subjects (``eegmmidb:<n>`` or a YAML subject file):
   calibration and play recordings with their event maps.
 - :mod:`~mindgrasp_eeg.replay_eeg`: the replay subject's generator (real epochs by intent).
-- :mod:`~mindgrasp_eeg.export`: rosbag2 (``/eeg/raw``, prompts, targets) -> FIF/EDF.
+- :mod:`~mindgrasp_eeg.export`: rosbag2 (``/eeg/raw``, prompts, targets) -> FIF/EDF;
+  :mod:`~mindgrasp_eeg.bids`: runs and sessions -> EEG-BIDS (mne-bids);
+  :mod:`~mindgrasp_eeg.event_markers`: the events' names, shared with the LSL marker stream.
 - :mod:`~mindgrasp_eeg.lsl_scope`: LSL discovery on this host unless ``MINDGRASP_LSL_SCOPE=network``
   (applied when this package is imported, before liblsl reads its configuration).
-- Nodes: :mod:`~mindgrasp_eeg.acquisition_node`, :mod:`~mindgrasp_eeg.virtual_amp_node`.
+- Nodes: :mod:`~mindgrasp_eeg.acquisition_node`, :mod:`~mindgrasp_eeg.virtual_amp_node`,
+  :mod:`~mindgrasp_eeg.marker_node` (events -> LSL markers).
 """
 
 import sys

@@ -44,7 +44,8 @@ from mindgrasp_ros.topics import (
 )
 
 from . import EEGError
-from .montage import class_name, standard_montage
+from .event_markers import prompt_marker, result_marker, state_marker, target_marker
+from .montage import standard_montage
 
 FORMATS = ('fif', 'edf')
 
@@ -98,7 +99,9 @@ def read_session(path: str | Path, eeg_topic: str = EEG_RAW.name) -> Recording:
             wanted = {eeg_topic, TRAINER_PROMPT.name, TASK_TARGET.name,
                       VIRTUAL_SUBJECT_INTENT.name, TASK_RESULT.name, FSM_STATE.name}
             conns = [c for c in reader.connections if c.topic in wanted]
-            for conn, t_log, raw in reader.messages(connections=conns):
+            if not any(c.topic == eeg_topic for c in conns):
+                conns = []    # no EEG: reported below (rosbags reads every topic for [])
+            for conn, t_log, raw in (reader.messages(connections=conns) if conns else ()):
                 msg = store.deserialize_cdr(raw, conn.msgtype)
                 if conn.topic == eeg_topic:
                     this = (float(msg.sample_rate), tuple(msg.channel_names))
@@ -111,18 +114,17 @@ def read_session(path: str | Path, eeg_topic: str = EEG_RAW.name) -> Recording:
                     chunks.append((int(msg.first_sample_index), _stamp_ns(msg.header), data))
                 elif conn.topic == TRAINER_PROMPT.name:
                     events.append((_stamp_ns(msg.header), float(msg.duration),
-                                   f'prompt/{msg.phase}/{class_name(int(msg.class_index))}'))
+                                   prompt_marker(msg.phase, msg.class_index)))
                 elif conn.topic == TASK_TARGET.name:
                     targets.append((_stamp_ns(msg.header) or t_log,
-                                    f'target/{msg.colour} {msg.shape}'))
+                                    target_marker(msg.colour, msg.shape)))
                 elif conn.topic == TASK_RESULT.name:
                     end = _stamp_ns(msg.header) or t_log
-                    outcome = 'success' if msg.success else 'failure'
                     events.append((end - round(float(msg.duration) * 1e9), float(msg.duration),
-                                   f'result/{outcome}/{msg.desired_object}'))
+                                   result_marker(msg.success, msg.desired_object)))
                 elif conn.topic == FSM_STATE.name:
                     states.append((_stamp_ns(msg.header) or t_log,
-                                   f'state/{int(msg.state)} {msg.state_name}'))
+                                   state_marker(msg.state, msg.state_name)))
                 else:
                     events.append((t_log, 0.0, f'intent/{msg.data}'))
     except EEGError:

@@ -17,7 +17,8 @@ from mindgrasp_eeg.montage import NAUTILUS_32
 from mindgrasp_eeg.subject import MODES
 from mindgrasp_ros.params import param
 
-__all__ = ['OUTPUTS', 'AcquisitionParams', 'VirtualAmpParams', 'default_params_path']
+__all__ = ['OUTPUTS', 'AcquisitionParams', 'MarkerParams', 'VirtualAmpParams',
+           'default_params_path']
 
 #: ``output`` of the virtual amplifier: an LSL stream (live runs) or /eeg/raw (lock-step)
 OUTPUTS = ('lsl', 'ros')
@@ -137,3 +138,17 @@ class VirtualAmpParams:
     eeg_source: str = param('synthetic', 'synthetic (head model) | eegmmidb:<subject> | '
                             'path/to/subject.yaml (real imagery epochs of a replay subject, '
                             'mindgrasp_eeg.subject_file)')
+
+
+@dataclass
+class MarkerParams:
+    """Parameters of the LSL marker node (``lsl_markers``): the outlet LabRecorder records and
+    where the cue times come from."""
+
+    stream_name: str = param('MIndGrasp-Markers', 'LSL name of the marker stream')
+    source_id: str = param('mindgrasp-markers', 'LSL source_id (stable: LabRecorder and other '
+                           'inlets find the stream again after a restart)')
+    cue_topic: str = param('/trainer/prompt', "prompts to mirror: /trainer/prompt (the "
+                           "trainer's time) or /display/flip (the display's flip time, when a "
+                           'display runs)')
+    duration: float = param(0.0, 'end after this long (0 = until stopped)', unit='s', min=0.0)

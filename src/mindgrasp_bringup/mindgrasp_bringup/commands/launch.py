@@ -113,7 +113,12 @@ def _run_lockstep(args: argparse.Namespace, service: LaunchService,
     import os
 
     os.environ['MINDGRASP_RUN_DIR'] = str(run_dir)
-    return run_lockstep(components, duration_s=duration)
+    code = run_lockstep(components, duration_s=duration)
+    # every run directory has a report; simulated time has no latencies, and it says so
+    from mindgrasp_bringup.launch_system.run_report import write_run_report
+
+    write_run_report(run_dir, service.name)
+    return code
 
 
 def main(args: argparse.Namespace) -> int:

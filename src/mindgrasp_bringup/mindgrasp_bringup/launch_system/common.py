@@ -79,6 +79,12 @@ def display_arguments() -> list[Any]:
                               description='display layout; auto follows the prompts'),
         la.DeclareLaunchArgument('display_label', default_value='',
                               description="phase name in the display's banner"),
+        la.DeclareLaunchArgument('markers', default_value='auto',
+                              choices=['auto', 'true', 'false'],
+                              description='mirror prompts (at the display flip when a display '
+                                          'runs), targets, results and controller states to the '
+                                          'LSL marker stream MIndGrasp-Markers, for LabRecorder; '
+                                          'auto: when a display shows the participant something'),
     ]
 
 
@@ -94,7 +100,16 @@ def display_nodes(files: list[Path], n_trials: object = 0) -> list[Any]:
                                   'fullscreen': mode == 'fullscreen'}],
              condition=_if_equal('display', mode))
         for mode in DISPLAY_MODES[1:]
-    ]
+    ] + [
+        # what the participant saw, when: the display's flips (markers auto or true); without a
+        # display (markers true) the prompts as sent
+        la.GroupAction([la.Node(package='mindgrasp_eeg', executable='marker_node',
+                                name='lsl_markers', condition=display,
+                                parameters=[*la.config_files('eeg'), {'cue_topic': cues}])],
+                       condition=markers)
+        for markers, display, cues in (
+            (_if_differs('markers', 'false'), _if_differs('display', 'off'), '/display/flip'),
+            (_if_equal('markers', 'true'), _if_equal('display', 'off'), '/trainer/prompt'))]
 
 
 def sim_scene_camera(display_rate: float = 3.0) -> list[tuple[object, dict]]:

@@ -10,6 +10,7 @@ Layout::
     logs/<node>.log         output of each process; logs/launch.log: the launcher's messages
     bag/                    the rosbag2 recording (record:=true)
     summary.yaml            how the launch and each process ended (written at the end)
+    report.md               timing of the run from its bag (written at the end; latency.json)
 """
 
 from __future__ import annotations

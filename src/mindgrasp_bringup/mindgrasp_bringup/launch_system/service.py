@@ -45,6 +45,7 @@ from mindgrasp_bringup.launch_system.run_extras import (
     record_enabled,
     recorder_parameters,
 )
+from mindgrasp_bringup.launch_system.run_report import write_run_report
 from mindgrasp_bringup.launch_system.supervisor import ProcessResult, Supervisor
 from mindgrasp_common.safe_files import DeferredWriter
 
@@ -303,6 +304,7 @@ class LaunchService:
             # that node's work for a while (a controller, a recorder), so it is not clean
             code = 0 if all(r.clean and not r.restarts for r in self.results) else 1
             self._write_summary(run_dir, code)
+            write_run_report(run_dir, self.name)
             if code == 0:
                 logger.info('every process ended cleanly; run directory: %s', run_dir)
             else:

@@ -1,0 +1,116 @@
+"""Read the stamps :mod:`.latency` needs from a run's MCAP bag (and its params.yaml).
+
+Each message's publication time is the MCAP ``publish_time`` (the DDS source timestamp our
+recorder and rosbag2 Jazzy store); bags without it (0) fall back to the receive time
+(``log_time``). Unfinished files (a killed recorder) are read up to their last complete record.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+from mcap.exceptions import McapError
+from mcap.reader import make_reader
+
+from .errors import BagError
+from .latency import RunStamps
+from .metadata import mcap_files
+from .paths import run_dir_of
+from .typestore import typestore
+
+__all__ = ['PERIODIC', 'read_run_stamps']
+
+EEG, PRED, CMD = '/eeg/raw', '/bci/prediction', '/arm_controller/commands'
+PROMPT, FLIP = '/trainer/prompt', '/display/flip'
+
+#: periodic topic -> (node, parameter, 'period' | 'rate'): where its nominal rate is set
+PERIODIC: dict[str, tuple[str, str, str]] = {
+    EEG: ('eeg_acquisition', 'chunk_period', 'period'),
+    PRED: ('classifier', '', ''),                      # set by the model's window step
+    CMD: ('fsm', 'control_period', 'period'),
+    '/joint_states': ('sim', 'joint_state_rate', 'rate'),
+    '/camera/color/image_raw': ('sim', 'camera_rate', 'rate'),
+}
+
+
+def _stamp_ns(header: Any) -> int:
+    return int(header.stamp.sec) * 10**9 + int(header.stamp.nanosec)
+
+
+def _messages(bag: Path, topics: set[str]) -> Iterator[tuple[str, int, bytes]]:
+    """``(topic, publication ns, cdr bytes)`` of ``topics`` from every MCAP file of ``bag``."""
+    files = mcap_files(bag) if bag.is_dir() else [bag]
+    if not files:
+        msg = (f'{bag} holds no .mcap file; the timing report reads MCAP bags (the format '
+               '`mindgrasp launch` records).')
+        raise BagError(msg)
+    for path in files:
+        with path.open('rb') as f:
+            try:
+                for _, channel, message in make_reader(f).iter_messages(topics=list(topics)):
+                    yield channel.topic, message.publish_time or message.log_time, message.data
+            except (McapError, EOFError, ValueError):
+                continue   # an unfinished file: its complete records were read
+
+
+def _nominal_periods(bag: Path) -> dict[str, float]:
+    """Nominal period (s) of each :data:`PERIODIC` topic set in the run's params.yaml."""
+    run_dir = run_dir_of(bag)
+    if run_dir is None:
+        return {}
+    params = yaml.safe_load((run_dir / 'params.yaml').read_text(encoding='utf-8')) or {}
+    out: dict[str, float] = {}
+    for topic, (node, name, kind) in PERIODIC.items():
+        value = (params.get(f'/{node}') or params.get(node) or {}).get(
+            'ros__parameters', {}).get(name) if name else None
+        if isinstance(value, (int, float)) and value > 0:
+            out[topic] = float(value) if kind == 'period' else 1.0 / float(value)
+    return out
+
+
+def read_run_stamps(bag: Path | str) -> RunStamps:
+    """The stamps of the bag's EEG chunks, predictions, commands, cues and flips.
+
+    Args:
+        bag: a bag directory (``runs/<run>/bag``) or one .mcap file.
+
+    Raises:
+        BagError: no MCAP file in ``bag``.
+    """
+    bag = Path(bag)
+    store = typestore()
+    chunks: list[tuple[int, int, int]] = []
+    preds: list[tuple[int, int]] = []
+    commands: list[int] = []
+    s = RunStamps()
+    periodic: dict[str, list[int]] = {t: [] for t in PERIODIC}
+    for topic, pub, data in _messages(bag, {EEG, PRED, CMD, PROMPT, FLIP, *PERIODIC}):
+        if topic in periodic:
+            periodic[topic].append(pub)
+        if topic == EEG:
+            m = store.deserialize_cdr(data, 'mindgrasp_msgs/msg/EEGChunk')
+            first = _stamp_ns(m.header)
+            n = max(1, int(m.n_samples))
+            last = first + round((n - 1) * 1e9 / float(m.sample_rate)) if m.sample_rate else first
+            chunks.append((first, last, pub))
+        elif topic == PRED:
+            m = store.deserialize_cdr(data, 'mindgrasp_msgs/msg/MIPrediction')
+            preds.append((_stamp_ns(m.header), pub))
+        elif topic == CMD:
+            commands.append(pub)
+        elif topic in (PROMPT, FLIP):
+            m = store.deserialize_cdr(data, 'mindgrasp_msgs/msg/Prompt')
+            target = s.cue_ns if topic == PROMPT else s.flip_ns
+            target.setdefault((int(m.trial), str(m.phase)), _stamp_ns(m.header))
+    c = np.array(sorted(chunks, key=lambda r: r[1]), np.int64).reshape(-1, 3)
+    p = np.array(sorted(preds, key=lambda r: r[1]), np.int64).reshape(-1, 2)
+    s.chunk_first_ns, s.chunk_last_ns, s.chunk_pub_ns = c[:, 0], c[:, 1], c[:, 2]
+    s.pred_stamp_ns, s.pred_pub_ns = p[:, 0], p[:, 1]
+    s.command_pub_ns = np.sort(np.array(commands, np.int64))
+    s.periodic_ns = {t: np.array(v, np.int64) for t, v in periodic.items() if v}
+    s.nominal_period_s = _nominal_periods(bag)
+    return s

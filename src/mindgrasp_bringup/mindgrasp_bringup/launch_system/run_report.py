@@ -1,0 +1,49 @@
+"""``report.md`` of a launch's run directory: written when the launch ends, from its bag.
+
+Today it holds the timing section (:mod:`mindgrasp_bringup.bag.latency`): per hop and end to end
+latency of the BCI loop, the display's cue-to-flip delay, and the jitter of periodic topics. A
+run that cannot give latencies (no EEG, no classifier or controller, no bag) says why in one line,
+so every run directory has a report.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+from pathlib import Path
+
+from mindgrasp_bringup.bag import BagError
+from mindgrasp_bringup.bag.latency import LatencyError, format_markdown, latency_report
+from mindgrasp_bringup.bag.run_stamps import read_run_stamps
+
+__all__ = ['write_run_report']
+
+logger = logging.getLogger('launch')
+
+
+def write_run_report(run_dir: Path, title: str) -> Path:
+    """Write ``run_dir/report.md`` (and ``latency.json`` when the run gives latencies).
+
+    Never raises for a bad or missing bag: the report then says why there are no figures.
+    """
+    run_dir = Path(run_dir)
+    bag = run_dir / 'bag'
+    lines = [f'# Run {run_dir.name}: {title}', '']
+    try:
+        if not bag.is_dir():
+            msg = ('The run has no bag (record:=false, or the recorder ended before it opened '
+                   'one), so it has no timing report; record the run to get one.')
+            raise LatencyError(msg)
+        report = latency_report(read_run_stamps(bag))
+    except (BagError, LatencyError, OSError) as exc:
+        lines += ['## Timing', '', f'No latency figures: {exc}', '']
+    else:
+        (run_dir / 'latency.json').write_text(json.dumps(report, indent=1) + '\n',
+                                              encoding='utf-8')
+        lines.append(format_markdown(report))
+        e2e = report['end_to_end']
+        logger.info('latency EEG sample -> arm command: p50 %.1f ms, p99 %.1f ms (%d); report: '
+                    '%s', e2e['p50_ms'], e2e['p99_ms'], e2e['count'], run_dir / 'report.md')
+    path = run_dir / 'report.md'
+    path.write_text('\n'.join(lines).rstrip() + '\n', encoding='utf-8')
+    return path

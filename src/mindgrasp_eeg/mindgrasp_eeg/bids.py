@@ -1,0 +1,204 @@
+"""Export recorded runs as an EEG-BIDS dataset with mne-bids (ROS-free).
+
+Each run directory (or every phase of a calibration session folder) becomes one BIDS EEG
+recording::
+
+    <root>/dataset_description.json, participants.tsv, README
+    <root>/sub-<ID>[/ses-<S>]/eeg/sub-<ID>[_ses-<S>]_task-<task>_run-<n>_eeg.edf   EEG, volts
+        ..._eeg.json        SamplingFrequency (the amplifier's), EEGReference, PowerLineFrequency
+        ..._channels.tsv    name, type, units (uV in the EDF header's physical unit)
+        ..._events.tsv      onset, duration, trial_type, value, sample: the annotations of
+                            :func:`mindgrasp_eeg.export.read_session` (prompts, targets, grasp
+                            results, controller states, intents)
+        ..._electrodes.tsv, ..._coordsystem.json   the standard_1020 montage
+    <root>/sourcedata/sub-<ID>[/ses-<S>]/<task>_run-<n>/bag/   the run's rosbag2, as recorded
+    <root>/derivatives/mindgrasp/sub-<ID>[/ses-<S>]/motion/
+        ..._desc-robot_timeseries.tsv.gz, .json   joint states and end-effector pose
+                            (:mod:`.robot_motion`; mne-bids does not write BIDS motion data)
+
+The task is the protocol: a session phase's kind (``graz``, ``grazfeedback``, ``trainer``), else
+the run's trial manager protocol (``setlocations``, ``randomlocations``), else the prompter that
+ran (``graz``, ``trainer``), else the launch profile; runs of one task are numbered in the order
+given. The recording is written as EDF (mne-bids converts; EDF keeps volts as
+physical values).
+"""
+
+from __future__ import annotations
+
+import json
+import re
+import shutil
+import warnings
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from . import EEGError
+from .export import find_bag, read_session, to_raw
+from .robot_motion import read_robot_motion
+
+__all__ = ['BidsRun', 'bids_label', 'export_bids', 'runs_to_export']
+
+_LABEL = re.compile(r'^[A-Za-z0-9]+$')
+
+
+@dataclass
+class BidsRun:
+    """One run to export: its run directory and its BIDS task label."""
+
+    run_dir: Path
+    task: str
+
+
+def bids_label(value: str, option: str) -> str:
+    """``value`` when it is a BIDS label (letters and digits only), else an EEGError."""
+    if not _LABEL.match(value or ''):
+        fixed = re.sub(r'[^A-Za-z0-9]', '', value or '') or 'S01'
+        msg = (f'{option} {value!r} is not a BIDS label: use letters and digits only (e.g. '
+               f'{option} {fixed}).')
+        raise EEGError(msg)
+    return value
+
+
+def _task_label(text: str) -> str:
+    return re.sub(r'[^A-Za-z0-9]', '', text).lower() or 'task'
+
+
+def runs_to_export(paths: list[str | Path]) -> list[BidsRun]:
+    """The runs of ``paths``: a session folder (with session.yaml) gives its finished phases in
+    order, a run directory (or bag) itself.
+
+    Raises:
+        EEGError: a path that is neither.
+    """
+    runs: list[BidsRun] = []
+    for path in map(Path, paths):
+        log_file = path / 'session.yaml'
+        if log_file.is_file():
+            log = yaml.safe_load(log_file.read_text(encoding='utf-8')) or {}
+            phases = {p['name']: p for p in (log.get('plan') or {}).get('phases', [])}
+            done = [e for e in log.get('phases', []) if e.get('status') == 'done']
+            if not done:
+                msg = (f'The session {str(path)!r} has no finished phase to export; run or '
+                       'resume it first (`mindgrasp session resume`).')
+                raise EEGError(msg)
+            for entry in done:
+                spec = phases.get(entry['name'], {})
+                kind = spec.get('kind', entry.get('kind', entry['name']))
+                task = _task_label(kind + ('feedback' if spec.get('feedback') else ''))
+                runs.append(BidsRun(path / entry['run_dir'], task))
+            continue
+        bag = find_bag(path)
+        run_dir = bag.parent if bag.name == 'bag' else bag
+        runs.append(BidsRun(run_dir, _task_label(_protocol(run_dir))))
+    return runs
+
+
+def _yaml(path: Path) -> dict:
+    return (yaml.safe_load(path.read_text(encoding='utf-8')) or {}) if path.is_file() else {}
+
+
+def _protocol(run_dir: Path) -> str:
+    """The run's protocol: the trial manager's ``protocol`` (``set_locations``, ...), else the
+    prompter that ran (``graz``, ``trainer``), else the launch profile, else the folder name."""
+    params = run_dir / 'params'
+    for node_params in _yaml(params / 'trial_manager.yaml').values():
+        protocol = (node_params or {}).get('ros__parameters', {}).get('protocol')
+        if protocol:
+            return str(protocol)
+    for node, task in (('graz_prompter', 'graz'), ('trainer', 'trainer')):
+        if (params / f'{node}.yaml').is_file():
+            return task
+    return str(_yaml(run_dir / 'launch.yaml').get('profile') or run_dir.name)
+
+
+def export_bids(paths: list[str | Path], root: str | Path, subject: str,
+                session: str | None = None, *, line_freq: float = 50.0,
+                reference: str = 'n/a', overwrite: bool = False) -> list[Path]:
+    """Write the runs of ``paths`` into the BIDS dataset at ``root``; returns the EEG files.
+
+    Args:
+        paths: run directories, bags or session folders.
+        root: the dataset's root (created; an existing dataset gets the new runs).
+        subject: participant label (letters and digits).
+        session: session label, or None for none.
+        line_freq: power line frequency (Hz) for eeg.json (50 in Europe, 60 in the Americas).
+        reference: the EEG reference for eeg.json (e.g. ``'Cz'``, ``'linked mastoids'``).
+        overwrite: replace runs that exist already.
+
+    Raises:
+        EEGError: a bad label, a run without EEG, or a run that exists already; the message
+            says what to do.
+    """
+    import mne_bids
+
+    bids_label(subject, '--subject')
+    if session is not None:
+        bids_label(session, '--session')
+    runs = runs_to_export(paths)
+    recordings = [(run, read_session(run.run_dir)) for run in runs]   # bad input before writing
+    root = Path(root)
+    counts: dict[str, int] = {}
+    written = []
+    for run, recording in recordings:
+        counts[run.task] = counts.get(run.task, 0) + 1
+        with warnings.catch_warnings():
+            # MNE 1.13 renames the standard_1020 montage to_raw sets; the positions are the same
+            warnings.simplefilter('ignore', FutureWarning)
+            raw = to_raw(recording)
+        raw.info['line_freq'] = float(line_freq)
+        bids_path = mne_bids.BIDSPath(subject=subject, session=session, task=run.task,
+                                      run=counts[run.task], datatype='eeg', root=root)
+        try:
+            mne_bids.write_raw_bids(raw, bids_path, format='EDF', allow_preload=True,
+                                    overwrite=overwrite, verbose='error')
+        except FileExistsError as exc:
+            msg = (f'{bids_path.basename} exists already in {str(root)!r}; pass --overwrite '
+                   'or another --session.')
+            raise EEGError(msg) from exc
+        sidecar = bids_path.copy().update(suffix='eeg', extension='.json')
+        mne_bids.update_sidecar_json(sidecar, {
+            'EEGReference': reference, 'TaskName': run.task,
+            'SoftwareFilters': 'n/a', 'RecordingType': 'continuous',
+            'InstitutionName': 'n/a', 'Manufacturer': 'n/a'}, verbose='error')
+        source = root / 'sourcedata' / f'sub-{subject}' / (f'ses-{session}' if session else '') \
+            / f'{run.task}_run-{counts[run.task]}'
+        if source.exists():
+            shutil.rmtree(source)
+        shutil.copytree(find_bag(run.run_dir), source / 'bag')
+        _write_motion(run.run_dir, recording.start_ns, root, bids_path)
+        written.append(Path(str(bids_path.fpath)))
+    return written
+
+
+def _write_motion(run_dir: Path, start_ns: int, root: Path, bids_path: object) -> None:
+    """The robot's motion of one run as a derivatives time series (nothing without joints)."""
+    import mne_bids
+
+    motion = read_robot_motion(find_bag(run_dir), start_ns)
+    if motion is None:
+        return
+    columns, table = motion
+    deriv = root / 'derivatives' / 'mindgrasp'
+    if not (deriv / 'dataset_description.json').is_file():
+        mne_bids.make_dataset_description(
+            path=deriv, name='MIndGrasp robot motion', dataset_type='derivative',
+            generated_by=[{'Name': 'mindgrasp export bids'}], overwrite=True, verbose='error')
+        # the robot's time series has no BIDS name yet (motion data would, but mne-bids does
+        # not write them): tell the validator (-r) to skip it
+        (deriv / '.bidsignore').write_text('*_desc-robot_timeseries.*\n', encoding='utf-8')
+    out = bids_path.copy().update(root=deriv, datatype='motion', suffix='timeseries',
+                                  description='robot', extension='.tsv.gz', check=False)
+    out.mkdir(exist_ok=True)
+    # a headerless TSV with its columns in the JSON sidecar, as BIDS physio / timeseries files
+    np.savetxt(str(out.fpath), table, delimiter='\t', fmt='%.6g')
+    units = {c: ('s' if c == 'onset' else 'm' if c in ('ee_x', 'ee_y', 'ee_z')
+                 else 'rad/s' if c.endswith('_velocity') else 'rad' if c.endswith('_position')
+                 else 'n/a') for c in columns}
+    sidecar = Path(str(out.fpath)).with_name(out.fpath.name.replace('.tsv.gz', '.json'))
+    sidecar.write_text(json.dumps({
+        'Description': 'Robot joint states (/joint_states) and end-effector pose (/ee_pose) '
+                       'from the run\'s bag; onset in s from the first EEG sample.',
+        'Columns': columns, 'Units': units}, indent=1) + '\n', encoding='utf-8')
