@@ -40,7 +40,7 @@ from pathlib import Path
 from typing import Any, TypeVar
 
 __all__ = ['ParameterError', 'declare_params', 'describe', 'from_mapping', 'param',
-           'parameter_type', 'read_yaml_section']
+           'parameter_type', 'read_yaml_section', 'type_code']
 
 T = TypeVar('T')
 
@@ -133,6 +133,15 @@ def parameter_type(field: dataclasses.Field, default: Any) -> Any:
     raise ParameterError(msg)
 
 
+def type_code(kind: Any) -> int:
+    """The ``rcl_interfaces/ParameterType`` number of a ``Parameter.Type`` member.
+
+    Real rclpy's ``Parameter.Type`` is a plain ``Enum`` whose ``value`` is that number (``int()``
+    of it raises ``TypeError``); our runtime's is an ``IntEnum``. ``.value`` serves both.
+    """
+    return int(getattr(kind, 'value', kind))
+
+
 def describe(cls: type) -> dict[str, tuple[Any, Any]]:
     """``{name: (default, ParameterDescriptor)}`` for every field of the dataclass ``cls``."""
     from mindgrasp_ros import rclpy
@@ -148,7 +157,7 @@ def describe(cls: type) -> dict[str, tuple[Any, Any]]:
     for field, name, default in _flat_fields(cls, defaults):
         info = _info(field)
         kind = parameter_type(field, default)
-        desc = ParameterDescriptor(name=name, type=int(kind), description=info.text(),
+        desc = ParameterDescriptor(name=name, type=type_code(kind), description=info.text(),
                                    additional_constraints=info.constraints(),
                                    read_only=not info.live)
         if info.min is not None or info.max is not None:
