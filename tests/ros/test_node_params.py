@@ -94,17 +94,8 @@ def test_describe_works_with_an_enum_parameter_type_as_real_rclpy_has(monkeypatc
 
     from mindgrasp_ros.runtime.parameter import Parameter
 
-    class RclpyType(enum.Enum):   # rclpy/parameter.py: class Type(Enum), values ParameterType.*
-        NOT_SET = 0
-        BOOL = 1
-        INTEGER = 2
-        DOUBLE = 3
-        STRING = 4
-        BYTE_ARRAY = 5
-        BOOL_ARRAY = 6
-        INTEGER_ARRAY = 7
-        DOUBLE_ARRAY = 8
-        STRING_ARRAY = 9
+    # rclpy/parameter.py: ``class Type(Enum)``, values ParameterType.*; same members as ours
+    RclpyType = enum.Enum('Type', {m.name: m.value for m in Parameter.Type})  # noqa: N806
 
     with pytest.raises(TypeError):
         int(RclpyType.BOOL)   # the failure the old code hit under real rclpy

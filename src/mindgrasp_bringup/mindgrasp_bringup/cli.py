@@ -39,6 +39,11 @@ COMMANDS: dict[str, str | dict[str, str]] = {
         'list': 'mindgrasp_bringup.commands.node_list',
         'info': 'mindgrasp_bringup.commands.node_info',
     },
+    'service': {
+        'list': 'mindgrasp_bringup.commands.service_list',
+        'type': 'mindgrasp_bringup.commands.service_type',
+        'call': 'mindgrasp_bringup.commands.service_call',
+    },
     'param': {
         'list': 'mindgrasp_bringup.commands.param_list',
         'get': 'mindgrasp_bringup.commands.param_get',

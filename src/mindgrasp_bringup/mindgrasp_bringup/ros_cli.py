@@ -16,12 +16,23 @@ from typing import Any
 import numpy as np
 import yaml
 
-__all__ = ['CliError', 'cli_node', 'find_topic_type', 'message_to_yaml', 'resolve_field',
-           'set_fields', 'wait_for_graph']
+__all__ = ['CliError', 'UsageError', 'cli_node', 'find_topic_type', 'is_hidden_name',
+           'message_to_yaml', 'print_names_and_types', 'resolve_field', 'set_fields',
+           'wait_for_graph']
 
 
 class CliError(Exception):
-    """A command-line error with a message for the user."""
+    """A command-line error with a message for the user (exit code 1)."""
+
+
+class UsageError(CliError):
+    """The command's own input is wrong (a type name, YAML values): exit code 2, like argparse."""
+
+
+def is_hidden_name(name: str) -> bool:
+    """A topic or service name with a token that starts with ``_`` (rcl's hidden names, which
+    ``ros2 service list`` leaves out unless ``--include-hidden-services``)."""
+    return any(token.startswith('_') for token in name.split('/'))
 
 
 @contextlib.contextmanager
@@ -45,13 +56,24 @@ def wait_for_graph(node: Any, settle_s: float = 1.0, max_s: float = 3.0) -> None
     last: list = []
     stable_since = time.monotonic()
     while time.monotonic() - start < max_s:
-        now = node.get_topic_names_and_types() + [tuple(x) for x in
-                                                  node.get_node_names_and_namespaces()]
+        now = (node.get_topic_names_and_types() + node.get_service_names_and_types()
+               + [tuple(x) for x in node.get_node_names_and_namespaces()])
         if now != last:
             last, stable_since = now, time.monotonic()
         elif time.monotonic() - stable_since >= settle_s:
             return
         time.sleep(0.1)
+
+
+def print_names_and_types(items: list[tuple[str, list[str]]], show_types: bool,
+                          count: bool) -> None:
+    """Print topics or services as ``ros2 topic|service list`` does: the count (``-c``), or one
+    name a line, with ``[type, ...]`` after it (``-t``)."""
+    if count:
+        print(len(items))
+        return
+    for name, types in items:
+        print(f'{name} [{", ".join(types)}]' if show_types else name)
 
 
 def find_topic_type(node: Any, topic: str, timeout_s: float = 5.0) -> str:
@@ -142,5 +164,6 @@ def set_fields(msg: Any, values: dict[str, Any]) -> Any:
 
 
 def print_error(exc: Exception) -> int:
+    """Print ``exc`` as one line on stderr; its exit code (2 for a :class:`UsageError`)."""
     print(f'mindgrasp: {exc}', file=sys.stderr)
-    return 1
+    return 2 if isinstance(exc, UsageError) else 1

@@ -425,8 +425,8 @@ def _unknown_type_message(typename: str, kind: str) -> str:
     store = typestore()
     package = typename.split('/')[0]
     known = sorted({n.split('/')[0] for n in store.fielddefs})
-    same = sorted(n.rsplit('/', 1)[-1] for n in store.fielddefs
-                  if n.startswith(f'{package}/{kind}/'))
+    same = sorted({n.rsplit('/', 1)[-1].removesuffix('_Request').removesuffix('_Response')
+                   for n in store.fielddefs if n.startswith(f'{package}/{kind}/')})
     hint = (f' Known {package} {kind} types: {", ".join(same)}.' if same
             else f' Known packages: {", ".join(known)}.')
     return (f'Unknown {kind} type {typename!r}.{hint} Custom types belong in '
