@@ -49,6 +49,8 @@ COMMANDS: dict[str, str | dict[str, str]] = {
         'get': 'mindgrasp_bringup.commands.param_get',
         'set': 'mindgrasp_bringup.commands.param_set',
         'describe': 'mindgrasp_bringup.commands.param_describe',
+        'dump': 'mindgrasp_bringup.commands.param_dump',
+        'load': 'mindgrasp_bringup.commands.param_load',
     },
     'eeg': {
         'virtual-amp': 'mindgrasp_eeg.virtual_amp_cli',
