@@ -41,6 +41,11 @@ def test_service_verbs_against_the_sim_node(spawn_node):
             'new_random_draw=False, seed=7)\n\nresponse:\n'
             'mindgrasp_msgs.srv.ResetSim_Response(success=True, ') in call.stdout
     assert 'Reset: robots home' in call.stdout
+    # interface proto's quoted YAML is what a user pastes into service call
+    proto = mindgrasp('interface', 'proto', 'mindgrasp_msgs/srv/ResetSim').stdout.strip()
+    pasted = mindgrasp('service', 'call', '/sim/reset', 'mindgrasp_msgs/srv/ResetSim',
+                       proto.strip('"'))
+    assert pasted.returncode == 0 and 'ResetSim_Response(success=True' in pasted.stdout
 
 
 @pytest.mark.parametrize(('args', 'expected'), [

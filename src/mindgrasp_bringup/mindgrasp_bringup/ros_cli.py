@@ -16,6 +16,8 @@ from typing import Any
 import numpy as np
 import yaml
 
+from mindgrasp_ros.typesupport import EMPTY_PLACEHOLDER
+
 __all__ = ['CliError', 'UsageError', 'cli_node', 'find_topic_type', 'is_hidden_name',
            'message_to_yaml', 'print_names_and_types', 'resolve_field', 'set_fields',
            'wait_for_graph']
@@ -98,8 +100,9 @@ def find_topic_type(node: Any, topic: str, timeout_s: float = 5.0) -> str:
 
 def to_plain(value: Any, truncate: int | None = 128) -> Any:
     """Message -> nested dicts/lists of plain values (long arrays truncated like ros2)."""
-    if hasattr(value, '_fields'):
-        return {name: to_plain(getattr(value, name), truncate) for name in value._fields}
+    if hasattr(value, '_fields'):   # an empty message's placeholder is no field to rclpy
+        return {name: to_plain(getattr(value, name), truncate) for name in value._fields
+                if name != EMPTY_PLACEHOLDER}
     if isinstance(value, np.ndarray):
         items = value.tolist()
     elif isinstance(value, (list, tuple)):
