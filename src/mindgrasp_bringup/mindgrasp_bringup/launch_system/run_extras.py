@@ -64,9 +64,16 @@ def duration_limit(configurations: Mapping[str, str]) -> float | None:
     return duration if duration > 0 else None
 
 
+def recorder_outputs(bag: str | Path) -> dict[str, str]:
+    """Where the recorder of a run writes: the bag (``<run dir>/bag``) and the live parameter
+    changes (``<run dir>/params/changes.jsonl``)."""
+    return {'output': str(bag),
+            'parameter_changes': str(Path(bag).parent / 'params' / 'changes.jsonl')}
+
+
 def recorder_parameters(configurations: Mapping[str, str], bag: str) -> dict[str, Any]:
     """Parameters of the recorder node for ``record_topics:=`` / ``record_regex:=``."""
-    parameters: dict[str, Any] = {'output': bag}
+    parameters: dict[str, Any] = recorder_outputs(bag)
     topics = configurations.get('record_topics', '')
     if topics.strip():
         parameters['topics'] = [t for t in topics.replace(',', ' ').split() if t]
