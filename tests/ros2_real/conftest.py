@@ -38,8 +38,8 @@ def ros2_env() -> dict[str, str]:
     else:
         found = sorted(CACHE.glob('*/env.sh'), key=lambda p: p.stat().st_mtime)
         if not found:
-            pytest.skip('no real ROS 2: run scripts/build_ros2.sh once (7-20 min on 2 cores), or source '
-                        'a ROS 2 Jazzy installation')
+            pytest.skip('no real ROS 2: run scripts/build_ros2.sh once (7-20 min on 2 cores), '
+                        'or source a ROS 2 Jazzy installation')
         env = _sourced_env(found[-1])
     for key in ('ROS_DOMAIN_ID', 'ROS_AUTOMATIC_DISCOVERY_RANGE', 'HOME'):
         if key in os.environ:

@@ -93,3 +93,27 @@ def test_our_controller_on_real_rclpy(spawn_node, rclpy_env, ros2):
     assert 'Setting parameter failed' in refused.stdout + refused.stderr
     assert mindgrasp('param', 'get', '/fsm', 'lock_duration').stdout.strip() == \
         'Double value is: 2.5'
+
+
+def test_a_recorded_launch_on_real_rclpy(rclpy_env, tmp_path):
+    """`MINDGRASP_RMW=rclpy mindgrasp launch sim`: the recorder and the simulator on the real
+    rclpy (both died at start before: params.py), served and recorded as on our runtime."""
+    run = tmp_path / 'run'
+    proc = subprocess.Popen([sys.executable, '-m', 'mindgrasp_bringup', 'launch', 'sim',
+                             'duration:=300', '--run-dir', str(run)], env=rclpy_env,
+                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                            start_new_session=True)
+    changes = run / 'params' / 'changes.jsonl'
+    try:
+        call = until(lambda: mindgrasp('service', 'call', '/sim/reset',
+                                       'mindgrasp_msgs/srv/ResetSim', '{seed: 2}'),
+                     lambda r: r.returncode == 0, 120)
+        assert 'ResetSim_Response(success=True' in call.stdout, call.stdout + call.stderr
+        assert mindgrasp('param', 'set', '/sim', 'use_sim_time', 'false').returncode == 0
+        assert until(lambda: changes.read_text(), lambda text: '"/sim"' in text, 60)
+    finally:
+        proc.send_signal(2)   # SIGINT, as Ctrl-C
+        out = proc.communicate(timeout=180)[0]
+    assert proc.returncode == 0, out[-3000:]
+    row = [r for r in map(yaml.safe_load, changes.read_text().splitlines()) if r['node'] == '/sim']
+    assert (row[0]['name'], row[0]['old'], row[0]['new']) == ('use_sim_time', False, False)

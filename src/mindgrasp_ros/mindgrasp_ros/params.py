@@ -258,11 +258,9 @@ def declare_params(node: Any, cls: type[T], *,
     ptype = rclpy.parameter.Parameter.Type
     for name, (default, desc) in specs.items():
         if isinstance(default, list) and not default:
-            # an empty list has no type of its own: declare it with the descriptor's type
-            value = rclpy.parameter.Parameter(name, ptype(desc.type), []).get_parameter_value()
+            _declare_empty_list(node, name, ptype(desc.type), desc)
         else:
-            value = default
-        node.declare_parameter(name, value, desc)
+            node.declare_parameter(name, default, desc)
     values = {name: _python(node.get_parameter(name).value, specs[name][0]) for name in specs}
     instance = from_mapping(cls, _nest(cls, values))
 
@@ -293,6 +291,25 @@ def declare_params(node: Any, cls: type[T], *,
 
     node.add_on_set_parameters_callback(callback)
     return instance
+
+
+def _declare_empty_list(node: Any, name: str, kind: Any, desc: Any) -> None:
+    """Declare a parameter whose default is an empty list of type ``kind``: an empty list
+    has no type of its own, so the type goes with it as a ``ParameterValue``. rclpy 7.1.3 (Jazzy)
+    cannot take that (``TypeError``); there it is declared by its type, set to ``[]`` of that
+    type when no override gave a value (writable until then), then made read-only if it is."""
+    from mindgrasp_ros import rclpy
+
+    Parameter = rclpy.parameter.Parameter   # noqa: N806 - rclpy's class
+    try:
+        node.declare_parameter(name, Parameter(name, kind, []).get_parameter_value(), desc)
+    except TypeError:
+        writable = copy.deepcopy(desc)
+        writable.read_only = False
+        node.declare_parameter(name, kind, writable)
+        if node.get_parameter_or(name).type_ == Parameter.Type.NOT_SET:
+            node.set_parameters([Parameter(name, kind, [])])
+        node.set_descriptor(name, desc)
 
 
 def _python(value: Any, default: Any) -> Any:
