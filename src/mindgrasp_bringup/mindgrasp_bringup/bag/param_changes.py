@@ -21,7 +21,11 @@ from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
 
-__all__ = ['ParameterChangeLog', 'read_changes']
+__all__ = ['EVENT_TYPE', 'PARAMETER_EVENTS', 'ParameterChangeLog', 'read_changes']
+
+#: the topic every ROS 2 node announces its parameter changes on, and its type
+PARAMETER_EVENTS = '/parameter_events'
+EVENT_TYPE = 'rcl_interfaces/msg/ParameterEvent'
 
 
 class ParameterChangeLog:

@@ -6,10 +6,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from mindgrasp_bringup.bag.param_changes import ParameterChangeLog
-
-PARAMETER_EVENTS = '/parameter_events'
-EVENT_TYPE = 'rcl_interfaces/msg/ParameterEvent'
+from mindgrasp_bringup.bag.param_changes import EVENT_TYPE, ParameterChangeLog
 
 
 def _values(params: Any) -> dict[str, Any]:

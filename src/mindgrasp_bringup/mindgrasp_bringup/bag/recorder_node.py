@@ -32,8 +32,8 @@ from dataclasses import dataclass
 from typing import Any
 
 from mindgrasp_bringup.bag.errors import BagError
-from mindgrasp_bringup.bag.param_changes import ParameterChangeLog
-from mindgrasp_bringup.bag.param_watch import PARAMETER_EVENTS, ParameterWatch
+from mindgrasp_bringup.bag.param_changes import PARAMETER_EVENTS, ParameterChangeLog
+from mindgrasp_bringup.bag.param_watch import ParameterWatch
 from mindgrasp_bringup.bag.qos import adapted_qos, qos_to_dict, resubscribe_qos
 from mindgrasp_bringup.bag.recorder import Recorder
 from mindgrasp_bringup.bag.ros_glue import message_class, qos_profile

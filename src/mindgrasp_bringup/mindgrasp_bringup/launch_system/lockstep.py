@@ -31,8 +31,11 @@ __all__ = ['LOCKSTEP_NODES', 'RECORDER_MODULE', 'LockstepComponent', 'check_eeg_
 LOCKSTEP_NODES: dict[str, str | dict[str, Any]] = {
     'mindgrasp_eeg.acquisition_node': 'LSL runs on wall time; the virtual amplifier publishes '
                                       '/eeg/raw itself in lock-step',
-    # the runner's own /clock is not a topic of the launch (a live run has none)
-    'mindgrasp_bringup.bag.recorder_node': {'exclude_regex': '^/clock$'},
+    # the runner's own /clock is not a topic of the launch (a live run has none); /rosout and
+    # /parameter_events are left out: they name paths of the run, and an experiment's bag is
+    # the same bit for bit when run again (nothing changes parameters live in lock-step)
+    'mindgrasp_bringup.bag.recorder_node': {'exclude_regex': '^/clock$',
+                                            'include_ros_topics': False},
     'mindgrasp_eeg.virtual_amp_node': {'output': 'ros'},
 }
 

@@ -29,6 +29,7 @@ from typing import Any
 import yaml
 
 from mindgrasp_bringup.bag.errors import BagError
+from mindgrasp_bringup.bag.param_changes import PARAMETER_EVENTS
 from mindgrasp_bringup.bag.paths import resolve_bag, run_dir_of
 from mindgrasp_bringup.bag.qos import adapted_qos
 from mindgrasp_bringup.bag.reader import BagReader
@@ -48,7 +49,6 @@ COMPARED_TOPICS = {BCI_PREDICTION.name: BCI_PREDICTION.type, FSM_STATE.name: FSM
 EEG_TOPIC = EEG_RAW.name
 EEG_TYPE = EEG_RAW.type
 STATUS_TOPIC = BCI_STATUS.name
-PARAMETER_EVENTS = '/parameter_events'
 #: never fed from the bag: the runner owns /clock; graph topics (live parameter changes are
 #: applied to the re-run nodes instead: replay.param_changes)
 _NOT_FED = (CLOCK.name, PARAMETER_EVENTS, '/rosout')

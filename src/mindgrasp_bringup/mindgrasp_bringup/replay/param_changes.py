@@ -13,9 +13,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-__all__ = ['ParameterChange', 'apply_change', 'recorded_changes']
+from mindgrasp_bringup.bag.param_changes import EVENT_TYPE
 
-EVENT_TYPE = 'rcl_interfaces/msg/ParameterEvent'
+__all__ = ['ParameterChange', 'apply_change', 'recorded_changes']
 
 
 @dataclass(frozen=True)
