@@ -35,7 +35,7 @@ LOCKSTEP_NODES: dict[str, str | dict[str, Any]] = {
     # /parameter_events are left out: they name paths of the run, and an experiment's bag is
     # the same bit for bit when run again (nothing changes parameters live in lock-step)
     'mindgrasp_bringup.bag.recorder_node': {'exclude_regex': '^/clock$',
-                                            'include_ros_topics': False},
+                                            'include_ros_topics': False, 'parameter_changes': ''},
     'mindgrasp_eeg.virtual_amp_node': {'output': 'ros'},
 }
 
