@@ -65,18 +65,19 @@ def test_run_files_of_another_launcher_are_complete_whenever_it_stops(tmp_path) 
 
 
 @pytest.mark.parametrize(('arguments', 'record', 'duration', 'parameters'), [
-    ({}, True, None, {'output': 'B', 'exclude_regex': DEFAULT_RECORD_EXCLUDE,
-                      'compression': 'zstd'}),
+    ({}, True, None, {'output': 'R/bag', 'parameter_changes': 'R/params/changes.jsonl',
+                      'exclude_regex': DEFAULT_RECORD_EXCLUDE, 'compression': 'zstd'}),
     ({'record': 'false', 'duration': '30', 'record_topics': '/a, /b /c', 'record_regex': '/x.*',
       'record_exclude_regex': '', 'record_compression': 'none'},
-     False, 30.0, {'output': 'B', 'topics': ['/a', '/b', '/c'], 'regex': '/x.*',
+     False, 30.0, {'output': 'R/bag', 'parameter_changes': 'R/params/changes.jsonl',
+                   'topics': ['/a', '/b', '/c'], 'regex': '/x.*',
                    'exclude_regex': '', 'compression': 'none'}),
 ])
 def test_both_launchers_read_the_common_arguments_alike(arguments, record, duration,
                                                          parameters) -> None:
     assert record_enabled(arguments) is record
     assert duration_limit(arguments) == duration
-    assert recorder_parameters(arguments, 'B') == parameters
+    assert recorder_parameters(arguments, 'R/bag') == parameters
 
 
 @pytest.mark.parametrize(('name', 'value', 'problem'), [

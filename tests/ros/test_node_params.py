@@ -86,3 +86,26 @@ def test_vision_live_change_rebuilds_the_pipeline_or_is_refused(rclpy_ctx):
         assert not out.successful and 'within [1, 100000]' in out.reason, out.reason
     finally:
         node.destroy_node()
+
+
+def test_describe_works_with_an_enum_parameter_type_as_real_rclpy_has(monkeypatch):
+    """Real rclpy's ``Parameter.Type`` is a plain ``Enum`` (``int()`` of a member raises
+    ``TypeError``); the descriptors must carry the ``ParameterType`` numbers all the same."""
+    import enum
+
+    from mindgrasp_ros.runtime.parameter import Parameter
+
+    # rclpy/parameter.py: ``class Type(Enum)``, values ParameterType.*; same members as ours
+    RclpyType = enum.Enum('Type', {m.name: m.value for m in Parameter.Type})  # noqa: N806
+
+    with pytest.raises(TypeError):
+        int(RclpyType.BOOL)   # the failure the old code hit under real rclpy
+    monkeypatch.setattr(Parameter, 'Type', RclpyType)
+    specs = describe(_cls('mindgrasp_fsm.params', 'FsmParams'))
+    expected = {bool: 1, int: 2, float: 3, str: 4}
+    for name, (default, desc) in specs.items():
+        assert isinstance(desc.type, int) and not isinstance(desc.type, enum.Enum), name
+        if type(default) in expected:
+            assert desc.type == expected[type(default)], name
+    ranged = [d for _, d in specs.values() if d.type == 3 and len(d.floating_point_range)]
+    assert ranged, 'a DOUBLE with a range keeps its FloatingPointRange under an Enum Type'

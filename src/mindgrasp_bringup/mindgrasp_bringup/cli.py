@@ -42,11 +42,23 @@ COMMANDS: dict[str, str | dict[str, str]] = {
         'list': 'mindgrasp_bringup.commands.node_list',
         'info': 'mindgrasp_bringup.commands.node_info',
     },
+    'service': {
+        'list': 'mindgrasp_bringup.commands.service_list',
+        'type': 'mindgrasp_bringup.commands.service_type',
+        'call': 'mindgrasp_bringup.commands.service_call',
+    },
+    'interface': {
+        'list': 'mindgrasp_bringup.commands.interface_list',
+        'show': 'mindgrasp_bringup.commands.interface_show',
+        'proto': 'mindgrasp_bringup.commands.interface_proto',
+    },
     'param': {
         'list': 'mindgrasp_bringup.commands.param_list',
         'get': 'mindgrasp_bringup.commands.param_get',
         'set': 'mindgrasp_bringup.commands.param_set',
         'describe': 'mindgrasp_bringup.commands.param_describe',
+        'dump': 'mindgrasp_bringup.commands.param_dump',
+        'load': 'mindgrasp_bringup.commands.param_load',
     },
     'eeg': {
         'virtual-amp': 'mindgrasp_eeg.virtual_amp_cli',
@@ -130,6 +142,8 @@ def build_parser(argv: Sequence[str]) -> argparse.ArgumentParser:
     parser = OneLineParser(
         prog='mindgrasp',
         description='MIndGrasp-ROS: motor-imagery EEG control of an assistive arm on ROS 2.')
+    parser.add_argument('--version', action='store_true',
+                        help="print the project's version (and git revision) and exit")
     sub = parser.add_subparsers(dest='command', metavar='<command>')
     chosen = argv[0] if argv else None
     for command, target in COMMANDS.items():
@@ -149,12 +163,25 @@ def build_parser(argv: Sequence[str]) -> argparse.ArgumentParser:
     return parser
 
 
+def version_text() -> str:
+    """``mindgrasp 0.1.0`` and, in a git checkout, ``(git <describe>)``: what every run's
+    provenance records."""
+    from mindgrasp_bringup.launch_system.rundir import DIST_NAME, git_info, package_versions
+
+    text = f'mindgrasp {package_versions()[DIST_NAME] or "(not installed)"}'
+    describe = git_info().get('describe')
+    return f'{text} (git {describe})' if describe else text
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``mindgrasp`` console script."""
     argv = list(sys.argv[1:] if argv is None else argv)
     parser = build_parser(argv)
     args = parser.parse_args(argv)
     module_name = getattr(args, '_module', None)
+    if args.version and module_name is None:
+        print(version_text())
+        return 0
     if module_name is None:
         if not argv:
             parser.print_help()

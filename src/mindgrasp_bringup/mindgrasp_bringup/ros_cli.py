@@ -17,13 +17,26 @@ from typing import Any
 import numpy as np
 import yaml
 
-__all__ = ['CliError', 'UsageError', 'cli_node', 'find_topic_type', 'message_to_yaml',
-           'message_type', 'node_name', 'resolve_field', 'set_fields', 'topic_name',
-           'wait_for_graph']
+from mindgrasp_ros.typesupport import EMPTY_PLACEHOLDER
+
+__all__ = ['CliError', 'UsageError', 'cli_node', 'find_topic_type', 'is_hidden_name',
+           'message_to_yaml', 'message_type', 'node_name', 'print_names_and_types',
+           'resolve_field', 'set_fields', 'topic_name', 'wait_for_graph']
 
 
 class CliError(Exception):
-    """A command-line error with a message for the user."""
+    """A command-line error with a message for the user (exit code 1)."""
+
+
+class UsageError(CliError):
+    """The command's own input is wrong (a name, a type, a value that does not fit its field),
+    found before anything is sent: exit code 2, like argparse."""
+
+
+def is_hidden_name(name: str) -> bool:
+    """A topic or service name with a token that starts with ``_`` (rcl's hidden names, which
+    ``ros2 service list`` leaves out unless ``--include-hidden-services``)."""
+    return any(token.startswith('_') for token in name.split('/'))
 
 
 # argparse ``type=`` checks of names and types: a bad one is a usage error (one line, exit 2)
@@ -89,13 +102,24 @@ def wait_for_graph(node: Any, settle_s: float = 1.0, max_s: float = 3.0) -> None
     last: list = []
     stable_since = time.monotonic()
     while time.monotonic() - start < max_s:
-        now = node.get_topic_names_and_types() + [tuple(x) for x in
-                                                  node.get_node_names_and_namespaces()]
+        now = (node.get_topic_names_and_types() + node.get_service_names_and_types()
+               + [tuple(x) for x in node.get_node_names_and_namespaces()])
         if now != last:
             last, stable_since = now, time.monotonic()
         elif time.monotonic() - stable_since >= settle_s:
             return
         time.sleep(0.1)
+
+
+def print_names_and_types(items: list[tuple[str, list[str]]], show_types: bool,
+                          count: bool) -> None:
+    """Print topics or services as ``ros2 topic|service list`` does: the count (``-c``), or one
+    name a line, with ``[type, ...]`` after it (``-t``)."""
+    if count:
+        print(len(items))
+        return
+    for name, types in items:
+        print(f'{name} [{", ".join(types)}]' if show_types else name)
 
 
 def find_topic_type(node: Any, topic: str, timeout_s: float = 5.0) -> str:
@@ -120,8 +144,9 @@ def find_topic_type(node: Any, topic: str, timeout_s: float = 5.0) -> str:
 
 def to_plain(value: Any, truncate: int | None = 128) -> Any:
     """Message -> nested dicts/lists of plain values (long arrays truncated like ros2)."""
-    if hasattr(value, '_fields'):
-        return {name: to_plain(getattr(value, name), truncate) for name in value._fields}
+    if hasattr(value, '_fields'):   # an empty message's placeholder is no field to rclpy
+        return {name: to_plain(getattr(value, name), truncate) for name in value._fields
+                if name != EMPTY_PLACEHOLDER}
     if isinstance(value, np.ndarray):
         items = value.tolist()
     elif isinstance(value, (list, tuple)):
@@ -189,11 +214,6 @@ def set_fields(msg: Any, values: dict[str, Any]) -> Any:
             except (TypeError, ValueError, OverflowError) as exc:
                 raise UsageError(str(exc)) from None
     return msg
-
-
-class UsageError(CliError):
-    """Bad input found before anything is sent (a value that does not fit its field): exit
-    code 2, as argparse gives for a bad value."""
 
 
 def print_error(exc: Exception) -> int:

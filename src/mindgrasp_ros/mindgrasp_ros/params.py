@@ -40,7 +40,7 @@ from pathlib import Path
 from typing import Any, TypeVar
 
 __all__ = ['ParameterError', 'declare_params', 'describe', 'from_mapping', 'param',
-           'parameter_type', 'read_yaml_section']
+           'parameter_type', 'read_yaml_section', 'type_code']
 
 T = TypeVar('T')
 
@@ -133,6 +133,15 @@ def parameter_type(field: dataclasses.Field, default: Any) -> Any:
     raise ParameterError(msg)
 
 
+def type_code(kind: Any) -> int:
+    """The ``rcl_interfaces/ParameterType`` number of a ``Parameter.Type`` member.
+
+    Real rclpy's ``Parameter.Type`` is a plain ``Enum`` whose ``value`` is that number (``int()``
+    of it raises ``TypeError``); our runtime's is an ``IntEnum``. ``.value`` serves both.
+    """
+    return int(getattr(kind, 'value', kind))
+
+
 def describe(cls: type) -> dict[str, tuple[Any, Any]]:
     """``{name: (default, ParameterDescriptor)}`` for every field of the dataclass ``cls``."""
     from mindgrasp_ros import rclpy
@@ -148,7 +157,7 @@ def describe(cls: type) -> dict[str, tuple[Any, Any]]:
     for field, name, default in _flat_fields(cls, defaults):
         info = _info(field)
         kind = parameter_type(field, default)
-        desc = ParameterDescriptor(name=name, type=int(kind), description=info.text(),
+        desc = ParameterDescriptor(name=name, type=type_code(kind), description=info.text(),
                                    additional_constraints=info.constraints(),
                                    read_only=not info.live)
         if info.min is not None or info.max is not None:
@@ -249,11 +258,9 @@ def declare_params(node: Any, cls: type[T], *,
     ptype = rclpy.parameter.Parameter.Type
     for name, (default, desc) in specs.items():
         if isinstance(default, list) and not default:
-            # an empty list has no type of its own: declare it with the descriptor's type
-            value = rclpy.parameter.Parameter(name, ptype(desc.type), []).get_parameter_value()
+            _declare_empty_list(node, name, ptype(desc.type), desc)
         else:
-            value = default
-        node.declare_parameter(name, value, desc)
+            node.declare_parameter(name, default, desc)
     values = {name: _python(node.get_parameter(name).value, specs[name][0]) for name in specs}
     instance = from_mapping(cls, _nest(cls, values))
 
@@ -284,6 +291,25 @@ def declare_params(node: Any, cls: type[T], *,
 
     node.add_on_set_parameters_callback(callback)
     return instance
+
+
+def _declare_empty_list(node: Any, name: str, kind: Any, desc: Any) -> None:
+    """Declare a parameter whose default is an empty list of type ``kind``: an empty list
+    has no type of its own, so the type goes with it as a ``ParameterValue``. rclpy 7.1.3 (Jazzy)
+    cannot take that (``TypeError``); there it is declared by its type, set to ``[]`` of that
+    type when no override gave a value (writable until then), then made read-only if it is."""
+    from mindgrasp_ros import rclpy
+
+    Parameter = rclpy.parameter.Parameter   # noqa: N806 - rclpy's class
+    try:
+        node.declare_parameter(name, Parameter(name, kind, []).get_parameter_value(), desc)
+    except TypeError:
+        writable = copy.deepcopy(desc)
+        writable.read_only = False
+        node.declare_parameter(name, kind, writable)
+        if node.get_parameter_or(name).type_ == Parameter.Type.NOT_SET:
+            node.set_parameters([Parameter(name, kind, [])])
+        node.set_descriptor(name, desc)
 
 
 def _python(value: Any, default: Any) -> Any:

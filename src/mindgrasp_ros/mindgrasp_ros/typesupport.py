@@ -33,6 +33,7 @@ from mindgrasp_common.resources import ResourceNotFoundError, resource_path
 from mindgrasp_ros.errors import RosError
 
 __all__ = [
+    'EMPTY_PLACEHOLDER',
     'MessageTypeError',
     'deserialize',
     'get_message_class',
@@ -63,6 +64,9 @@ _FIELD_DEFAULTS: dict[str, dict[str, Any]] = {
 
 #: Service types the runtime needs beyond the rosbags store (which has no srv types).
 _EXTRA_SERVICE_FILES = ('rcl_interfaces', 'std_srvs')
+
+#: the member rosidl gives a message without fields; not a field of rclpy's Python classes
+EMPTY_PLACEHOLDER = 'structure_needs_at_least_one_member'
 
 _lock = threading.RLock()
 
@@ -205,7 +209,9 @@ def _numeric_dtype(desc: tuple) -> tuple[Any, int | None] | None:
     return _NUMPY_DTYPES[sub_detail[0]], (count if kind == Nodetype.ARRAY else None)
 
 
-def _ros_type_string(desc: tuple) -> str:
+def _ros_type_string(desc: tuple, msg_syntax: bool = False) -> str:
+    """A field's type as ``get_fields_and_field_types`` gives it (``sequence<float64>``), or
+    with ``msg_syntax`` as a ``.msg`` file writes it (``float64[]``, ``int32[<=5]``)."""
     kind, detail = desc
     if kind == Nodetype.BASE:
         base, bound = detail
@@ -213,9 +219,11 @@ def _ros_type_string(desc: tuple) -> str:
     if kind == Nodetype.NAME:
         return detail.replace('/msg/', '/')
     (sub, count) = detail
-    inner = _ros_type_string(sub)
+    inner = _ros_type_string(sub, msg_syntax)
     if kind == Nodetype.ARRAY:
         return f'{inner}[{count}]'
+    if msg_syntax:
+        return f'{inner}[<={count}]' if count else f'{inner}[]'
     return f'sequence<{inner}, {count}>' if count else f'sequence<{inner}>'
 
 
@@ -425,8 +433,8 @@ def _unknown_type_message(typename: str, kind: str) -> str:
     store = typestore()
     package = typename.split('/')[0]
     known = sorted({n.split('/')[0] for n in store.fielddefs})
-    same = sorted(n.rsplit('/', 1)[-1] for n in store.fielddefs
-                  if n.startswith(f'{package}/{kind}/'))
+    same = sorted({n.rsplit('/', 1)[-1].removesuffix('_Request').removesuffix('_Response')
+                   for n in store.fielddefs if n.startswith(f'{package}/{kind}/')})
     hint = (f' Known {package} {kind} types: {", ".join(same)}.' if same
             else f' Known packages: {", ".join(known)}.')
     return (f'Unknown {kind} type {typename!r}.{hint} Custom types belong in '

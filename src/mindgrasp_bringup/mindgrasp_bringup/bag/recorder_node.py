@@ -32,16 +32,19 @@ from dataclasses import dataclass
 from typing import Any
 
 from mindgrasp_bringup.bag.errors import BagError
+from mindgrasp_bringup.bag.param_changes import PARAMETER_EVENTS, ParameterChangeLog
+from mindgrasp_bringup.bag.param_watch import ParameterWatch
 from mindgrasp_bringup.bag.qos import adapted_qos, qos_to_dict, resubscribe_qos
 from mindgrasp_bringup.bag.recorder import Recorder
 from mindgrasp_bringup.bag.ros_glue import message_class, qos_profile
 from mindgrasp_bringup.bag.writer import BagWriter
 from mindgrasp_ros import rclpy
 from mindgrasp_ros.node_main import NodeFailure, end_after, run_node
+from mindgrasp_ros.node_traits import NodeTraits
 from mindgrasp_ros.params import ParameterError, declare_params, param
 
-#: Topics of the ROS graph itself that a bag never needs.
-_ALWAYS_EXCLUDED = ('/rosout', '/parameter_events')
+#: Topics of the ROS graph itself, left out with include_ros_topics:=false.
+_ALWAYS_EXCLUDED = ('/rosout', PARAMETER_EVENTS)
 
 
 @dataclass
@@ -66,7 +69,10 @@ class RecorderParams:
     discovery_period: float = param(0.5, 'how often new topics are looked for', unit='s',
                                     min=0.01)
     duration: float = param(0.0, 'end after this long (0: run until stopped)', unit='s', min=0.0)
-    include_ros_topics: bool = param(False, 'record /rosout and /parameter_events too')
+    include_ros_topics: bool = param(True, 'record /rosout and /parameter_events too (as '
+                                     "'ros2 bag record -a' does)")
+    parameter_changes: str = param('', 'append every live parameter change to this JSONL file '
+                                   "(time, node, name, old and new value; '': none)")
 
     def __post_init__(self) -> None:
         for name in ('regex', 'exclude_regex'):
@@ -80,6 +86,12 @@ class RecorderParams:
 
 class RecorderNode(rclpy.node.Node):
     """Subscribes to matching topics as they appear and feeds a :class:`Recorder`."""
+
+    # In lock-step /rosout and /parameter_events are left out: they name paths of the run, and
+    # an experiment's bag is the same bit for bit when run again (nothing changes parameters
+    # live in lock-step). The runner's own /clock is left out too (launch_system.lockstep).
+    node_traits = NodeTraits(lockstep_parameters={'include_ros_topics': False,
+                                                  'parameter_changes': ''})
 
     def __init__(self, **kwargs: Any) -> None:
         super().__init__('recorder', **kwargs)
@@ -101,6 +113,8 @@ class RecorderNode(rclpy.node.Node):
         self._unpublished: set[str] = set()                 # seen with subscribers only
         self._refused: set[str] = set()
         self._types: dict[str, str] = {}
+        self.param_watch = (ParameterWatch(self, ParameterChangeLog(p.parameter_changes))
+                            if p.parameter_changes else None)
         self.get_logger().info(f'Recording to {writer.path} (MCAP, compression '
                                f'{writer.compression}).')
         self.create_timer(p.discovery_period, self.discover_callback)
@@ -109,7 +123,7 @@ class RecorderNode(rclpy.node.Node):
         self.discover_callback()
 
     def _wanted(self, topic: str) -> bool:
-        if topic in self.topics:
+        if topic in self.topics or (topic == PARAMETER_EVENTS and self.param_watch):
             return True
         if not self.params.include_ros_topics and topic in _ALWAYS_EXCLUDED:
             return False
@@ -123,6 +137,8 @@ class RecorderNode(rclpy.node.Node):
         """Subscribe to every new matching topic that has a publisher; re-match changed ones."""
         if self.recorder.error is not None:
             return
+        if self.param_watch is not None:
+            self.param_watch.poll()
         for topic, types in self.get_topic_names_and_types():
             if topic in self._refused or not self._wanted(topic):
                 continue
@@ -216,11 +232,15 @@ class RecorderNode(rclpy.node.Node):
     def _make_callback(self, topic: str) -> Any:
         push = self.recorder.push
         clock = self.get_clock()
+        watch = self.param_watch if topic == PARAMETER_EVENTS else None
 
         def callback(data: bytes, info: Any) -> None:
             # Two arguments: rclpy passes MessageInfo with the DDS source timestamp (ns).
             sent = info.get('source_timestamp') if isinstance(info, dict) else None
-            push(topic, data, clock.now().nanoseconds, sent or None)
+            now = clock.now().nanoseconds
+            push(topic, data, now, sent or None)
+            if watch is not None:   # the change log's time is the event's log time in the bag
+                watch.event(bytes(data), now)
         return callback
 
     def report_callback(self) -> None:
@@ -259,6 +279,8 @@ class RecorderNode(rclpy.node.Node):
         missing = self.not_recorded()
         for topic, why in missing.items():
             self.recorder.writer.custom_data[f'not_recorded:{topic}'] = why
+        if self.param_watch is not None:
+            self.param_watch.log.close()
         try:
             counters = self.recorder.stop()
         except BagError as exc:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from mindgrasp_bringup.ros_cli import cli_node, wait_for_graph
+from mindgrasp_bringup.ros_cli import cli_node, print_names_and_types, wait_for_graph
 from mindgrasp_common.cli_checks import non_negative_float
 
 
@@ -19,9 +19,5 @@ def main(args: argparse.Namespace) -> int:
     with cli_node() as node:
         wait_for_graph(node, settle_s=args.spin_time, max_s=args.spin_time + 3)
         topics = node.get_topic_names_and_types()
-    if args.count_topics:
-        print(len(topics))
-        return 0
-    for name, types in topics:
-        print(f'{name} [{", ".join(types)}]' if args.show_types else name)
+    print_names_and_types(topics, args.show_types, args.count_topics)
     return 0

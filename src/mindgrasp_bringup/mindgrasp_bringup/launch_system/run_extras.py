@@ -81,11 +81,18 @@ def duration_limit(configurations: Mapping[str, str]) -> float | None:
     return duration if duration > 0 else None
 
 
+def recorder_outputs(bag: str | Path) -> dict[str, str]:
+    """Where the recorder of a run writes: the bag (``<run dir>/bag``) and the live parameter
+    changes (``<run dir>/params/changes.jsonl``)."""
+    return {'output': str(bag),
+            'parameter_changes': str(Path(bag).parent / 'params' / 'changes.jsonl')}
+
+
 def recorder_parameters(configurations: Mapping[str, str], bag: str) -> dict[str, Any]:
     """Parameters of the recorder node for ``record_topics:=``, ``record_regex:=``,
     ``record_exclude_regex:=`` and ``record_compression:=``."""
     parameters: dict[str, Any] = {
-        'output': bag,
+        **recorder_outputs(bag),
         'exclude_regex': configurations.get('record_exclude_regex', DEFAULT_RECORD_EXCLUDE),
         'compression': configurations.get('record_compression', 'zstd')}
     topics = configurations.get('record_topics', '')

@@ -6,6 +6,7 @@ Layout::
     launch_arguments.yaml   every launch argument with its value (given or default)
     params.yaml             resolved parameters of every node (ROS YAML, by node name)
     params/<node>.yaml      the file each node got with --params-file
+    params/changes.jsonl    live parameter changes while the run went on (the recorder)
     provenance.yaml         git revision, package versions, Python, host, ROS environment
     logs/<node>.log         output of each process; logs/launch.log: the launcher's messages
     bag/                    the rosbag2 recording (record:=true)

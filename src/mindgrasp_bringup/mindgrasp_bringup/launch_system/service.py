@@ -43,6 +43,7 @@ from mindgrasp_bringup.launch_system.run_extras import (
     RECORDER_PACKAGE,
     duration_limit,
     record_enabled,
+    recorder_outputs,
     recorder_parameters,
 )
 from mindgrasp_bringup.launch_system.run_report import write_run_report
@@ -276,7 +277,7 @@ class LaunchService:
         run_dir = rundir.create_run_dir(self.name, self.run_dir_option, self.runs_root)
         self.run_dir = run_dir
         if plan.record:
-            plan.processes[0].parameters['output'] = str(run_dir / 'bag')
+            plan.processes[0].parameters.update(recorder_outputs(run_dir / 'bag'))
         handlers = configure_launch_logger(run_dir / 'logs' / 'launch.log')
         try:
             processes = plan.processes

@@ -30,12 +30,14 @@ import yaml
 
 from mindgrasp_bringup.bag.damage import assess_bag
 from mindgrasp_bringup.bag.errors import BagError
+from mindgrasp_bringup.bag.param_changes import PARAMETER_EVENTS
 from mindgrasp_bringup.bag.paths import resolve_bag, run_dir_of
 from mindgrasp_bringup.bag.qos import adapted_qos
 from mindgrasp_bringup.bag.reader import BagReader
 from mindgrasp_bringup.bag.ros_glue import qos_profile
 from mindgrasp_bringup.bag.typestore import typestore as default_typestore
 from mindgrasp_bringup.bag.writer import BagWriter
+from mindgrasp_bringup.replay.param_changes import ParameterChange, apply_change, recorded_changes
 from mindgrasp_ros.topics import BCI_PREDICTION, BCI_STATUS, CLOCK, EEG_RAW, FSM_STATE
 
 __all__ = ['COMPARED_TOPICS', 'NODES', 'ReplayConfig', 'ReplayResult', 'replay']
@@ -48,8 +50,9 @@ COMPARED_TOPICS = {BCI_PREDICTION.name: BCI_PREDICTION.type, FSM_STATE.name: FSM
 EEG_TOPIC = EEG_RAW.name
 EEG_TYPE = EEG_RAW.type
 STATUS_TOPIC = BCI_STATUS.name
-#: never fed from the bag: the runner owns /clock; graph topics
-_NOT_FED = (CLOCK.name, '/parameter_events', '/rosout')
+#: never fed from the bag: the runner owns /clock; graph topics (live parameter changes are
+#: applied to the re-run nodes instead: replay.param_changes)
+_NOT_FED = (CLOCK.name, PARAMETER_EVENTS, '/rosout')
 
 
 @dataclass
@@ -97,6 +100,7 @@ class ReplayResult:
     damage: dict[str, Any] = field(default_factory=dict)   # :meth:`BagDamage.as_dict`
     report_path: Path | None = None
     summary: dict[str, Any] = field(default_factory=dict)
+    parameter_changes: list[dict[str, Any]] = field(default_factory=list)  # recorded, re-applied
 
 
 def _node_params(run_dir: Path | None, name: str) -> dict[str, Any]:
@@ -210,12 +214,16 @@ def replay(cfg: ReplayConfig) -> ReplayResult:
                 t: [] for t in COMPARED_TOPICS if t in reader.topics}
             statuses: list[bytes] = []
             inputs: list[tuple[str, int, bytes]] = []
-            wanted = set(feed) | set(recorded) | ({STATUS_TOPIC} & set(reader.topics))
+            events: list[tuple[int, bytes]] = []   # /parameter_events: live changes
+            wanted = set(feed) | set(recorded) | ({STATUS_TOPIC, PARAMETER_EVENTS}
+                                                  & set(reader.topics))
             for topic, t_ns, data in reader.messages(sorted(wanted)):
                 if topic in recorded:
                     recorded[topic].append((t_ns, data))
                 if topic == STATUS_TOPIC:
                     statuses.append(data)
+                if topic == PARAMETER_EVENTS:
+                    events.append((t_ns, data))
                 if topic in pubs:
                     inputs.append((topic, t_ns, data))
             starts = _segment_starts(statuses, store)
@@ -224,7 +232,11 @@ def replay(cfg: ReplayConfig) -> ReplayResult:
                                   reader.end_ns, damage=damage.as_dict())
             result.notes += [f'Damaged bag: {line}' for line in damage.lines()]
             max_step = cfg.max_step_s or (0.01 if cfg.controller else 0.1)
-            _feed(runner, inputs, pubs, store, starts, result, max_step, cfg.progress)
+            by_name = {f'/{NODES[k][1]}': n for k, n in zip(keys, nodes, strict=True)}
+            changes = recorded_changes(events, store, set(by_name), {
+                (f'/{NODES[k][1]}', name) for k in keys for name in cfg.params.get(k, {})})
+            _feed(runner, inputs, pubs, store, starts, result, max_step, cfg.progress,
+                  changes, by_name)
         finally:
             runner.close()
     finally:
@@ -239,8 +251,10 @@ def replay(cfg: ReplayConfig) -> ReplayResult:
 
 
 def _feed(runner: Any, inputs: list[tuple[str, int, bytes]], pubs: dict[str, Any], store: Any,
-          starts: list[int], result: ReplayResult, max_step_s: float, progress: bool) -> None:
-    """Publish every recorded input at its recorded time; the graph settles after each."""
+          starts: list[int], result: ReplayResult, max_step_s: float, progress: bool,
+          changes: list[ParameterChange] = (), nodes: dict[str, Any] | None = None) -> None:
+    """Publish every recorded input at its recorded time; the graph settles after each.
+    ``changes`` (live parameter changes) are set on ``nodes`` (by name) at their times."""
     from tqdm import tqdm
 
     max_step_ns = max(1, round(max_step_s * 1e9))
@@ -248,8 +262,21 @@ def _feed(runner: Any, inputs: list[tuple[str, int, bytes]], pubs: dict[str, Any
     later_starts = set(starts[1:])
 
     def advance(t_ns: int) -> None:
+        while pending and pending[0].time_ns <= t_ns:
+            change = pending.pop(0)
+            advance(change.time_ns)
+            row = apply_change(nodes[change.node], change, runner._time_ns)
+            result.parameter_changes.append(row)
+            at_s = (row['applied_ns'] - result.start_ns) / 1e9
+            result.notes.append(
+                f'Live change of the run applied at {at_s:.3f} s: {change.node} '
+                f'{change.name}={change.value!r}'
+                + ('' if row['successful'] else f' (refused: {row["reason"]})'))
+            runner.spin_until_quiescent()
         while runner._time_ns < t_ns:
             runner.step(min(max_step_ns, t_ns - runner._time_ns) / 1e9)
+
+    pending = list(changes)
 
     bar = tqdm(total=total, unit='msg', desc='replay', disable=not progress, file=sys.stderr,
                leave=True)

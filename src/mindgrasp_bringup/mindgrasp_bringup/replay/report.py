@@ -85,6 +85,7 @@ def compare(result: ReplayResult, store: Any) -> dict[str, Any]:
         'open_loop': 'controller' in result.nodes, 'fed': result.fed,
         'skipped_eeg_chunks': result.skipped_eeg_chunks, 'topics': {}, 'notes': result.notes,
         'damage': result.damage,
+        'parameter_changes': result.parameter_changes,
     }
     rec = _predictions(result.recorded.get(BCI_PREDICTION.name, []), store)
     rep = _predictions(result.replayed.get(BCI_PREDICTION.name, []), store)

@@ -246,10 +246,17 @@ def _read_params_file(path: Path) -> list[tuple[str, dict]]:
     return _file_cache[key]
 
 
-def load_params_file(path: Path, node_fqn: str | None) -> dict[str, Any]:
-    """Parameters for ``node_fqn`` (``/ns/name``) from a ROS YAML file (all when None)."""
+def load_params_file(path: Path, node_fqn: str | None, *,
+                     use_wildcard: bool = True) -> dict[str, Any]:
+    """Parameters for ``node_fqn`` (``/ns/name``) from a ROS YAML file (all when None).
+
+    ``use_wildcard=False`` leaves out the ``/**`` and ``/*`` sections (``ros2 param load``
+    without ``--use-wildcard``).
+    """
     values: dict[str, Any] = {}
     for pattern, params in _read_params_file(Path(path)):
+        if not use_wildcard and pattern.strip('/') in ('**', '*'):
+            continue
         if node_fqn is None or _matches(pattern, node_fqn):
             _flatten('', params, values)
     return values
