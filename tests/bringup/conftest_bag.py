@@ -186,14 +186,15 @@ def mindgrasp_cli(*args: str, timeout: float = 300) -> subprocess.CompletedProce
                           capture_output=True, text=True, env=cli_env(), timeout=timeout)
 
 
-def run_with_bag(tmp_path: Path, n: int = 30, chunk_size: int = 2000) -> Path:
+def run_with_bag(tmp_path: Path, n: int = 30, chunk_size: int = 2000,
+                 compression: str = 'none') -> Path:
     """A run directory with a finished bag of ``n`` EEG chunks and ``n`` strings at 10 Hz
-    (bag time 1.0-3.9 s), in several MCAP chunks."""
+    (bag time 1.0-3.9 s), in several MCAP chunks (``compression``: none, zstd or lz4)."""
     from mindgrasp_bringup.bag import BagWriter
 
     run = tmp_path / 'run'
     run.mkdir()
-    with BagWriter(run / 'bag', chunk_size=chunk_size) as writer:
+    with BagWriter(run / 'bag', chunk_size=chunk_size, compression=compression) as writer:
         writer.add_topic('/eeg/raw', EEG)
         writer.add_topic('/chatter', STRING)
         for k in range(n):

@@ -9,6 +9,7 @@ import contextlib
 import re
 from pathlib import Path
 
+import pytest
 import yaml
 from conftest_bag import cut_in_half, damage_chunks, mindgrasp_cli, run_with_bag
 
@@ -46,8 +47,11 @@ def test_bag_cut_in_half_reports_readable_and_recorded_counts_and_writes_nothing
     assert _files(run) == before          # read-only: not even metadata.yaml is rewritten
 
 
-def test_three_damaged_chunks_are_skipped_counted_and_the_rest_is_played(tmp_path):
-    run = run_with_bag(tmp_path)
+# zstd: what runs record by default; a damaged compressed chunk fails to decompress before its
+# CRC is checked
+@pytest.mark.parametrize('compression', ['none', 'zstd', 'lz4'])
+def test_three_damaged_chunks_are_skipped_counted_and_the_rest_is_played(tmp_path, compression):
+    run = run_with_bag(tmp_path, compression=compression)
     offsets = damage_chunks(run / 'bag' / 'bag_0.mcap')
     damage = assess_bag(run / 'bag')
     assert damage.skipped_records == 3 and damage.damaged

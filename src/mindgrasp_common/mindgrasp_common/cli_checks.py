@@ -13,10 +13,11 @@ from __future__ import annotations
 
 import argparse
 import math
+from pathlib import Path
 from typing import NoReturn
 
-__all__ = ['OneLineParser', 'finite_float', 'non_negative_float', 'non_negative_int',
-           'positive_float', 'positive_int', 'probability', 'yaml_error_text']
+__all__ = ['OneLineParser', 'existing_directory', 'finite_float', 'non_negative_float',
+           'non_negative_int', 'positive_float', 'positive_int', 'probability', 'yaml_error_text']
 
 
 class OneLineParser(argparse.ArgumentParser):
@@ -92,6 +93,15 @@ def positive_float(text: str) -> float:
         msg = f'must be > 0, got {value:g}'
         raise argparse.ArgumentTypeError(msg)
     return value
+
+
+def existing_directory(text: str) -> Path:
+    """A directory that exists (where a command writes files of its own names)."""
+    path = Path(text)
+    if not path.is_dir():
+        msg = f"'{text}' is not a directory; create it first"
+        raise argparse.ArgumentTypeError(msg)
+    return path
 
 
 def probability(text: str) -> float:

@@ -15,6 +15,8 @@ from __future__ import annotations
 import argparse
 import sys
 
+from mindgrasp_common.cli_checks import positive_float
+
 from . import EEGError
 
 
@@ -25,7 +27,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--root', required=True, help='root folder of the BIDS dataset')
     parser.add_argument('--subject', required=True, help='participant label (letters, digits)')
     parser.add_argument('--session', default=None, help='session label (letters, digits)')
-    parser.add_argument('--line-freq', type=float, default=50.0,
+    parser.add_argument('--line-freq', type=positive_float, default=50.0,
                         help='power line frequency for eeg.json (Hz; default 50)')
     parser.add_argument('--reference', default='n/a',
                         help="the amplifier's EEG reference for eeg.json (e.g. Cz)")

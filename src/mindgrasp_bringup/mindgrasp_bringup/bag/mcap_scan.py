@@ -10,6 +10,8 @@ incomplete or corrupt record, so everything before it is recovered.
 
 from __future__ import annotations
 
+import contextlib
+import importlib
 import io
 import struct
 from collections import defaultdict
@@ -25,6 +27,22 @@ from mcap.stream_reader import StreamReader
 from mindgrasp_common.safe_files import write_atomic
 
 from .errors import BagError
+
+
+def _zstd_errors() -> tuple[type[Exception], ...]:
+    """The ZstdError classes of the zstd bindings mcap (zstandard) and rosbags (backports.zstd,
+    compression.zstd from Python 3.14) decompress with."""
+    errors: list[type[Exception]] = []
+    for module in ('zstandard', 'backports.zstd', 'compression.zstd'):
+        with contextlib.suppress(ImportError):
+            errors.append(importlib.import_module(module).ZstdError)
+    return tuple(errors)
+
+
+#: what reading a damaged record raises: a failed CRC or framing (mcap), bad bytes, or a chunk
+#: whose compressed data no longer decompresses (a ZstdError; lz4.frame's RuntimeError)
+CORRUPT_RECORD_ERRORS = (McapError, ValueError, struct.error, UnicodeDecodeError, EOFError,
+                         RuntimeError, *_zstd_errors())
 
 __all__ = ['ChannelInfo', 'McapContents', 'damage_sentences', 'is_finished', 'iter_mcap_messages',
            'read_mcap_contents', 'recover_mcap', 'verify_mcap']
@@ -116,7 +134,7 @@ def _records(path: Path, f: io.BufferedReader, size: int,
                 yield next(records)
         except (EndOfFile, StopIteration):
             pass
-        except (McapError, ValueError, struct.error, UnicodeDecodeError) as exc:
+        except CORRUPT_RECORD_ERRORS as exc:
             # framing intact, content not (a flipped bit fails the chunk CRC): skip this record,
             # the ones after it are still readable
             contents.damaged.append(f'record at byte {start} (opcode 0x{opcode:02x}, '
@@ -151,7 +169,7 @@ def read_mcap_contents(path: Path, *, scan: bool = False) -> McapContents:
             f.seek(0)
             try:
                 summary = make_reader(f).get_summary()
-            except (McapError, ValueError, struct.error, EOFError):
+            except CORRUPT_RECORD_ERRORS:
                 summary = None
             if summary is not None and summary.statistics is not None:
                 stats: Statistics = summary.statistics

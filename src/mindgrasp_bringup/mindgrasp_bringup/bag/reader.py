@@ -18,7 +18,12 @@ from rosbags.rosbag2 import Reader
 from rosbags.rosbag2.errors import ReaderError
 
 from .errors import BagError
-from .mcap_scan import is_finished, iter_mcap_messages, read_mcap_contents
+from .mcap_scan import (
+    CORRUPT_RECORD_ERRORS,
+    is_finished,
+    iter_mcap_messages,
+    read_mcap_contents,
+)
 from .metadata import METADATA_FILE, load_metadata, mcap_files, rebuild_metadata
 from .qos import parse_offered_qos
 
@@ -216,7 +221,7 @@ class BagReader:
                         last, at_last = timestamp, set()
                     at_last.add(_key(conn.topic, data))
                     yield conn.topic, timestamp, data
-            except ReaderError as exc:
+            except (ReaderError, *CORRUPT_RECORD_ERRORS) as exc:
                 mcap = [f for f in self.files if f.suffix == '.mcap']
                 if not mcap:
                     msg = (f'The bag {self.path} is corrupt: {exc} Messages up to this point '

@@ -10,18 +10,18 @@ with dotted names nested (``colour_ranges.red`` under ``colour_ranges:``).
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 from typing import Any
 
 import yaml
 
 from mindgrasp_bringup.commands._param_client import call
-from mindgrasp_bringup.ros_cli import CliError, UsageError, cli_node, print_error
+from mindgrasp_bringup.ros_cli import CliError, cli_node, print_error
+from mindgrasp_common.cli_checks import existing_directory
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('node_name', help='fully qualified node name, e.g. /fsm')
-    parser.add_argument('--output-dir', type=Path,
+    parser.add_argument('--output-dir', type=existing_directory,
                         help='write <node>.yaml there instead of printing it (as ros2 Humble)')
 
 
@@ -50,9 +50,6 @@ def parameter_file(target: str, params: dict[str, Any]) -> str:
 def main(args: argparse.Namespace) -> int:
     target = '/' + args.node_name.lstrip('/')
     try:
-        if args.output_dir is not None and not args.output_dir.is_dir():
-            msg = f"--output-dir '{args.output_dir}' is not a directory; create it first."
-            raise UsageError(msg)
         with cli_node('param') as node:
             text = parameter_file(target, node_parameters(node, target))
     except CliError as exc:
