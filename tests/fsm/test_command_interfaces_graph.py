@@ -11,6 +11,8 @@ import pytest
 
 from mindgrasp_testing import spin_until
 
+from .conftest import publish_left_hand
+
 pytestmark = pytest.mark.slow
 
 JOINTS = [f'joint_{i}' for i in range(1, 7)]
@@ -59,17 +61,7 @@ def test_the_arm_follows_each_interface_and_stops_when_inputs_go_stale(
     pred_pub = node.create_publisher(MIPrediction, '/bci/prediction', 10)
     sending = [True]
 
-    def publish() -> None:
-        stamp = node.get_clock().now().to_msg()
-        det = DetectionArray(image_width=128, image_height=128, object_of_interest=-1)
-        det.header.stamp = stamp
-        det_pub.publish(det)
-        if sending[0]:
-            pred = MIPrediction(class_index=MIPrediction.LEFT_HAND, certainty=1.0)
-            pred.header.stamp = stamp
-            pred_pub.publish(pred)
-
-    node.create_timer(0.05, publish)
+    node.create_timer(0.05, lambda: publish_left_hand(node, det_pub, pred_pub, sending[0]))
     # left-hand imagery turns joint 1 at search_gain (0.4 rad/s): the simulated arm follows
     assert spin_until(node, lambda: joints and joints[-1].velocity[0] > 0.35, 120.0), (
         commands[-3:], fsm.output()[-2000:], sim.output()[-2000:])
