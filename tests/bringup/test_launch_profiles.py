@@ -142,5 +142,5 @@ def test_command_interface_reaches_the_controller(profile: str, tmp_path, monkey
     for interface in ('trajectory', 'servo_twist'):
         fsm = processes(profile, *extra, f'command_interface:={interface}')['fsm']
         assert fsm.parameters['command_interface'] == interface
-    with pytest.raises(LaunchError, match="'joint_jog'.*velocity, trajectory, servo_twist"):
+    with pytest.raises(LaunchError, match=r"'joint_jog'.*velocity, trajectory, servo_twist"):
         processes(profile, *extra, 'command_interface:=joint_jog')
