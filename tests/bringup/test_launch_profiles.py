@@ -128,3 +128,19 @@ def test_a_profile_can_be_included_by_name() -> None:
     assert list(procs) == ['virtual_amp', 'eeg_acquisition']
     assert procs['virtual_amp'].parameters['stream_name'] == 'inner-amp'
     assert procs['virtual_amp'].parameters['seed'] == 7  # the including launch's argument
+
+
+@pytest.mark.parametrize('profile', ['demo', 'experiment', 'hardware'])
+def test_command_interface_reaches_the_controller(profile: str, tmp_path, monkeypatch) -> None:
+    """Issue 28: ``command_interface:=`` of the profiles sets the fsm node's parameter; a value
+    that is not an interface is refused before anything starts, naming the choices."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / 'alice.json').write_text('{}')
+    extra = {'hardware': ['eeg_stream:=a', 'arm_driver:=true', 'model:=alice.json']}.get(profile,
+                                                                                          [])
+    assert processes(profile, *extra)['fsm'].parameters['command_interface'] == 'velocity'
+    for interface in ('trajectory', 'servo_twist'):
+        fsm = processes(profile, *extra, f'command_interface:={interface}')['fsm']
+        assert fsm.parameters['command_interface'] == interface
+    with pytest.raises(LaunchError, match=r"'joint_jog'.*velocity, trajectory, servo_twist"):
+        processes(profile, *extra, 'command_interface:=joint_jog')

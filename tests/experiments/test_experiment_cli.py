@@ -43,6 +43,9 @@ def last_json(result: subprocess.CompletedProcess) -> dict:
     (['random-locations', '--realism', 'foggy'], "--realism: Unknown realism profile 'foggy'"),
     (['set-locations', '--realism', 'foggy'], "--realism: Unknown realism profile 'foggy'"),
     (['report', 'no/such/run'], 'is not a directory'),
+    (['set-locations', '--param', 'fsm.command_interface=joint_jog'],
+     "--param fsm.command_interface: The parameter 'command_interface' is 'joint_jog'; use one "
+     'of velocity, trajectory, servo_twist.'),
 ])
 def test_bad_input_is_one_clear_line_and_exit_2(args: list[str], message: str) -> None:
     result = mindgrasp('experiment', *args, timeout=120)
@@ -77,6 +80,21 @@ def test_a_subject_that_decides_right_picks_the_desired_object_and_every_file_is
     (out / 'report.md').unlink()
     assert mindgrasp('experiment', 'report', str(out), timeout=300).returncode == 0
     assert (out / 'report.md').read_text() == report
+
+
+@pytest.mark.slow
+@pytest.mark.timeout(1800)   # whole experiments in subprocesses, on a loaded machine
+@pytest.mark.parametrize('interface', ['trajectory', 'servo_twist'])
+def test_the_oracle_grasps_through_a_trajectory_controller_and_moveit_servo(
+        tmp_path: Path, interface: str) -> None:
+    """Issue 28: the controller's commands as JointTrajectory or MoveIt Servo twists, which the
+    simulator takes like a JointTrajectoryController or MoveIt Servo: the grasp succeeds."""
+    out = tmp_path / 'run'
+    s = last_json(mindgrasp('experiment', 'set-locations', '--trials', '1', '--subject',
+                            'oracle', '--out', str(out), '--json', '--no-progress', '--param',
+                            f'fsm.command_interface={interface}'))
+    assert s['correct_and_successful_count'] == 1, s
+    assert f'command_interface: {interface}' in (out / 'params' / 'fsm.yaml').read_text()
 
 
 @pytest.mark.slow

@@ -110,3 +110,18 @@ def params() -> FsmParams:
 def fsm(params: FsmParams) -> GraspFsm:
     """A BCI-mode controller with the project's robot model."""
     return GraspFsm.from_params(params)
+
+
+def publish_left_hand(node: object, det_pub: object, pred_pub: object, predicting: bool) -> None:
+    """Publish an empty /vision/detections frame (128 x 128 px) and, when ``predicting``, a sure
+    left-hand /bci/prediction, both stamped now (a driver of the fsm node in its own process)."""
+    from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import DetectionArray, MIPrediction
+
+    stamp = node.get_clock().now().to_msg()
+    det = DetectionArray(image_width=128, image_height=128, object_of_interest=-1)
+    det.header.stamp = stamp
+    det_pub.publish(det)
+    if predicting:
+        pred = MIPrediction(class_index=MIPrediction.LEFT_HAND, certainty=1.0)
+        pred.header.stamp = stamp
+        pred_pub.publish(pred)

@@ -9,6 +9,8 @@ import pytest
 
 from mindgrasp_testing import spin_until
 
+from .conftest import publish_left_hand
+
 pytestmark = pytest.mark.slow
 
 HOME = [0.0, 0.0, 0.0, np.pi / 2, 1.2, 0.0]
@@ -50,13 +52,7 @@ def test_fsm_node_turns_on_left_hand_and_stops_when_predictions_end(rclpy_ctx, s
                         velocity=np.zeros(6))
         js.header.stamp = stamp
         js_pub.publish(js)
-        det = DetectionArray(image_width=128, image_height=128, object_of_interest=-1)
-        det.header.stamp = stamp
-        det_pub.publish(det)
-        if send_predictions[0]:
-            pred = MIPrediction(class_index=MIPrediction.LEFT_HAND, certainty=1.0)
-            pred.header.stamp = stamp
-            pred_pub.publish(pred)
+        publish_left_hand(node, det_pub, pred_pub, send_predictions[0])
 
     node.create_timer(0.05, publish)
     # left-hand imagery in Object Search turns joint 1 left at search_gain * certainty

@@ -76,6 +76,8 @@ _HELPERS = {
     'live_view_nodes': 'mindgrasp_bringup.launch_system.common',
     'run_directory_actions': 'mindgrasp_bringup.launch_system.common',
     'driver_nodes': 'mindgrasp_bringup.launch_system.common',
+    'fsm_node': 'mindgrasp_bringup.launch_system.common',
+    'command_interface_argument': 'mindgrasp_bringup.launch_system.common',
 }
 
 __all__ = ['own_launcher', 'using_real_launch', *_SOURCES, *_HELPERS]

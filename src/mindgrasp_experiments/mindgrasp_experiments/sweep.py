@@ -152,8 +152,30 @@ def check_params(params: Sequence[Param], components: Sequence[Any]) -> list[Par
             msg = (f'--param {full}: {node} has no parameter {name!r} in its parameter files; '
                    f'it has {", ".join(sorted(known))}.')
             raise ExperimentError(msg)
-        out.append((node, name, [_typed(v, known[name], full) for v in values]))
+        typed = [_typed(v, known[name], full) for v in values]
+        _check_range(nodes[node], name, typed, full)
+        out.append((node, name, typed))
     return out
+
+
+def _check_range(component: Any, name: str, values: Sequence[Any], full: str) -> None:
+    """ExperimentError for a value outside the range or choices that the node class declares
+    (:attr:`NodeTraits.parameters`), before any trial runs."""
+    import dataclasses
+
+    from mindgrasp_ros.composition import load_node_class
+    from mindgrasp_ros.node_traits import traits_of
+    from mindgrasp_ros.params import ParameterError, check_value
+
+    cls = traits_of(load_node_class(component.module)).parameters
+    if cls is None or name not in {f.name for f in dataclasses.fields(cls)}:
+        return
+    for value in values:
+        try:
+            check_value(cls, name, value)
+        except ParameterError as exc:
+            msg = f'--param {full}: {exc}'
+            raise ExperimentError(msg) from None
 
 
 def combinations(params: Sequence[Param]) -> list[dict[str, Any]]:

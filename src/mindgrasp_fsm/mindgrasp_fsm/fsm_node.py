@@ -5,8 +5,12 @@ src/mindgrasp_fsm/mindgrasp_fsm/param/fsm.yaml``
 
 Subscribes ``/bci/prediction`` (mindgrasp_msgs/MIPrediction), ``/vision/detections``
 (DetectionArray), ``/joint_states``, ``/gripper/joint_states`` + ``/gripper/contacts`` (finger
-angles, efforts and contact flags), ``/camera/color/camera_info``. Publishes
-``/arm_controller/commands`` (std_msgs/Float64MultiArray, 6 joint velocities in rad/s),
+angles, efforts and contact flags), ``/camera/color/camera_info``. Publishes the arm
+command in the form of ``command_interface`` (:mod:`mindgrasp_fsm.arm_output`):
+``/arm_controller/commands`` (std_msgs/Float64MultiArray, 6 joint velocities in rad/s; default),
+``/arm_controller/joint_trajectory`` (trajectory_msgs/JointTrajectory) or
+``/servo_node/delta_twist_cmds`` (geometry_msgs/TwistStamped, after
+``/servo_node/switch_command_type``);
 ``/gripper_controller/commands`` (``[closure]``, 0 open .. 1 closed) and ``/fsm/state``
 (FsmState, transient local). Topic names and QoS: :mod:`mindgrasp_ros.topics`. Parameters: every
 field of :class:`mindgrasp_fsm.params.FsmParams` (``mindgrasp param describe /fsm <name>`` shows
@@ -25,6 +29,7 @@ from mindgrasp_ros.interfaces.std_msgs.msg import Float64MultiArray, UInt8MultiA
 
 from mindgrasp_common.errors import CommonError
 from mindgrasp_common.mi import decoder_class_index
+from mindgrasp_fsm.arm_output import ArmCommandOutput
 from mindgrasp_fsm.conversions import gripper_from_fingers, vision_frame_from_msg
 from mindgrasp_fsm.errors import FsmError
 from mindgrasp_fsm.grasp_fsm import SENSOR_FAULT, GraspFsm
@@ -39,9 +44,9 @@ from mindgrasp_fsm.types import (
 )
 from mindgrasp_ros import rclpy
 from mindgrasp_ros.node_main import declare_duration, run_node
+from mindgrasp_ros.node_traits import NodeTraits
 from mindgrasp_ros.params import declare_params
 from mindgrasp_ros.topics import (
-    ARM_COMMANDS,
     BCI_PREDICTION,
     COLOR_INFO,
     FSM_STATE,
@@ -58,6 +63,8 @@ _NUMBER = re.compile(r'\d+(\.\d+)?')
 class FsmNode(rclpy.node.Node):
     """Thin ROS wrapper round :class:`GraspFsm` (parameters: mindgrasp_fsm/param/fsm.yaml)."""
 
+    node_traits = NodeTraits(parameters=FsmParams)   # --param values checked before a trial
+
     def __init__(self, **kwargs: object) -> None:
         super().__init__('fsm', **kwargs)
         # one FsmParams object, shared with the controller: live changes apply at the next tick
@@ -73,7 +80,7 @@ class FsmNode(rclpy.node.Node):
         self.done = rclpy.task.Future()
         self.ticks = 0
 
-        self.arm_pub = self.create_publisher(Float64MultiArray, ARM_COMMANDS.name, ARM_COMMANDS.qos)
+        self.arm = ArmCommandOutput(self, self.params, self.fsm.kinematics)
         self.gripper_pub = self.create_publisher(Float64MultiArray, GRIPPER_COMMANDS.name,
                                                  GRIPPER_COMMANDS.qos)
         self.state_pub = self.create_publisher(FsmState, FSM_STATE.name, FSM_STATE.qos)
@@ -91,7 +98,8 @@ class FsmNode(rclpy.node.Node):
         self.create_timer(self.params.control_period, self.control_callback)
         declare_duration(self)
         mode = 'autonomous' if self.params.autonomous else 'BCI'
-        self.get_logger().info(f'Grasp controller ready ({mode} mode, '
+        self.get_logger().info(f'Grasp controller ready ({mode} mode, arm commands on '
+                               f'{self.arm.topic} ({self.arm.interface}), '
                                f'{1.0 / self.params.control_period:.0f} Hz, lock '
                                f'{self.params.lock_duration:.1f} s, watchdog '
                                f'{self.params.watchdog_timeout:.2f} s).')
@@ -178,7 +186,8 @@ class FsmNode(rclpy.node.Node):
         self.inputs.time = now
         out = self.fsm.tick(self.inputs)
         self.ticks += 1
-        self.arm_pub.publish(Float64MultiArray(data=np.asarray(out.joint_velocities, float)))
+        joints = self.inputs.joints
+        self.arm.publish(out.joint_velocities, None if joints is None else joints.position)
         self.gripper_pub.publish(Float64MultiArray(data=np.array([out.gripper.position])))
         self._publish_state(out, now)
         for event in out.events:
@@ -213,7 +222,8 @@ class FsmNode(rclpy.node.Node):
     def destroy_node(self) -> None:
         """Stop the arm (when the context still runs) and say how long the controller ran."""
         if rclpy.ok():
-            self.arm_pub.publish(Float64MultiArray(data=np.zeros(6)))
+            joints = self.inputs.joints
+            self.arm.stop(None if joints is None else joints.position)
         self.get_logger().info(f'Controller ran {self.ticks} ticks.')
         super().destroy_node()
 

@@ -143,6 +143,11 @@ class UrdfKinematics:
         c, s = np.cos(yaw), np.sin(yaw)
         return np.array([[c, s, 0.0], [s, -c, 0.0], [0.0, 0.0, -1.0]])
 
+    def jacobian(self, q: np.ndarray) -> np.ndarray:
+        """Geometric Jacobian (6, 6) of the tool at joints ``q`` (rad): rows linear (m/s) and
+        angular (rad/s) velocity in the base frame per rad/s of each joint."""
+        return self._fk_jacobian(np.asarray(q, dtype=float))[1]
+
     def _fk_jacobian(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Tool pose (4x4) and the geometric Jacobian (6, 6) [linear; angular] at ``q``."""
         t = np.eye(4)

@@ -24,6 +24,7 @@ from mindgrasp_common.robot import (
     HOME_POSE,
     URDF_URI,
 )
+from mindgrasp_fsm.command_interface import COMMAND_INTERFACES, check_command_interface
 from mindgrasp_fsm.errors import FsmError
 from mindgrasp_ros.params import param
 
@@ -65,6 +66,16 @@ class FsmParams:
                                                 'velocity command', unit='rad/s^2', live=True)
     control_period: float = param(0.02, 'control tick (the node ticks at 1 / control_period)',
                                   unit='s', min=0.001, max=1.0)
+    # the form of the arm command for the driver (mindgrasp_fsm.command_interface): the same
+    # acceleration-limited joint velocities, sent as a driver of each kind takes them
+    command_interface: str = param('velocity', 'arm command: velocity (ros2_control forward '
+                                   'velocity controller), trajectory (JointTrajectoryController) '
+                                   'or servo_twist (MoveIt Servo)', choices=COMMAND_INTERFACES)
+    trajectory_horizon: float = param(0.1, 'trajectory: time of the last point of each streamed '
+                                      'trajectory (one point per control tick ahead, 2 at least)',
+                                      unit='s', min=0.001, max=1.0)
+    servo_frame: str = param('base_link', 'servo_twist: frame_id of the twist (the arm base '
+                             'frame, MoveIt Servo robot_link_command_frame)')
     lock_duration: float = param(1.0, 'all joints held between states (paper: locks)', unit='s',
                                  min=0.001, max=30.0, live=True)
     watchdog_timeout: float = param(0.3, 'oldest acceptable prediction / joint state; older '
@@ -329,6 +340,7 @@ class FsmParams:
 
     def validate(self) -> None:
         """Raise :class:`FsmError` naming the first bad parameter and how to fix it."""
+        check_command_interface(self.command_interface)
         for name in ('joint_names', 'home_position', 'joint_lower_limits', 'joint_upper_limits',
                      'max_joint_velocity', 'max_joint_acceleration'):
             values = getattr(self, name)

@@ -37,6 +37,9 @@ class NodeTraits:
             node provides, naming the fix.
         trial_manager: The node that runs an experiment's trials and keeps its records; the
             engine tells it which trial to run and reads its records.
+        parameters: The dataclass the node declares its parameters from
+            (:func:`mindgrasp_ros.params.declare_params`), so that a host checks a value's range
+            and choices before it starts the node (None: checked when the node starts).
     """
 
     seed_parameters: tuple[str, ...] = ()
@@ -45,6 +48,7 @@ class NodeTraits:
     provides: tuple[str, ...] = ()
     lockstep_missing: str = ''
     trial_manager: bool = False
+    parameters: type | None = None
 
 
 _DEFAULT = NodeTraits()

@@ -119,6 +119,15 @@ JOINT_STATES = _t('/joint_states', 'sensor_msgs/msg/JointState', RELIABLE,
                   'sim (or arm driver)', 'fsm, virtual subject', 'rad, rad/s')
 ARM_COMMANDS = _t('/arm_controller/commands', 'std_msgs/msg/Float64MultiArray', RELIABLE,
                   'fsm', 'sim (or arm driver)', '6 joint velocities, rad/s')
+ARM_TRAJECTORY = _t('/arm_controller/joint_trajectory', 'trajectory_msgs/msg/JointTrajectory',
+                    RELIABLE, 'fsm (command_interface trajectory)',
+                    'sim (or JointTrajectoryController)',
+                    'streamed, 0.1 s ahead, header stamp 0 = start now')
+SERVO_TWIST = _t('/servo_node/delta_twist_cmds', 'geometry_msgs/msg/TwistStamped', RELIABLE,
+                 'fsm (command_interface servo_twist)', 'sim (or MoveIt Servo)',
+                 'tool twist in base_link, m/s, rad/s')
+#: MoveIt Servo's service that selects the command type (moveit_msgs/srv/ServoCommandType)
+SERVO_COMMAND_TYPE_SERVICE = '/servo_node/switch_command_type'
 GRIPPER_COMMANDS = _t('/gripper_controller/commands', 'std_msgs/msg/Float64MultiArray',
                       RELIABLE, 'fsm', 'sim (or arm driver)', '[closure], 0 open .. 1 closed')
 GRIPPER_JOINT_STATES = _t('/gripper/joint_states', 'sensor_msgs/msg/JointState', RELIABLE,
@@ -172,7 +181,8 @@ TRAINER_ROBOT_TOPICS = tuple(
 TOPICS: dict[str, Topic] = {t.name: t for t in (
     EEG_RAW, EEG_STATUS, BCI_PREDICTION, BCI_STATUS, TRAINER_PROMPT, TRAINER_DISPLAY,
     TRAINER_EE_DISTANCE, COLOR_IMAGE, DEPTH_IMAGE, COLOR_INFO, DEPTH_INFO, JOINT_STATES,
-    ARM_COMMANDS, GRIPPER_COMMANDS, GRIPPER_JOINT_STATES, GRIPPER_CONTACTS, EE_POSE,
+    ARM_COMMANDS, ARM_TRAJECTORY, SERVO_TWIST, GRIPPER_COMMANDS, GRIPPER_JOINT_STATES,
+    GRIPPER_CONTACTS, EE_POSE,
     VISION_DETECTIONS, VISION_OVERLAY, FSM_STATE, TASK_TARGET, TASK_RESULT, SIM_OBJECTS,
     ROBOT_DESCRIPTION, TF, TF_STATIC, SIM_STATUS, VIRTUAL_SUBJECT_INTENT, SCENE_IMAGE,
     DISPLAY_FLIP, DISPLAY_IMAGE, CLOCK,

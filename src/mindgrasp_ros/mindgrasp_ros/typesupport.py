@@ -2,8 +2,8 @@
 
 One typestore holds every type the runtime knows: ROS 2 Jazzy's common_interfaces (from the
 ``rosbags`` Jazzy store), the service types the runtime serves (rcl_interfaces parameter services,
-std_srvs), and ``mindgrasp_msgs`` registered from its own ``msg/*.msg`` and ``srv/*.srv`` files, so
-the interface package is the one source of truth.
+std_srvs, moveit_msgs/srv/ServoCommandType), and ``mindgrasp_msgs`` registered from its own
+``msg/*.msg`` and ``srv/*.srv`` files, so the interface package is the one source of truth.
 
 Message classes behave like rclpy's generated classes: keyword construction with ROS defaults,
 numeric sequences as numpy arrays, ``get_fields_and_field_types()``. Serialisation uses ``rosbags``'
@@ -62,8 +62,9 @@ _FIELD_DEFAULTS: dict[str, dict[str, Any]] = {
     'geometry_msgs/msg/Quaternion': {'w': 1.0},
 }
 
-#: Service types the runtime needs beyond the rosbags store (which has no srv types).
-_EXTRA_SERVICE_FILES = ('rcl_interfaces', 'std_srvs')
+#: Service types the runtime needs beyond the rosbags store (which has no srv types); MoveIt
+#: Servo's switch_command_type is served by the simulator and called by the controller.
+_EXTRA_SERVICE_FILES = ('moveit_msgs', 'rcl_interfaces', 'std_srvs')
 
 #: the member rosidl gives a message without fields; not a field of rclpy's Python classes
 EMPTY_PLACEHOLDER = 'structure_needs_at_least_one_member'

@@ -1,5 +1,7 @@
 """Command handling shared by the node and tests (ROS-free): validation of joint velocity and
-gripper commands and the command timeout of a forward velocity controller."""
+gripper commands, the command timeout of a forward velocity controller, and the joint velocities
+the two other arm interfaces stand for (a streamed JointTrajectoryController trajectory, a MoveIt
+Servo twist), so that every interface goes through the same gate, limits and warnings."""
 
 from __future__ import annotations
 
@@ -23,6 +25,54 @@ def validate_velocities(values: object, n_joints: int = 6) -> np.ndarray:
               'velocities in rad/s.'
         raise SimError(msg)
     return v
+
+
+def velocities_from_trajectory(joint_names: list[str], arm_joints: list[str] | tuple[str, ...],
+                               positions: np.ndarray, velocities: np.ndarray,
+                               time_from_start: float, q: np.ndarray) -> np.ndarray:
+    """Joint velocities (n,) rad/s, in ``arm_joints`` order, that follow the first point of a
+    streamed trajectory: its velocities when it has them, else the way from the joints ``q``
+    (n,) rad to its positions in ``time_from_start`` s. SimError naming the problem for joint
+    names other than the arm's, sizes that do not match them, NaN/inf or a point at time 0
+    without velocities."""
+    names = list(joint_names)
+    if sorted(names) != sorted(arm_joints):
+        msg = (f'JointTrajectory joint_names {names} are not the arm joints; send '
+               f'joint_names {list(arm_joints)} (any order).')
+        raise SimError(msg)
+    order = [names.index(n) for n in arm_joints]
+    velocities = np.asarray(velocities, dtype=float).reshape(-1)
+    positions = np.asarray(positions, dtype=float).reshape(-1)
+    if velocities.size:
+        if velocities.size != len(names):
+            msg = (f'JointTrajectory point has {velocities.size} velocities for {len(names)} '
+                   'joint_names; send one per joint (rad/s) or none.')
+            raise SimError(msg)
+        return validate_velocities(velocities[order], len(names))
+    if positions.size != len(names):
+        msg = (f'JointTrajectory point has {positions.size} positions for {len(names)} '
+               'joint_names; send one per joint (rad).')
+        raise SimError(msg)
+    if not (math.isfinite(time_from_start) and time_from_start > 0):
+        msg = (f'JointTrajectory point without velocities has time_from_start '
+               f'{time_from_start} s; give it a time > 0 s or velocities.')
+        raise SimError(msg)
+    return validate_velocities((positions[order] - np.asarray(q, dtype=float)) / time_from_start,
+                               len(names))
+
+
+def velocities_from_twist(jacobian: np.ndarray, linear: np.ndarray, angular: np.ndarray,
+                          damping: float = 0.01) -> np.ndarray:
+    """Joint velocities (n,) rad/s that move the tool at ``linear`` (3,) m/s and ``angular``
+    (3,) rad/s, by damped least squares on the tool ``jacobian`` (6, n), as MoveIt Servo does
+    with its inverse Jacobian (the damping keeps a near-singular arm from racing). SimError for
+    NaN/inf."""
+    twist = np.concatenate([np.asarray(linear, dtype=float), np.asarray(angular, dtype=float)])
+    if not np.isfinite(twist).all():
+        msg = f'Twist contains NaN or inf ({twist.tolist()}); send finite m/s and rad/s.'
+        raise SimError(msg)
+    j = np.asarray(jacobian, dtype=float)
+    return j.T @ np.linalg.solve(j @ j.T + damping ** 2 * np.eye(6), twist)
 
 
 def gripper_closure(values: object) -> float:
@@ -126,4 +176,5 @@ def _read_only(a: np.ndarray) -> np.ndarray:
     return a
 
 
-__all__ = ['CommandBursts', 'CommandGate', 'gripper_closure', 'validate_velocities']
+__all__ = ['CommandBursts', 'CommandGate', 'gripper_closure', 'validate_velocities',
+           'velocities_from_trajectory', 'velocities_from_twist']

@@ -9,7 +9,11 @@ RGB-D camera driver, served by :class:`~mindgrasp_sim.simulation.Simulation`.
 Subscribes ``/arm_controller/commands`` (std_msgs/Float64MultiArray, 6 joint velocities, rad/s;
 older than ``command_timeout`` s means zero; clipped to the velocity limits of the loaded URDF;
 NaN/inf or a wrong length is refused and holds the arm until no refused command came for
-``bad_command_hold`` s; one warning per burst of bad commands), ``/gripper_controller/commands``
+``bad_command_hold`` s; one warning per burst of bad commands), and, with the same timeout,
+limits and refusals, ``/arm_controller/joint_trajectory`` (trajectory_msgs/JointTrajectory, as a
+JointTrajectoryController) and ``/servo_node/delta_twist_cmds`` (geometry_msgs/TwistStamped, as
+MoveIt Servo, after ``/servo_node/switch_command_type``; see
+:mod:`mindgrasp_sim.command_inputs`), ``/gripper_controller/commands``
 (Float64MultiArray: [closure] 0 open .. 1 closed, or [thumb, left, right]) and ``/task/target``.
 Publishes ``/joint_states`` (6 arm joints), ``/gripper/joint_states`` (3 fingers: angles, efforts
 in N m), ``/gripper/contacts`` (std_msgs/UInt8MultiArray, 1 = finger touches an object; with
@@ -49,6 +53,7 @@ import math
 import os
 import sys
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -95,6 +100,7 @@ from mindgrasp_ros.topics import (
     TRAINER_ROBOT,
 )
 from mindgrasp_sim import messages as msgs
+from mindgrasp_sim.command_inputs import ArmCommandInputs
 from mindgrasp_sim.control import CommandBursts, CommandGate, gripper_closure, validate_velocities
 from mindgrasp_sim.errors import SimError
 from mindgrasp_sim.simulation import CameraConfig, Simulation
@@ -175,6 +181,7 @@ class _RobotIO:
     bursts: CommandBursts
     pubs: dict = field(default_factory=dict)
     applied: np.ndarray = field(default_factory=lambda: np.zeros(6))
+    inputs: object = None     #: its ArmCommandInputs (trajectory, servo twist)
 
 
 def _check_params(p: dict) -> None:
@@ -269,6 +276,7 @@ class SimNode(rclpy.node.Node):
             self.create_subscription(
                 Float64MultiArray, gripper.name,
                 lambda msg, io=io: self.gripper_command_callback(msg, io), gripper.qos)
+            io.inputs = ArmCommandInputs(self, io)    # trajectory and MoveIt Servo twist
             self.robots[name] = io
         self.color_pub = self.create_publisher(Image, COLOR_IMAGE.name, COLOR_IMAGE.qos)
         self.depth_pub = self.create_publisher(Image, DEPTH_IMAGE.name, DEPTH_IMAGE.qos)
@@ -404,14 +412,20 @@ class SimNode(rclpy.node.Node):
 
     # ------------------------------------------------------------------ commands
     def arm_command_callback(self, msg: Float64MultiArray, io: _RobotIO) -> None:
-        """Joint velocities (rad/s). A refused command stops the arm, which then holds until
-        the commands were valid for ``bad_command_hold`` s; a command beyond the URDF's velocity
-        limits is clipped to them. One warning per burst of each."""
+        """Joint velocities (rad/s) on /arm_controller/commands."""
+        self.accept_arm_command(lambda: validate_velocities(msg.data, io.gate.n_joints), io,
+                                f'{io.prefix}{ARM_COMMANDS.name}')
+
+    def accept_arm_command(self, velocities: Callable[[], np.ndarray], io: _RobotIO,
+                           topic: str) -> None:
+        """The joint velocities (6,) rad/s that ``velocities()`` reads from a command of any
+        interface. A refused command (``velocities()`` raises SimError) stops the arm, which then
+        holds until the commands were valid for ``bad_command_hold`` s; a command beyond the
+        URDF's velocity limits is clipped to them. One warning per burst of each."""
         now = self.sim_now()
-        topic = f'{io.prefix}/arm_controller/commands'
         hold = io.bursts.hold
         try:
-            v = validate_velocities(msg.data, io.gate.n_joints)
+            v = velocities()
         except SimError as err:
             io.gate.clear()
             if io.bursts.bad('refused', now):

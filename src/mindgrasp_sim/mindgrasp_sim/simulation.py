@@ -903,6 +903,22 @@ class Simulation:
         st = self._kin.getLinkState(self._kin_body, idx, computeForwardKinematics=True)
         return np.array(st[4]), np.array(st[5])
 
+    def tool_jacobian(self, q: np.ndarray) -> np.ndarray:
+        """Geometric Jacobian (6, 6) of the TCP at joints ``q`` (6,) rad, on the kinematic twin:
+        rows linear (m/s) and angular (rad/s) velocity in the base frame per rad/s of each arm
+        joint (pybullet.calculateJacobian, fingers open)."""
+        q = np.asarray(q, dtype=float)
+        self._kin_set(q)
+        movable = [j for j in range(self._kin.getNumJoints(self._kin_body))
+                   if self._kin.getJointInfo(self._kin_body, j)[2] != pb.JOINT_FIXED]
+        positions = [float(q[self._arm_idx.index(j)]) if j in self._arm_idx else 0.0
+                     for j in movable]
+        zeros = [0.0] * len(movable)
+        lin, ang = self._kin.calculateJacobian(self._kin_body, self._tcp_idx, [0.0, 0.0, 0.0],
+                                               positions, zeros, zeros)
+        cols = [movable.index(j) for j in self._arm_idx]
+        return np.vstack([np.asarray(lin)[:, cols], np.asarray(ang)[:, cols]])
+
     def inverse_kinematics(self, target_pos: np.ndarray, target_quat: np.ndarray | None = None,
                            robot: str = 'user', seed_q: np.ndarray | None = None,
                            iterations: int = 30, tolerance: float = 1e-3) -> np.ndarray:

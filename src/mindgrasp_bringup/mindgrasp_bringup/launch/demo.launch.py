@@ -7,6 +7,7 @@ acquisition, MI classifier, vision and the grasp controller, recorded to the run
     mindgrasp launch demo display:=window           # with the participant's screen
     mindgrasp launch demo realism:=default          # noisy camera, miscalibrated, lagging arm
     mindgrasp launch demo live_view:=false          # without the Foxglove live view
+    mindgrasp launch demo command_interface:=trajectory   # JointTrajectory (or servo_twist)
     mindgrasp launch demo --show-args
     ros2 launch mindgrasp_bringup demo.launch.py    # the same, in a sourced ROS 2 workspace
 
@@ -26,10 +27,12 @@ from mindgrasp_bringup.launch_api import (
     Node,
     Shutdown,
     classifier_nodes,
+    command_interface_argument,
     config_files,
     display_arguments,
     display_nodes,
     file_argument,
+    fsm_node,
     live_view_arguments,
     live_view_nodes,
     number_argument,
@@ -70,6 +73,7 @@ def generate_launch_description() -> LaunchDescription:
         number_argument('trials', default_value='3', minimum=0,
                         description='grasp trials before the demo ends (0: until duration or '
                                     'Ctrl-C)'),
+        command_interface_argument(),
         *display_arguments(),
         *live_view_arguments(),
         *run_directory_actions(),  # ros2 launch: run directory, recorder, duration
@@ -101,8 +105,7 @@ def generate_launch_description() -> LaunchDescription:
         Node(package='mindgrasp_vision', executable='vision_node', name='vision',
              parameters=config_files('vision', 'demo')),
         # 6 controller: predictions + detections -> arm and gripper commands
-        Node(package='mindgrasp_fsm', executable='fsm_node', name='fsm',
-             parameters=config_files('fsm', 'demo')),
+        fsm_node(config_files('fsm', 'demo')),
         # 7 live view for the experimenter: Foxglove at ws://localhost:8765
         *live_view_nodes(),
     ])

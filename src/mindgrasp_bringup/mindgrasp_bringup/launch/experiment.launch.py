@@ -28,8 +28,10 @@ from mindgrasp_bringup.launch_api import (
     NotEqualsSubstitution,
     Shutdown,
     checked_argument,
+    command_interface_argument,
     config_files,
     file_argument,
+    fsm_node,
     number_argument,
     run_directory_actions,
 )
@@ -90,6 +92,7 @@ def generate_launch_description() -> LaunchDescription:
                                           'spread; mindgrasp_sim.realism), seeded by seed'),
         DeclareLaunchArgument('gui', default_value='false', choices=['true', 'false'],
                               description='open the PyBullet window (needs a display)'),
+        command_interface_argument(),
         *run_directory_actions(),  # ros2 launch: run directory, recorder, duration
         *[Node(package='mindgrasp_experiments', executable='trial_manager_node',
                name='trial_manager', parameters=[*manager, {'wait_for': topics}],
@@ -120,8 +123,7 @@ def generate_launch_description() -> LaunchDescription:
              name='oracle_subject', parameters=[{'seed': seed}], condition=_when('oracle')),
         Node(package='mindgrasp_vision', executable='vision_node', name='vision',
              parameters=config_files('vision', 'experiment')),
-        Node(package='mindgrasp_fsm', executable='fsm_node', name='fsm',
-             parameters=[*config_files('fsm', 'experiment'),
-                         {'autonomous': EqualsSubstitution(subject, 'autonomous')}]),
+        fsm_node(config_files('fsm', 'experiment'),
+                 {'autonomous': EqualsSubstitution(subject, 'autonomous')}),
     ])
 

@@ -8,6 +8,8 @@ classifier, vision and the grasp controller.
         model:=models/alice.json
     mindgrasp launch hardware eeg_stream:=gNautilus arm_driver:=my_ros_pkg/arm_node \\
         model:=package://mindgrasp_classifier/models/default_classifier.json   # bench test only
+    mindgrasp launch hardware eeg_stream:=gNautilus arm_driver:=my_arm_driver \
+        model:=models/alice.json command_interface:=servo_twist    # the arm behind MoveIt Servo
 
 ``model:=`` is required: a real person's EEG is never decoded by the classifier trained on the
 simulated head unless it is named on purpose (the last line, for a bench test without a person).
@@ -16,7 +18,11 @@ ends with a non-zero exit code (``mindgrasp launch``; ``ros2 launch`` shuts down
 
 The arm driver must serve the arm contract of ros2_control's forward velocity controller:
 subscribe /arm_controller/commands and /gripper_controller/commands (std_msgs/Float64MultiArray,
-rad/s), publish /joint_states (sensor_msgs/JointState). The camera (the driver itself or
+rad/s), publish /joint_states (sensor_msgs/JointState). With ``command_interface:=trajectory`` the
+arm commands go to a JointTrajectoryController instead (trajectory_msgs/JointTrajectory on
+/arm_controller/joint_trajectory), with ``command_interface:=servo_twist`` to MoveIt Servo
+(geometry_msgs/TwistStamped on /servo_node/delta_twist_cmds, after
+/servo_node/switch_command_type). The camera (the driver itself or
 camera_driver) publishes /camera/color/image_raw (rgb8), /camera/depth/image_raw (32FC1, m) and
 /camera/color/camera_info. Drivers are started as ROS nodes (``--ros-args -r __node:=...``).
 """
@@ -29,9 +35,11 @@ from mindgrasp_bringup.launch_api import (
     Node,
     NotEqualsSubstitution,
     classifier_nodes,
+    command_interface_argument,
     config_files,
     driver_nodes,
     file_argument,
+    fsm_node,
     run_directory_actions,
 )
 
@@ -60,6 +68,7 @@ def generate_launch_description() -> LaunchDescription:
                                           'arm driver or another system publishes the camera)'),
         DeclareLaunchArgument('camera_driver_args', default_value='',
                               description='command-line arguments of the camera driver'),
+        command_interface_argument(),
         *run_directory_actions(),  # ros2 launch: run directory, recorder, duration
         *driver_nodes('arm'),
         *driver_nodes('camera', condition=IfCondition(
@@ -70,6 +79,5 @@ def generate_launch_description() -> LaunchDescription:
         *classifier_nodes(config_files('classifier', 'hardware')),
         Node(package='mindgrasp_vision', executable='vision_node', name='vision',
              parameters=config_files('vision', 'hardware')),
-        Node(package='mindgrasp_fsm', executable='fsm_node', name='fsm',
-             parameters=config_files('fsm', 'hardware')),
+        fsm_node(config_files('fsm', 'hardware')),
     ])

@@ -124,6 +124,28 @@ def sim_scene_camera(display_rate: float = 3.0) -> list[tuple[object, dict]]:
              {'scene_camera_rate': display_rate})]
 
 
+def fsm_node(files: list[Path], parameters: dict | None = None) -> Any:
+    """The grasp controller (name ``fsm``) with ``command_interface:=`` of the profile (declare
+    it with :func:`command_interface_argument`) after its parameter files."""
+    return la.Node(package='mindgrasp_fsm', executable='fsm_node', name='fsm',
+                   parameters=[*files, {**(parameters or {}), 'command_interface':
+                                        la.LaunchConfiguration('command_interface')}])
+
+
+def command_interface_argument(default: str = 'velocity') -> Any:
+    """``command_interface:=velocity|trajectory|servo_twist``: the arm command the driver takes
+    (mindgrasp_fsm.command_interface)."""
+    from mindgrasp_fsm.command_interface import COMMAND_INTERFACES
+
+    return la.DeclareLaunchArgument(
+        'command_interface', default_value=default, choices=list(COMMAND_INTERFACES),
+        description='arm command of the controller: velocity (std_msgs/Float64MultiArray on '
+                    '/arm_controller/commands, forward velocity controller), trajectory '
+                    '(trajectory_msgs/JointTrajectory on /arm_controller/joint_trajectory, '
+                    'JointTrajectoryController) or servo_twist (geometry_msgs/TwistStamped on '
+                    '/servo_node/delta_twist_cmds, MoveIt Servo)')
+
+
 def live_view_arguments() -> list[Any]:
     """``live_view:=true|false`` and ``live_view_port:=8765``, for :func:`live_view_nodes`."""
     return [
