@@ -160,6 +160,8 @@ class SimParams:
     realism: str = param('none', 'none, default or the path of a realism profile YAML (sensor '
                          'noise, physical spread)')
     realism_seed: int = param(0, 'seed of the realism draws (same seed, same noise)', min=0)
+    robot: str = param('mindgrasp_arm', 'the arm: a shipped robot (mindgrasp_arm, xarm6) or the '
+                       'path of a robot description YAML (mindgrasp_common.robot_description)')
 
     def __post_init__(self) -> None:
         _check_params(dataclasses.asdict(self))
@@ -221,7 +223,8 @@ class SimNode(rclpy.node.Node):
                 solver_iterations=int(p['solver_iterations']),
                 trainer_robot=bool(p['trainer_robot']), gui=gui,
                 n_objects=None if int(p['n_objects']) < 0 else int(p['n_objects']),
-                realism=str(p['realism']), realism_seed=int(p['realism_seed']))
+                realism=str(p['realism']), realism_seed=int(p['realism_seed']),
+                robot=str(p['robot']))
         except SimError as err:
             self.get_logger().error(str(err))
             raise

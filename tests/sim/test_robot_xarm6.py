@@ -1,0 +1,41 @@
+"""robot:=xarm6: the simulator node loads the UFactory xArm6 description in its own process, over
+real DDS: its joints at the description's home pose on /joint_states, and the joints follow
+velocity commands on /arm_controller/commands."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from test_sim_node import Probe, spin_until, start
+
+from mindgrasp_common.robot_description import load_robot
+
+pytestmark = pytest.mark.slow
+
+
+def test_xarm6_starts_at_home_and_follows_velocity_commands(rclpy_ctx, spawn_node):
+    xarm = load_robot('xarm6')
+    proc = start(spawn_node, 'robot:=xarm6')
+    probe = Probe(rclpy_ctx)
+    rclpy, node = rclpy_ctx, probe.node
+    assert spin_until(rclpy, node, lambda: len(probe.joints) > 20, 120), proc.output()
+    js = probe.joints[-1]
+    assert list(js.name) == list(xarm.arm_joints) == [f'joint{i}' for i in range(1, 7)]
+    np.testing.assert_allclose(probe.q(), xarm.home_pose, atol=0.01)
+    assert probe.matched(), proc.output()
+    # base yaw and wrist roll move at the commanded rate, the others hold
+    v = np.array([0.3, 0.0, 0.0, 0.0, 0.0, -0.4])
+    assert probe.drive(v, lambda: probe.q()[0] > xarm.home_pose[0] + 0.3), proc.output()
+    moving = probe.joints[-1]
+    np.testing.assert_allclose(np.asarray(moving.velocity), v, atol=0.05)
+    assert probe.q()[5] < xarm.home_pose[5] - 0.3
+    np.testing.assert_allclose(probe.q()[1:5], xarm.home_pose[1:5], atol=0.01)
+    proc.stop()
+
+
+def test_unknown_robot_exits_with_one_line_naming_the_fix(spawn_node):
+    proc = spawn_node('mindgrasp_sim.sim_node', '--ros-args', '-p', 'robot:=ur5')
+    assert proc.wait(60) == 2
+    out = proc.output()
+    assert "No robot is named 'ur5'; use one of ['mindgrasp_arm', 'xarm6']" in out
+    assert 'Traceback' not in out
