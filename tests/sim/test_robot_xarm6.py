@@ -16,6 +16,7 @@ pytestmark = pytest.mark.slow
 def test_xarm6_starts_at_home_and_follows_velocity_commands(rclpy_ctx, spawn_node):
     xarm = load_robot('xarm6')
     proc = start(spawn_node, 'robot:=xarm6')
+    assert "with the robot 'xarm6'" in proc.output()
     probe = Probe(rclpy_ctx)
     rclpy, node = rclpy_ctx, probe.node
     assert spin_until(rclpy, node, lambda: len(probe.joints) > 20, 120), proc.output()

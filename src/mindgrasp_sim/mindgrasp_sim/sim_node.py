@@ -307,7 +307,8 @@ class SimNode(rclpy.node.Node):
             robots += (f", realism profile '{self.sim.realism.profile.name}' (seed "
                        f'{self.sim.realism.seed})')
         self.get_logger().info(
-            f"Simulating scene '{self.sim.scene.name}' ({len(self.sim.objects())} objects){robots}"
+            f"Simulating scene '{self.sim.scene.name}' ({len(self.sim.objects())} objects) with "
+            f"the robot '{self.sim.robot.name}'{robots}"
             f' at {self.sim.physics_hz:.0f} Hz physics, camera {self.sim.camera.width}x'
             f'{self.sim.camera.height} px at {self.sim.camera.rate_hz:g} Hz, {self.mode} mode.')
 
