@@ -18,7 +18,7 @@ def test_the_description_sets_the_robot_parameters():
     xarm = load_robot('xarm6')
     p = FsmParams(robot='xarm6')
     assert p.joint_names == list(xarm.arm_joints) and p.home_position == list(xarm.home_pose)
-    assert p.urdf_file == str(xarm.urdf) and p.tool_link == p.camera_link == \
+    assert p.urdf_file == xarm.urdf_uri and p.tool_link == p.camera_link == \
         'xarm_gripper_base_link'
     assert p.joint_lower_limits == list(xarm.lower) and p.max_joint_velocity == [1.0, 1.0, 1.3,
                                                                                  1.3, 1.6, 1.6]

@@ -331,7 +331,9 @@ class FsmParams:
         """Set the robot parameters (``urdf_file`` .. ``max_joint_velocity``) from the robot
         description ``robot``; a bad description raises its one-line error."""
         description = load_robot(self.robot)
-        self.urdf_file = str(description.urdf)
+        # the description's package:// URI as it is (the node resolves it), else the file
+        self.urdf_file = description.urdf_uri if description.urdf_uri.startswith('package://') \
+            else str(description.urdf)
         self.tool_link = description.tcp.link
         self.camera_link = description.camera.link
         self.joint_names = list(description.arm_joints)
