@@ -34,6 +34,32 @@ def test_xarm6_starts_at_home_and_follows_velocity_commands(rclpy_ctx, spawn_nod
     proc.stop()
 
 
+def test_xarm6_mounted_camera_and_tcp_are_frames_of_tf_static(rclpy_ctx, spawn_node):
+    """The wrist camera mount and the TCP offset, which the xArm's URDF lacks, are on /tf_static,
+    so viewers place the camera images (frame camera_color_optical_frame) on the arm."""
+    from mindgrasp_ros.interfaces.tf2_msgs.msg import TFMessage
+
+    proc = start(spawn_node, 'robot:=xarm6')
+    node = rclpy_ctx.node.Node('xarm_tf_probe')
+    static: list = []
+    latched = rclpy_ctx.qos.QoSProfile(
+        depth=1, reliability=rclpy_ctx.qos.ReliabilityPolicy.RELIABLE,
+        durability=rclpy_ctx.qos.DurabilityPolicy.TRANSIENT_LOCAL)
+    node.create_subscription(TFMessage, '/tf_static', static.append, latched)
+    assert spin_until(rclpy_ctx, node, lambda: bool(static), 60), proc.output()
+    frames = {t.child_frame_id: t for t in static[-1].transforms}
+    cam, tcp = frames['camera_color_optical_frame'], frames['tcp']
+    assert cam.header.frame_id == tcp.header.frame_id == 'xarm_gripper_base_link'
+    v = cam.transform.translation
+    np.testing.assert_allclose([v.x, v.y, v.z], [-0.07, 0.0, 0.02], atol=1e-9)
+    q = cam.transform.rotation
+    np.testing.assert_allclose([q.x, q.y, q.z, q.w], [0.0, np.sin(0.125), 0.0, np.cos(0.125)],
+                               atol=1e-9)
+    assert tcp.transform.translation.z == pytest.approx(0.172)
+    node.destroy_node()
+    proc.stop()
+
+
 def test_unknown_robot_exits_with_one_line_naming_the_fix(spawn_node):
     proc = spawn_node('mindgrasp_sim.sim_node', '--ros-args', '-p', 'robot:=ur5')
     assert proc.wait(60) == 2

@@ -67,6 +67,7 @@ from mindgrasp_ros.interfaces.std_msgs.msg import (
 )
 from mindgrasp_ros.interfaces.tf2_msgs.msg import TFMessage
 from mindgrasp_ros.interfaces.visualization_msgs.msg import MarkerArray
+from scipy.spatial.transform import Rotation
 
 from mindgrasp_ros import rclpy
 from mindgrasp_ros.node_main import run_node
@@ -516,9 +517,20 @@ class SimNode(rclpy.node.Node):
         base = Transform(self.p['frame_id'], self.tf_tree.root, np.zeros(3),
                          np.array([0.0, 0.0, 0.0, 1.0]))
         self.tf_static_pub = self.create_publisher(TFMessage, TF_STATIC.name, TF_STATIC.qos)
-        self.tf_static_pub.publish(msgs.tf_message(self._stamp(),
-                                                   [base, *self.tf_tree.static_transforms()]))
+        self.tf_static_pub.publish(msgs.tf_message(
+            self._stamp(), [base, *self.tf_tree.static_transforms(), *self._mount_transforms()]))
         self.tf_pub = self.create_publisher(TFMessage, TF.name, TF.qos)
+
+    def _mount_transforms(self) -> list[Transform]:
+        """The robot description's frames the URDF lacks, as static transforms from their links:
+        the camera optical frame (the camera topics' frame) on a wrist-camera mount, the TCP."""
+        robot = self.sim.robot
+        out = []
+        for name, frame in ((msgs.OPTICAL_FRAME, robot.camera), ('tcp', robot.tcp)):
+            if name not in self.tf_tree.links:
+                quat = Rotation.from_euler('xyz', frame.rpy).as_quat()   # URDF rpy, xyzw
+                out.append(Transform(frame.link, name, np.array(frame.xyz), quat))
+        return out
 
     def publish_all(self) -> None:
         self.publish_states()
