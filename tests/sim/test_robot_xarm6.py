@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from scipy.spatial.transform import Rotation
 from test_sim_node import Probe, spin_until, start
 
 from mindgrasp_common.robot_description import load_robot
@@ -53,7 +54,8 @@ def test_xarm6_mounted_camera_and_tcp_are_frames_of_tf_static(rclpy_ctx, spawn_n
     v = cam.transform.translation
     np.testing.assert_allclose([v.x, v.y, v.z], [-0.07, 0.0, 0.02], atol=1e-9)
     q = cam.transform.rotation
-    np.testing.assert_allclose([q.x, q.y, q.z, q.w], [0.0, np.sin(0.125), 0.0, np.cos(0.125)],
+    np.testing.assert_allclose([q.x, q.y, q.z, q.w],
+                               Rotation.from_euler('xyz', [0.45, 0.0, np.pi / 2]).as_quat(),
                                atol=1e-9)
     assert tcp.transform.translation.z == pytest.approx(0.172)
     node.destroy_node()
