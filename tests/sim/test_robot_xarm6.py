@@ -62,6 +62,16 @@ def test_xarm6_mounted_camera_and_tcp_are_frames_of_tf_static(rclpy_ctx, spawn_n
     proc.stop()
 
 
+def test_urdf_importer_warnings_stay_off_stdout(capfd):
+    """PyBullet warns about the xArm URDF's inertias from C; stdout stays the caller's (a
+    command's --json line)."""
+    from mindgrasp_sim.simulation import Simulation
+
+    Simulation(robot='xarm6', n_objects=0).close()
+    out, err = capfd.readouterr()
+    assert 'Bad inertia' not in out and 'Bad inertia' in err
+
+
 def test_unknown_robot_exits_with_one_line_naming_the_fix(spawn_node):
     proc = spawn_node('mindgrasp_sim.sim_node', '--ros-args', '-p', 'robot:=ur5')
     assert proc.wait(60) == 2

@@ -95,8 +95,9 @@ class _Client(BulletClient):
 
 @contextlib.contextmanager
 def _c_stdout_to_stderr() -> Iterator[None]:
-    """PyBullet's C code may print to stdout while it connects (the GUI's OpenGL report); send it
-    to stderr so stdout stays the caller's (e.g. a command's --json line)."""
+    """PyBullet's C code may print to stdout while it connects (the GUI's OpenGL report) or loads
+    a URDF (its importer's warnings); send it to stderr so stdout stays the caller's (e.g. a
+    command's --json line)."""
     libc = ctypes.CDLL(None)
     sys.stdout.flush()
     saved = os.dup(1)
@@ -276,7 +277,8 @@ class Simulation:
         self._robots['user'] = self._load_robot(p, ghost=False)
         if trainer_robot:
             self._robots['trainer'] = self._load_robot(p, ghost=True)
-        self._kin_body = self._kin.loadURDF(str(self.urdf), useFixedBase=True)
+        with _c_stdout_to_stderr():
+            self._kin_body = self._kin.loadURDF(str(self.urdf), useFixedBase=True)
         names = {p.getJointInfo(self._robots['user'].body, j)[1].decode():
                  j for j in range(p.getNumJoints(self._robots['user'].body))}
         self._names = names
@@ -367,7 +369,8 @@ class Simulation:
         flags = pb.URDF_USE_INERTIA_FROM_FILE
         if not ghost:
             flags |= pb.URDF_USE_SELF_COLLISION | pb.URDF_USE_SELF_COLLISION_EXCLUDE_PARENT
-        body = p.loadURDF(str(self.urdf), useFixedBase=True, flags=flags)
+        with _c_stdout_to_stderr():
+            body = p.loadURDF(str(self.urdf), useFixedBase=True, flags=flags)
         n = p.getNumJoints(body)
         for link in range(-1, n):
             if ghost:
