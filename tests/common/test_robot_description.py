@@ -73,6 +73,7 @@ def _no_limit_urdf(tmp_path: Path):
     (_set('arm', 'max_velocity', [5.0] * 6), r"max_velocity 5.0 rad/s of 'joint1' must be in"),
     (_set('gripper', 'kind', 'suction'), "gripper kind 'suction' is not one of"),
     (_set('gripper', 'grasp_check', 'vibes'), "grasp_check 'vibes' is not one of"),
+    (_set('gripper', 'self_collision', 'no'), "self_collision must be true or false, got 'no'"),
     (_set('gripper', 'closed', 2.0), r'open 0.0 and closed 2.0 of .* must lie in its URDF'),
     (_set('camera', 'link', 'camera_link'),
      "the camera link 'camera_link' is not a link of the URDF xarm6_with_gripper.urdf; name one"),

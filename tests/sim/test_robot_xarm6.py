@@ -35,6 +35,26 @@ def test_xarm6_starts_at_home_and_follows_velocity_commands(rclpy_ctx, spawn_nod
     proc.stop()
 
 
+def test_xarm6_gripper_closes_on_command(rclpy_ctx, spawn_node):
+    """/gripper_controller/commands [1.0] closes all six joints of the xArm's gripper linkage
+    to the description's closed position (self_collision: false keeps its links from jamming
+    each other half way); /gripper/joint_states names them."""
+    from mindgrasp_ros.interfaces.sensor_msgs.msg import JointState
+
+    xarm = load_robot('xarm6')
+    proc = start(spawn_node, 'robot:=xarm6')
+    probe = Probe(rclpy_ctx)
+    fingers: list = []
+    probe.node.create_subscription(JointState, '/gripper/joint_states', fingers.append, 100)
+    assert probe.matched(), proc.output()
+    probe.grip_pub.publish(probe.Float64MultiArray(data=[1.0]))
+    assert spin_until(rclpy_ctx, probe.node, lambda: bool(fingers) and np.allclose(
+        fingers[-1].position, xarm.gripper.closed, atol=0.02), 60), \
+        (fingers[-1].position if fingers else None, proc.output())
+    assert list(fingers[-1].name) == list(xarm.gripper.joints)
+    proc.stop()
+
+
 def test_xarm6_mounted_camera_and_tcp_are_frames_of_tf_static(rclpy_ctx, spawn_node):
     """The wrist camera mount and the TCP offset, which the xArm's URDF lacks, are on /tf_static,
     so viewers place the camera images (frame camera_color_optical_frame) on the arm."""

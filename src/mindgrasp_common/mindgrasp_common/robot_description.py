@@ -71,7 +71,9 @@ class JointLimits:
 class GripperDescription:
     """The gripper: ``joints`` driven together from ``open`` (closure 0) to ``closed`` (closure 1),
     one position per joint (rad or m); ``kind`` in :data:`GRIPPER_KINDS`; ``grasp_check`` in
-    :data:`GRASP_CHECKS`; ``limits`` (one per joint) from the URDF."""
+    :data:`GRASP_CHECKS`; ``limits`` (one per joint) from the URDF; ``self_collision``: whether
+    the gripper's links (and the links they hang from) collide with each other (false for a
+    linkage whose links overlap, as an SRDF's ``disable_collisions`` says)."""
 
     kind: str
     joints: tuple[str, ...]
@@ -79,6 +81,7 @@ class GripperDescription:
     closed: tuple[float, ...]
     grasp_check: str
     limits: tuple[JointLimits, ...]
+    self_collision: bool = True
 
 
 @dataclass(frozen=True)
@@ -317,8 +320,13 @@ def _load(path: Path) -> RobotDescription:
         msg = (f'{where}: gripper grasp_check {check!r} is not one of {list(GRASP_CHECKS)}; '
                'pick how a closed gripper is judged to hold an object.')
         raise RobotDescriptionError(msg)
+    self_collision = g.get('self_collision', True)
+    if not isinstance(self_collision, bool):
+        msg = f'{where}: gripper self_collision must be true or false, got {self_collision!r}.'
+        raise RobotDescriptionError(msg)
     gripper = GripperDescription(kind=kind, joints=g_joints, open=g_open, closed=g_closed,
-                                 grasp_check=check, limits=g_limits)
+                                 grasp_check=check, limits=g_limits,
+                                 self_collision=self_collision)
 
     tcp = _frame(_section(data, 'tcp', where), 'tcp', where, links, urdf)
     camera = _frame(_section(data, 'camera', where), 'camera', where, links, urdf)

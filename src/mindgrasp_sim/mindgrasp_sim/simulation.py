@@ -298,6 +298,13 @@ class Simulation:
         self._arm_idx = [names[n] for n in self.joint_names]
         self._finger_idx = [names[n] for n in self.finger_names]
         self._tcp_idx = links[self.robot.tcp.link]
+        # the base and the links welded to it (the xArm's link_base under its world link) stand
+        # on the ground: their contact with it is no collision
+        self._base_links = {-1}
+        for j in range(p.getNumJoints(self._robots['user'].body)):
+            info = p.getJointInfo(self._robots['user'].body, j)
+            if info[2] == pb.JOINT_FIXED and info[16] in self._base_links:
+                self._base_links.add(j)
         self._cam_idx = links[self.robot.camera.link]
         infos = [p.getJointInfo(self._robots['user'].body, j) for j in self._arm_idx]
         self.lower = np.array([i[8] for i in infos])
@@ -386,8 +393,23 @@ class Simulation:
             if link >= 0:
                 p.changeDynamics(body, link, linearDamping=0.0, angularDamping=0.0,
                                  jointDamping=0.05)
+        if not ghost and not self.robot.gripper.self_collision:
+            self._disable_gripper_self_collision(p, body)
         # velocity motors off: joints are driven by the PD reference in step()
         return _Robot(body=body, q_ref=self.home_pose.copy())
+
+    def _disable_gripper_self_collision(self, p: BulletClient, body: int) -> None:
+        """No contacts among the gripper's links and the links they hang from (the
+        description's ``self_collision: false``)."""
+        joints = {p.getJointInfo(body, j)[1].decode(): j for j in range(p.getNumJoints(body))}
+        links = set()
+        for name in self.robot.gripper.joints:
+            j = joints[name]
+            links |= {j, p.getJointInfo(body, j)[16]}   # the joint's child link and its parent
+        for a in links:
+            for b in links:
+                if a < b:
+                    p.setCollisionFilterPair(body, body, a, b, 0)
 
     def _spawn(self, spec: ObjectSpec) -> int:
         p = self._p
@@ -745,7 +767,7 @@ class Simulation:
         names[-1] = 'base_link'
         out = set()
         for c in self._p.getContactPoints(r.body, self._ground):
-            if c[3] not in self._finger_links and c[3] != -1:
+            if c[3] not in self._finger_links and c[3] not in self._base_links:
                 out.add(f'{names[c[3]]} - ground')
         for c in self._p.getContactPoints(r.body, r.body):
             a, b = sorted((names[c[3]], names[c[4]]))
