@@ -55,16 +55,15 @@ def test_fsm_node_reads_the_simulated_xarm6(rclpy_ctx, spawn_node):
     xArm's /joint_states (no joint fault), and stops for want of vision, not of joints."""
     from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import FsmState
 
+    from mindgrasp_ros.topics import FSM_STATE
+
     sim = spawn_node('mindgrasp_sim.sim_node', '--ros-args', '-p', 'robot:=xarm6',
                      '-p', 'duration:=300.0')
     fsm = spawn_node('mindgrasp_fsm.fsm_node', '--ros-args', '-p', 'robot:=xarm6',
                      '-p', 'autonomous:=true', '-p', 'duration:=300.0')
     node = rclpy_ctx.node.Node('fsm_xarm_observer')
     states: list = []
-    latched = rclpy_ctx.qos.QoSProfile(
-        depth=1, reliability=rclpy_ctx.qos.ReliabilityPolicy.RELIABLE,
-        durability=rclpy_ctx.qos.DurabilityPolicy.TRANSIENT_LOCAL)
-    node.create_subscription(FsmState, '/fsm/state', states.append, latched)
+    node.create_subscription(FsmState, FSM_STATE.name, states.append, FSM_STATE.qos)
     assert sim.wait_for_output("with the robot 'xarm6'", 120), sim.output()
     ok = spin_until(node, lambda: bool(states) and states[-1].stopped
                     and 'camera' in states[-1].reason, 120.0)

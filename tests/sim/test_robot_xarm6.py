@@ -60,13 +60,12 @@ def test_xarm6_mounted_camera_and_tcp_are_frames_of_tf_static(rclpy_ctx, spawn_n
     so viewers place the camera images (frame camera_color_optical_frame) on the arm."""
     from mindgrasp_ros.interfaces.tf2_msgs.msg import TFMessage
 
+    from mindgrasp_ros.topics import TF_STATIC
+
     proc = start(spawn_node, 'robot:=xarm6')
     node = rclpy_ctx.node.Node('xarm_tf_probe')
     static: list = []
-    latched = rclpy_ctx.qos.QoSProfile(
-        depth=1, reliability=rclpy_ctx.qos.ReliabilityPolicy.RELIABLE,
-        durability=rclpy_ctx.qos.DurabilityPolicy.TRANSIENT_LOCAL)
-    node.create_subscription(TFMessage, '/tf_static', static.append, latched)
+    node.create_subscription(TFMessage, TF_STATIC.name, static.append, TF_STATIC.qos)
     assert spin_until(rclpy_ctx, node, lambda: bool(static), 60), proc.output()
     frames = {t.child_frame_id: t for t in static[-1].transforms}
     cam, tcp = frames['camera_color_optical_frame'], frames['tcp']
