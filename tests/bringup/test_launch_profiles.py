@@ -38,6 +38,14 @@ def test_demo_starts_every_node_after_the_recorder() -> None:
     assert 'recorder' not in procs and procs['sim'].parameters['gui'] is True
 
 
+def test_the_robot_reaches_the_simulator_and_the_controller() -> None:
+    assert processes('sim')['sim'].parameters['robot'] == 'mindgrasp_arm'
+    assert processes('sim', 'robot:=xarm6')['sim'].parameters['robot'] == 'xarm6'
+    for profile in ('demo', 'experiment'):
+        procs = processes(profile, 'robot:=xarm6')
+        assert procs['sim'].parameters['robot'] == procs['fsm'].parameters['robot'] == 'xarm6'
+
+
 def test_hardware_has_drivers_and_no_simulator(tmp_path, monkeypatch) -> None:
     monkeypatch.chdir(tmp_path)            # model:= must name an existing file
     (tmp_path / 'models').mkdir()

@@ -46,6 +46,7 @@ def last_json(result: subprocess.CompletedProcess) -> dict:
     (['set-locations', '--param', 'fsm.command_interface=joint_jog'],
      "--param fsm.command_interface: The parameter 'command_interface' is 'joint_jog'; use one "
      'of velocity, trajectory, servo_twist.'),
+    (['random-locations', '--robot', 'ur5'], "--robot: No robot is named 'ur5'; use one of"),
 ])
 def test_bad_input_is_one_clear_line_and_exit_2(args: list[str], message: str) -> None:
     result = mindgrasp('experiment', *args, timeout=120)
@@ -161,6 +162,20 @@ def test_random_locations_and_a_users_own_controller(tmp_path: Path) -> None:
     (rec,) = read_records(out)
     assert rec.failure == 'stalled' and 'no controller state change for 4 s' in rec.reason
     assert rec.states.startswith('1') and rec.path_length_m > 0.01
+
+
+@pytest.mark.slow
+@pytest.mark.timeout(1800)   # whole experiments in subprocesses, on a loaded machine
+def test_random_locations_on_the_xarm6(tmp_path: Path) -> None:
+    """--robot xarm6: the same experiment runs the simulator, vision and the controller on the
+    xArm6: its wrist camera finds the object, the controller centres it and approaches (the
+    parallel-jaw grasp is not tuned yet, issue 28)."""
+    s = last_json(mindgrasp('experiment', 'random-locations', '--robot', 'xarm6', '--trials', '1',
+                            '--seed', '1', '--trial-timeout', '15', '--out', str(tmp_path),
+                            '--json', '--no-progress'))
+    assert s['trials'] == 1 and s['node_errors'] == 0
+    (rec,) = read_records(tmp_path)
+    assert rec.states.startswith('1-2-3'), (rec.states, rec.reason)
 
 
 @pytest.mark.slow

@@ -99,6 +99,9 @@ def add_common_arguments(parser: argparse.ArgumentParser, trials: int) -> None:
                         help='run the trials as Ray tasks (pip install -e ".[cluster]"): auto '
                              '(a local Ray instance of this run) or '
                              'HOST:PORT of a cluster\'s head node; same records as --workers')
+    parser.add_argument('--robot', default='mindgrasp_arm', metavar='NAME|YAML',
+                        help='the arm: mindgrasp_arm (default), xarm6 or a robot description '
+                             'YAML path (mindgrasp_common.robot_description)')
     parser.add_argument('--realism', default='none',
                         help='sensor noise and physical spread: none (default), default or a '
                              'profile YAML path (mindgrasp_sim.realism), seeded per trial')
@@ -137,6 +140,13 @@ def check(args: argparse.Namespace, command: str) -> str | None:
             check_ray_address(args.ray)
         except ExperimentError as exc:
             return str(exc)
+    if getattr(args, 'robot', None) is not None:
+        from mindgrasp_common.robot_description import RobotDescriptionError, load_robot
+
+        try:
+            load_robot(args.robot)
+        except RobotDescriptionError as exc:
+            return f'--robot: {exc}'
     realism = getattr(args, 'realism', None)
     if realism is not None:
         from mindgrasp_sim.errors import SimError
@@ -214,6 +224,8 @@ def run_experiment(args: argparse.Namespace, protocol: str, command: str) -> int
         launch_args['accuracy'] = str(args.accuracy)
     if getattr(args, 'realism', None) is not None:
         launch_args['realism'] = str(args.realism)
+    if getattr(args, 'robot', None) is not None:
+        launch_args['robot'] = str(args.robot)
     log = [] if args.json else None
     try:
         components = lockstep_components('experiment', launch_args, out / 'params',

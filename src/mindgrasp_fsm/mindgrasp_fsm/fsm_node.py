@@ -29,6 +29,8 @@ from mindgrasp_ros.interfaces.std_msgs.msg import Float64MultiArray, UInt8MultiA
 
 from mindgrasp_common.errors import CommonError
 from mindgrasp_common.mi import decoder_class_index
+from mindgrasp_common.robot import DEFAULT_ROBOT
+from mindgrasp_common.robot_description import load_robot
 from mindgrasp_fsm.arm_output import ArmCommandOutput
 from mindgrasp_fsm.conversions import gripper_from_fingers, vision_frame_from_msg
 from mindgrasp_fsm.errors import FsmError
@@ -70,6 +72,10 @@ class FsmNode(rclpy.node.Node):
         # one FsmParams object, shared with the controller: live changes apply at the next tick
         self.params = declare_params(self, FsmParams)
         self.fsm = GraspFsm.from_params(self.params)
+        # open and closed positions (rad) of the gripper's first (driving) joint: the others
+        # move with it over the same range (the shipped hand's fingers, the xArm's linkage)
+        gripper = load_robot(self.params.robot or DEFAULT_ROBOT).gripper
+        self._gripper_range = {'open_angle': gripper.open[0], 'closed_angle': gripper.closed[0]}
         self.inputs = FsmInputs(time=0.0)
         self._fingers: np.ndarray | None = None
         self._finger_stamp = 0.0
@@ -170,7 +176,7 @@ class FsmNode(rclpy.node.Node):
         contacts = self._contacts if self._contacts is not None and \
             self._contacts.size == self._fingers.size else None
         self.inputs.gripper = gripper_from_fingers(self._fingers, self._finger_stamp, contacts,
-                                                   self._finger_efforts)
+                                                   self._finger_efforts, **self._gripper_range)
 
     def info_callback(self, msg: CameraInfo) -> None:
         k = np.asarray(msg.k, dtype=float)

@@ -131,16 +131,23 @@ class GraspFsm:
     def from_params(cls, params: FsmParams | None = None) -> GraspFsm:
         """Controller with the robot model named by ``params.urdf_file`` (URDF)."""
         from mindgrasp_common.resources import ResourceNotFoundError, resolve_path
-        from mindgrasp_fsm.kinematics import UrdfKinematics
+        from mindgrasp_common.robot_description import load_robot
+        from mindgrasp_fsm.kinematics import UrdfKinematics, frame_offset
 
         params = params or FsmParams()
+        offsets = {}
+        if params.robot:
+            # the description's TCP offset and camera mount (params.__post_init__ checked it)
+            robot = load_robot(params.robot)
+            offsets = {'tool_offset': frame_offset(robot.tcp.xyz, robot.tcp.rpy),
+                       'camera_offset': frame_offset(robot.camera.xyz, robot.camera.rpy)}
         try:
             urdf = resolve_path(params.urdf_file, 'mindgrasp_fsm')
         except ResourceNotFoundError as exc:
             msg = f'Cannot read the robot description {params.urdf_file}: {exc}'
             raise FsmError(msg) from None
         kinematics = UrdfKinematics(str(urdf), params.joint_names, params.tool_link,
-                                    params.camera_link)
+                                    params.camera_link, **offsets)
         return cls(params, kinematics)
 
     # ---------------------------------------------------------------------------- lifecycle

@@ -36,6 +36,12 @@ class ArmKinematics(Protocol):
         ...
 
 
+def frame_offset(xyz: tuple[float, ...], rpy: tuple[float, ...]) -> np.ndarray:
+    """4x4 transform of a frame at ``xyz`` (3,) m, ``rpy`` (3,) rad (URDF fixed-axis roll,
+    pitch, yaw) in its link, e.g. a robot description's TCP or camera mount."""
+    return _transform(np.asarray(xyz, dtype=float), Rotation.from_euler('xyz', rpy).as_matrix())
+
+
 def _transform(xyz: np.ndarray, rot: np.ndarray) -> np.ndarray:
     t = np.eye(4)
     t[:3, :3] = rot
@@ -54,10 +60,16 @@ class UrdfKinematics:
         The six arm joints, base to wrist.
     tool_link, camera_link : str
         Grasp point link (``tcp``) and camera optical frame link.
+    tool_offset, camera_offset : ndarray, shape (4, 4), optional
+        The grasp point and the camera optical frame in their links (a robot description's TCP
+        offset and eye-in-hand camera mount, :mod:`mindgrasp_common.robot_description`); None:
+        the link's own frame.
     """
 
     def __init__(self, urdf_path: str, joint_names: tuple[str, ...] | list[str],
-                 tool_link: str = 'tcp', camera_link: str = 'camera_color_optical_frame') -> None:
+                 tool_link: str = 'tcp', camera_link: str = 'camera_color_optical_frame',
+                 tool_offset: np.ndarray | None = None,
+                 camera_offset: np.ndarray | None = None) -> None:
         import xml.etree.ElementTree as ET
 
         from mindgrasp_fsm.errors import FsmError
@@ -106,6 +118,8 @@ class UrdfKinematics:
                     raise FsmError(msg)
             self._chains[link] = chain
         self.tool_link, self.camera_link = tool_link, camera_link
+        self._tool_offset = np.eye(4) if tool_offset is None else np.asarray(tool_offset)
+        self._camera_offset = np.eye(4) if camera_offset is None else np.asarray(camera_offset)
         by_name = {c['name']: c for c in joints.values()}
         self.lower = np.array([by_name[n]['lower'] for n in joint_names])
         self.upper = np.array([by_name[n]['upper'] for n in joint_names])
@@ -130,12 +144,12 @@ class UrdfKinematics:
 
     def camera_pose(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Camera optical frame: position (3,) m and rotation (3, 3) in the base frame."""
-        t = self.link_pose(q, self.camera_link)
+        t = self.link_pose(q, self.camera_link) @ self._camera_offset
         return t[:3, 3].copy(), t[:3, :3].copy()
 
     def tool_position(self, q: np.ndarray) -> np.ndarray:
         """Grasp point (3,) m in the base frame."""
-        return self.link_pose(q, self.tool_link)[:3, 3].copy()
+        return (self.link_pose(q, self.tool_link) @ self._tool_offset)[:3, 3].copy()
 
     @staticmethod
     def down_rotation(yaw: float) -> np.ndarray:
@@ -159,6 +173,7 @@ class UrdfKinematics:
                 axes.append((self._index[joint['name']], t[:3, :3] @ joint['axis'],
                              t[:3, 3].copy()))
                 t[:3, :3] = t[:3, :3] @ next(rotations)
+        t = t @ self._tool_offset
         jac = np.zeros((6, 6))
         p = t[:3, 3]
         for i, z, o in axes:
@@ -189,7 +204,7 @@ class UrdfKinematics:
             if n > 0.3:
                 step *= 0.3 / n
             q = np.clip(q + step, self.lower, self.upper)
-        t = self.link_pose(q, self.tool_link)
+        t = self.link_pose(q, self.tool_link) @ self._tool_offset
         e = self._error(t, position, rotation)
         return q, float(np.linalg.norm(e[:3])), float(np.linalg.norm(e[3:]))
 

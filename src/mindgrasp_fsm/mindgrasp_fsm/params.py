@@ -24,6 +24,7 @@ from mindgrasp_common.robot import (
     HOME_POSE,
     URDF_URI,
 )
+from mindgrasp_common.robot_description import load_robot
 from mindgrasp_fsm.command_interface import COMMAND_INTERFACES, check_command_interface
 from mindgrasp_fsm.errors import FsmError
 from mindgrasp_ros.params import param
@@ -44,6 +45,9 @@ class FsmParams:
 
     # --- general (read-only: the robot model and timer are built at start) ---------------------
     autonomous: bool = param(False, 'no BCI: search left, approach and grasp on vision alone')
+    robot: str = param('', "the arm: mindgrasp_arm, xarm6 or a robot description YAML path; its "
+                       'URDF, TCP and camera links, joints, home pose, limits and velocity '
+                       "limits replace the eight parameters below; '' = those as given")
     urdf_file: str = param(URDF_URI, 'URDF for forward / inverse kinematics: a path or a '
                            'package:// URI')
     tool_link: str = param('tcp', 'URDF link of the grasp point between the fingertips')
@@ -330,7 +334,24 @@ class FsmParams:
                                       'height', unit='m', min=0.0, max=2.0, live=True)
 
     def __post_init__(self) -> None:
+        if self.robot:
+            self.apply_robot()
         self.validate()
+
+    def apply_robot(self) -> None:
+        """Set the robot parameters (``urdf_file`` .. ``max_joint_velocity``) from the robot
+        description ``robot``; a bad description raises its one-line error."""
+        description = load_robot(self.robot)
+        # the description's package:// URI as it is (the node resolves it), else the file
+        self.urdf_file = description.urdf_uri if description.urdf_uri.startswith('package://') \
+            else str(description.urdf)
+        self.tool_link = description.tcp.link
+        self.camera_link = description.camera.link
+        self.joint_names = list(description.arm_joints)
+        self.home_position = list(description.home_pose)
+        self.joint_lower_limits = list(description.lower)
+        self.joint_upper_limits = list(description.upper)
+        self.max_joint_velocity = list(description.max_velocity)
 
     # ---------------------------------------------------------------------------------------
     def shape_value(self, shape: str, name: str) -> float:

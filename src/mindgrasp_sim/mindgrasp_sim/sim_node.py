@@ -72,6 +72,7 @@ from mindgrasp_ros.interfaces.std_msgs.msg import (
 )
 from mindgrasp_ros.interfaces.tf2_msgs.msg import TFMessage
 from mindgrasp_ros.interfaces.visualization_msgs.msg import MarkerArray
+from scipy.spatial.transform import Rotation
 
 from mindgrasp_ros import rclpy
 from mindgrasp_ros.node_main import run_node
@@ -166,6 +167,8 @@ class SimParams:
     realism: str = param('none', 'none, default or the path of a realism profile YAML (sensor '
                          'noise, physical spread)')
     realism_seed: int = param(0, 'seed of the realism draws (same seed, same noise)', min=0)
+    robot: str = param('mindgrasp_arm', 'the arm: a shipped robot (mindgrasp_arm, xarm6) or the '
+                       'path of a robot description YAML (mindgrasp_common.robot_description)')
 
     def __post_init__(self) -> None:
         _check_params(dataclasses.asdict(self))
@@ -228,7 +231,8 @@ class SimNode(rclpy.node.Node):
                 solver_iterations=int(p['solver_iterations']),
                 trainer_robot=bool(p['trainer_robot']), gui=gui,
                 n_objects=None if int(p['n_objects']) < 0 else int(p['n_objects']),
-                realism=str(p['realism']), realism_seed=int(p['realism_seed']))
+                realism=str(p['realism']), realism_seed=int(p['realism_seed']),
+                robot=str(p['robot']))
         except SimError as err:
             self.get_logger().error(str(err))
             raise
@@ -312,7 +316,8 @@ class SimNode(rclpy.node.Node):
             robots += (f", realism profile '{self.sim.realism.profile.name}' (seed "
                        f'{self.sim.realism.seed})')
         self.get_logger().info(
-            f"Simulating scene '{self.sim.scene.name}' ({len(self.sim.objects())} objects){robots}"
+            f"Simulating scene '{self.sim.scene.name}' ({len(self.sim.objects())} objects) with "
+            f"the robot '{self.sim.robot.name}'{robots}"
             f' at {self.sim.physics_hz:.0f} Hz physics, camera {self.sim.camera.width}x'
             f'{self.sim.camera.height} px at {self.sim.camera.rate_hz:g} Hz, {self.mode} mode.')
 
@@ -526,9 +531,20 @@ class SimNode(rclpy.node.Node):
         base = Transform(self.p['frame_id'], self.tf_tree.root, np.zeros(3),
                          np.array([0.0, 0.0, 0.0, 1.0]))
         self.tf_static_pub = self.create_publisher(TFMessage, TF_STATIC.name, TF_STATIC.qos)
-        self.tf_static_pub.publish(msgs.tf_message(self._stamp(),
-                                                   [base, *self.tf_tree.static_transforms()]))
+        self.tf_static_pub.publish(msgs.tf_message(
+            self._stamp(), [base, *self.tf_tree.static_transforms(), *self._mount_transforms()]))
         self.tf_pub = self.create_publisher(TFMessage, TF.name, TF.qos)
+
+    def _mount_transforms(self) -> list[Transform]:
+        """The robot description's frames the URDF lacks, as static transforms from their links:
+        the camera optical frame (the camera topics' frame) on a wrist-camera mount, the TCP."""
+        robot = self.sim.robot
+        out = []
+        for name, frame in ((msgs.OPTICAL_FRAME, robot.camera), ('tcp', robot.tcp)):
+            if name not in self.tf_tree.links:
+                quat = Rotation.from_euler('xyz', frame.rpy).as_quat()   # URDF rpy, xyzw
+                out.append(Transform(frame.link, name, np.array(frame.xyz), quat))
+        return out
 
     def publish_all(self) -> None:
         self.publish_states()

@@ -42,13 +42,12 @@ from scipy.spatial.transform import Rotation
 
 from mindgrasp_common.geometry import top_down_quat
 from mindgrasp_common.resources import ResourceNotFoundError, resolve_path
-from mindgrasp_common.robot import (
-    ARM_JOINTS,
-    FINGER_CLOSED,
-    FINGER_JOINTS,
-    FINGER_OPEN,
-    HOME_POSE,
-    URDF_URI,
+from mindgrasp_common.robot import DEFAULT_ROBOT, HOME_POSE
+from mindgrasp_common.robot_description import (
+    LinkFrame,
+    RobotDescription,
+    RobotDescriptionError,
+    load_robot,
 )
 from mindgrasp_common.types import SceneObject
 from mindgrasp_sim.control import validate_velocities
@@ -96,8 +95,9 @@ class _Client(BulletClient):
 
 @contextlib.contextmanager
 def _c_stdout_to_stderr() -> Iterator[None]:
-    """PyBullet's C code may print to stdout while it connects (the GUI's OpenGL report); send it
-    to stderr so stdout stays the caller's (e.g. a command's --json line)."""
+    """PyBullet's C code may print to stdout while it connects (the GUI's OpenGL report) or loads
+    a URDF (its importer's warnings); send it to stderr so stdout stays the caller's (e.g. a
+    command's --json line)."""
     libc = ctypes.CDLL(None)
     sys.stdout.flush()
     saved = os.dup(1)
@@ -197,8 +197,8 @@ class Simulation:
     n_objects : int | None
         Number of random objects (random scenes); None: the scene file's number.
     urdf : str | Path | None
-        Robot description: a path or ``package://`` URI (default
-        ``package://mindgrasp_sim/urdf/mindgrasp_arm.urdf``).
+        A URDF (path or ``package://`` URI) in place of the robot description's, with the same
+        joint and link names; None: the description's URDF.
     solver_iterations : int
         Constraint solver iterations per step (contacts and motors; 50 holds grasps well).
     realism : RealismProfile | str | Path | None
@@ -207,17 +207,18 @@ class Simulation:
     realism_seed : int
         Seed of the realism draws; with the layout seed and the trial number (resets since the
         scene was loaded) it fixes every noise sample, so the same seeds give the same images.
+    robot : RobotDescription | str | Path
+        The arm (:mod:`mindgrasp_common.robot_description`): a shipped name (``'mindgrasp_arm'``,
+        ``'xarm6'``), the path of a robot YAML file, or a loaded description.
     """
-
-    joint_names: tuple[str, ...] = ARM_JOINTS
-    finger_names: tuple[str, ...] = FINGER_JOINTS
 
     def __init__(self, scene: str | Path = 'set_locations', seed: int = 0,
                  camera: CameraConfig | None = None, physics_hz: float = 240.0,
                  trainer_robot: bool = False, gui: bool = False, n_objects: int | None = None,
                  urdf: str | Path | None = None, solver_iterations: int = 50,
                  realism: RealismProfile | str | Path | None = None,
-                 realism_seed: int = 0) -> None:
+                 realism_seed: int = 0,
+                 robot: RobotDescription | str | Path = DEFAULT_ROBOT) -> None:
         if not (isinstance(physics_hz, (int, float)) and math.isfinite(physics_hz)
                 and 30.0 <= physics_hz <= 10000.0):
             msg = f'physics_hz must be a rate in 30..10000 Hz, got {physics_hz!r}; the ' \
@@ -234,9 +235,19 @@ class Simulation:
         self.dt = 1.0 / self.physics_hz
         self.gui = bool(gui)
         self.n_objects = n_objects
-        self.home_pose = np.array(HOME_POSE, dtype=float)
         try:
-            self.urdf = resolve_path(urdf or URDF_URI, 'mindgrasp_sim')
+            self.robot = load_robot(robot)
+        except RobotDescriptionError as exc:
+            raise SimError(str(exc)) from None
+        #: arm joints (n,) base to wrist, and the gripper joints, as the description names them
+        self.joint_names: tuple[str, ...] = self.robot.arm_joints
+        self.finger_names: tuple[str, ...] = self.robot.gripper.joints
+        self.home_pose = np.array(self.robot.home_pose, dtype=float)
+        # gripper joint positions (n_fingers,) of closure 0 and 1
+        self._finger_open = np.array(self.robot.gripper.open)
+        self._finger_closed = np.array(self.robot.gripper.closed)
+        try:
+            self.urdf = resolve_path(urdf or self.robot.urdf, 'mindgrasp_sim')
         except ResourceNotFoundError as exc:
             raise SimError(f'{exc} Give an existing URDF.') from None
         if not self.urdf.is_file():
@@ -266,21 +277,35 @@ class Simulation:
         self._robots['user'] = self._load_robot(p, ghost=False)
         if trainer_robot:
             self._robots['trainer'] = self._load_robot(p, ghost=True)
-        self._kin_body = self._kin.loadURDF(str(self.urdf), useFixedBase=True)
+        with _c_stdout_to_stderr():
+            self._kin_body = self._kin.loadURDF(str(self.urdf), useFixedBase=True)
         names = {p.getJointInfo(self._robots['user'].body, j)[1].decode():
                  j for j in range(p.getNumJoints(self._robots['user'].body))}
         self._names = names
-        missing = [n for n in (*ARM_JOINTS, *FINGER_JOINTS, 'tcp_joint', 'camera_joint')
-                   if n not in names]
-        if missing:
-            msg = (f'Robot description {str(self.urdf)!r} lacks the joints {missing}; a MIndGrasp '
-                   'arm needs joint_1..joint_6, the three finger joints, tcp_joint and '
-                   'camera_joint (see mindgrasp_sim.robot_model).')
+        # pybullet's link i is the child of joint i
+        links = {p.getJointInfo(self._robots['user'].body, j)[12].decode(): j
+                 for j in range(p.getNumJoints(self._robots['user'].body))}
+        missing = {'joints': [n for n in (*self.joint_names, *self.finger_names)
+                              if n not in names],
+                   'links': [n for n in (self.robot.tcp.link, self.robot.camera.link)
+                             if n not in links]}
+        if any(missing.values()):
+            lacks = ' and '.join(f'the {k} {v}' for k, v in missing.items() if v)
+            msg = (f'The URDF {str(self.urdf)!r} lacks {lacks}, which the robot description '
+                   f'{self.robot.name!r} names; give the URDF of that robot or fix the '
+                   f'description {str(self.robot.path)!r}.')
             raise SimError(msg)
-        self._arm_idx = [names[n] for n in ARM_JOINTS]
-        self._finger_idx = [names[n] for n in FINGER_JOINTS]
-        self._tcp_idx = names['tcp_joint']
-        self._cam_idx = names['camera_joint']
+        self._arm_idx = [names[n] for n in self.joint_names]
+        self._finger_idx = [names[n] for n in self.finger_names]
+        self._tcp_idx = links[self.robot.tcp.link]
+        # the base and the links welded to it (the xArm's link_base under its world link) stand
+        # on the ground: their contact with it is no collision
+        self._base_links = {-1}
+        for j in range(p.getNumJoints(self._robots['user'].body)):
+            info = p.getJointInfo(self._robots['user'].body, j)
+            if info[2] == pb.JOINT_FIXED and info[16] in self._base_links:
+                self._base_links.add(j)
+        self._cam_idx = links[self.robot.camera.link]
         infos = [p.getJointInfo(self._robots['user'].body, j) for j in self._arm_idx]
         self.lower = np.array([i[8] for i in infos])
         self.upper = np.array([i[9] for i in infos])
@@ -291,7 +316,8 @@ class Simulation:
         finfo = [p.getJointInfo(self._robots['user'].body, j) for j in self._finger_idx]
         self._finger_effort = [i[10] for i in finfo]
         self._finger_velocity = [i[11] for i in finfo]
-        self._finger_links = {j: n for j, n in zip(self._finger_idx, FINGER_JOINTS, strict=True)}
+        self._finger_links = {j: n for j, n in zip(self._finger_idx, self.finger_names,
+                                                   strict=True)}
         self._objects: list[tuple[ObjectSpec, int]] = []
         self._step_count = 0
         self._proj = None
@@ -350,7 +376,8 @@ class Simulation:
         flags = pb.URDF_USE_INERTIA_FROM_FILE
         if not ghost:
             flags |= pb.URDF_USE_SELF_COLLISION | pb.URDF_USE_SELF_COLLISION_EXCLUDE_PARENT
-        body = p.loadURDF(str(self.urdf), useFixedBase=True, flags=flags)
+        with _c_stdout_to_stderr():
+            body = p.loadURDF(str(self.urdf), useFixedBase=True, flags=flags)
         n = p.getNumJoints(body)
         for link in range(-1, n):
             if ghost:
@@ -358,7 +385,7 @@ class Simulation:
                 p.setCollisionFilterGroupMask(body, link, 0, 0)
                 p.changeVisualShape(body, link, rgbaColor=TRAINER_RGBA)
             name = p.getJointInfo(body, link)[1].decode() if link >= 0 else ''
-            if name.startswith('finger_'):
+            if name in self.robot.gripper.joints:
                 p.changeDynamics(body, link, lateralFriction=1.2, spinningFriction=0.003,
                                  rollingFriction=0.0, frictionAnchor=1)
             else:
@@ -366,8 +393,23 @@ class Simulation:
             if link >= 0:
                 p.changeDynamics(body, link, linearDamping=0.0, angularDamping=0.0,
                                  jointDamping=0.05)
+        if not ghost and not self.robot.gripper.self_collision:
+            self._disable_gripper_self_collision(p, body)
         # velocity motors off: joints are driven by the PD reference in step()
-        return _Robot(body=body, q_ref=np.array(HOME_POSE, dtype=float))
+        return _Robot(body=body, q_ref=self.home_pose.copy())
+
+    def _disable_gripper_self_collision(self, p: BulletClient, body: int) -> None:
+        """No contacts among the gripper's links and the links they hang from (the
+        description's ``self_collision: false``)."""
+        joints = {p.getJointInfo(body, j)[1].decode(): j for j in range(p.getNumJoints(body))}
+        links = set()
+        for name in self.robot.gripper.joints:
+            j = joints[name]
+            links |= {j, p.getJointInfo(body, j)[16]}   # the joint's child link and its parent
+        for a in links:
+            for b in links:
+                if a < b:
+                    p.setCollisionFilterPair(body, body, a, b, 0)
 
     def _spawn(self, spec: ObjectSpec) -> int:
         p = self._p
@@ -439,8 +481,8 @@ class Simulation:
         for robot in self._robots.values():
             for i, j in enumerate(self._arm_idx):
                 p.resetJointState(robot.body, j, self.home_pose[i], 0.0)
-            for j in self._finger_idx:
-                p.resetJointState(robot.body, j, FINGER_OPEN, 0.0)
+            for j, q in zip(self._finger_idx, self._finger_open, strict=True):
+                p.resetJointState(robot.body, j, q, 0.0)
             robot.q_ref = self.home_pose.copy()
             robot.command(np.zeros(6))
             robot.apply(np.zeros(6))
@@ -547,10 +589,11 @@ class Simulation:
                         positionGains=_ARM_POSITION_GAINS, velocityGains=_ARM_VELOCITY_GAINS)
                     r.holding = True
                 if r.gripper_dirty:
-                    target = FINGER_OPEN + (FINGER_CLOSED - FINGER_OPEN) * r.closure
+                    target = self._finger_open + (self._finger_closed - self._finger_open) \
+                        * r.closure
                     for k, j in enumerate(self._finger_idx):
                         p.setJointMotorControl2(
-                            r.body, j, pb.POSITION_CONTROL, targetPosition=target,
+                            r.body, j, pb.POSITION_CONTROL, targetPosition=float(target[k]),
                             force=self._finger_effort[k], maxVelocity=self._finger_velocity[k],
                             positionGain=0.05, velocityGain=1.0)
                     r.gripper_dirty = False
@@ -639,11 +682,13 @@ class Simulation:
     def ee_pose(self, robot: str = 'user') -> tuple[np.ndarray, np.ndarray]:
         """Tool centre point (between the fingertips) pose: position (3,) m, quaternion (4,)
         xyzw, world frame."""
-        return self._link_pose(self._robot(robot).body, self._tcp_idx)
+        pos, orn = self._link_pose(self._robot(robot).body, self._tcp_idx)
+        return _in_link(pos, orn, self.robot.tcp)
 
     def camera_pose(self, robot: str = 'user') -> tuple[np.ndarray, np.ndarray]:
         """Camera optical frame pose (z forward, x right, y down): position (3,) m, quat xyzw."""
-        return self._link_pose(self._robot(robot).body, self._cam_idx)
+        pos, orn = self._link_pose(self._robot(robot).body, self._cam_idx)
+        return _in_link(pos, orn, self.robot.camera)
 
     def link_pose(self, link: str, robot: str = 'user') -> tuple[np.ndarray, np.ndarray]:
         """Pose of a named link of the robot (the child link of joint ``link`` or link name)."""
@@ -678,7 +723,7 @@ class Simulation:
             efforts = self.realism.finger_efforts(efforts)
         return {'closure': r.closure, 'positions': self.finger_positions(robot),
                 'efforts': efforts, 'contacts': np.array(contacts, dtype=bool),
-                'names': FINGER_JOINTS}
+                'names': self.finger_names}
 
     def objects(self) -> list[SceneObject]:
         """Current state of all scene objects (id = index in the scene layout)."""
@@ -722,7 +767,7 @@ class Simulation:
         names[-1] = 'base_link'
         out = set()
         for c in self._p.getContactPoints(r.body, self._ground):
-            if c[3] not in self._finger_links and c[3] != -1:
+            if c[3] not in self._finger_links and c[3] not in self._base_links:
                 out.add(f'{names[c[3]]} - ground')
         for c in self._p.getContactPoints(r.body, r.body):
             a, b = sorted((names[c[3]], names[c[4]]))
@@ -901,7 +946,8 @@ class Simulation:
             msg = f"forward_kinematics link must be 'tcp' or 'camera', got {link!r}."
             raise SimError(msg)
         st = self._kin.getLinkState(self._kin_body, idx, computeForwardKinematics=True)
-        return np.array(st[4]), np.array(st[5])
+        pos, orn = np.array(st[4]), np.array(st[5])
+        return _in_link(pos, orn, self.robot.camera if link == 'camera' else self.robot.tcp)
 
     def tool_jacobian(self, q: np.ndarray) -> np.ndarray:
         """Geometric Jacobian (6, 6) of the TCP at joints ``q`` (6,) rad, on the kinematic twin:
@@ -951,8 +997,8 @@ class Simulation:
     def _ik_from(self, q: np.ndarray, target_pos: np.ndarray, target_quat: np.ndarray | None,
                  iterations: int, tolerance: float) -> tuple[np.ndarray, float]:
         n_fingers = len(self._finger_idx)
-        lower = [*self.lower, *[FINGER_OPEN] * n_fingers]
-        upper = [*self.upper, *[FINGER_CLOSED] * n_fingers]
+        lower = [*self.lower, *np.minimum(self._finger_open, self._finger_closed)]
+        upper = [*self.upper, *np.maximum(self._finger_open, self._finger_closed)]
         ranges = [u - lo for u, lo in zip(upper, lower, strict=True)]
         best, best_err = q.copy(), math.inf
         for _ in range(iterations):
@@ -991,6 +1037,15 @@ class Simulation:
 
     def __exit__(self, *exc: object) -> None:
         self.close()
+
+
+def _in_link(pos: np.ndarray, orn: np.ndarray, frame: LinkFrame) -> tuple[np.ndarray, np.ndarray]:
+    """World pose (position (3,) m, quaternion xyzw (4,)) of ``frame`` given its link's."""
+    if not any(frame.xyz) and not any(frame.rpy):
+        return pos, orn
+    fpos, forn = pb.multiplyTransforms(pos.tolist(), orn.tolist(), list(frame.xyz),
+                                       list(pb.getQuaternionFromEuler(frame.rpy)))
+    return np.array(fpos), np.array(forn)
 
 
 __all__ = ['HOME_POSE', 'CameraConfig', 'SceneObject', 'Simulation', 'top_down_quat']

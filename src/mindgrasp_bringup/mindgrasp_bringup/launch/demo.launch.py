@@ -51,6 +51,9 @@ def generate_launch_description() -> LaunchDescription:
         number_argument('seed', default_value='0', minimum=0,
                         description='seed of the scene, the virtual subject and the synthetic '
                                     'EEG (same seed, same run)'),
+        DeclareLaunchArgument('robot', default_value='mindgrasp_arm',
+                              description='the arm of the simulator and the controller: '
+                                          'mindgrasp_arm, xarm6 or a robot description YAML'),
         DeclareLaunchArgument('realism', default_value='none',
                               description='simulator realism: none, default or a profile YAML '
                                           'path (noisy camera, miscalibration, arm lag, object '
@@ -87,7 +90,8 @@ def generate_launch_description() -> LaunchDescription:
         *[Node(package='mindgrasp_sim', executable='sim_node', name='sim',
                parameters=[*config_files('sim', 'demo'),
                            {'gui': gui, 'seed': seed, 'realism': LaunchConfiguration('realism'),
-                            'realism_seed': seed, **scene}],
+                            'realism_seed': seed, 'robot': LaunchConfiguration('robot'),
+                            **scene}],
                condition=condition) for condition, scene in sim_scene_camera()],
         # 2 virtual amplifier: synthetic EEG of the virtual subject as an LSL stream
         Node(package='mindgrasp_eeg', executable='virtual_amp_node', name='virtual_amp',
@@ -105,7 +109,7 @@ def generate_launch_description() -> LaunchDescription:
         Node(package='mindgrasp_vision', executable='vision_node', name='vision',
              parameters=config_files('vision', 'demo')),
         # 6 controller: predictions + detections -> arm and gripper commands
-        fsm_node(config_files('fsm', 'demo')),
+        fsm_node(config_files('fsm', 'demo'), {'robot': LaunchConfiguration('robot')}),
         # 7 live view for the experimenter: Foxglove at ws://localhost:8765
         *live_view_nodes(),
     ])

@@ -4,6 +4,7 @@ trials through the full node graph (simulator, EEG, classifier, vision, controll
     mindgrasp launch experiment subject:=virtual accuracy:=0.8 trials:=6 --lockstep
     mindgrasp launch experiment protocol:=random_locations subject:=autonomous trials:=3
     mindgrasp experiment set-locations --trials 160 --subject noise     # records and report
+    mindgrasp experiment random-locations --subject autonomous --robot xarm6 --trials 1
 
 Subjects: ``noise`` (the paper's unworn cap: EEG without imagery, decoded by a classifier trained
 on noise; give it with model:=), ``virtual`` (the virtual subject pursues the target at
@@ -90,6 +91,9 @@ def generate_launch_description() -> LaunchDescription:
                               description='simulator realism: none, default or a profile YAML '
                                           '(sensor noise, camera mount error, arm lag, object '
                                           'spread; mindgrasp_sim.realism), seeded by seed'),
+        DeclareLaunchArgument('robot', default_value='mindgrasp_arm',
+                              description='the arm of the simulator and the controller: '
+                                          'mindgrasp_arm, xarm6 or a robot description YAML'),
         DeclareLaunchArgument('gui', default_value='false', choices=['true', 'false'],
                               description='open the PyBullet window (needs a display)'),
         command_interface_argument(),
@@ -102,7 +106,8 @@ def generate_launch_description() -> LaunchDescription:
              parameters=[*config_files('sim', 'experiment'),
                          {'gui': LaunchConfiguration('gui'), 'seed': seed,
                           'realism': LaunchConfiguration('realism'), 'realism_seed': seed,
-                          'scene': LaunchConfiguration('protocol')}]),  # a scene per protocol
+                          'scene': LaunchConfiguration('protocol'),  # a scene per protocol
+                          'robot': LaunchConfiguration('robot')}]),
         # EEG subjects: the virtual amplifier (pursue: the virtual subject; noise: the unworn
         # cap), acquisition and the classifier
         *[GroupAction([
@@ -124,6 +129,7 @@ def generate_launch_description() -> LaunchDescription:
         Node(package='mindgrasp_vision', executable='vision_node', name='vision',
              parameters=config_files('vision', 'experiment')),
         fsm_node(config_files('fsm', 'experiment'),
-                 {'autonomous': EqualsSubstitution(subject, 'autonomous')}),
+                 {'autonomous': EqualsSubstitution(subject, 'autonomous'),
+                  'robot': LaunchConfiguration('robot')}),
     ])
 

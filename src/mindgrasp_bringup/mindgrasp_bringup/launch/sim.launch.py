@@ -6,6 +6,7 @@ the arm contract of a ros2_control forward velocity controller (drive it from ou
     mindgrasp launch sim time_mode:=fast                   # + /clock; others on use_sim_time
     mindgrasp launch sim trainer_robot:=true gui:=true duration:=60
     mindgrasp launch sim realism:=default realism_seed:=3  # a real camera's noise, a real arm's lag
+    mindgrasp launch sim robot:=xarm6                      # UFactory xArm6 (or a robot YAML path)
     mindgrasp topic hz /joint_states                       # in another shell
 
 Parameters: mindgrasp_sim/param/sim.yaml, then the launch arguments below.
@@ -49,6 +50,9 @@ def generate_launch_description() -> LaunchDescription:
                                           'profile YAML path (mindgrasp_sim.realism)'),
         number_argument('realism_seed', default_value='0', minimum=0,
                         description='seed of the realism draws'),
+        DeclareLaunchArgument('robot', default_value='mindgrasp_arm',
+                              description='the arm: mindgrasp_arm, xarm6 or a robot description '
+                                          'YAML path (mindgrasp_common.robot_description)'),
         *run_directory_actions(),  # ros2 launch: run directory, recorder, duration
         Node(package='mindgrasp_sim', executable='sim_node', name='sim',
              parameters=[*config_files('sim'),
@@ -59,5 +63,6 @@ def generate_launch_description() -> LaunchDescription:
                           'trainer_robot': LaunchConfiguration('trainer_robot'),
                           'gui': LaunchConfiguration('gui'),
                           'realism': LaunchConfiguration('realism'),
-                          'realism_seed': LaunchConfiguration('realism_seed')}]),
+                          'realism_seed': LaunchConfiguration('realism_seed'),
+                          'robot': LaunchConfiguration('robot')}]),
     ])
