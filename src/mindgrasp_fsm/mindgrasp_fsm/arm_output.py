@@ -14,7 +14,6 @@ from __future__ import annotations
 import numpy as np
 from mindgrasp_ros.interfaces.builtin_interfaces.msg import Duration
 from mindgrasp_ros.interfaces.geometry_msgs.msg import TwistStamped
-from mindgrasp_ros.interfaces.moveit_msgs.srv import ServoCommandType
 from mindgrasp_ros.interfaces.std_msgs.msg import Float64MultiArray
 from mindgrasp_ros.interfaces.trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
@@ -55,6 +54,11 @@ class ArmCommandOutput:
             self.pub = node.create_publisher(JointTrajectory, ARM_TRAJECTORY.name,
                                              ARM_TRAJECTORY.qos)
         else:
+            # imported here: a ROS 2 install without MoveIt (moveit_msgs) runs the other two
+            from mindgrasp_ros.interfaces.moveit_msgs.srv import ServoCommandType
+
+            self._servo_request = ServoCommandType.Request(
+                command_type=ServoCommandType.Request.TWIST)
             self.pub = node.create_publisher(TwistStamped, SERVO_TWIST.name, SERVO_TWIST.qos)
             self._servo_client = node.create_client(ServoCommandType, SERVO_COMMAND_TYPE_SERVICE)
 
@@ -106,8 +110,7 @@ class ArmCommandOutput:
             return
         if not self._servo_asked:
             self._servo_asked = True
-            self._servo_future = self._servo_client.call_async(
-                ServoCommandType.Request(command_type=ServoCommandType.Request.TWIST))
+            self._servo_future = self._servo_client.call_async(self._servo_request)
         if self._servo_future is not None and self._servo_future.done():
             result = self._servo_future.result()
             self._servo_future = None

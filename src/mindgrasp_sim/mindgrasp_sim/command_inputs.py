@@ -21,15 +21,16 @@ from typing import Any
 
 import numpy as np
 from mindgrasp_ros.interfaces.geometry_msgs.msg import TwistStamped
-from mindgrasp_ros.interfaces.moveit_msgs.srv import ServoCommandType
 from mindgrasp_ros.interfaces.trajectory_msgs.msg import JointTrajectory
 
 from mindgrasp_ros.topics import ARM_TRAJECTORY, SERVO_COMMAND_TYPE_SERVICE, SERVO_TWIST
 from mindgrasp_sim.control import velocities_from_trajectory, velocities_from_twist
 from mindgrasp_sim.errors import SimError
 
-_TYPE_NAMES = {ServoCommandType.Request.JOINT_JOG: 'JOINT_JOG',
-               ServoCommandType.Request.TWIST: 'TWIST', ServoCommandType.Request.POSE: 'POSE'}
+#: moveit_msgs/srv/ServoCommandType's command types (its constants; the message is imported only
+#: where the service is offered, so a ROS 2 install without MoveIt runs the other inputs)
+JOINT_JOG, TWIST, POSE = 0, 1, 2
+_TYPE_NAMES = {JOINT_JOG: 'JOINT_JOG', TWIST: 'TWIST', POSE: 'POSE'}
 
 
 class ArmCommandInputs:
@@ -38,11 +39,18 @@ class ArmCommandInputs:
 
     def __init__(self, node: Any, io: Any) -> None:
         self.node, self.io = node, io
-        self.servo_type = ServoCommandType.Request.JOINT_JOG   # MoveIt Servo's type at start
+        self.servo_type = JOINT_JOG   # MoveIt Servo's type at start
         traj, twist = (t.in_namespace(io.prefix) for t in (ARM_TRAJECTORY, SERVO_TWIST))
         self.trajectory_topic, self.twist_topic = traj.name, twist.name
         node.create_subscription(JointTrajectory, traj.name, self.trajectory_callback, traj.qos)
         node.create_subscription(TwistStamped, twist.name, self.twist_callback, twist.qos)
+        try:
+            from mindgrasp_ros.interfaces.moveit_msgs.srv import ServoCommandType
+        except ImportError:   # real rclpy without moveit_msgs: no twists, the rest works
+            node.get_logger().info(f'{io.prefix}{SERVO_COMMAND_TYPE_SERVICE} is not offered: '
+                                   'moveit_msgs is not installed (install ros-jazzy-moveit-msgs '
+                                   'for servo_twist).')
+            return
         node.create_service(ServoCommandType, f'{io.prefix}{SERVO_COMMAND_TYPE_SERVICE}',
                             self.switch_command_type_callback)
 
@@ -65,7 +73,7 @@ class ArmCommandInputs:
         t = msg.twist
         linear = np.array([t.linear.x, t.linear.y, t.linear.z])
         angular = np.array([t.angular.x, t.angular.y, t.angular.z])
-        if self.servo_type != ServoCommandType.Request.TWIST:
+        if self.servo_type != TWIST:
             # MoveIt Servo ignores commands of a type it was not switched to
             moving = bool(np.any(linear) or np.any(angular))
             if moving and io.bursts.bad('servo_type', self.node.sim_now()):
@@ -87,16 +95,15 @@ class ArmCommandInputs:
 
         self.node.accept_arm_command(velocities, io, self.twist_topic)
 
-    def switch_command_type_callback(self, request: ServoCommandType.Request,
-                                     response: ServoCommandType.Response
-                                     ) -> ServoCommandType.Response:
+    def switch_command_type_callback(self, request: Any, response: Any) -> Any:
+        """moveit_msgs/srv/ServoCommandType: select the command type (TWIST moves the arm)."""
         kind = int(request.command_type)
         response.success = kind in _TYPE_NAMES
         if response.success:
             self.servo_type = kind
             self.node.get_logger().info(f'Servo command type {_TYPE_NAMES[kind]} '
                                         f'({self.twist_topic} moves the arm: '
-                                        f'{kind == ServoCommandType.Request.TWIST}).')
+                                        f'{kind == TWIST}).')
         else:
             self.node.get_logger().warning(
                 f'{self.io.prefix}{SERVO_COMMAND_TYPE_SERVICE}: command_type {kind} is not one '
