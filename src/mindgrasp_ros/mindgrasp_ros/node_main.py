@@ -55,7 +55,7 @@ from collections.abc import Callable
 from typing import Any
 
 from mindgrasp_ros import rclpy
-from mindgrasp_ros.process import exit_if_main_program
+from mindgrasp_ros.process import exit_if_main_program, stop_requested
 
 __all__ = ['EXIT_FAILED', 'EXIT_OK', 'EXIT_REFUSED', 'NodeFailure', 'declare_duration',
            'end_after', 'error_text', 'exit_code', 'fail', 'help_text', 'is_done', 'run_node']
@@ -259,10 +259,11 @@ def run_node(node_class: Callable[[], Any], args: list[str] | None = None, *,
             # quiet) blocked Ctrl-C for good
             while not done.done() and rclpy.ok():
                 executor.spin_once(timeout_sec=_SIGNAL_CHECK_SEC)
+                _raise_if_stop_requested()
         if done.done() and linger_sec > 0 and rclpy.ok():
             executor.spin_until_future_complete(rclpy.task.Future(), timeout_sec=linger_sec)
     except (KeyboardInterrupt, _external_shutdown()):
-        pass   # a stop: exit 0 unless the cleanup below fails the node
+        stop_requested.clear()   # a stop: exit 0 unless the cleanup below fails the node
     finally:
         if node is not None:
             node.destroy_node()
@@ -278,6 +279,12 @@ def run_node(node_class: Callable[[], Any], args: list[str] | None = None, *,
     return code
 
 
+def _raise_if_stop_requested() -> None:
+    """A stop signal whose KeyboardInterrupt was lost (see process.stop_requested)."""
+    if stop_requested.is_set():
+        raise KeyboardInterrupt
+
+
 def _poll_until_done(executor: Any, done: Any, poll_sec: float) -> None:
     """Run ready callbacks without waiting in the middleware; in between, sleep on ``done`` (the
     GIL is released) for up to ``poll_sec`` s. Ends when ``done`` completes or the context shuts
@@ -287,3 +294,4 @@ def _poll_until_done(executor: Any, done: Any, poll_sec: float) -> None:
     while rclpy.ok() and not done.done():
         executor.spin_once(timeout_sec=0.0)
         completed.wait(poll_sec)
+        _raise_if_stop_requested()

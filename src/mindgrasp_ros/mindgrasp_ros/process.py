@@ -27,9 +27,22 @@ __all__ = ['exit_if_main_program', 'exit_process', 'handle_stop_signals', 'is_ma
            'run_program']
 
 
+#: set by SIGINT and SIGTERM (handle_stop_signals). A node's spin loop also checks it: the signal's
+#: KeyboardInterrupt is lost when Python raises it inside a weakref callback (importlib's module
+#: lock clean-up prints "Exception ignored ... KeyboardInterrupt" and drops it), which left a node
+#: running after the launcher's SIGINT.
+stop_requested = threading.Event()
+
+
+def _interrupt(signum: int, frame: object) -> None:
+    stop_requested.set()
+    signal.default_int_handler(signal.SIGINT, frame)
+
+
 def handle_stop_signals() -> None:
     """Ctrl-C (SIGINT) and SIGTERM raise KeyboardInterrupt in the main thread, whatever this
-    process inherited, so a program stopped either way cleans up the same way.
+    process inherited, so a program stopped either way cleans up the same way; both also set
+    :data:`stop_requested`.
 
     A process started in the background of a script (or by a test runner's worker) inherits
     SIGINT *ignored*, and Python keeps it so: such a node ignored the launcher's SIGINT until it
@@ -39,10 +52,11 @@ def handle_stop_signals() -> None:
     """
     if threading.current_thread() is not threading.main_thread():
         return
-    if signal.getsignal(signal.SIGINT) in (signal.SIG_IGN, signal.SIG_DFL, None):
-        signal.signal(signal.SIGINT, signal.default_int_handler)
+    if signal.getsignal(signal.SIGINT) in (signal.SIG_IGN, signal.SIG_DFL, None,
+                                           signal.default_int_handler):
+        signal.signal(signal.SIGINT, _interrupt)
     if signal.getsignal(signal.SIGTERM) in (signal.SIG_DFL, None):
-        signal.signal(signal.SIGTERM, lambda *_: signal.default_int_handler(signal.SIGINT, None))
+        signal.signal(signal.SIGTERM, _interrupt)
 
 
 def is_main_program(module: str) -> bool:
