@@ -12,8 +12,6 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from pyriemann.geometry.base import invsqrtm
-from pyriemann.geometry.geodesic import geodesic_riemann
 from pyriemann.geometry.mean import mean_riemann
 
 from mindgrasp_classifier.errors import ClassifierError
@@ -202,8 +200,7 @@ class MiDecoder:
         self._filter = CausalBandpass(
             design_bandpass(*self.model.band, self.model.rate, self.model.filter_order),
             len(self._idx))
-        self.reference = np.array(self.model.reference, dtype=float)
-        self._ref_invsqrt = invsqrtm(self.reference)
+        self._set_reference(np.array(self.model.reference, dtype=float))
         # the training reference counts as this many windows of the running mean
         self._n_ref_updates = round(self.adaptation.recenter_prior / self.model.step)
         self.label: int | None = None
@@ -245,8 +242,7 @@ class MiDecoder:
 
         ``covs`` shape (n_windows, n_channels, n_channels), from :meth:`MiModel.covariances`.
         """
-        self.reference = mean_riemann(np.asarray(covs, dtype=float))
-        self._ref_invsqrt = invsqrtm(self.reference)
+        self._set_reference(mean_riemann(np.asarray(covs, dtype=float)))
         self._n_ref_updates = len(covs)
 
     # --- streaming -----------------------------------------------------------------------
@@ -344,8 +340,33 @@ class MiDecoder:
         if cfg.recenter == 'adaptive':
             self._n_ref_updates += 1
             w = max(1.0 / self._n_ref_updates, cfg.recenter_rate)
-            self.reference = geodesic_riemann(self.reference, cov, w)
-            self._ref_invsqrt = invsqrtm(self.reference)
+            # the affine-invariant geodesic A^1/2 (A^-1/2 B A^-1/2)^w A^1/2, as pyriemann's
+            # geodesic_riemann computes it, but with A's square roots from the one
+            # eigendecomposition already made for the re-centering (2 eigh per window, not 4)
+            inner = _spd_function(self._ref_invsqrt @ cov @ self._ref_invsqrt, lambda x: x ** w)
+            self._set_reference(self._ref_sqrt @ inner @ self._ref_sqrt)
+
+    def _set_reference(self, reference: np.ndarray) -> None:
+        """The re-centering reference (n_channels, n_channels) and its square roots."""
+        self.reference = reference
+        vals, vecs = np.linalg.eigh(reference)
+        self._ref_sqrt = _from_eigen(vals, vecs, np.sqrt(vals))
+        self._ref_invsqrt = _from_eigen(vals, vecs, 1.0 / np.sqrt(vals))
+
+
+def _from_eigen(vals: np.ndarray, vecs: np.ndarray, f_vals: np.ndarray) -> np.ndarray:
+    """``V diag(f(vals)) V^T``, the product pyriemann's matrix functions form (same order of
+    operations, so the same bits)."""
+    return vecs @ (f_vals[..., None] * vecs.T)
+
+
+def _spd_function(matrix: np.ndarray, f) -> np.ndarray:
+    """A matrix function of a symmetric positive-definite matrix (n, n), via eigh."""
+    if not np.isfinite(matrix).all():
+        msg = 'Re-centering met a non-finite covariance; check the amplifier and electrodes.'
+        raise ClassifierError(msg)
+    vals, vecs = np.linalg.eigh(matrix)
+    return _from_eigen(vals, vecs, f(vals))
 
 
 def _grid(first: int, stop: int, n_step: int) -> range:
