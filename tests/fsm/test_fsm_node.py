@@ -43,6 +43,10 @@ def test_fsm_node_turns_on_left_hand_and_stops_when_predictions_end(rclpy_ctx, s
     # nothing published yet: the controller holds still and says why
     assert spin_until(node, lambda: any(s.stopped for s in states), 60.0), proc.output()
     assert 'no joint states' in next(s for s in states if s.stopped).reason
+    # waiting for a first input is how every start begins: said as information, not a warning
+    assert proc.wait_for_output('no joint states received yet', 60.0), proc.output()
+    waiting = [line for line in proc.output().splitlines() if 'received yet' in line]
+    assert waiting and all('[INFO]' in line for line in waiting), waiting
 
     send_predictions = [True]
 

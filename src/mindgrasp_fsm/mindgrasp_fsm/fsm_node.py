@@ -60,6 +60,8 @@ from mindgrasp_ros.topics import (
 )
 
 _NUMBER = re.compile(r'\d+(\.\d+)?')
+# the watchdog's reasons while a first input is awaited ('no joint states received yet')
+_WAITING = 'received yet'
 
 
 class FsmNode(rclpy.node.Node):
@@ -214,7 +216,11 @@ class FsmNode(rclpy.node.Node):
         latched = any(e.startswith(f'{SENSOR_FAULT}:') for e in out.events)
         if out.stopped and not latched and (self._last_state_msg is None or
                                             not self._last_state_msg[2]):
-            self.get_logger().warning(out.reason)   # a latch said why in its own line
+            # a latch said why in its own line; waiting for a first input is how every start
+            # begins (the nodes come up in any order): information, not a warning
+            log = self.get_logger().info if _WAITING in out.reason else \
+                self.get_logger().warning
+            log(out.reason)
         self._last_state_msg, self._last_state_pub = key, now
         msg = FsmState(state=int(out.state), state_name=STATE_NAMES[out.state],
                        previous_state=int(out.previous_state),
