@@ -16,6 +16,10 @@ import math
 import sys
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from mindgrasp_experiments.experiment import Experiment
 
 PROTOCOL_SUBJECTS = {'set_locations': ('noise', 'virtual', 'oracle'),
                      'random_locations': ('autonomous',)}
@@ -185,124 +189,76 @@ def compare_by_sweep(args: argparse.Namespace, command: str) -> int:
                                             'subject': subject, 'seeds': None}))
 
 
+def experiment_from(args: argparse.Namespace, protocol: str,
+                    params: dict[str, Any] | None = None) -> Experiment:
+    """The :class:`~mindgrasp_experiments.experiment.Experiment` the options describe."""
+    from mindgrasp_experiments.experiment import Experiment
+
+    return Experiment(protocol, subject=getattr(args, 'subject', 'autonomous'),
+                      trials=args.trials, seed=args.seed, workers=args.workers,
+                      accuracy=getattr(args, 'accuracy', None), params=params or {},
+                      robot=getattr(args, 'robot', None), realism=getattr(args, 'realism', None),
+                      launch=args.launch, step_s=args.step, trial_timeout_s=args.trial_timeout,
+                      stall_timeout_s=args.stall_timeout, ray=args.ray)
+
+
 def run_experiment(args: argparse.Namespace, protocol: str, command: str) -> int:
     """Run the protocol with ``args``; write the run directory; print the figures."""
     from tqdm import tqdm
 
-    from mindgrasp_bringup.launch_system import LaunchError
-    from mindgrasp_bringup.launch_system.rundir import create_run_dir
-    from mindgrasp_common.safe_files import DeferredWriter
-    from mindgrasp_eeg import EEGError
     from mindgrasp_experiments import ExperimentError
-    from mindgrasp_experiments.engine import is_trial_manager, lockstep_components
-    from mindgrasp_experiments.records import write_records
-    from mindgrasp_experiments.report import finite, write_run
-    from mindgrasp_experiments.summary import calibration_accuracy_of, summarise
-    from mindgrasp_experiments.sweep import apply_params, check_params, parse_param
-    from mindgrasp_experiments.workers import run_trials
+    from mindgrasp_experiments.sweep import parse_param
 
     problem = check(args, command)
     if problem:
         return fail(command, problem)
-    subject = getattr(args, 'subject', 'autonomous')
     try:
         params = [parse_param(p) for p in getattr(args, 'param', [])]
     except ExperimentError as exc:
         return fail(command, str(exc))
     if any(len(values) > 1 for _node, _name, values in params):
         return compare_by_sweep(args, command)
+    experiment = experiment_from(args, protocol, {f'{node}.{name}': values[0]
+                                                  for node, name, values in params})
+    bars: list[tqdm] = []     # made once the graph is checked: an error stays one line
+    started: list[float] = []
+
+    def start() -> None:
+        started.append(time.perf_counter())
+        bars.append(tqdm(total=args.trials, unit='trial', disable=args.no_progress,
+                         file=sys.stderr, desc=f'{protocol} ({experiment.subject})',
+                         dynamic_ncols=True))
+
+    def progress(runs: list) -> None:
+        done = [r.record for r in runs]
+        bars[0].update(1)
+        bars[0].set_postfix(
+            success=f'{sum(r.success for r in done)}/{len(done)}',
+            rtf=f'{sum(r.sim_s for r in runs) / (time.perf_counter() - started[0]):.1f}')
+
+    def warn(line: str) -> None:
+        text = f'mindgrasp experiment {command}: {line}'
+        if bars:
+            bars[0].write(text, file=sys.stderr)
+        else:
+            print(text, file=sys.stderr)
+
+    log: list[str] | None = [] if args.json else None
     try:
-        out = create_run_dir(protocol, args.out)
-    except LaunchError as exc:
-        return fail(command, str(exc))
-    try:
-        launch_args = subject_launch_args(subject, out)
-    except (ExperimentError, EEGError) as exc:
-        return fail(command, str(exc))
-    launch_args.update({'protocol': protocol, 'seed': str(args.seed), 'trials': '1'})
-    if getattr(args, 'accuracy', None) is not None:
-        launch_args['accuracy'] = str(args.accuracy)
-    if getattr(args, 'realism', None) is not None:
-        launch_args['realism'] = str(args.realism)
-    if getattr(args, 'robot', None) is not None:
-        launch_args['robot'] = str(args.robot)
-    log = [] if args.json else None
-    try:
-        components = lockstep_components('experiment', launch_args, out / 'params',
-                                         overlay=args.launch,
-                                         log=log.append if log is not None else print)
+        results = experiment.run(
+            args.out, command=' '.join(['mindgrasp', 'experiment', command, *sys.argv[3:]]),
+            log=log.append if log is not None else print, on_start=start, on_trial=progress,
+            warn=warn)
     except ExperimentError as exc:
         return fail(command, str(exc))
-    for comp in components:
-        if is_trial_manager(comp):
-            comp.ros_args += ['-p', f'stall_timeout:={args.stall_timeout}',
-                              '-p', f'trial_timeout:={args.trial_timeout}']
-    try:
-        params = check_params(params, components)
-    except ExperimentError as exc:
-        return fail(command, str(exc))
-    components = apply_params(components, {f'{node}.{name}': values[0]
-                                           for node, name, values in params}, out / 'params')
-    trials = list(range(1, args.trials + 1))
-    runs = []
-    interrupted = False
-    wall0, cpu0 = time.perf_counter(), time.process_time()
-    bar = tqdm(total=len(trials), unit='trial', disable=args.no_progress, file=sys.stderr,
-               desc=f'{protocol} ({subject})', dynamic_ncols=True)
-    # on disk as they finish: nothing is lost on a crash; a full disk costs one line, the
-    # records stay in memory and in a fallback copy until the run directory takes them
-    files = DeferredWriter(out)
-    try:
-        for run in run_trials(components, trials, seed=args.seed, workers=args.workers,
-                              step_s=args.step, ray=args.ray):
-            runs.append(run)
-            done = [r.record for r in runs]
-            for line in files.write(out, 'trial records',
-                                    lambda folder, done=done: write_records(done, folder)):
-                bar.write(f'mindgrasp experiment {command}: {line}', file=sys.stderr)
-            bar.update(1)
-            bar.set_postfix(success=f'{sum(r.success for r in done)}/{len(done)}',
-                            rtf=f'{sum(r.sim_s for r in runs) / (time.perf_counter() - wall0):.1f}')
-    except KeyboardInterrupt:
-        interrupted = True
-        print(f'\nInterrupted: writing the {len(runs)} finished trial(s).', file=sys.stderr)
     finally:
-        bar.close()
-    wall = time.perf_counter() - wall0
-    sim = sum(r.sim_s for r in runs)
-    # CPU of this process and of the worker processes (the parent mostly waits with workers)
-    cpu = sum(r.cpu_s for r in runs) + (time.process_time() - cpu0 if args.workers > 1 else 0.0)
-    node_s: dict[str, float] = {}
-    for r in runs:
-        for name, sec in r.node_s.items():
-            node_s[name] = node_s.get(name, 0.0) + sec
-    records = sorted((r.record for r in runs), key=lambda rec: rec.trial)
-    info = {
-        'command': ' '.join(['mindgrasp', 'experiment', command, *sys.argv[3:]]),
-        'protocol': protocol, 'subject': subject, 'seed': args.seed,
-        'accuracy': getattr(args, 'accuracy', None), 'workers': args.workers, 'ray': args.ray,
-        'realism': getattr(args, 'realism', None),
-        'trials_requested': args.trials, 'interrupted': interrupted,
-        'launch_overlay': args.launch, 'step_s': args.step,
-        'trial_timeout_s': args.trial_timeout, 'stall_timeout_s': args.stall_timeout,
-        'sim_s': sim, 'wall_s': wall, 'cpu_s': cpu,
-        'real_time_factor': sim / wall if wall > 0 else math.nan,
-        'cpu_s_per_sim_s': cpu / sim if sim > 0 else math.nan,
-        'build_s': sum(r.build_s for r in runs), 'node_s': node_s,
-    }
-    written: dict[str, dict] = {}
-    calibration = calibration_accuracy_of(out)   # from the run's parameters, wherever it lands
-    lines = files.write(out, 'run report', lambda folder: written.update(
-        doc=write_run(folder, records, info, calibration)))
-    lines += files.close()
-    for line in lines:
-        print(f'mindgrasp experiment {command}: {line}', file=sys.stderr)
-    doc = written.get('doc') or {'summary': summarise(records, calibration)}
-    s = doc['summary']
+        for bar in bars:
+            bar.close()
+    s, info, out = results.summary, results.info, results.run_dir
     cut = (f" (and {s['interrupted_trials']} interrupted, left out)"
            if s['interrupted_trials'] else '')
-    print(f"{protocol.replace('_', ' ').capitalize()}, subject {subject}: {s['trials']} trials"
-          f"{cut} in {out}")
+    print(f"{protocol.replace('_', ' ').capitalize()}, subject {experiment.subject}: "
+          f"{s['trials']} trials{cut} in {out}")
     print(f"  correct grasp {_pct(s['correct_and_successful_rate'])}, wrong grasp "
           f"{_pct(s['wrong_grasp_rate'])}, no grasp {_pct(s['no_grasp_rate'])}; grasp success "
           f"{_pct(s['success_rate'])}, correct choice {_pct(s['correct_choice_rate'])}")
@@ -312,15 +268,12 @@ def run_experiment(args: argparse.Namespace, protocol: str, command: str) -> int
     if s['online_windows'] or math.isfinite(s['calibration_accuracy']):
         print(f"  decoder online accuracy {_pct(s['online_accuracy'])} of "
               f"{s['online_windows']} windows (calibration {_pct(s['calibration_accuracy'])})")
-    print(f'  simulated {sim:.0f} s in {wall:.0f} s wall: real-time factor '
+    print(f"  simulated {info['sim_s']:.0f} s in {info['wall_s']:.0f} s wall: real-time factor "
           f"{info['real_time_factor']:.1f}, {info['cpu_s_per_sim_s']:.3f} CPU s per simulated s")
     print(f"  report: {out / 'report.md'}")
     if args.json:
-        print(json.dumps(finite({**s, 'run_dir': str(out), 'report_path': str(out / 'report.md'),
-                                 'real_time_factor': info['real_time_factor'],
-                                 'cpu_s_per_sim_s': info['cpu_s_per_sim_s'],
-                                 'wall_s': wall, 'sim_s': sim, 'interrupted': interrupted})))
-    return 130 if interrupted else 1 if files.pending else 0
+        print(json.dumps(results.figures()))
+    return 130 if results.interrupted else 1 if results.unwritten else 0
 
 
 def _pct(rate: float) -> str:

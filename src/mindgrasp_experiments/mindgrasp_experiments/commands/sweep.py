@@ -20,8 +20,12 @@ import argparse
 import json
 import sys
 import time
+from typing import TYPE_CHECKING
 
 from mindgrasp_experiments.cli import add_common_arguments, check, fail, subject_type
+
+if TYPE_CHECKING:
+    from mindgrasp_experiments.experiment import Experiment
 
 COMMAND = 'sweep'
 
@@ -53,13 +57,9 @@ def main(args: argparse.Namespace) -> int:
     from mindgrasp_bringup.launch_system.rundir import create_run_dir
     from mindgrasp_eeg import EEGError
     from mindgrasp_experiments import ExperimentError
-    from mindgrasp_experiments.cli import subject_launch_args
-    from mindgrasp_experiments.engine import is_trial_manager, lockstep_components
-    from mindgrasp_experiments.records import write_records
-    from mindgrasp_experiments.report import write_run
+    from mindgrasp_experiments.cli import experiment_from, subject_launch_args
     from mindgrasp_experiments.subjects import is_replay
     from mindgrasp_experiments.sweep import (
-        apply_params,
         check_params,
         combinations,
         parse_accuracies,
@@ -70,7 +70,6 @@ def main(args: argparse.Namespace) -> int:
         point_name,
         write_sweep,
     )
-    from mindgrasp_experiments.workers import run_trials
 
     try:
         accuracies = parse_accuracies(args.accuracy)
@@ -100,21 +99,17 @@ def main(args: argparse.Namespace) -> int:
         return fail(COMMAND, str(exc))
     log = [] if args.json else None
 
-    def components_at(accuracy: float, params_dir, subject: str, seed: int):
-        launch_args = {**subject_args[subject], 'protocol': 'set_locations', 'seed': str(seed),
-                       'trials': '1', 'accuracy': str(accuracy)}
-        comps = lockstep_components('experiment', launch_args, params_dir, overlay=args.launch,
-                                    log=log.append if log is not None else print)
-        for comp in comps:
-            if is_trial_manager(comp):
-                comp.ros_args += ['-p', f'stall_timeout:={args.stall_timeout}',
-                                  '-p', f'trial_timeout:={args.trial_timeout}']
-        return comps
+    def experiment_at(accuracy: float, subject: str, seed: int,
+                      combo: dict[str, object]) -> Experiment:
+        return experiment_from(argparse.Namespace(**{**vars(args), 'subject': subject,
+                                                     'seed': seed, 'accuracy': accuracy}),
+                               'set_locations', combo)
 
     try:
         # the names of --param are checked against the profile's nodes before any trial runs
-        params = check_params(params, components_at(accuracies[0], out / 'params', subjects[0],
-                                                    seeds[0]))
+        params = check_params(params, experiment_at(accuracies[0], subjects[0], seeds[0], {})
+                              .components(out, subject_args[subjects[0]],
+                                          log=log.append if log is not None else print))
     except ExperimentError as exc:
         return fail(COMMAND, str(exc))
     combos = combinations(params)
@@ -125,52 +120,36 @@ def main(args: argparse.Namespace) -> int:
                 **({'seed': seed} if len(seeds) > 1 else {})}
 
     varied = [*axis_of(subjects[0], seeds[0]), *combos[0]]
-    trials = list(range(1, args.trials + 1))
     points = []
     interrupted = False
     wall0 = time.perf_counter()
     sim_total = 0.0
     points_to_run = [(subject, seed, combo, accuracy) for subject in subjects for seed in seeds
                      for combo in combos for accuracy in accuracies]
-    bar = tqdm(total=len(points_to_run) * len(trials), unit='trial',
+    bar = tqdm(total=len(points_to_run) * args.trials, unit='trial',
                disable=args.no_progress, file=sys.stderr, desc='sweep', dynamic_ncols=True)
     try:
         for subject, seed, combo, accuracy in points_to_run:
             axis = axis_of(subject, seed)
             name = point_name(accuracy, {**axis, **combo})
-            point_dir = out / 'points' / name
-            comps = apply_params(components_at(accuracy, point_dir / 'params', subject,
-                                               seed), combo, point_dir / 'params')
             bar.set_description(f'sweep {name}')
-            runs = []
-            wall_p = time.perf_counter()
             try:
-                for run in run_trials(comps, trials, seed=seed, workers=args.workers,
-                                      step_s=args.step, ray=args.ray):
-                    runs.append(run)
-                    write_records([r.record for r in runs], point_dir)
-                    bar.update(1)
-            except KeyboardInterrupt:
-                interrupted = True
-            records = sorted((r.record for r in runs), key=lambda rec: rec.trial)
-            sim = sum(r.sim_s for r in runs)
-            sim_total += sim
-            if records:
-                wall = time.perf_counter() - wall_p
-                point_doc = write_run(point_dir, records, {
-                    'command': f'mindgrasp experiment sweep (point {name})',
-                    'protocol': 'set_locations', 'subject': subject, 'seed': seed,
-                    'accuracy': accuracy, 'params': combo, 'workers': args.workers,
-                    'trials_requested': args.trials, 'interrupted': interrupted,
-                    'step_s': args.step, 'sim_s': sim, 'wall_s': wall,
-                    'cpu_s': sum(r.cpu_s for r in runs),
-                    'real_time_factor': sim / wall if wall > 0 else float('nan'),
-                    'cpu_s_per_sim_s': (sum(r.cpu_s for r in runs) / sim if sim > 0
-                                        else float('nan'))})
+                results = experiment_at(accuracy, subject, seed, combo).run(
+                    out / 'points' / name, subject_args=subject_args[subject],
+                    command=f'mindgrasp experiment sweep (point {name})',
+                    log=log.append if log is not None else print,
+                    warn=lambda line: bar.write(f'mindgrasp experiment {COMMAND}: {line}',
+                                                file=sys.stderr),
+                    on_trial=lambda runs: bar.update(1))
+            except ExperimentError as exc:
+                bar.close()
+                return fail(COMMAND, str(exc))
+            sim_total += results.info['sim_s']
+            if results.records:
                 points.append({'point': name, **point_figures(
-                    records, accuracy, {**axis, **combo},
-                    point_doc['summary']['calibration_accuracy'])})
-            if interrupted:
+                    results.records, accuracy, {**axis, **combo},
+                    results.summary['calibration_accuracy'])})
+            if results.interrupted:
                 raise KeyboardInterrupt
     except KeyboardInterrupt:
         interrupted = True
