@@ -68,8 +68,11 @@ def test_dataclass_checks_name_the_parameter() -> None:
     ('mindgrasp_bringup.replay.replay_node', [], 'No bag given'),
     ('mindgrasp_bringup.replay.replay_node', ['bag:={tmp}/nope'],
      'nope does not exist; pass a run directory'),
+    ('mindgrasp_bringup.replay.replay_node', ['bag:={tmp}/nope', 'robot:=ur5'],
+     "No robot is named 'ur5'; use one of"),
 ], ids=['recorder-regex', 'recorder-compression', 'recorder-queue', 'player-no-bag',
-        'player-missing-bag', 'player-rate', 'replay-no-bag', 'replay-missing-bag'])
+        'player-missing-bag', 'player-rate', 'replay-no-bag', 'replay-missing-bag',
+        'replay-robot'])
 def test_bad_parameter_refuses_to_start_with_exit_2_and_one_line(tmp_path, module, params, match):
     args = [a.format(tmp=tmp_path) for a in params]
     ros_args = ['--ros-args', *[x for a in args for x in ('-p', a)]] if args else []

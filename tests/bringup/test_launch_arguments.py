@@ -45,6 +45,40 @@ def test_every_profile_checks_its_numbers(profile, args, message):
         LaunchService(profile, args).plan(strict=True)
 
 
+#: the arguments a profile cannot start without
+REQUIRED = {'hardware': ['eeg_stream:=amp', 'arm_driver:=true', 'model:=package://'
+                         'mindgrasp_classifier/models/default_classifier.json'],
+            'replay': ['bag:=runs/x']}
+
+
+@pytest.mark.parametrize('profile', ['sim', 'demo', 'experiment', 'trainer', 'graz', 'hardware',
+                                     'replay'])
+def test_every_profile_checks_its_robot(profile, tmp_path):
+    required = REQUIRED.get(profile, [])
+    with pytest.raises(LaunchError, match=r"launch argument 'robot' is 'ur5': No robot is named "
+                                          r"'ur5'; use one of \[.*'xarm6'.*\]"):
+        LaunchService(profile, [*required, 'robot:=ur5']).plan(strict=True)
+    bad = tmp_path / 'my_arm.yaml'
+    bad.write_text('name: my_arm\nurdf: package://mindgrasp_sim/urdf/mindgrasp_arm.urdf\n'
+                   'arm: {joints: [joint_1, joint_2, joint_3], home: [0, 0, 0]}\n')
+    with pytest.raises(LaunchError, match=r"launch argument 'robot' is '.*my_arm.yaml': Robot "
+                                          r'description .*: the arm has 3 joints'):
+        LaunchService(profile, [*required, f'robot:={bad}']).plan(strict=True)
+
+
+def test_bad_robot_starts_nothing_and_exits_2(tmp_path):
+    run_dir = tmp_path / 'run'
+    out = subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', 'launch', 'trainer',
+                          'robot:=ur5', '--run-dir', str(run_dir)],
+                         capture_output=True, text=True, timeout=120)
+    assert out.returncode == 2
+    lines = out.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(
+        "mindgrasp launch: error: launch argument 'robot' is 'ur5': No robot is named 'ur5'"), \
+        out.stderr
+    assert not run_dir.exists() and not out.stdout.strip()
+
+
 def test_bad_argument_starts_nothing_and_exits_2(tmp_path):
     run_dir = tmp_path / 'run'
     out = subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', 'launch', 'demo',
