@@ -41,7 +41,7 @@ def test_demo_starts_every_node_after_the_recorder() -> None:
 #: every node that reads the robot description, per profile (plus what each profile needs)
 ROBOT_READERS = {
     'sim': ((), ('sim',)),
-    'demo': ((), ('sim', 'fsm')),
+    'demo': ((), ('sim', 'fsm', 'foxglove_bridge')),
     'experiment': ((), ('sim', 'fsm')),
     'trainer': ((), ('sim', 'fsm', 'trainer')),
     'hardware': (('eeg_stream:=amp', 'arm_driver:=true',

@@ -177,15 +177,16 @@ def live_view_arguments() -> list[Any]:
 
 
 def live_view_nodes() -> list[Any]:
-    """The Foxglove bridge (``foxglove_bridge``) when ``live_view:=true``; declare
-    :func:`live_view_arguments` in the profile."""
+    """The Foxglove bridge (``foxglove_bridge``) when ``live_view:=true``, its layout following
+    ``robot:=``; declare :func:`live_view_arguments` and :func:`robot_argument` in the
+    profile."""
     return [
         la.Node(package='mindgrasp_bringup', executable='foxglove_bridge_node',
                 name='foxglove_bridge',
                 # no parameter file of its own; $MINDGRASP_PARAMS_FILES reach it like any node
                 parameters=[*la.config_files('live_view'),
                             {'port': la.LaunchConfiguration('live_view_port'),
-                             'port_in_use': 'skip'}],
+                             'port_in_use': 'skip', 'robot': la.LaunchConfiguration('robot')}],
                 condition=la.IfCondition(la.LaunchConfiguration('live_view'))),
     ]
 
