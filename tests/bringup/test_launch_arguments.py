@@ -66,6 +66,20 @@ def test_every_profile_checks_its_robot(profile, tmp_path):
         LaunchService(profile, [*required, f'robot:={bad}']).plan(strict=True)
 
 
+def test_a_robot_is_a_name_a_path_or_a_package_uri(tmp_path, monkeypatch):
+    from mindgrasp_common.robot_description import load_robot
+
+    monkeypatch.chdir(tmp_path)
+    path = load_robot('xarm6').path
+    for robot in ('xarm6', str(path), 'package://mindgrasp_sim/robots/xarm6.yaml'):
+        plan = LaunchService('sim', [f'robot:={robot}']).plan(strict=True)
+        assert load_robot(plan.processes[-1].parameters['robot']).path == path
+    with pytest.raises(LaunchError, match=r"The robot description 'package://mindgrasp_sim/"
+                                          r"robots/nope.yaml' does not exist"):
+        LaunchService('sim', ['robot:=package://mindgrasp_sim/robots/nope.yaml']).plan(
+            strict=True)
+
+
 def test_bad_robot_starts_nothing_and_exits_2(tmp_path):
     run_dir = tmp_path / 'run'
     out = subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', 'launch', 'trainer',
