@@ -80,29 +80,21 @@ def test_a_robot_is_a_name_a_path_or_a_package_uri(tmp_path, monkeypatch):
             strict=True)
 
 
-def test_bad_robot_starts_nothing_and_exits_2(tmp_path):
+@pytest.mark.parametrize(('profile', 'argument', 'line'), [
+    ('demo', 'seed:=abc', "launch argument 'seed' is 'abc': a whole number >= 0 is expected, "
+                          'e.g. seed:=3.'),
+    ('trainer', 'robot:=ur5', "launch argument 'robot' is 'ur5': No robot is named 'ur5'; use "
+                              'one of '),
+])
+def test_bad_argument_starts_nothing_and_exits_2(tmp_path, profile, argument, line):
     run_dir = tmp_path / 'run'
-    out = subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', 'launch', 'trainer',
-                          'robot:=ur5', '--run-dir', str(run_dir)],
+    out = subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', 'launch', profile,
+                          argument, '--run-dir', str(run_dir)],
                          capture_output=True, text=True, timeout=120)
     assert out.returncode == 2
     lines = out.stderr.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith(
-        "mindgrasp launch: error: launch argument 'robot' is 'ur5': No robot is named 'ur5'"), \
-        out.stderr
+    assert len(lines) == 1 and lines[0].startswith(f'mindgrasp launch: error: {line}'), out.stderr
     assert not run_dir.exists() and not out.stdout.strip()
-
-
-def test_bad_argument_starts_nothing_and_exits_2(tmp_path):
-    run_dir = tmp_path / 'run'
-    out = subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', 'launch', 'demo',
-                          'seed:=abc', '--run-dir', str(run_dir)],
-                         capture_output=True, text=True, timeout=120)
-    assert out.returncode == 2
-    lines = out.stderr.strip().splitlines()
-    assert lines == ["mindgrasp launch: error: launch argument 'seed' is 'abc': a whole number "
-                     '>= 0 is expected, e.g. seed:=3.'], out.stderr
-    assert not run_dir.exists()
 
 
 def test_good_arguments_pass():
