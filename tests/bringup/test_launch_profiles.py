@@ -69,6 +69,11 @@ def test_every_profile_passes_robot_to_every_node_that_reads_it(profile) -> None
     # the default: the shipped arm, or (replay) the robot the recorded run used
     default = '' if profile == 'replay' else 'mindgrasp_arm'
     assert all(processes(profile, *extra)[r].parameters['robot'] == default for r in readers)
+    # the bag's metadata.yaml names the robot (custom_data), the replay's the recorded run's
+    custom = procs['recorder'].parameters.get('custom_data')
+    assert custom == ['robot=xarm6']
+    assert processes(profile, *extra)['recorder'].parameters.get('custom_data') == (
+        None if profile == 'replay' else ['robot=mindgrasp_arm'])
 
 
 def test_hardware_has_drivers_and_no_simulator(tmp_path, monkeypatch) -> None:

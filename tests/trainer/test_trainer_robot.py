@@ -42,6 +42,9 @@ def test_a_trainer_session_runs_on_two_xarm6(tmp_path: Path) -> None:
     for node in ('sim', 'fsm', 'trainer'):
         section = params.get(f'/{node}', params.get(node))
         assert section['ros__parameters']['robot'] == 'xarm6', node
+    # the bag says which robot it holds, for a reader that has the bag folder only
+    metadata = yaml.safe_load((run_dir / 'bag' / 'metadata.yaml').read_text())
+    assert metadata['rosbag2_bagfile_information']['custom_data']['robot'] == 'xarm6'
     store = typestore()
     with BagReader(run_dir / 'bag') as reader:
         states = [store.deserialize_cdr(data, 'sensor_msgs/msg/JointState')
