@@ -61,6 +61,8 @@ def test_dataclass_checks_name_the_parameter() -> None:
      "The parameter 'compression' is 'bz2'; use one of none, zstd, lz4."),
     ('mindgrasp_bringup.bag.recorder_node', ['max_queue_mb:=0', 'output:={tmp}/bag'],
      "'max_queue_mb'"),
+    ('mindgrasp_bringup.bag.recorder_node', ['custom_data:=["robot"]', 'output:={tmp}/bag'],
+     "custom_data entry 'robot' is not KEY=VALUE"),
     ('mindgrasp_bringup.bag.player_node', [], 'The parameter bag is empty'),
     ('mindgrasp_bringup.bag.player_node', ['bag:={tmp}/nope'],
      'nope does not exist; pass a run directory'),
@@ -68,8 +70,12 @@ def test_dataclass_checks_name_the_parameter() -> None:
     ('mindgrasp_bringup.replay.replay_node', [], 'No bag given'),
     ('mindgrasp_bringup.replay.replay_node', ['bag:={tmp}/nope'],
      'nope does not exist; pass a run directory'),
-], ids=['recorder-regex', 'recorder-compression', 'recorder-queue', 'player-no-bag',
-        'player-missing-bag', 'player-rate', 'replay-no-bag', 'replay-missing-bag'])
+    ('mindgrasp_bringup.replay.replay_node', ['bag:={tmp}/nope', 'robot:=ur5'],
+     "No robot is named 'ur5'; use one of"),
+], ids=['recorder-regex', 'recorder-compression', 'recorder-queue', 'recorder-custom-data',
+        'player-no-bag',
+        'player-missing-bag', 'player-rate', 'replay-no-bag', 'replay-missing-bag',
+        'replay-robot'])
 def test_bad_parameter_refuses_to_start_with_exit_2_and_one_line(tmp_path, module, params, match):
     args = [a.format(tmp=tmp_path) for a in params]
     ros_args = ['--ros-args', *[x for a in args for x in ('-p', a)]] if args else []

@@ -38,12 +38,42 @@ def test_demo_starts_every_node_after_the_recorder() -> None:
     assert 'recorder' not in procs and procs['sim'].parameters['gui'] is True
 
 
+#: every node that reads the robot description, per profile (plus what each profile needs)
+ROBOT_READERS = {
+    'sim': ((), ('sim',)),
+    'demo': ((), ('sim', 'fsm', 'foxglove_bridge')),
+    'experiment': ((), ('sim', 'fsm')),
+    'trainer': ((), ('sim', 'fsm', 'trainer')),
+    'hardware': (('eeg_stream:=amp', 'arm_driver:=true',
+                  'model:=package://mindgrasp_classifier/models/default_classifier.json'),
+                 ('fsm',)),
+    'replay': (('bag:=runs/x',), ('replay',)),
+    'graz': ((), ()),
+}
+
+
 def test_the_robot_reaches_the_simulator_and_the_controller() -> None:
     assert processes('sim')['sim'].parameters['robot'] == 'mindgrasp_arm'
     assert processes('sim', 'robot:=xarm6')['sim'].parameters['robot'] == 'xarm6'
     for profile in ('demo', 'experiment'):
         procs = processes(profile, 'robot:=xarm6')
         assert procs['sim'].parameters['robot'] == procs['fsm'].parameters['robot'] == 'xarm6'
+
+
+@pytest.mark.parametrize('profile', sorted(ROBOT_READERS))
+def test_every_profile_passes_robot_to_every_node_that_reads_it(profile) -> None:
+    extra, readers = ROBOT_READERS[profile]
+    procs = processes(profile, *extra, 'robot:=xarm6')
+    given = {label for label, spec in procs.items() if spec.parameters.get('robot') == 'xarm6'}
+    assert given == set(readers)
+    # the default: the shipped arm, or (replay) the robot the recorded run used
+    default = '' if profile == 'replay' else 'mindgrasp_arm'
+    assert all(processes(profile, *extra)[r].parameters['robot'] == default for r in readers)
+    # the bag's metadata.yaml names the robot (custom_data), the replay's the recorded run's
+    custom = procs['recorder'].parameters.get('custom_data')
+    assert custom == ['robot=xarm6']
+    assert processes(profile, *extra)['recorder'].parameters.get('custom_data') == (
+        None if profile == 'replay' else ['robot=mindgrasp_arm'])
 
 
 def test_hardware_has_drivers_and_no_simulator(tmp_path, monkeypatch) -> None:

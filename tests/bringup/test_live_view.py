@@ -158,6 +158,28 @@ def test_bad_whitelist_regex_exits_2(spawn_node) -> None:
     assert 'is not a regular expression' in proc.output()
 
 
+def test_the_layout_follows_the_robot(spawn_node, tmp_path) -> None:
+    """robot:=xarm6: the bridge writes the xArm6's layout (its 3D view follows the URDF's root
+    link, its joint plot names the description's joints); a bad robot is one line, exit 2."""
+    from mindgrasp_common.robot_description import load_robot
+
+    xarm = load_robot('xarm6')
+    proc, _port = _start_bridge(spawn_node, robot='xarm6', layout_dir=str(tmp_path))
+    assert proc.wait_for_output("Layout for the robot 'xarm6'", 60), proc.output()
+    layout = json.loads((tmp_path / 'mindgrasp_live.json').read_text())
+    text = json.dumps(layout)
+    assert '"followTf": "world"' in text             # the xArm's URDF root
+    assert '"label": "xarm6 (URDF)"' in text
+    labels = re.findall(r'"label": "([^"]+)", "value": "/joint_states\.position\[(\d)\]"', text)
+    assert [(name, str(i)) for i, name in enumerate(xarm.arm_joints)] == labels, labels
+    assert (tmp_path / 'mindgrasp_live_lichtblick.json').is_file()
+    proc.stop()
+    bad = spawn_node(MODULE, '--ros-args', '-p', 'robot:=ur5', '-p', 'port:=0')
+    assert bad.wait(60) == 2, bad.output()
+    lines = [line for line in bad.output().splitlines() if line.strip()]
+    assert len(lines) == 1 and "No robot is named 'ur5'" in lines[0], lines
+
+
 def test_committed_layouts_are_the_generated_ones_and_show_demo_topics() -> None:
     from mindgrasp_bringup.live_layout import (
         LAYOUT_FILE,

@@ -16,11 +16,13 @@ import uuid
 from pathlib import Path
 
 import pytest
+import yaml
 from conftest_bag import EEG, cut_in_half, damage_chunks, eeg_chunk
 from launch_fixtures.runner import launch_cmd, launch_env, run_launch
 
 from mindgrasp_bringup.bag import BagWriter
 from mindgrasp_bringup.bag.mcap_scan import read_mcap_contents
+from mindgrasp_common.robot_description import load_robot
 
 pytestmark = pytest.mark.slow
 
@@ -118,8 +120,10 @@ def test_replay_of_a_bag_with_three_damaged_chunks_reads_the_rest(demo_run, tmp_
 
 def test_launch_replay_with_the_controller_reports_it_open_loop(demo_run, tmp_path):
     out = tmp_path / 'report'
+    # robot:= reaches the re-run controller (the run's own arm, named by its description file)
+    robot = str(load_robot('mindgrasp_arm').path)
     result = run_launch('replay', f'bag:={demo_run / "bag"}', 'controller:=true',
-                        f'output:={out}', 'record:=false', timeout=600)
+                        f'output:={out}', 'record:=false', f'robot:={robot}', timeout=600)
     assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
     summary = json.loads((out / 'comparison.json').read_text())
     assert summary['open_loop'] is True and summary['nodes'] == ['classifier', 'controller']
@@ -132,6 +136,8 @@ def test_launch_replay_with_the_controller_reports_it_open_loop(demo_run, tmp_pa
         in report
     for name in (*REPORT_FILES, 'states.csv', 'params/fsm.yaml'):
         assert (out / name).exists(), name
+    params = yaml.safe_load((out / 'params' / 'fsm.yaml').read_text())
+    assert params['/fsm']['ros__parameters']['robot'] == robot
 
 
 def test_replay_bad_input_is_one_clear_line(tmp_path):

@@ -10,6 +10,7 @@ import sys
 
 import pytest
 
+from mindgrasp_common.robot_description import robot_names
 from mindgrasp_ros.params import ParameterError, describe, from_mapping
 from mindgrasp_trainer.graz_node import GrazParams
 from mindgrasp_trainer.trainer_node import TrainerParams
@@ -39,8 +40,12 @@ def test_only_the_live_parameters_can_change_while_it_runs(node, cls, module, li
     (GrazParams, {'n_trials': -3}, r"'n_trials' must be within \[1, 100000\]; -3 is invalid"),
     (TrainerParams, {'classes': [4]}, r"'classes' holds \[4\], which are not class indices"),
     (TrainerParams, {'approach_joint': 6},
-     r"'approach_joint' is 6, outside the 6 joints; use an index from 0 to 5"),
-    (TrainerParams, {'n_joints': 1}, r"'approach_joint' is 1, outside the 1 joints"),
+     r"'approach_joint' is 6, outside the 6 arm joints of the robot 'mindgrasp_arm'; use an "
+     r'index from 0 to 5'),
+    (TrainerParams, {'turn_joint': 6, 'robot': 'xarm6'},
+     r"'turn_joint' is 6, outside the 6 arm joints of the robot 'xarm6'"),
+    (TrainerParams, {'robot': 'ur5'},
+     r"No robot is named 'ur5'; use one of \[.*'xarm6'.*\] or the path of a robot YAML"),
     (TrainerParams, {'reset_timeout': 0.0}, r"'reset_timeout' must be within \[0.001, 3600\] s"),
 ])
 def test_bad_values_name_the_parameter_and_the_fix(cls, values, match):
@@ -91,10 +96,13 @@ def test_running_prompters_show_their_descriptors(spawn_node):
     ('mindgrasp_trainer.trainer_node', {'n_trials': -3},
      "[TrainerNode] ERROR: Invalid value -3 for parameter 'n_trials': must be within [1, "
      '100000]'),
-    ('mindgrasp_trainer.trainer_node', {'turn_joint': 6, 'n_joints': 6},
-     "[TrainerNode] ERROR: 'turn_joint' is 6, outside the 6 joints; use an index from 0 to 5 "
-     "(or raise 'n_joints')."),
-], ids=['graz-n_trials', 'trainer-n_trials', 'trainer-turn_joint'])
+    ('mindgrasp_trainer.trainer_node', {'turn_joint': 6},
+     "[TrainerNode] ERROR: 'turn_joint' is 6, outside the 6 arm joints of the robot "
+     "'mindgrasp_arm'; use an index from 0 to 5."),
+    ('mindgrasp_trainer.trainer_node', {'robot': 'ur5'},
+     f"[TrainerNode] ERROR: No robot is named 'ur5'; use one of {robot_names()} or the path of "
+     'a robot YAML file (robot:=path/to/robot.yaml).'),
+], ids=['graz-n_trials', 'trainer-n_trials', 'trainer-turn_joint', 'trainer-robot'])
 def test_bad_value_ends_the_process_with_exit_2_and_one_line(spawn_node, module, params, message):
     proc = spawn_node(module, **params)
     assert proc.wait(60) == 2, proc.output()

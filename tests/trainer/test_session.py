@@ -13,6 +13,7 @@ from pathlib import Path
 import pytest
 import yaml
 
+from mindgrasp_common.robot_description import robot_names
 from mindgrasp_trainer.session import SessionError, check_subject, load_plan
 
 
@@ -60,6 +61,11 @@ def test_cli_bad_input_is_one_line_and_exit_code_2(tmp_path):
     assert res.returncode == 2 and '--amp lsl needs --eeg-stream NAME' in res.stderr
     res = mindgrasp('session', 'resume', '--subject', 'S1', cwd=tmp_path)
     assert res.returncode == 2 and 'No session of subject S1' in res.stderr
+    res = mindgrasp('session', 'run', '--subject', 'S1', '--robot', 'ur5', cwd=tmp_path)
+    assert res.returncode == 2 and res.stderr.strip().splitlines() == [
+        f"mindgrasp session run: --robot: No robot is named 'ur5'; use one of {robot_names()} or "
+        'the path of a robot YAML file (robot:=path/to/robot.yaml).']
+    assert not (tmp_path / 'subjects').exists()
 
 
 def _log(folder: Path) -> dict:

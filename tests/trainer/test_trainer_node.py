@@ -234,7 +234,8 @@ def test_trainer_without_training_robot_exits_with_the_fix(ros, spawn_node):
 @pytest.mark.parametrize(
     ('params', 'match'),
     [
-        ({'turn_joint': 9}, "'turn_joint' is 9, outside the 6 joints"),
+        ({'turn_joint': 9}, "'turn_joint' is 9, outside the 6 arm joints of the robot "
+                            "'mindgrasp_arm'"),
         ({'reset_timeout': 0.0}, "parameter 'reset_timeout': must be within [0.001, 3600.0]"),
         ({'robot_timeout': -1.0}, "parameter 'robot_timeout': must be within [0.0, inf]"),
         ({'rate': 0.0}, "parameter 'rate': must be within [1.0, 10000.0]"),

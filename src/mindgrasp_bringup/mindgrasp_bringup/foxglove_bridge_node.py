@@ -5,8 +5,10 @@
 
 Open Foxglove (desktop app, or app.foxglove.dev in a browser on this machine), "Open connection",
 ``ws://localhost:8765``; the layout ``foxglove/mindgrasp_live.json`` of mindgrasp_bringup
-shows the camera with its overlay, the 3D scene (TF + URDF from /robot_description), the EEG
-traces, the prediction certainty and the controller state.
+shows the camera with its overlay, the 3D scene (TF + URDF from /robot_description), the arm
+joints, the EEG traces, the prediction certainty and the controller state. The layout follows the
+robot (``robot:=``): in a launch the node writes that robot's layout into the run directory
+(``<run>/foxglove/``, ``layout_dir:=`` elsewhere) and logs where (mindgrasp_bringup.live_layout).
 
 Like foxglove_bridge (its parameter names ``port``, ``address``, ``topic_whitelist``): every topic
 that has a publisher and matches a ``topic_whitelist`` regex is advertised with its ROS 2 schema;
@@ -25,14 +27,19 @@ runs on without its live view.
 
 from __future__ import annotations
 
+import os
 import re
 import time
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 from mindgrasp_bringup.bag.qos import adapted_qos, qos_to_dict, resubscribe_qos
 from mindgrasp_bringup.bag.ros_glue import message_class, qos_profile
+from mindgrasp_bringup.live_layout import write_layouts
 from mindgrasp_bringup.live_view import DEFAULT_PORT, FoxgloveServer, LiveViewError
+from mindgrasp_common.robot import DEFAULT_ROBOT
+from mindgrasp_common.robot_description import RobotDescriptionError, load_robot
 from mindgrasp_ros import rclpy, using_real_rclpy
 from mindgrasp_ros.node_main import end_after, run_node
 from mindgrasp_ros.params import ParameterError, declare_params, param
@@ -64,7 +71,13 @@ class BridgeParams:
         0.04, 'how often the watched topics are read and sent on, in one burst (0: each message '
         'as it arrives, at two to three times the CPU)', unit='s', min=0.0)
 
+    robot: str = param(DEFAULT_ROBOT, 'the robot the layout follows (3D view root, joint plot '
+                       'labels): a shipped robot or a robot description YAML path')
+    layout_dir: str = param('', "where to write the robot's layout files ('': "
+                            "$MINDGRASP_RUN_DIR/foxglove in a launch, none outside one)")
+
     def __post_init__(self) -> None:
+        load_robot(self.robot)   # a bad description: one line before the server starts
         for pattern in self.topic_whitelist:
             try:
                 re.compile(pattern)
@@ -102,6 +115,7 @@ class FoxgloveBridgeNode(rclpy.node.Node):
         self._requested: dict[str, dict[str, Any]] = {}    # watched topic -> QoS
         self.get_logger().info(f'Live view on {self.server.url}: open it in Foxglove '
                                '(Open connection > Foxglove WebSocket).')
+        self._write_layout()
         self.create_timer(self.params.discovery_period, self.discover_callback)
         # polled subscriptions are this runtime's (rclpy has no take); the timer runs only while
         # a client watches something
@@ -110,6 +124,22 @@ class FoxgloveBridgeNode(rclpy.node.Node):
                                               autostart=False) if polling else None)
         end_after(self, self.params.duration)
         self.discover_callback()
+
+    def _write_layout(self) -> None:
+        """Write the layout of the robot into ``layout_dir`` (or the run directory's
+        ``foxglove/``) and say where; a failed write is a warning: the view still serves."""
+        run_dir = os.environ.get('MINDGRASP_RUN_DIR', '')
+        folder = self.params.layout_dir or (str(Path(run_dir) / 'foxglove') if run_dir else '')
+        if not folder:
+            return
+        try:
+            path = write_layouts(Path(folder), self.params.robot)[0]
+        except OSError as exc:
+            self.get_logger().warning(f'Cannot write the layout into {folder} ({exc}); the live '
+                                      'view runs on without it.')
+            return
+        self.get_logger().info(f"Layout for the robot {self.params.robot!r}: {path} (Layouts > "
+                               'Import from file).')
 
     def _wanted(self, topic: str) -> bool:
         return topic not in _EXCLUDED and any(p.fullmatch(topic) for p in self.whitelist)
@@ -209,7 +239,7 @@ class FoxgloveBridgeNode(rclpy.node.Node):
 
 
 def main(args: list[str] | None = None) -> int:
-    return run_node(FoxgloveBridgeNode, args, errors=(LiveViewError,))
+    return run_node(FoxgloveBridgeNode, args, errors=(LiveViewError, RobotDescriptionError))
 
 
 if __name__ == '__main__':

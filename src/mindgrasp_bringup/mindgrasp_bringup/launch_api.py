@@ -78,6 +78,7 @@ _HELPERS = {
     'driver_nodes': 'mindgrasp_bringup.launch_system.common',
     'fsm_node': 'mindgrasp_bringup.launch_system.common',
     'command_interface_argument': 'mindgrasp_bringup.launch_system.common',
+    'robot_argument': 'mindgrasp_bringup.launch_system.common',
 }
 
 __all__ = ['own_launcher', 'using_real_launch', *_SOURCES, *_HELPERS]

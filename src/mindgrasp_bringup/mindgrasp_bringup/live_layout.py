@@ -1,6 +1,8 @@
-"""The Foxglove layout of the live view, built with ``foxglove.layouts`` (foxglove-sdk).
+"""The Foxglove layout of the live view, built with ``foxglove.layouts`` (foxglove-sdk) from the
+robot description, so it follows the robot (``robot:=``).
 
-    python -m mindgrasp_bringup.live_layout     # rewrites both files in foxglove/
+    python -m mindgrasp_bringup.live_layout                      # rewrites both files in foxglove/
+    python -m mindgrasp_bringup.live_layout /tmp/xarm --robot xarm6   # another robot's layout
 
 Two files of the same layout (in mindgrasp_bringup's ``foxglove/``;
 ``share/mindgrasp_bringup/foxglove/`` of a colcon install), for Layouts > Import from file:
@@ -12,22 +14,28 @@ Two files of the same layout (in mindgrasp_bringup's ``foxglove/``;
   converts its tree.
 
 Panels: the eye-in-hand camera with the vision overlay, the 3D scene (URDF from
-/robot_description moved by /tf, the objects from /sim/objects), the EEG (first sample of the
+/robot_description moved by /tf, the objects from /sim/objects, following the URDF's root link),
+the arm joint positions (named after the description's arm joints), the EEG (first sample of the
 first channels of each chunk), the classifier's certainty and class, and the controller state.
+The committed files are the shipped arm's; the live view node writes the layout of the robot it
+is given into the run directory (``foxglove/``).
 """
 
 from __future__ import annotations
 
+import argparse
 import json
-import sys
 from pathlib import Path
 from typing import Any
 
 from mindgrasp_common.resources import resource_path
+from mindgrasp_common.robot import DEFAULT_ROBOT
+from mindgrasp_common.robot_description import RobotDescription, RobotDescriptionError, load_robot
 from mindgrasp_ros.topics import (
     BCI_PREDICTION,
     EEG_RAW,
     FSM_STATE,
+    JOINT_STATES,
     ROBOT_DESCRIPTION,
     SIM_OBJECTS,
     TF,
@@ -35,7 +43,8 @@ from mindgrasp_ros.topics import (
     VISION_OVERLAY,
 )
 
-__all__ = ['LAYOUT_FILE', 'STUDIO_LAYOUT_FILE', 'TOPICS', 'build_layout', 'studio_layout']
+__all__ = ['LAYOUT_FILE', 'STUDIO_LAYOUT_FILE', 'TOPICS', 'build_layout', 'studio_layout',
+           'write_layouts']
 
 #: the committed layout files (package data of mindgrasp_bringup): Foxglove's format, and that
 #: of Lichtblick / Foxglove Studio
@@ -49,17 +58,25 @@ EEG_RANGE_V = 100e-6
 #: topics the layout's panels show (each published by the demo): what the Foxglove app
 #: subscribes to with this layout open
 TOPICS = tuple(t.name for t in (VISION_OVERLAY, ROBOT_DESCRIPTION, TF, TF_STATIC, SIM_OBJECTS,
-                                 EEG_RAW, BCI_PREDICTION, FSM_STATE))
+                                 JOINT_STATES, EEG_RAW, BCI_PREDICTION, FSM_STATE))
 
 
-def build_layout() -> str:
-    """The layout as Foxglove layout JSON text."""
+def build_layout(robot: str | Path | RobotDescription = DEFAULT_ROBOT) -> str:
+    """The layout of ``robot`` (a shipped name, a description YAML path or a description) as
+    Foxglove layout JSON text; a bad description raises its one-line
+    :class:`~mindgrasp_common.robot_description.RobotDescriptionError`."""
     import foxglove.layouts as fl
 
+    from mindgrasp_sim.tf_tree import TfTree
+
+    description = load_robot(robot)
+    # the 3D view follows the URDF's root link (base_link, link_base, world, ...), the frame the
+    # simulator (or robot_state_publisher) hangs the arm from
+    root = TfTree(description.urdf.read_text(encoding='utf-8')).root
     camera = fl.ImagePanel(title='Eye-in-hand camera + overlay', config=fl.ImageConfig(
         image_mode=fl.ImageModeConfig(image_topic=VISION_OVERLAY.name)))
     scene = fl.ThreeDeePanel(title='Arm and objects (TF, URDF)', config=fl.ThreeDeeConfig(
-        follow_tf='base_link', fixed_frame='world',
+        follow_tf=root, fixed_frame='world',
         # the arm is ~1 m tall: look at it from 2.3 m (the apps' default camera is 20 m away),
         # frame axes without their labels, which would hide the arm
         camera_state=fl.ThreeDeeCameraState(
@@ -69,11 +86,19 @@ def build_layout() -> str:
         scene=fl.BaseRendererSceneSettings(transforms=fl.BaseRendererTransforms(
             show_label=False)),
         layers={'urdf': fl.BaseRendererUrdfLayerSettings(
-            layer_id='foxglove.Urdf', instance_id='urdf', label='MIndGrasp arm',
+            layer_id='foxglove.Urdf', instance_id='urdf', label=f'{description.name} (URDF)',
             source_type='topic', topic=ROBOT_DESCRIPTION.name, control_mode='transforms')},
         topics={SIM_OBJECTS.name: fl.BaseRendererRosMarkerTopicSettings(visible=True)}))
     # series enabled, time axes not synced across panels: Lichtblick hides series without
     # 'enabled' and a synced axis ignores each panel's window
+    # /joint_states lists the arm joints in the description's order (the simulator's contract;
+    # a driver's order may differ: the labels then say which index is which in its message)
+    joints = fl.PlotPanel(title=f'Arm joints (rad, {description.name})', config=fl.PlotConfig(
+        paths=[fl.PlotSeries(value=f'{JOINT_STATES.name}.position[{i}]', label=name,
+                             timestamp_method='headerStamp', enabled=True)
+               for i, name in enumerate(description.arm_joints)],
+        is_synced=False, time_window_mode='sliding', following_view_width=30.0,
+        show_legend=True))
     eeg = fl.PlotPanel(title='EEG (V, first sample of each chunk)', config=fl.PlotConfig(
         paths=[fl.PlotSeries(value=f'{EEG_RAW.name}.data[{i}]', label=f'channel {i + 1}',
                              timestamp_method='headerStamp', enabled=True) for i in range(3)],
@@ -95,7 +120,8 @@ def build_layout() -> str:
                                          timestamp_method='headerStamp', enabled=True)],
         is_synced=False, time_window_mode='sliding', x_axis_range=60.0))
     left = fl.SplitContainer(direction='column', items=[
-        fl.SplitItem(proportion=0.5, content=camera), fl.SplitItem(proportion=0.5, content=scene)])
+        fl.SplitItem(proportion=0.4, content=camera), fl.SplitItem(proportion=0.4, content=scene),
+        fl.SplitItem(proportion=0.2, content=joints)])
     right = fl.SplitContainer(direction='column', items=[
         fl.SplitItem(proportion=0.35, content=eeg),
         fl.SplitItem(proportion=0.35, content=prediction),
@@ -148,15 +174,34 @@ def studio_layout(sdk_layout: str) -> str:
                        'playbackConfig': {'speed': 1.0}, 'layout': layout}, indent=2)
 
 
-def main(argv: list[str] | None = None) -> int:
-    """Write :data:`LAYOUT_FILE` and :data:`STUDIO_LAYOUT_FILE` (or into the folder given)."""
-    argv = sys.argv[1:] if argv is None else argv
-    folder = Path(argv[0]) if argv else LAYOUT_FILE.parent
+def write_layouts(folder: Path, robot: str | Path | RobotDescription = DEFAULT_ROBOT
+                  ) -> list[Path]:
+    """Write the layout of ``robot`` in both formats into ``folder`` (created); the paths."""
     folder.mkdir(parents=True, exist_ok=True)
-    sdk = build_layout()
+    sdk = build_layout(robot)
+    out = []
     for name, text in ((LAYOUT_FILE.name, sdk), (STUDIO_LAYOUT_FILE.name, studio_layout(sdk))):
         (folder / name).write_text(text + '\n', encoding='utf-8')
-        print(f'wrote {folder / name}')
+        out.append(folder / name)
+    return out
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Write :data:`LAYOUT_FILE` and :data:`STUDIO_LAYOUT_FILE` (or into the folder given)."""
+    parser = argparse.ArgumentParser(prog='python -m mindgrasp_bringup.live_layout',
+                                     description='Write the Foxglove layouts of the live view.')
+    parser.add_argument('folder', nargs='?', default=str(LAYOUT_FILE.parent),
+                        help='where to write them (default: the committed files)')
+    parser.add_argument('--robot', default=DEFAULT_ROBOT, metavar='NAME|YAML',
+                        help='the robot whose description the layout follows (default '
+                             f'{DEFAULT_ROBOT})')
+    args = parser.parse_args(argv)
+    try:
+        paths = write_layouts(Path(args.folder), args.robot)
+    except RobotDescriptionError as exc:
+        parser.exit(2, f'{parser.prog}: error: --robot: {exc}\n')
+    for path in paths:
+        print(f'wrote {path}')
     return 0
 
 

@@ -179,7 +179,12 @@ def robot_names() -> list[str]:
 def _find(spec: str | Path) -> Path:
     text = str(spec)
     if text.endswith(('.yaml', '.yml')) or '/' in text:
-        path = Path(text).expanduser()
+        # a path, or package://<pkg>/<file> as the URDFs and models are named
+        try:
+            path = resolve_path(text if '://' in text else Path(text).expanduser(),
+                                ROBOTS_PACKAGE)
+        except ResourceNotFoundError:
+            path = Path(text)
         if not path.is_file():
             msg = (f'The robot description {text!r} does not exist; give a robot YAML file or '
                    f'one of the shipped names {robot_names()}.')

@@ -96,8 +96,8 @@ class VirtualAmpParams:
     decision_period: float = param(0.5, 'pursue: time between decisions', unit='s', min=1e-3)
     heading_tolerance: float = param(0.1, 'pursue: heading error taken as centred', unit='rad',
                                      min=0.0)
-    base_joint: str = param('', "pursue: joint giving the arm heading ('' = joint_1 or the "
-                            'first)')
+    base_joint: str = param('', "pursue: joint giving the arm heading ('' = the first joint "
+                            'of /joint_states, the base)')
     base_position: list[float] = param([0.0, 0.0], 'pursue: arm base in the /sim/objects frame',
                                        unit='m')
     heading_offset: float = param(0.0, 'pursue: arm heading at base_joint = 0', unit='rad',

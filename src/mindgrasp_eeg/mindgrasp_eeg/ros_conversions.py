@@ -22,7 +22,8 @@ def ns_to_time_fields(ns: int) -> tuple[int, int]:
 
 def base_yaw_from_joint_state(names: Sequence[str], positions: Sequence[float],
                               joint: str = '') -> float | None:
-    """Base joint angle (rad): ``joint`` if given, else ``joint_1``, else the first joint."""
+    """Base joint angle (rad): ``joint`` if given, else the first joint (/joint_states lists the
+    arm joints base to wrist, in the order of the robot description)."""
     names = list(names)
     if not names or len(positions) == 0:
         return None
@@ -30,7 +31,7 @@ def base_yaw_from_joint_state(names: Sequence[str], positions: Sequence[float],
         return float(positions[names.index(joint)])
     if joint:
         return None
-    return float(positions[names.index('joint_1') if 'joint_1' in names else 0])
+    return float(positions[0])
 
 
 def status_level_byte(level: int) -> bytes | int:

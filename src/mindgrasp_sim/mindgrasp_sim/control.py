@@ -18,7 +18,8 @@ def validate_velocities(values: object, n_joints: int = 6) -> np.ndarray:
     v = np.asarray(values, dtype=float).reshape(-1)
     if v.size != n_joints:
         msg = (f'Joint velocity command has {v.size} values but the arm has {n_joints} joints; '
-               f'send {n_joints} velocities in rad/s (joint_1 .. joint_{n_joints}).')
+               f'send {n_joints} velocities in rad/s, one per arm joint in the order of '
+               '/joint_states.')
         raise SimError(msg)
     if not np.isfinite(v).all():
         msg = f'Joint velocity command contains NaN or inf ({v.tolist()}); send finite ' \

@@ -527,12 +527,15 @@ class SimNode(rclpy.node.Node):
         self.tf_tree = TfTree(urdf)
         self.create_publisher(String, ROBOT_DESCRIPTION.name, ROBOT_DESCRIPTION.qos).publish(
             String(data=urdf))
-        # the arm stands at the world origin (the simulation loads it there)
-        base = Transform(self.p['frame_id'], self.tf_tree.root, np.zeros(3),
-                         np.array([0.0, 0.0, 0.0, 1.0]))
+        # the arm stands at the world origin (the simulation loads it there); a URDF whose root
+        # is that frame already (the xArm's 'world') gets no transform: tf2 refuses a frame that
+        # is its own parent
+        base = [] if self.tf_tree.root == self.p['frame_id'] else [
+            Transform(self.p['frame_id'], self.tf_tree.root, np.zeros(3),
+                      np.array([0.0, 0.0, 0.0, 1.0]))]
         self.tf_static_pub = self.create_publisher(TFMessage, TF_STATIC.name, TF_STATIC.qos)
         self.tf_static_pub.publish(msgs.tf_message(
-            self._stamp(), [base, *self.tf_tree.static_transforms(), *self._mount_transforms()]))
+            self._stamp(), [*base, *self.tf_tree.static_transforms(), *self._mount_transforms()]))
         self.tf_pub = self.create_publisher(TFMessage, TF.name, TF.qos)
 
     def _mount_transforms(self) -> list[Transform]:

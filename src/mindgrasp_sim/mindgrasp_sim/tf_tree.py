@@ -9,7 +9,7 @@ robot_state_publisher produces the same tree from the same URDF.
 
     tree = TfTree(Path('mindgrasp_arm.urdf').read_text())
     static = tree.static_transforms()                 # [Transform('palm', 'tcp', ...), ...]
-    moving = tree.transforms({'joint_1': 0.3, ...})   # joints without a position are left out
+    moving = tree.transforms(dict(zip(robot.arm_joints, q)))  # joints without one: left out
     pos, quat = tree.pose('base_link', 'tcp', {...})  # composed along the chain
 """
 

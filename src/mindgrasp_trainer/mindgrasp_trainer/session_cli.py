@@ -3,6 +3,7 @@
     mindgrasp session run --subject S01 --plan graded            # virtual subject, headless
     mindgrasp session run --subject S01 --amp lsl --eeg-stream MyAmp --display fullscreen
     mindgrasp session run --subject S01 --plan my_plan.yaml
+    mindgrasp session run --subject S01 --plan quick --robot xarm6   # trains on the lab's arm
     mindgrasp session resume --subject S01                       # after an interruption
     mindgrasp session calibrate --subject V01 --virtual-accuracy 0.9 --trials-per-class 10 --json
 """
@@ -18,6 +19,7 @@ import time
 from pathlib import Path
 
 from mindgrasp_common.cli_checks import non_negative_int, positive_int, probability
+from mindgrasp_common.robot_description import RobotDescriptionError, load_robot
 from mindgrasp_trainer.session import (
     Session,
     SessionError,
@@ -46,6 +48,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                                            'virtual subject with off runs in lock-step')
     parser.add_argument('--seed', type=non_negative_int, default=None,
                         help='seed of every phase (0)')
+    parser.add_argument('--robot', default=None, metavar='NAME|YAML',
+                        help='the arm of the Trainer and test phases (the user\'s arm and the '
+                             'training robot, a second copy of it): mindgrasp_arm (default), '
+                             'xarm6 or a robot description YAML path')
     if getattr(parser, 'prog', '').endswith('calibrate'):
         parser.set_defaults(plan='calibrate')
         parser.add_argument('--virtual-accuracy', type=probability, required=True, metavar='A',
@@ -61,7 +67,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def _launch_args(args: argparse.Namespace) -> dict[str, str]:
     out = {}
     for key, name in (('amp', 'amp'), ('eeg_stream', 'eeg_stream'), ('display', 'display'),
-                      ('seed', 'seed')):
+                      ('seed', 'seed'), ('robot', 'robot')):
         value = getattr(args, key)
         if value is not None:
             out[name] = str(value)
@@ -97,6 +103,11 @@ def main(args: argparse.Namespace) -> int:
     t0 = time.monotonic()
     try:
         check_subject(args.subject)
+        if args.robot is not None:    # one line before any phase starts
+            try:
+                load_robot(args.robot)
+            except RobotDescriptionError as exc:
+                raise SessionError(f'--robot: {exc}') from None
         root = Path(args.root)
         if verb in ('run', 'calibrate'):
             plan = load_plan(args.plan)

@@ -28,6 +28,7 @@ from mindgrasp_ros.interfaces.mindgrasp_msgs.srv import ResetSim
 from mindgrasp_ros.interfaces.sensor_msgs.msg import JointState
 from mindgrasp_ros.interfaces.std_msgs.msg import Float64, Float64MultiArray
 
+from mindgrasp_common.robot_description import RobotDescriptionError, load_robot
 from mindgrasp_ros import rclpy
 from mindgrasp_ros.node_main import run_node
 from mindgrasp_ros.params import declare_params, param
@@ -75,7 +76,10 @@ class TrainerParams:
                             'yaw)', min=0, max=63)
     approach_joint: int = param(1, 'zero-based joint moved for both hands/feet (1: joint 2, '
                                 'shoulder)', min=0, max=63)
-    n_joints: int = param(6, 'length of the velocity command', min=1, max=64)
+    robot: str = param('mindgrasp_arm', "the training robot, a second copy of the user's arm "
+                       '(the same robot:= as the simulator): a shipped robot (mindgrasp_arm, '
+                       'xarm6) or a robot description YAML path; the command has one velocity '
+                       'per arm joint')
     reset_height: float = param(0.1, 'reset when the training end-effector goes below this',
                                 unit='m', min=-10.0, max=10.0)
     grasp_state: int = param(GRASP_OBJECT, '... or when /fsm/state enters this state '
@@ -99,11 +103,13 @@ class TrainerParams:
 
     def __post_init__(self) -> None:
         check_classes(self.classes)
+        # the length of the velocity command (n arm joints) comes from the robot's description
+        self.n_joints = len(load_robot(self.robot).arm_joints)
         for name in ('turn_joint', 'approach_joint'):
             index = getattr(self, name)
             if not 0 <= index < self.n_joints:
-                msg = (f"'{name}' is {index}, outside the {self.n_joints} joints; use an index "
-                       f"from 0 to {self.n_joints - 1} (or raise 'n_joints').")
+                msg = (f"'{name}' is {index}, outside the {self.n_joints} arm joints of the "
+                       f"robot {self.robot!r}; use an index from 0 to {self.n_joints - 1}.")
                 raise TrainerError(msg)
 
 
@@ -198,9 +204,10 @@ class TrainerNode(rclpy.node.Node):
                 return False
             if self.joint_count != self.protocol.n_joints:
                 self.get_logger().error(
-                    f'/trainer_robot/joint_states has {self.joint_count} joints but the trainer '
-                    f"commands {self.protocol.n_joints}; set the parameter 'n_joints' to "
-                    f'{self.joint_count} or check the remapping.'
+                    f'/trainer_robot/joint_states has {self.joint_count} joints but the '
+                    f'trainer commands the {self.protocol.n_joints} arm joints of the robot '
+                    f"{self.p.robot!r}; start the simulator and the trainer with the same "
+                    'robot:= (mindgrasp launch trainer robot:=NAME) or check the remapping.'
                 )
                 self._finish(1)
                 return False
@@ -364,7 +371,8 @@ def _fmt(x: float) -> str:
 def main(args: list[str] | None = None) -> int:
     """Run the session until it ends (exit code of ``done``), Ctrl-C or a bad parameter (2); the
     last prompts get 0.5 s to reach reliable readers."""
-    return run_node(TrainerNode, args, errors=(TrainerError,), linger_sec=0.5)
+    return run_node(TrainerNode, args, errors=(TrainerError, RobotDescriptionError),
+                    linger_sec=0.5)
 
 
 if __name__ == '__main__':

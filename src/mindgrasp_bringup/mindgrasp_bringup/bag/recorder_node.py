@@ -73,8 +73,16 @@ class RecorderParams:
                                      "'ros2 bag record -a' does)")
     parameter_changes: str = param('', 'append every live parameter change to this JSONL file '
                                    "(time, node, name, old and new value; '': none)")
+    # as ros2 bag record --custom-data: what the run was (the launch's robot:=) travels with the
+    # bag, for a reader that has the bag folder only
+    custom_data: list[str] = param([], 'KEY=VALUE pairs stored in metadata.yaml custom_data')
 
     def __post_init__(self) -> None:
+        for item in self.custom_data:
+            if not item.partition('=')[0].strip() or '=' not in item:
+                msg = (f'custom_data entry {item!r} is not KEY=VALUE; write each as '
+                       "key=value, e.g. custom_data:=\"['robot=xarm6']\".")
+                raise ParameterError(msg)
         for name in ('regex', 'exclude_regex'):
             try:
                 re.compile(getattr(self, name))
@@ -103,7 +111,8 @@ class RecorderNode(rclpy.node.Node):
         writer = BagWriter(p.output or time.strftime('rosbag2_%Y_%m_%d-%H_%M_%S'),
                            chunk_size=p.chunk_size, compression=p.compression,
                            flush_interval=p.flush_interval, max_bag_size=p.max_bag_size,
-                           max_bag_duration=p.max_bag_duration)
+                           max_bag_duration=p.max_bag_duration,
+                           custom_data=dict(item.split('=', 1) for item in p.custom_data))
         self.recorder = Recorder(writer, max_queue_bytes=p.max_queue_mb << 20,
                                  on_error=self._on_error)
         self.recorder.start()

@@ -36,6 +36,7 @@ from mindgrasp_bringup.launch_api import (
     live_view_arguments,
     live_view_nodes,
     number_argument,
+    robot_argument,
     run_directory_actions,
     sim_scene_camera,
 )
@@ -51,9 +52,7 @@ def generate_launch_description() -> LaunchDescription:
         number_argument('seed', default_value='0', minimum=0,
                         description='seed of the scene, the virtual subject and the synthetic '
                                     'EEG (same seed, same run)'),
-        DeclareLaunchArgument('robot', default_value='mindgrasp_arm',
-                              description='the arm of the simulator and the controller: '
-                                          'mindgrasp_arm, xarm6 or a robot description YAML'),
+        robot_argument(),
         DeclareLaunchArgument('realism', default_value='none',
                               description='simulator realism: none, default or a profile YAML '
                                           'path (noisy camera, miscalibration, arm lag, object '

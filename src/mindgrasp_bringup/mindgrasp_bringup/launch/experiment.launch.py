@@ -34,6 +34,7 @@ from mindgrasp_bringup.launch_api import (
     file_argument,
     fsm_node,
     number_argument,
+    robot_argument,
     run_directory_actions,
 )
 from mindgrasp_eeg.subject_file import check_eeg_source
@@ -91,9 +92,7 @@ def generate_launch_description() -> LaunchDescription:
                               description='simulator realism: none, default or a profile YAML '
                                           '(sensor noise, camera mount error, arm lag, object '
                                           'spread; mindgrasp_sim.realism), seeded by seed'),
-        DeclareLaunchArgument('robot', default_value='mindgrasp_arm',
-                              description='the arm of the simulator and the controller: '
-                                          'mindgrasp_arm, xarm6 or a robot description YAML'),
+        robot_argument(),
         DeclareLaunchArgument('gui', default_value='false', choices=['true', 'false'],
                               description='open the PyBullet window (needs a display)'),
         command_interface_argument(),

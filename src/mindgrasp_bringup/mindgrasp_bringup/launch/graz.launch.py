@@ -5,6 +5,7 @@ EEG are recorded so that the classifier can be trained on them.
     mindgrasp launch graz amp:=lsl eeg_stream:=MyAmp trials:=80
     mindgrasp launch graz feedback:=true              # classifier feedback bar (trained model)
     mindgrasp launch graz display:=window             # the participant's screen (pygame)
+    mindgrasp launch graz robot:=xarm6                # the arm this calibration is for (recorded)
 
 The launch ends when the prompter has run all its trials (or after duration:=S).
 """
@@ -25,6 +26,7 @@ from mindgrasp_bringup.launch_api import (
     eeg_source_nodes,
     file_argument,
     number_argument,
+    robot_argument,
     run_directory_actions,
 )
 
@@ -45,6 +47,10 @@ def generate_launch_description() -> LaunchDescription:
                       description='classifier model for feedback:=true (.json written '
                                   'by mindgrasp train classifier); empty: the one in '
                                   'mindgrasp_classifier/param/classifier.yaml'),
+        robot_argument(description='the arm this calibration is for: no arm moves in a Graz '
+                                   "session; the value is recorded with the run's launch "
+                                   'arguments (mindgrasp_arm, xarm6 or a robot description YAML '
+                                   'path)'),
         *run_directory_actions(),  # ros2 launch: run directory, recorder, duration
         *eeg_source_nodes(config_files('eeg'), seed, 'follow'),
         GroupAction(classifier_nodes(config_files('classifier')),

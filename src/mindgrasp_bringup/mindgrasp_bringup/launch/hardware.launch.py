@@ -10,6 +10,8 @@ classifier, vision and the grasp controller.
         model:=package://mindgrasp_classifier/models/default_classifier.json   # bench test only
     mindgrasp launch hardware eeg_stream:=gNautilus arm_driver:=my_arm_driver \
         model:=models/alice.json command_interface:=servo_twist    # the arm behind MoveIt Servo
+    mindgrasp launch hardware eeg_stream:=gNautilus arm_driver:=my_xarm_driver \
+        model:=models/alice.json robot:=xarm6     # the controller's kinematics: the lab's arm
 
 ``model:=`` is required: a real person's EEG is never decoded by the classifier trained on the
 simulated head unless it is named on purpose (the last line, for a bench test without a person).
@@ -40,6 +42,7 @@ from mindgrasp_bringup.launch_api import (
     driver_nodes,
     file_argument,
     fsm_node,
+    robot_argument,
     run_directory_actions,
 )
 
@@ -69,6 +72,9 @@ def generate_launch_description() -> LaunchDescription:
         DeclareLaunchArgument('camera_driver_args', default_value='',
                               description='command-line arguments of the camera driver'),
         command_interface_argument(),
+        robot_argument(description="the driver's arm, whose description the controller reads "
+                                   '(joints, limits, URDF kinematics, TCP, camera): '
+                                   'mindgrasp_arm, xarm6 or a robot description YAML path'),
         *run_directory_actions(),  # ros2 launch: run directory, recorder, duration
         *driver_nodes('arm'),
         *driver_nodes('camera', condition=IfCondition(
@@ -79,5 +85,5 @@ def generate_launch_description() -> LaunchDescription:
         *classifier_nodes(config_files('classifier', 'hardware')),
         Node(package='mindgrasp_vision', executable='vision_node', name='vision',
              parameters=config_files('vision', 'hardware')),
-        fsm_node(config_files('fsm', 'hardware')),
+        fsm_node(config_files('fsm', 'hardware'), {'robot': LaunchConfiguration('robot')}),
     ])

@@ -3,6 +3,7 @@
     mindgrasp launch replay bag:=runs/<run>                   # classifier on the recorded EEG
     mindgrasp launch replay bag:=runs/<run> controller:=true  # and the controller, open loop
     mindgrasp launch replay bag:=runs/<run> model:=my_model.json
+    mindgrasp launch replay bag:=runs/<run> controller:=true robot:=xarm6   # another arm's limits
 
 The classifier (and the controller) run lock-step on the bag's clock in the replay process:
 every recorded input at its recorded time, the same node classes as live. The replay writes a
@@ -19,6 +20,7 @@ from mindgrasp_bringup.launch_api import (
     Node,
     Shutdown,
     file_argument,
+    robot_argument,
     run_directory_actions,
 )
 
@@ -40,12 +42,16 @@ def generate_launch_description() -> LaunchDescription:
                               description='accept a damaged bag (its readable part is '
                                           'replayed either way; without this the replay ends '
                                           'with exit code 1)'),
+        robot_argument(default='', description='the arm of the re-run controller: a shipped '
+                                               'robot or a robot description YAML path; empty: '
+                                               'the one the run used'),
         *run_directory_actions(),  # ros2 launch: run directory, recorder, duration
         Node(package='mindgrasp_bringup', executable='replay_node', name='replay',
              parameters=[{'bag': LaunchConfiguration('bag'),
                           'controller': LaunchConfiguration('controller'),
                           'model': LaunchConfiguration('model'),
                           'output': LaunchConfiguration('output'),
+                          'robot': LaunchConfiguration('robot'),
                           'allow_damaged': LaunchConfiguration('allow_damaged')}],
              on_exit=Shutdown(reason='the replay ended')),
     ])

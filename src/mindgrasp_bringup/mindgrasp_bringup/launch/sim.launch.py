@@ -20,6 +20,7 @@ from mindgrasp_bringup.launch_api import (
     Node,
     config_files,
     number_argument,
+    robot_argument,
     run_directory_actions,
 )
 
@@ -50,9 +51,7 @@ def generate_launch_description() -> LaunchDescription:
                                           'profile YAML path (mindgrasp_sim.realism)'),
         number_argument('realism_seed', default_value='0', minimum=0,
                         description='seed of the realism draws'),
-        DeclareLaunchArgument('robot', default_value='mindgrasp_arm',
-                              description='the arm: mindgrasp_arm, xarm6 or a robot description '
-                                          'YAML path (mindgrasp_common.robot_description)'),
+        robot_argument(),
         *run_directory_actions(),  # ros2 launch: run directory, recorder, duration
         Node(package='mindgrasp_sim', executable='sim_node', name='sim',
              parameters=[*config_files('sim'),

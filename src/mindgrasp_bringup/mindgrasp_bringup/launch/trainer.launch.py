@@ -2,6 +2,7 @@
 follows it with their own arm by motor imagery; prompts and EEG are recorded for training.
 
     mindgrasp launch trainer                          # virtual subject, simulated arms
+    mindgrasp launch trainer robot:=xarm6 trials:=8   # both robots xArm6s
     mindgrasp launch trainer amp:=lsl eeg_stream:=MyAmp trials:=80 display:=fullscreen
     mindgrasp train classifier runs/<run>/bag         # then train on the recording
 
@@ -22,6 +23,7 @@ from mindgrasp_bringup.launch_api import (
     eeg_source_nodes,
     file_argument,
     number_argument,
+    robot_argument,
     run_directory_actions,
     sim_scene_camera,
 )
@@ -29,6 +31,7 @@ from mindgrasp_bringup.launch_api import (
 
 def generate_launch_description() -> LaunchDescription:
     seed = LaunchConfiguration('seed')
+    robot = {'robot': LaunchConfiguration('robot')}
     return LaunchDescription([
         *eeg_source_arguments(),
         *display_arguments(),
@@ -46,22 +49,24 @@ def generate_launch_description() -> LaunchDescription:
                       description='classifier model (.json written by mindgrasp train '
                                   'classifier); empty: the one in '
                                   'mindgrasp_classifier/param/classifier.yaml'),
+        robot_argument(description="the user's arm and the training robot, a second copy of "
+                                   'it: mindgrasp_arm, xarm6 or a robot description YAML path'),
         *run_directory_actions(),  # ros2 launch: run directory, recorder, duration
         *[Node(package='mindgrasp_sim', executable='sim_node', name='sim',
                parameters=[*config_files('sim'),
                            {'gui': LaunchConfiguration('gui'), 'seed': seed,
-                            'trainer_robot': True, **scene}], condition=condition)
+                            'trainer_robot': True, **robot, **scene}], condition=condition)
           for condition, scene in sim_scene_camera()],
         *eeg_source_nodes(config_files('eeg'), seed, LaunchConfiguration('subject')),
         *classifier_nodes(config_files('classifier')),
         Node(package='mindgrasp_vision', executable='vision_node', name='vision',
              parameters=config_files('vision')),
         Node(package='mindgrasp_fsm', executable='fsm_node', name='fsm',
-             parameters=config_files('fsm')),
+             parameters=[*config_files('fsm'), robot]),
         *display_nodes(config_files('trainer'), LaunchConfiguration('trials')),
         # last: it starts prompting once everything else runs, and its end ends the launch
         Node(package='mindgrasp_trainer', executable='trainer_node', name='trainer',
              parameters=[*config_files('trainer'),
-                         {'n_trials': LaunchConfiguration('trials'), 'seed': seed}],
+                         {'n_trials': LaunchConfiguration('trials'), 'seed': seed, **robot}],
              on_exit=Shutdown(reason='the trainer ended')),
     ])

@@ -146,6 +146,23 @@ def command_interface_argument(default: str = 'velocity') -> Any:
                     '/servo_node/delta_twist_cmds, MoveIt Servo)')
 
 
+def robot_argument(default: str = 'mindgrasp_arm', description: str = '') -> Any:
+    """``robot:=NAME|path/to/robot.yaml``: the arm every node that reads it gets (simulator,
+    controller, trainer, live view). Under ``mindgrasp launch`` a bad name or description is
+    one line naming the problem and the fix, before any process starts (checked by
+    :func:`~mindgrasp_common.robot_description.load_robot`, which the nodes use too); an empty
+    ``default`` accepts an empty value (the profile then means "the recorded run's robot")."""
+    from mindgrasp_common.robot_description import load_robot, robot_names
+
+    def check(text: str) -> object:
+        return None if not text.strip() and not default else load_robot(text.strip())
+
+    return la.checked_argument(
+        'robot', check=check, default_value=default,
+        description=description or f'the arm: {", ".join(robot_names())} or the path of a robot '
+                                   'description YAML (mindgrasp_common.robot_description)')
+
+
 def live_view_arguments() -> list[Any]:
     """``live_view:=true|false`` and ``live_view_port:=8765``, for :func:`live_view_nodes`."""
     return [
@@ -160,15 +177,16 @@ def live_view_arguments() -> list[Any]:
 
 
 def live_view_nodes() -> list[Any]:
-    """The Foxglove bridge (``foxglove_bridge``) when ``live_view:=true``; declare
-    :func:`live_view_arguments` in the profile."""
+    """The Foxglove bridge (``foxglove_bridge``) when ``live_view:=true``, its layout following
+    ``robot:=``; declare :func:`live_view_arguments` and :func:`robot_argument` in the
+    profile."""
     return [
         la.Node(package='mindgrasp_bringup', executable='foxglove_bridge_node',
                 name='foxglove_bridge',
                 # no parameter file of its own; $MINDGRASP_PARAMS_FILES reach it like any node
                 parameters=[*la.config_files('live_view'),
                             {'port': la.LaunchConfiguration('live_view_port'),
-                             'port_in_use': 'skip'}],
+                             'port_in_use': 'skip', 'robot': la.LaunchConfiguration('robot')}],
                 condition=la.IfCondition(la.LaunchConfiguration('live_view'))),
     ]
 

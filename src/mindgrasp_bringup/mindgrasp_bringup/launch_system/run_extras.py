@@ -90,7 +90,8 @@ def recorder_outputs(bag: str | Path) -> dict[str, str]:
 
 def recorder_parameters(configurations: Mapping[str, str], bag: str) -> dict[str, Any]:
     """Parameters of the recorder node for ``record_topics:=``, ``record_regex:=``,
-    ``record_exclude_regex:=`` and ``record_compression:=``."""
+    ``record_exclude_regex:=`` and ``record_compression:=``; a profile's ``robot:=`` goes into
+    the bag's metadata.yaml (``custom_data: robot``)."""
     parameters: dict[str, Any] = {
         **recorder_outputs(bag),
         'exclude_regex': configurations.get('record_exclude_regex', DEFAULT_RECORD_EXCLUDE),
@@ -101,6 +102,9 @@ def recorder_parameters(configurations: Mapping[str, str], bag: str) -> dict[str
     regex = configurations.get('record_regex', '')
     if regex:
         parameters['regex'] = regex
+    robot = configurations.get('robot', '').strip()
+    if robot:
+        parameters['custom_data'] = [f'robot={robot}']
     return parameters
 
 

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 from mindgrasp_bringup.bag.errors import BagError
 from mindgrasp_bringup.bag.paths import resolve_bag
 from mindgrasp_bringup.replay import ReplayConfig, damage_lines, run_replay, summary_line
+from mindgrasp_common.robot_description import RobotDescriptionError, load_robot
 from mindgrasp_ros import rclpy
 from mindgrasp_ros.node_main import EXIT_OK, EXIT_REFUSED, fail, run_node
 from mindgrasp_ros.params import ParameterError, declare_params, param
@@ -30,6 +31,8 @@ class ReplayParams:
     controller: bool = param(False, 're-run the controller too (open loop)')
     model: str = param('', "classifier model (.json); '': the one the run used")
     output: str = param('', "report directory; '': <run>/replays/<time>")
+    robot: str = param('', "the arm of the re-run controller: a shipped robot or a robot "
+                       "description YAML path; '': the one the run used")
     progress: bool = param(True, 'show a progress bar on stderr')
     allow_damaged: bool = param(False, 'end with exit code 0 after replaying the readable part '
                                 'of a damaged bag (default: 1)')
@@ -44,6 +47,8 @@ class ReplayNode(rclpy.node.Node):
         self.done = rclpy.task.Future()
         if not self.params.bag:
             raise ParameterError('No bag given: mindgrasp launch replay bag:=runs/<run>.')
+        if self.params.robot:          # a bad description refuses to start (exit 2)
+            load_robot(self.params.robot)
         resolve_bag(self.params.bag)   # a missing bag refuses to start (BagError, exit 2)
         self.timer = self.create_timer(0.0, self.replay_callback)
 
@@ -52,7 +57,8 @@ class ReplayNode(rclpy.node.Node):
         self.timer.cancel()
         p = self.params
         cfg = ReplayConfig(p.bag, controller=p.controller, model=p.model,
-                           output=p.output or None, progress=p.progress)
+                           output=p.output or None, progress=p.progress,
+                           params={'controller': {'robot': p.robot}} if p.robot else {})
         try:
             result = run_replay(cfg)
         except BagError as exc:   # bad input found while reading the run: as a bad argument
@@ -71,7 +77,7 @@ class ReplayNode(rclpy.node.Node):
 
 def main(args: list[str] | None = None) -> int:
     """Replay once and end: 0 with the report written, 2 on a bad bag or parameter."""
-    return run_node(ReplayNode, args, errors=(BagError,))
+    return run_node(ReplayNode, args, errors=(BagError, RobotDescriptionError))
 
 
 if __name__ == '__main__':
