@@ -154,27 +154,13 @@ def set_log_level(level: str) -> None:
     set_logger_level('', level)
 
 
-def _exit_code_text(node: Any) -> str | None:
-    """'ended with exit code N' for a node that ended with a non-zero code (``done`` holds the
-    code its process would exit with, e.g. a prompter that gave up), else None."""
-    from mindgrasp_ros.node_main import is_done
-
-    done = getattr(node, 'done', None)
-    if not is_done(node) or isinstance(done, bool) or done.exception() is not None:
-        return None
-    code = done.result()
-    if isinstance(code, int) and not isinstance(code, bool) and code != 0:
-        return f'ended with exit code {code}'
-    return None
-
-
 def run_lockstep(components: Sequence[LockstepComponent], *, step_s: float = 0.02,
                  duration_s: float = 0.0, log: Any = print) -> int:
     """``mindgrasp launch <profile> --lockstep``: compose every node, step until a node is done
     (``done``), ``duration_s`` simulated seconds (> 0) or Ctrl-C. Returns 1 when a node raised
-    or reports an ``error``, else 0."""
+    or did not end well (:func:`~mindgrasp_ros.node_main.graph_exit_code`), else 0."""
     from mindgrasp_ros.composition import LockstepRunner, NodeCallbackError, load_node_class
-    from mindgrasp_ros.node_main import error_text, is_done
+    from mindgrasp_ros.node_main import graph_exit_code, is_done
 
     runner = LockstepRunner(start_time_s=0.0)   # nodes start with the clock at 0: no jump
     wall0, cpu0 = time.perf_counter(), time.process_time()
@@ -184,11 +170,7 @@ def run_lockstep(components: Sequence[LockstepComponent], *, step_s: float = 0.0
         end = runner.time_s + duration_s if duration_s > 0 else math.inf
         while runner.time_s < end and not any(is_done(n) for n in nodes):
             runner.step(step_s)
-        errors = [(n.get_name(), error_text(n) or _exit_code_text(n)) for n in nodes
-                  if error_text(n) or _exit_code_text(n)]
-        for name, error in errors:
-            log(f'[{name}] ERROR: {error}')
-        code = 1 if errors else 0
+        code = graph_exit_code(nodes, log)
     except NodeCallbackError as exc:
         log(f'[{exc.node}] ERROR: {type(exc.error).__name__}: {exc.error}')
         code = 1

@@ -49,6 +49,17 @@ class Entity:
         self.callback_group.add_entity(self)
         self._busy = False  # set by executors while a callback of this entity runs
 
+    def has_data_hint(self) -> bool:
+        """Whether in-process work is waiting for :meth:`take` (DDS samples are announced by the
+        executor's wait set instead). Executors ask this before they take, as rclpy's ask the
+        wait set; entities that queue nothing in-process answer False."""
+        return False
+
+    def take(self, dds: bool = True) -> list[Any]:
+        """The work items waiting for :meth:`execute`, oldest first (``dds`` False: only the
+        in-process ones)."""
+        return []
+
     def destroy(self) -> None:
         """Free the entity's resources (called by the node's ``destroy_*``)."""
 
@@ -245,6 +256,7 @@ class Subscription(Entity):
             f'({self.malformed_count} so far): {exc}', throttle_duration_sec=5.0)
 
     def has_data_hint(self) -> bool:
+        """Whether in-process deliveries wait in the queue (see :meth:`Entity.has_data_hint`)."""
         return bool(self._queue)
 
     def execute(self, item: tuple[Any, MessageInfo]) -> None:
@@ -322,9 +334,11 @@ class Timer(Entity):
         self.node.wake_executor()
 
     def is_ready(self) -> bool:
+        """Whether a period has elapsed since the last call (``rclpy.timer.Timer.is_ready``);
+        the executor then takes it with :meth:`call_timer`."""
         if self._canceled:
             return False
-        now = self.clock.now().nanoseconds
+        now = self.clock.now_ns()
         if now < self._last_ns:  # time jumped back (sim time restarted): restart the period
             self._last_ns = now
             self._next_ns = now + self.timer_period_ns
@@ -335,13 +349,15 @@ class Timer(Entity):
         """Nanoseconds until due (None when canceled)."""
         if self._canceled:
             return None
-        return max(0, self._next_ns - self.clock.now().nanoseconds)
+        return max(0, self._next_ns - self.clock.now_ns())
 
     def time_since_last_call(self) -> int:
-        return self.clock.now().nanoseconds - self._last_ns
+        return self.clock.now_ns() - self._last_ns
 
-    def _mark_called(self) -> None:
-        now = self.clock.now().nanoseconds
+    def call_timer(self) -> None:
+        """Take a ready timer: its next period starts now (the executor then runs
+        :meth:`execute`), as rcl's ``rcl_timer_call`` behind rclpy's ``_take_timer``."""
+        now = self.clock.now_ns()
         self._last_ns = now
         self._next_ns += self.timer_period_ns
         if self._next_ns <= now:  # missed periods: skip them, as rcl does
@@ -365,6 +381,17 @@ class GuardCondition(Entity):
     def trigger(self) -> None:
         self._triggered = True
         self.node.wake_executor()
+
+    def has_data_hint(self) -> bool:
+        """Whether :meth:`trigger` was called since the executor last took the guard."""
+        return self._triggered
+
+    def take(self, dds: bool = True) -> list[None]:
+        """One work item after a trigger (clearing it), else none."""
+        if not self._triggered:
+            return []
+        self._triggered = False
+        return [None]
 
     def execute(self, _item: object = None) -> None:
         self.callback()
@@ -429,6 +456,10 @@ class Service(Entity):
     def _enqueue_local(self, request: Any, future: Future) -> None:
         self._local.append((request, future))
         self.node.wake_executor()
+
+    def has_data_hint(self) -> bool:
+        """Whether in-process requests are waiting (see :meth:`Entity.has_data_hint`)."""
+        return bool(self._local)
 
     def take(self, dds: bool = True) -> list[tuple[Any, int, Any, int]]:
         out: list[Any] = []
