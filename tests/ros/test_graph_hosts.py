@@ -87,3 +87,27 @@ def test_the_graph_hosts_read_no_private_field_of_another_object():
              for n, line in enumerate(path.read_text().splitlines(), 1)
              if _FOREIGN_PRIVATE.search(line.split('#')[0])]
     assert not found, '\n'.join(found)
+
+
+def test_a_node_reports_the_entities_given_work_in_the_executors_order():
+    """Arrival order does not matter: subscriptions, then services, then guard conditions, each
+    in creation order, as a full scan would take them (the lock-step order, hence the records)."""
+    from mindgrasp_ros.interfaces.std_msgs.msg import String
+
+    from mindgrasp_ros.composition import LockstepRunner
+    from mindgrasp_ros.runtime.node import Node
+
+    with LockstepRunner() as runner:
+        node = runner.add(Node, 'hosted')
+        guard = node.create_guard_condition(lambda: None)
+        first = node.create_subscription(String, '/a', lambda _m: None, 10)
+        second = node.create_subscription(String, '/b', lambda _m: None, 10)
+        pub_a = node.create_publisher(String, '/a', 10)
+        pub_b = node.create_publisher(String, '/b', 10)
+        assert node.take_ready_entities() is None           # entities changed: look at all
+        guard.trigger()
+        pub_b.publish(String(data='b'))
+        pub_a.publish(String(data='a'))
+        pub_b.publish(String(data='b again'))
+        assert node.take_ready_entities() == [first, second, guard]
+        assert node.take_ready_entities() == []

@@ -33,6 +33,7 @@ if TYPE_CHECKING:
 __all__ = ['Client', 'GuardCondition', 'Publisher', 'Service', 'Subscription', 'Timer']
 
 _CDR_HEADER = b'\x00\x01\x00\x00'
+_creation_numbers = itertools.count()
 #: longest a service waits for a new caller's reply reader to be discovered (s)
 REPLY_READER_WAIT_S = 5.0
 
@@ -42,9 +43,15 @@ class Entity:
 
     #: read by its owner, never by executors (only a subscription can be; see Subscription)
     polled = False
+    #: where executors take this kind in a node's round: subscriptions, services, clients, guard
+    #: conditions (timers come first, on their own)
+    take_rank = 0
 
     def __init__(self, node: Node, callback_group: CallbackGroup | None) -> None:
         self.node = node
+        #: (take_rank, creation number): the order in which an executor takes ready entities,
+        #: the order of the node's entity lists
+        self.take_order = (self.take_rank, next(_creation_numbers))
         self.callback_group = callback_group or node.default_callback_group
         self.callback_group.add_entity(self)
         self._busy = False  # set by executors while a callback of this entity runs
@@ -215,7 +222,7 @@ class Subscription(Entity):
         if self._queue.maxlen is not None and len(self._queue) == self._queue.maxlen:
             self._local_lost += 1  # KEEP_LAST: the oldest undelivered message is dropped
         self._queue.append(delivery)
-        self.node.wake_executor()
+        self.node.wake_executor(self)
 
     @property
     def messages_lost(self) -> int:
@@ -372,6 +379,8 @@ class Timer(Entity):
 class GuardCondition(Entity):
     """Runs its callback on the executor after :meth:`trigger`."""
 
+    take_rank = 3
+
     def __init__(self, node: Node, callback: Callable,
                  callback_group: CallbackGroup | None) -> None:
         super().__init__(node, callback_group)
@@ -380,7 +389,7 @@ class GuardCondition(Entity):
 
     def trigger(self) -> None:
         self._triggered = True
-        self.node.wake_executor()
+        self.node.wake_executor(self)
 
     def has_data_hint(self) -> bool:
         """Whether :meth:`trigger` was called since the executor last took the guard."""
@@ -422,6 +431,8 @@ def _service_topics(name: str) -> tuple[str, str]:
 class Service(Entity):
     """Serves requests of one service type (``rclpy.service.Service``)."""
 
+    take_rank = 1
+
     def __init__(self, node: Node, srv_type: type, name: str, callback: Callable,
                  qos: QoSProfile, callback_group: CallbackGroup | None) -> None:
         super().__init__(node, callback_group)
@@ -455,7 +466,7 @@ class Service(Entity):
 
     def _enqueue_local(self, request: Any, future: Future) -> None:
         self._local.append((request, future))
-        self.node.wake_executor()
+        self.node.wake_executor(self)
 
     def has_data_hint(self) -> bool:
         """Whether in-process requests are waiting (see :meth:`Entity.has_data_hint`)."""
@@ -525,6 +536,8 @@ class Service(Entity):
 
 class Client(Entity):
     """Calls a service (``rclpy.client.Client``)."""
+
+    take_rank = 2
 
     _guids = itertools.count(1)
 

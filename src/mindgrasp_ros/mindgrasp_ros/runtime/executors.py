@@ -442,9 +442,10 @@ class LockstepExecutor(Executor):
     It never waits: nothing arrives from outside the process, and time moves only between
     steps. Readiness comes from the entities' own API, as rclpy's executors take it from the
     wait set: ``Timer.is_ready``/``call_timer``, and ``has_data_hint``/``take`` of
-    subscriptions, services, clients and guard conditions. A node's queues are looked at only
-    after a delivery flagged it (``Node.has_work``, set by ``Node.wake_executor``): most nodes get
-    nothing in most rounds, which is what makes lock-step cheaper than a generic scan.
+    subscriptions, services, clients and guard conditions. The entities looked at are those the
+    node reports as given work since the last round (``Node.take_ready_entities``, fed by
+    ``Node.wake_executor``), as a wait set reports what fired: most nodes get nothing in most
+    rounds, which is what makes lock-step cheaper than a generic scan.
     """
 
     def __init__(self, *, context: Context | None = None, max_rounds: int = 1000) -> None:
@@ -509,11 +510,10 @@ class LockstepExecutor(Executor):
                 if timer.is_ready():
                     timer.call_timer()
                     work.append((timer, None))
-            if not node.has_work:
-                continue
-            node.has_work = False
-            for entities in (node.subscriptions, node.services, node.clients, node.guards):
-                for entity in entities:
-                    if entity.has_data_hint() and not entity.polled:
-                        work.extend((entity, item) for item in entity.take())
+            ready = node.take_ready_entities()
+            if ready is None:   # entities changed: look at every one
+                ready = [*node.subscriptions, *node.services, *node.clients, *node.guards]
+            for entity in ready:
+                if entity.has_data_hint() and not entity.polled:
+                    work.extend((entity, item) for item in entity.take())
         return work
