@@ -62,11 +62,14 @@ def test_intra_graph_and_raw_subscriptions_in_lockstep() -> None:
 def test_lockstep_components_compose_the_launchs_recorder(tmp_path: Path) -> None:
     """The recorder of a live launch (same topics argument), writing the given bag; none without
     a bag (the experiments) or with record:=false."""
-    from mindgrasp_bringup.launch_system.lockstep import RECORDER_MODULE, lockstep_components
+    from mindgrasp_bringup.bag.recorder_node import RecorderNode
+    from mindgrasp_bringup.launch_system.lockstep import lockstep_components
 
     def recorders(args: dict, bag: Path | None) -> list:
         comps = lockstep_components('graz', args, tmp_path / 'params', bag=bag)
-        return [c for c in comps if c.module == RECORDER_MODULE]
+        found = [c for c in comps if c.module == RecorderNode.__module__]
+        assert comps[len(comps) - len(found):] == found            # composed last
+        return found
 
     (rec,) = recorders({'record_topics': '/eeg/raw /trainer/prompt'}, tmp_path / 'bag')
     assert rec.parameters['output'] == str(tmp_path / 'bag')

@@ -25,9 +25,21 @@ REPO = Path(__file__).resolve().parents[2]
 SRC = REPO / 'src'
 PACKAGES = sorted(p for p in SRC.iterdir() if (p / 'package.xml').is_file())
 PYTHON_PACKAGES = [p for p in PACKAGES if p.name != 'mindgrasp_msgs']
-#: imports that package.xml cannot declare: colcon refuses dependency cycles
-UNDECLARED = {('mindgrasp_trainer', 'mindgrasp_bringup'):
-              'session.py reads bags with BagReader lazily; bringup depends on the trainer'}
+#: a package using another: importing it, or running it (``'-m', 'mindgrasp_x'``)
+USES = re.compile(r"^\s*(?:from|import) (mindgrasp_(?!msgs)\w+)|'-m', '(mindgrasp_\w+)", re.M)
+
+
+def _declared(package_dir: Path) -> set[str]:
+    package = parse_package(package_dir / 'package.xml')
+    return {d.name for d in package.exec_depends + package.build_depends}
+
+
+def _used(package_dir: Path) -> set[str]:
+    """Our packages that the Python code of ``package_dir`` imports or runs (-m), lazy
+    imports inside functions included."""
+    text = ''.join(p.read_text(encoding='utf-8')
+                   for p in (package_dir / package_dir.name).rglob('*.py'))
+    return {a or b for a, b in USES.findall(text)} - {package_dir.name}
 
 
 def test_every_package_folder_is_a_ros_package() -> None:
@@ -45,13 +57,24 @@ def test_package_xml_is_valid_format_3(package_dir: Path) -> None:
     build_type = package.get_build_type()
     assert build_type == ('ament_cmake' if package.name == 'mindgrasp_msgs' else 'ament_python')
     # our own packages it uses are declared (colcon orders the build by them)
-    declared = {d.name for d in package.exec_depends + package.build_depends}
-    imported = set(re.findall(r'^\s*(?:from|import) (mindgrasp_(?!msgs)\w+)',
-                              ''.join(p.read_text(encoding='utf-8')
-                                      for p in (package_dir / package.name).rglob('*.py')),
-                              re.M)) - {package.name} if build_type == 'ament_python' else set()
-    imported -= {dep for pkg, dep in UNDECLARED if pkg == package.name}
-    assert imported <= declared, f'{package.name}: declare {sorted(imported - declared)}'
+    used = _used(package_dir) if build_type == 'ament_python' else set()
+    declared = _declared(package_dir)
+    assert used <= declared, f'{package.name}: declare {sorted(used - declared)}'
+
+
+def test_no_package_uses_a_package_that_depends_on_it() -> None:
+    """The packages' dependencies (declared, and used by their code) form no cycle: colcon
+    refuses a declared one, and an undeclared one breaks a workspace built package by package."""
+    deps = {p.name: (_declared(p) | (_used(p) if p in PYTHON_PACKAGES else set()))
+            & {q.name for q in PACKAGES} for p in PACKAGES}
+
+    def reaches(start: str, goal: str, seen: set[str]) -> bool:
+        return any(d == goal or (d not in seen and reaches(d, goal, seen | {d}))
+                   for d in deps[start])
+
+    cycles = sorted(f'{a} -> {b} -> ... -> {a}' for a in deps for b in deps[a]
+                    if reaches(b, a, {b}))
+    assert not cycles, '\n'.join(cycles)
 
 
 @pytest.mark.parametrize('package_dir', PYTHON_PACKAGES, ids=lambda p: p.name)

@@ -49,7 +49,7 @@ def predictions(bag: Path) -> int:
 def test_a_live_change_is_in_the_run_dir_the_bag_and_the_replay(tmp_path):
     run = tmp_path / 'run'
     stream = f'eeg_stream:=mg-live-{uuid.uuid4().hex[:8]}'   # LSL names are host-wide
-    proc = start_launch(fixture('bci_loop_recorded.launch.py'), stream, 'duration:=400',
+    proc = start_launch(fixture('bci_loop.launch.py'), stream, 'duration:=400',
                         '--sigint-timeout', '20', '--run-dir', str(run))
     try:
         def before() -> str | None:

@@ -62,6 +62,8 @@ def test_trial_manager_waits_for_the_eeg_says_so_and_gives_up(caplog) -> None:
             runner.step(0.02)
     assert manager.done.done() and not manager.records
     assert manager.error.startswith('Gave up before trial 1: no messages on /eeg/raw after 2 s')
+    # its parameters are read one way, as every node's: the declared dataclass
+    assert manager.params.ready_timeout == 2.0 and not hasattr(manager, 'p')
 
 
 def test_a_raising_callback_names_its_node() -> None:

@@ -7,7 +7,8 @@ import re
 
 import pytest
 
-from mindgrasp_bringup.launch_system import LaunchError
+from mindgrasp_bringup.bag.recorder_node import RecorderNode, RecorderParams
+from mindgrasp_bringup.launch_system import LaunchError, lockstep
 from mindgrasp_bringup.launch_system.lockstep import check_left_out_nodes, node_traits
 from mindgrasp_eeg.acquisition_node import AcquisitionNode
 from mindgrasp_eeg.virtual_amp_node import VirtualAmpNode, VirtualAmpParams
@@ -35,6 +36,28 @@ def test_roles_come_from_the_classes() -> None:
     assert acquisition.lockstep_left_out and acquisition.provides == ('eeg',)
     assert traits_of(VirtualAmpNode).provides == ('eeg',)
     assert traits_of(object) == NodeTraits()           # a class without traits: the defaults
+
+
+def test_the_recorder_declares_what_lockstep_sets_on_it() -> None:
+    """Its /clock exclusion and bag directory come from its class, not from its module name."""
+    traits = traits_of(RecorderNode)
+    names = {f.name for f in dataclasses.fields(RecorderParams)}
+    assert traits.lockstep_exclude_parameter == 'exclude_regex'
+    assert traits.lockstep_output_parameter == 'output'
+    assert {traits.lockstep_exclude_parameter, traits.lockstep_output_parameter} <= names
+
+
+def test_lockstep_components_load_each_node_class_once(tmp_path, monkeypatch) -> None:
+    asked: list[str] = []
+
+    def counting(spec):
+        asked.append(spec.label)
+        return node_traits(spec)
+
+    monkeypatch.setattr(lockstep, 'node_traits', counting)
+    comps = lockstep.lockstep_components('experiment', {'subject': 'oracle', 'seed': '0'},
+                                         tmp_path / 'params', log=lambda _text: None)
+    assert comps and sorted(asked) == sorted(set(asked)), asked
 
 
 def test_a_node_left_out_without_a_stand_in_is_refused() -> None:

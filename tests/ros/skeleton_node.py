@@ -19,6 +19,7 @@ class TickerParams:
     label: str = param('tick', 'prefix of each log line')
     cycles: int = param(0, 'ticks before the node ends (0: no limit)', min=0)
     fail_after: int = param(0, 'ticks before the node fails (0: never)', min=0)
+    end_code: int = param(0, "the exit code 'done' holds after 'cycles' ticks", min=0, max=125)
     duration: float = param(0.0, 'end after this long (0: run until stopped)', unit='s',
                             min=0.0)
 
@@ -48,7 +49,7 @@ class Ticker(rclpy.node.Node):
         if self.params.fail_after and self.ticks >= self.params.fail_after:
             fail(self, f'failed after {self.ticks} ticks as asked')
         elif self.params.cycles and self.ticks >= self.params.cycles:
-            self.done.set_result(0)
+            self.done.set_result(self.params.end_code)
 
     def destroy_node(self) -> None:
         print(f'ran {self.ticks} ticks', flush=True)

@@ -86,9 +86,9 @@ COMMANDS: dict[str, str | dict[str, str]] = {
         'schedule': 'mindgrasp_trainer.schedule_cli',
     },
     'session': {
-        'run': 'mindgrasp_trainer.session_cli',
-        'resume': 'mindgrasp_trainer.session_cli',
-        'calibrate': 'mindgrasp_trainer.session_cli',
+        'run': 'mindgrasp_bringup.session_cli',
+        'resume': 'mindgrasp_bringup.session_cli',
+        'calibrate': 'mindgrasp_bringup.session_cli',
     },
 }
 

@@ -191,6 +191,11 @@ class TrialTracker:
         return self.record is not None
 
     @property
+    def start_time(self) -> float:
+        """When the current trial started (s, node clock; 0 before the first)."""
+        return self._t0
+
+    @property
     def attempt_over(self) -> bool:
         """A grasp attempt ended without a lift: the controller went from the grasp (or the
         final approach) back to start and on to the search. A return the person cancelled is

@@ -108,13 +108,11 @@ class TrialManagerNode(rclpy.node.Node):
     def __init__(self, **kwargs) -> None:
         super().__init__('trial_manager', **kwargs)
         self.done = rclpy.task.Future()
-        self.params = declare_params(self, TrialManagerParams)
-        p = vars(self.params)
-        self.p = p
-        self.targets = [t.strip() for t in str(p['targets']).split(',') if t.strip()]
-        self.tracker = TrialTracker(p['protocol'], p['subject'], int(p['seed']))
+        self.params = p = declare_params(self, TrialManagerParams)
+        self.targets = [t.strip() for t in str(p.targets).split(',') if t.strip()]
+        self.tracker = TrialTracker(p.protocol, p.subject, int(p.seed))
         self.records: list[TrialRecord] = []
-        records_dir = p['records_dir'] or (
+        records_dir = p.records_dir or (
             str(Path(os.environ['MINDGRASP_RUN_DIR']) / 'trials')
             if os.environ.get('MINDGRASP_RUN_DIR') else '')
         self.records_dir = Path(records_dir) if records_dir else None
@@ -134,14 +132,14 @@ class TrialManagerNode(rclpy.node.Node):
         self.create_subscription(PoseStamped, EE_POSE.name, self.ee_callback, EE_POSE.qos)
         # readiness: any message type will do; the last arrival time of each topic is kept
         self.last_seen: dict[str, float] = {}
-        for topic in p['wait_for']:
+        for topic in p.wait_for:
             if topic and topic != BCI_PREDICTION.name:
                 self._watch(topic)
         self.reset_client = self.create_client(ResetSim, '/sim/reset')
         self.load_client = self.create_client(LoadScene, '/sim/load_scene')
         self.scene: dict[int, tuple[str, float, float]] = {}   # id -> (label, x, y)
         self.fsm_state = 0
-        self.trial = int(p['first_trial']) - 1
+        self.trial = int(p.first_trial) - 1
         self.n_done = 0
         self.target_id = -1
         self.target_label = ''
@@ -221,9 +219,9 @@ class TrialManagerNode(rclpy.node.Node):
         now = self.now_s()
         if self.phase == 'starting':
             # trial 1 waits for the simulator's services (nodes may start in any order)
-            client = self.load_client if self.p['protocol'] == 'random_locations' \
+            client = self.load_client if self.params.protocol == 'random_locations' \
                 else self.reset_client
-            if client.service_is_ready() or now - self.phase_since > self.p['service_timeout']:
+            if client.service_is_ready() or now - self.phase_since > self.params.service_timeout:
                 self._begin_trial()
         elif self.phase == 'preparing':
             if self.future is None or self.future.done():
@@ -235,23 +233,23 @@ class TrialManagerNode(rclpy.node.Node):
                     return
                 self.future = None
                 self._enter('waiting')
-            elif now - self.phase_since > self.p['service_timeout']:
+            elif now - self.phase_since > self.params.service_timeout:
                 self.fail(f'The simulator did not answer the scene reset of trial {self.trial} '
-                          f"within {self.p['service_timeout']:g} s; is the sim node running?")
+                          f"within {self.params.service_timeout:g} s; is the sim node running?")
         elif self.phase == 'waiting':
             self._wait_until_ready(now)
         elif self.phase == 'trial':
             self._follow_trial(now)
         elif self.phase == 'settling' and (
                 (self.fsm_state in (FsmState.OBJECT_SEARCH, 0)
-                 and now - self.phase_since > self.p['settle_time'])
+                 and now - self.phase_since > self.params.settle_time)
                 or now - self.phase_since > 30.0):
             # the controller brought the arm home before the scene is reset under it
             self._begin_trial()
 
     def _begin_trial(self) -> None:
         """Reset the scene for the next trial (or end after ``n_trials``)."""
-        if self.p['n_trials'] and self.n_done >= self.p['n_trials']:
+        if self.params.n_trials and self.n_done >= self.params.n_trials:
             self._report()
             self._enter('finished')
             self.done.set_result(0)
@@ -259,8 +257,8 @@ class TrialManagerNode(rclpy.node.Node):
         self.trial += 1
         self.result = None
         self.scene = {}
-        if self.p['protocol'] == 'random_locations':
-            spec = random_locations_trial(int(self.p['seed']), self.trial)
+        if self.params.protocol == 'random_locations':
+            spec = random_locations_trial(int(self.params.seed), self.trial)
             path = self._scene_file(spec.scene())
             self.future = self._call(self.load_client, LoadScene.Request(scene=str(path),
                                                                          seed=-1))
@@ -293,7 +291,7 @@ class TrialManagerNode(rclpy.node.Node):
             return path
 
     def _wait_until_ready(self, now: float) -> None:
-        missing = [t for t in self.p['wait_for']
+        missing = [t for t in self.params.wait_for
                    if t and now - self.last_seen.get(t, -math.inf) > 1.0]
         if self.scene == {}:
             missing.insert(0, SIM_OBJECTS.name)
@@ -303,10 +301,10 @@ class TrialManagerNode(rclpy.node.Node):
             if text != self.said_waiting:
                 self.said_waiting = text
                 self.get_logger().info(f'Trial {self.trial} waits for {text} to publish '
-                                       f"(up to {self.p['ready_timeout']:g} s).")
-            if waited > self.p['ready_timeout']:
+                                       f"(up to {self.params.ready_timeout:g} s).")
+            if waited > self.params.ready_timeout:
                 self.fail(f'Gave up before trial {self.trial}: no messages on {text} after '
-                          f"{self.p['ready_timeout']:g} s. Check that the nodes publishing "
+                          f"{self.params.ready_timeout:g} s. Check that the nodes publishing "
                           f'them run (mindgrasp topic hz {missing[0]}).')
             return
         self.said_waiting = ''
@@ -314,7 +312,7 @@ class TrialManagerNode(rclpy.node.Node):
 
     def _choose_target(self) -> tuple[int, str]:
         ids = sorted(self.scene)
-        if self.p['protocol'] == 'random_locations':
+        if self.params.protocol == 'random_locations':
             return ids[0], self.scene[ids[0]][0]
         if self.targets:
             label = self.targets[(self.trial - 1) % len(self.targets)]
@@ -324,7 +322,7 @@ class TrialManagerNode(rclpy.node.Node):
             known = ', '.join(sorted(v[0] for v in self.scene.values()))
             msg = f'Target {label!r} is not in the scene; the scene has: {known}.'
             raise ValueError(msg)
-        i = ids[set_locations_target(int(self.p['seed']), self.trial, len(ids))]
+        i = ids[set_locations_target(int(self.params.seed), self.trial, len(ids))]
         return i, self.scene[i][0]
 
     def _start_trial(self, now: float) -> None:
@@ -338,7 +336,7 @@ class TrialManagerNode(rclpy.node.Node):
                            state=self.fsm_state, n_objects=len(self.scene))
         colour, _, shape = self.target_label.partition(' ')
         msg = TaskTarget(trial=self.trial, object_id=self.target_id, colour=colour, shape=shape,
-                         scene=str(self.p['protocol']))
+                         scene=str(self.params.protocol))
         msg.header.stamp = self.get_clock().now().to_msg()
         self.target_pub.publish(msg)
         self.get_logger().info(f'Trial {self.trial}: grasp the {self.target_label}.')
@@ -348,12 +346,12 @@ class TrialManagerNode(rclpy.node.Node):
         tracker = self.tracker
         if self.result is not None:
             self._finish(now, '', '')
-        elif self.p['trial_timeout'] > 0 and now - tracker._t0 > self.p['trial_timeout']:
-            self._finish(now, 'timeout', f"no grasp within {self.p['trial_timeout']:g} s")
-        elif self.p['stall_timeout'] > 0 and \
-                now - tracker.last_state_change > self.p['stall_timeout']:
+        elif self.params.trial_timeout > 0 and now - tracker.start_time > self.params.trial_timeout:
+            self._finish(now, 'timeout', f"no grasp within {self.params.trial_timeout:g} s")
+        elif self.params.stall_timeout > 0 and \
+                now - tracker.last_state_change > self.params.stall_timeout:
             self._finish(now, 'stalled', f'no controller state change for '
-                                         f"{self.p['stall_timeout']:g} s (state "
+                                         f"{self.params.stall_timeout:g} s (state "
                                          f'{self.fsm_state})')
         elif tracker.attempt_over:      # a return the person cancelled goes on
             self._finish(now, 'no_grasp', 'the grasp attempt ended without a lift')
@@ -368,7 +366,7 @@ class TrialManagerNode(rclpy.node.Node):
         self.get_logger().info(f'Trial {rec.trial} ({rec.desired}): {verdict} after '
                                f"{rec.duration_s:.1f} s: {rec.outcome.replace('_', ' ')}.")
         self._save_records()
-        last = self.p['n_trials'] and self.n_done >= self.p['n_trials']
+        last = self.params.n_trials and self.n_done >= self.params.n_trials
         if last:
             self._begin_trial()          # ends the node
         else:

@@ -34,6 +34,10 @@ Exit codes (one convention for every node, as the launcher reports them):
   ``ParameterException`` family, :class:`~mindgrasp_ros.params.ParameterError`) or one of the
   ``errors`` the caller names (the package's own error class); one line, no traceback.
 
+Several nodes hosted in one process (``run_composed``, lock-step) end together when one of them
+ends; the process then exits 1 when any node did not end well (:func:`graph_exit_code`), and
+shuts down in one order (:func:`end_graph`).
+
 A node that must do something on the way out (stop the arm, log a count, close a bag) overrides
 ``destroy_node()`` and calls ``super().destroy_node()``, as in rclpy; ``rclpy.ok()`` there tells
 whether it may still publish. The exit code is read after that cleanup: a node stopped by Ctrl-C
@@ -51,14 +55,15 @@ from __future__ import annotations
 
 import sys
 import threading
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Any
 
 from mindgrasp_ros import rclpy
 from mindgrasp_ros.process import exit_if_main_program, stop_requested
 
 __all__ = ['EXIT_FAILED', 'EXIT_OK', 'EXIT_REFUSED', 'NodeFailure', 'declare_duration',
-           'end_after', 'error_text', 'exit_code', 'fail', 'help_text', 'is_done', 'run_node']
+           'end_after', 'end_graph', 'error_text', 'exit_code', 'fail', 'failure_text',
+           'graph_exit_code', 'help_text', 'is_done', 'run_node']
 
 EXIT_OK = 0       #: finished or stopped
 EXIT_FAILED = 1   #: failed while running
@@ -178,6 +183,37 @@ def error_text(node: Any) -> str | None:
     return None
 
 
+def failure_text(node: Any) -> str | None:
+    """Why a node that ended did not end well: its failure, or ``ended with exit code N`` for a
+    node whose ``done`` holds a non-zero code (a prompter that gave up); None otherwise."""
+    reason = error_text(node)
+    if reason is None and exit_code(node) != EXIT_OK:
+        reason = f'ended with exit code {exit_code(node)}'
+    return reason
+
+
+def graph_exit_code(nodes: Sequence[Any], log: Callable[[str], Any]) -> int:
+    """The exit code of a graph hosted in one process (composed, lock-step): 0 when every node
+    ended well or was stopped, else 1, after one ``[node] ERROR: reason`` line per node that did
+    not (:func:`failure_text`), through ``log``. Read after :func:`end_graph`: a clean-up that
+    failed counts too. A node alone in its process exits with its own :func:`exit_code`."""
+    failed = [(node.get_name(), failure_text(node)) for node in nodes
+              if failure_text(node) is not None]
+    for name, reason in failed:
+        log(f'[{name}] ERROR: {reason}')
+    return EXIT_FAILED if failed else EXIT_OK
+
+
+def end_graph(executor: Any, nodes: Sequence[Any]) -> None:
+    """The shutdown order of every graph host: the executor stops first (no callback runs
+    during a clean-up), then each node's ``destroy_node()``, newest first, so that a node's
+    clean-up may still use the nodes created before it."""
+    if executor is not None:
+        executor.shutdown()
+    for node in reversed(nodes):
+        node.destroy_node()
+
+
 #: longest single wait of a node's executor (s): how soon a signal is handled
 _SIGNAL_CHECK_SEC = 0.1
 
@@ -237,7 +273,7 @@ def run_node(node_class: Callable[[], Any], args: list[str] | None = None, *,
         print(f'[{label}] ERROR: {exc}', file=sys.stderr, flush=True)
         exit_if_main_program(EXIT_REFUSED, getattr(node_class, '__module__', ''))
         return EXIT_REFUSED
-    node = None
+    node = executor = None
     try:
         try:
             node = node_class()
@@ -257,7 +293,7 @@ def run_node(node_class: Callable[[], Any], args: list[str] | None = None, *,
             # waits of at most _SIGNAL_CHECK_SEC: Python runs the SIGINT handler only between
             # C calls, and a wait with nothing to wake it (a recorder whose publishers went
             # quiet) blocked Ctrl-C for good
-            while not done.done() and rclpy.ok():
+            while not is_done(node) and rclpy.ok():
                 executor.spin_once(timeout_sec=_SIGNAL_CHECK_SEC)
                 _raise_if_stop_requested()
         if done.done() and linger_sec > 0 and rclpy.ok():
@@ -265,8 +301,7 @@ def run_node(node_class: Callable[[], Any], args: list[str] | None = None, *,
     except (KeyboardInterrupt, _external_shutdown()):
         stop_requested.clear()   # a stop: exit 0 unless the cleanup below fails the node
     finally:
-        if node is not None:
-            node.destroy_node()
+        end_graph(executor, [node] if node is not None else [])
         rclpy.try_shutdown()
     # read after destroy_node(): a cleanup that failed (fail(node, ...)) counts too
     code = exit_code(node)

@@ -37,6 +37,12 @@ class NodeTraits:
             node provides, naming the fix.
         trial_manager: The node that runs an experiment's trials and keeps its records; the
             engine tells it which trial to run and reads its records.
+        lockstep_exclude_parameter: The node's parameter holding a regex of topics it leaves out
+            (a recorder's); lock-step adds the runner's own ``/clock`` to it, a topic that a
+            live run does not have ('' = none).
+        lockstep_output_parameter: The node's parameter that takes the bag directory of a
+            lock-step run (a recorder's output); such a node is composed last, so that its first
+            discovery sees every node's topics ('' = none).
         parameters: The dataclass the node declares its parameters from
             (:func:`mindgrasp_ros.params.declare_params`), so that a host checks a value's range
             and choices before it starts the node (None: checked when the node starts).
@@ -48,6 +54,8 @@ class NodeTraits:
     provides: tuple[str, ...] = ()
     lockstep_missing: str = ''
     trial_manager: bool = False
+    lockstep_exclude_parameter: str = ''
+    lockstep_output_parameter: str = ''
     parameters: type | None = None
 
 

@@ -1,6 +1,9 @@
-"""The live BCI loop without the simulator (fixture of the timing tests): virtual amplifier ->
-acquisition -> classifier -> controller, recorded; it ends by itself once ``predictions``
-predictions were published (a ``mindgrasp topic echo --times`` process with on_exit=Shutdown).
+"""The demo's BCI loop without the simulator and camera (fixture of the timing and live-change
+tests): virtual amplifier -> acquisition -> classifier -> controller, recorded like any run.
+With ``predictions:=N`` it ends by itself once N predictions were published (a ``mindgrasp topic
+echo --times`` process with on_exit=Shutdown); with 0 it runs until stopped (or ``duration:=``).
+
+    mindgrasp launch tests/bringup/launch_fixtures/bci_loop.launch.py predictions:=30
 
 The controller has no arm, so it holds it stopped, yet it publishes a command every tick: enough
 for the EEG sample -> command timing.
@@ -8,32 +11,25 @@ for the EEG sample -> command timing.
 
 import sys
 
-import mindgrasp_bringup.launch_system as ls
+import mindgrasp_bringup.launch_api as la
 
 
-def _node(package: str, executable: str, *parameters: object) -> ls.Node:
-    """A node of the loop named after its executable (``acquisition_node`` -> eeg_acquisition)."""
-    name = {'acquisition_node': 'eeg_acquisition'}.get(executable,
-                                                       executable.removesuffix('_node'))
-    return ls.Node(package=package, executable=executable, name=name, parameters=list(parameters))
-
-
-def generate_launch_description() -> ls.LaunchDescription:
-    stream = ls.LaunchConfiguration('eeg_stream')
-    eeg = ls.config_files('eeg')
-    return ls.LaunchDescription([
-        ls.DeclareLaunchArgument('eeg_stream', default_value='mg-bci-loop',
-                                 description='LSL name of the virtual amplifier (unique per test)'),
-        ls.DeclareLaunchArgument('predictions', default_value='40',
-                                 description='predictions to see before the launch ends'),
-        _node('mindgrasp_eeg', 'virtual_amp_node', *eeg,
-              {'stream_name': stream, 'seed': 0, 'subject_mode': 'noise'}),
-        _node('mindgrasp_eeg', 'acquisition_node', *eeg, {'stream_name': stream}),
-        _node('mindgrasp_classifier', 'classifier_node', *ls.config_files('classifier')),
-        _node('mindgrasp_fsm', 'fsm_node', *ls.config_files('fsm')),
-        ls.ExecuteProcess(cmd=[sys.executable, '-m', 'mindgrasp_bringup', 'topic', 'echo',
+def generate_launch_description() -> la.LaunchDescription:
+    predictions = la.LaunchConfiguration('predictions')
+    return la.LaunchDescription([
+        *la.eeg_source_arguments(),
+        la.DeclareLaunchArgument('model', default_value='', description='classifier model'),
+        la.DeclareLaunchArgument('predictions', default_value='0',
+                                 description='predictions to see before the launch ends (0: run '
+                                             'until stopped)'),
+        *la.eeg_source_nodes(la.config_files('eeg', 'demo'), seed=0, subject_mode='noise'),
+        *la.classifier_nodes(la.config_files('classifier', 'demo')),
+        la.Node(package='mindgrasp_fsm', executable='fsm_node', name='fsm',
+                parameters=la.config_files('fsm', 'demo')),
+        la.ExecuteProcess(cmd=[sys.executable, '-m', 'mindgrasp_bringup', 'topic', 'echo',
                                '/bci/prediction', 'mindgrasp_msgs/msg/MIPrediction', '--times',
-                               ls.LaunchConfiguration('predictions'), '--field', 'class_index'],
+                               predictions, '--field', 'class_index'],
                           name='enough_predictions',
-                          on_exit=ls.Shutdown(reason='enough predictions')),
+                          on_exit=la.Shutdown(reason='enough predictions'),
+                          condition=la.IfCondition(la.NotEqualsSubstitution(predictions, '0'))),
     ])

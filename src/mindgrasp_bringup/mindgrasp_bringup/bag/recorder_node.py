@@ -97,9 +97,11 @@ class RecorderNode(rclpy.node.Node):
 
     # In lock-step /rosout and /parameter_events are left out: they name paths of the run, and
     # an experiment's bag is the same bit for bit when run again (nothing changes parameters
-    # live in lock-step). The runner's own /clock is left out too (launch_system.lockstep).
+    # live in lock-step). The runner's own /clock is left out too, and the bag is the run's.
     node_traits = NodeTraits(lockstep_parameters={'include_ros_topics': False,
-                                                  'parameter_changes': ''})
+                                                  'parameter_changes': ''},
+                             lockstep_exclude_parameter='exclude_regex',
+                             lockstep_output_parameter='output')
 
     def __init__(self, **kwargs: Any) -> None:
         super().__init__('recorder', **kwargs)

@@ -26,13 +26,11 @@ from mindgrasp_bringup.launch_system import params as ros_params
 from mindgrasp_bringup.launch_system import rundir
 from mindgrasp_ros.node_traits import NodeTraits, traits_of
 
-__all__ = ['RECORDER_MODULE', 'LockstepComponent', 'check_left_out_nodes', 'lockstep_components',
-           'node_traits', 'run_lockstep', 'set_log_level']
+__all__ = ['LockstepComponent', 'check_left_out_nodes', 'lockstep_components', 'node_traits',
+           'run_lockstep', 'set_log_level']
 
-#: the recorder's node module (its ``output`` is the bag directory)
-RECORDER_MODULE = 'mindgrasp_bringup.bag.recorder_node'
-#: the runner's own /clock is not a topic of the launch (a live run has none): the recorder
-#: leaves it out beside the launch's record_exclude_regex
+#: the runner's own /clock is not a topic of the launch (a live run has none): a recorder
+#: leaves it out beside the launch's record_exclude_regex (NodeTraits.lockstep_exclude_parameter)
 _CLOCK_EXCLUDE = '^/clock$'
 
 
@@ -71,9 +69,10 @@ def lockstep_components(launch: str | Path, arguments: Sequence[str] | Mapping[s
         extra = user.plan().processes
         names = {p.label for p in extra}
         processes = [p for p in processes if p.label not in names] + list(extra)
-    check_left_out_nodes(processes)
-    out = []
-    for spec in processes:
+    traits_of_spec = [node_traits(spec) for spec in processes]
+    check_left_out_nodes(processes, traits_of_spec)
+    out, last = [], []
+    for spec, traits in zip(processes, traits_of_spec, strict=True):
         if not spec.is_node:
             msg = (f"'{spec.label}' is not a node ({spec.program[:1]}); lock-step composes "
                    'Python node modules only: leave it out of the launch file.')
@@ -83,17 +82,17 @@ def lockstep_components(launch: str | Path, arguments: Sequence[str] | Mapping[s
                    'lock-step; give it as Node(package=..., executable=...) of a Python '
                    'package.')
             raise LaunchError(msg)
-        traits = node_traits(spec)
         if traits.lockstep_left_out:
             if log is not None:
                 log(f"lock-step: '{spec.label}' left out ({traits.lockstep_left_out}).")
             continue
         params = {**spec.parameters, **traits.lockstep_parameters}
-        if spec.module == RECORDER_MODULE:
-            exclude = params.get('exclude_regex', '')
-            params['exclude_regex'] = f'{_CLOCK_EXCLUDE}|{exclude}' if exclude else _CLOCK_EXCLUDE
-            if bag is not None:
-                params['output'] = str(bag)
+        if traits.lockstep_exclude_parameter:
+            exclude = params.get(traits.lockstep_exclude_parameter, '')
+            params[traits.lockstep_exclude_parameter] = \
+                f'{_CLOCK_EXCLUDE}|{exclude}' if exclude else _CLOCK_EXCLUDE
+        if traits.lockstep_output_parameter and bag is not None:
+            params[traits.lockstep_output_parameter] = str(bag)
         path = params_dir / f'{spec.label}.yaml'
         rundir.write_yaml(path, ros_params.dump_parameters({'/**': params}),
                           header=f'parameters of {spec.label} (lock-step)')
@@ -103,12 +102,12 @@ def lockstep_components(launch: str | Path, arguments: Sequence[str] | Mapping[s
             raise LaunchError(msg)
         cmd = spec.command(path)
         ros_args = cmd[cmd.index('--ros-args') + 1:]
-        out.append(LockstepComponent(spec.label, spec.module, ros_args, params))
+        component = LockstepComponent(spec.label, spec.module, ros_args, params)
+        (last if traits.lockstep_output_parameter else out).append(component)
     # The recorder is composed last: its first discovery, when it is constructed, sees every
     # node's topics, so the bag starts at the first step (a live recorder, started first, finds
     # the other processes as they come up, seconds before they publish).
-    out.sort(key=lambda c: c.module == RECORDER_MODULE)
-    return out
+    return out + last
 
 
 def node_traits(spec: Any) -> NodeTraits:
@@ -126,12 +125,15 @@ def node_traits(spec: Any) -> NodeTraits:
         raise LaunchError(msg) from None
 
 
-def check_left_out_nodes(processes: Sequence[Any]) -> None:
+def check_left_out_nodes(processes: Sequence[Any],
+                         traits: Sequence[NodeTraits] | None = None) -> None:
     """Raise :class:`LaunchError` when a node that lock-step leaves out (the LSL acquisition
-    node) provides something that no composed node provides (EEG: the virtual amplifier)."""
+    node) provides something that no composed node provides (EEG: the virtual amplifier).
+    ``traits``: those of ``processes``, in order, when the caller has them already."""
     from mindgrasp_bringup.launch_system import LaunchError
 
-    traits = [node_traits(spec) for spec in processes]
+    if traits is None:
+        traits = [node_traits(spec) for spec in processes]
     composed = {what for t in traits if not t.lockstep_left_out for what in t.provides}
     for t in traits:
         if t.lockstep_left_out and not set(t.provides) <= composed:
@@ -154,27 +156,13 @@ def set_log_level(level: str) -> None:
     set_logger_level('', level)
 
 
-def _exit_code_text(node: Any) -> str | None:
-    """'ended with exit code N' for a node that ended with a non-zero code (``done`` holds the
-    code its process would exit with, e.g. a prompter that gave up), else None."""
-    from mindgrasp_ros.node_main import is_done
-
-    done = getattr(node, 'done', None)
-    if not is_done(node) or isinstance(done, bool) or done.exception() is not None:
-        return None
-    code = done.result()
-    if isinstance(code, int) and not isinstance(code, bool) and code != 0:
-        return f'ended with exit code {code}'
-    return None
-
-
 def run_lockstep(components: Sequence[LockstepComponent], *, step_s: float = 0.02,
                  duration_s: float = 0.0, log: Any = print) -> int:
     """``mindgrasp launch <profile> --lockstep``: compose every node, step until a node is done
     (``done``), ``duration_s`` simulated seconds (> 0) or Ctrl-C. Returns 1 when a node raised
-    or reports an ``error``, else 0."""
+    or did not end well (:func:`~mindgrasp_ros.node_main.graph_exit_code`), else 0."""
     from mindgrasp_ros.composition import LockstepRunner, NodeCallbackError, load_node_class
-    from mindgrasp_ros.node_main import error_text, is_done
+    from mindgrasp_ros.node_main import graph_exit_code, is_done
 
     runner = LockstepRunner(start_time_s=0.0)   # nodes start with the clock at 0: no jump
     wall0, cpu0 = time.perf_counter(), time.process_time()
@@ -184,11 +172,7 @@ def run_lockstep(components: Sequence[LockstepComponent], *, step_s: float = 0.0
         end = runner.time_s + duration_s if duration_s > 0 else math.inf
         while runner.time_s < end and not any(is_done(n) for n in nodes):
             runner.step(step_s)
-        errors = [(n.get_name(), error_text(n) or _exit_code_text(n)) for n in nodes
-                  if error_text(n) or _exit_code_text(n)]
-        for name, error in errors:
-            log(f'[{name}] ERROR: {error}')
-        code = 1 if errors else 0
+        code = graph_exit_code(nodes, log)
     except NodeCallbackError as exc:
         log(f'[{exc.node}] ERROR: {type(exc.error).__name__}: {exc.error}')
         code = 1

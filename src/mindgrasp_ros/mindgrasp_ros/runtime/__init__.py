@@ -8,7 +8,9 @@ submodules mirror ``rclpy.node``, ``rclpy.qos``, ``rclpy.executors``, ``rclpy.pa
 
 from __future__ import annotations
 
+import contextlib
 import threading
+from collections.abc import Iterator
 from typing import Any
 
 from mindgrasp_ros.process import handle_stop_signals
@@ -26,10 +28,10 @@ from mindgrasp_ros.runtime import (
 from mindgrasp_ros.runtime.context import Context
 
 __all__ = [
-    'callback_groups', 'clock', 'create_node', 'duration', 'exceptions', 'executors',
-    'get_default_context', 'init', 'logging', 'node', 'ok', 'parameter', 'qos', 'shutdown',
-    'spin', 'spin_once', 'spin_until_future_complete', 'task', 'time', 'try_shutdown',
-    'utilities',
+    'callback_groups', 'clock', 'create_node', 'default_context', 'duration', 'exceptions',
+    'executors', 'get_default_context', 'init', 'logging', 'node', 'ok', 'parameter', 'qos',
+    'shutdown', 'spin', 'spin_once', 'spin_until_future_complete', 'task', 'time',
+    'try_shutdown', 'utilities',
 ]
 
 _default_context = Context()
@@ -39,6 +41,21 @@ _executor_lock = threading.Lock()
 
 def get_default_context() -> Context:
     return _default_context
+
+
+@contextlib.contextmanager
+def default_context(ctx: Context) -> Iterator[None]:
+    """Make ``ctx`` the default context inside the block: nodes constructed there without a
+    ``context`` argument join it (a lock-step graph builds node classes that call
+    ``super().__init__(name)`` only). Not in rclpy, where a composable node gets its context
+    from the container."""
+    global _default_context
+    previous = _default_context
+    _default_context = ctx
+    try:
+        yield
+    finally:
+        _default_context = previous
 
 
 def init(*, args: list[str] | None = None, context: Context | None = None,

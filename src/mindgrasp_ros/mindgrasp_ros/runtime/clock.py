@@ -27,11 +27,17 @@ class Clock:
         return self._clock_type
 
     def now(self) -> Time:
-        if self._override_ns is not None:
-            return Time(nanoseconds=self._override_ns, clock_type=self._clock_type)
+        return Time(nanoseconds=self.now_ns(), clock_type=self._clock_type)
+
+    def now_ns(self) -> int:
+        """``now().nanoseconds`` without building a :class:`Time` (ns). Not in rclpy: timers ask
+        it on every executor round, and a lock-step run has thousands of rounds per trial."""
+        override = self._override_ns
+        if override is not None:
+            return override
         if self._clock_type == ClockType.STEADY_TIME:
-            return Time(nanoseconds=_time.monotonic_ns(), clock_type=self._clock_type)
-        return Time(nanoseconds=_time.time_ns(), clock_type=self._clock_type)
+            return _time.monotonic_ns()
+        return _time.time_ns()
 
     # ROS time override (used by the time source for use_sim_time, and by lock-step runs)
     @property

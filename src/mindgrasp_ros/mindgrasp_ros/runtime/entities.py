@@ -33,6 +33,7 @@ if TYPE_CHECKING:
 __all__ = ['Client', 'GuardCondition', 'Publisher', 'Service', 'Subscription', 'Timer']
 
 _CDR_HEADER = b'\x00\x01\x00\x00'
+_creation_numbers = itertools.count()
 #: longest a service waits for a new caller's reply reader to be discovered (s)
 REPLY_READER_WAIT_S = 5.0
 
@@ -42,12 +43,29 @@ class Entity:
 
     #: read by its owner, never by executors (only a subscription can be; see Subscription)
     polled = False
+    #: where executors take this kind in a node's round: subscriptions, services, clients, guard
+    #: conditions (timers come first, on their own)
+    take_rank = 0
 
     def __init__(self, node: Node, callback_group: CallbackGroup | None) -> None:
         self.node = node
+        #: (take_rank, creation number): the order in which an executor takes ready entities,
+        #: the order of the node's entity lists
+        self.take_order = (self.take_rank, next(_creation_numbers))
         self.callback_group = callback_group or node.default_callback_group
         self.callback_group.add_entity(self)
         self._busy = False  # set by executors while a callback of this entity runs
+
+    def has_data_hint(self) -> bool:
+        """Whether in-process work is waiting for :meth:`take` (DDS samples are announced by the
+        executor's wait set instead). Executors ask this before they take, as rclpy's ask the
+        wait set; entities that queue nothing in-process answer False."""
+        return False
+
+    def take(self, dds: bool = True) -> list[Any]:
+        """The work items waiting for :meth:`execute`, oldest first (``dds`` False: only the
+        in-process ones)."""
+        return []
 
     def destroy(self) -> None:
         """Free the entity's resources (called by the node's ``destroy_*``)."""
@@ -204,7 +222,7 @@ class Subscription(Entity):
         if self._queue.maxlen is not None and len(self._queue) == self._queue.maxlen:
             self._local_lost += 1  # KEEP_LAST: the oldest undelivered message is dropped
         self._queue.append(delivery)
-        self.node.wake_executor()
+        self.node.wake_executor(self)
 
     @property
     def messages_lost(self) -> int:
@@ -245,6 +263,7 @@ class Subscription(Entity):
             f'({self.malformed_count} so far): {exc}', throttle_duration_sec=5.0)
 
     def has_data_hint(self) -> bool:
+        """Whether in-process deliveries wait in the queue (see :meth:`Entity.has_data_hint`)."""
         return bool(self._queue)
 
     def execute(self, item: tuple[Any, MessageInfo]) -> None:
@@ -322,9 +341,11 @@ class Timer(Entity):
         self.node.wake_executor()
 
     def is_ready(self) -> bool:
+        """Whether a period has elapsed since the last call (``rclpy.timer.Timer.is_ready``);
+        the executor then takes it with :meth:`call_timer`."""
         if self._canceled:
             return False
-        now = self.clock.now().nanoseconds
+        now = self.clock.now_ns()
         if now < self._last_ns:  # time jumped back (sim time restarted): restart the period
             self._last_ns = now
             self._next_ns = now + self.timer_period_ns
@@ -335,13 +356,15 @@ class Timer(Entity):
         """Nanoseconds until due (None when canceled)."""
         if self._canceled:
             return None
-        return max(0, self._next_ns - self.clock.now().nanoseconds)
+        return max(0, self._next_ns - self.clock.now_ns())
 
     def time_since_last_call(self) -> int:
-        return self.clock.now().nanoseconds - self._last_ns
+        return self.clock.now_ns() - self._last_ns
 
-    def _mark_called(self) -> None:
-        now = self.clock.now().nanoseconds
+    def call_timer(self) -> None:
+        """Take a ready timer: its next period starts now (the executor then runs
+        :meth:`execute`), as rcl's ``rcl_timer_call`` behind rclpy's ``_take_timer``."""
+        now = self.clock.now_ns()
         self._last_ns = now
         self._next_ns += self.timer_period_ns
         if self._next_ns <= now:  # missed periods: skip them, as rcl does
@@ -356,6 +379,8 @@ class Timer(Entity):
 class GuardCondition(Entity):
     """Runs its callback on the executor after :meth:`trigger`."""
 
+    take_rank = 3
+
     def __init__(self, node: Node, callback: Callable,
                  callback_group: CallbackGroup | None) -> None:
         super().__init__(node, callback_group)
@@ -364,7 +389,18 @@ class GuardCondition(Entity):
 
     def trigger(self) -> None:
         self._triggered = True
-        self.node.wake_executor()
+        self.node.wake_executor(self)
+
+    def has_data_hint(self) -> bool:
+        """Whether :meth:`trigger` was called since the executor last took the guard."""
+        return self._triggered
+
+    def take(self, dds: bool = True) -> list[None]:
+        """One work item after a trigger (clearing it), else none."""
+        if not self._triggered:
+            return []
+        self._triggered = False
+        return [None]
 
     def execute(self, _item: object = None) -> None:
         self.callback()
@@ -394,6 +430,8 @@ def _service_topics(name: str) -> tuple[str, str]:
 
 class Service(Entity):
     """Serves requests of one service type (``rclpy.service.Service``)."""
+
+    take_rank = 1
 
     def __init__(self, node: Node, srv_type: type, name: str, callback: Callable,
                  qos: QoSProfile, callback_group: CallbackGroup | None) -> None:
@@ -428,7 +466,11 @@ class Service(Entity):
 
     def _enqueue_local(self, request: Any, future: Future) -> None:
         self._local.append((request, future))
-        self.node.wake_executor()
+        self.node.wake_executor(self)
+
+    def has_data_hint(self) -> bool:
+        """Whether in-process requests are waiting (see :meth:`Entity.has_data_hint`)."""
+        return bool(self._local)
 
     def take(self, dds: bool = True) -> list[tuple[Any, int, Any, int]]:
         out: list[Any] = []
@@ -494,6 +536,8 @@ class Service(Entity):
 
 class Client(Entity):
     """Calls a service (``rclpy.client.Client``)."""
+
+    take_rank = 2
 
     _guids = itertools.count(1)
 

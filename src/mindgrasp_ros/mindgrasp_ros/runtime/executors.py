@@ -30,6 +30,7 @@ from cyclonedds.core import (
 from cyclonedds.core import GuardCondition as DdsGuardCondition
 from cyclonedds.internal import dds_c_t
 
+from mindgrasp_ros.errors import CompositionError, NodeCallbackError
 from mindgrasp_ros.runtime.context import Context
 from mindgrasp_ros.runtime.entities import Client, GuardCondition, Service, Subscription, Timer
 from mindgrasp_ros.runtime.exceptions import RCLError
@@ -38,6 +39,7 @@ from mindgrasp_ros.runtime.task import Future
 __all__ = [
     'Executor',
     'ExternalShutdownException',
+    'LockstepExecutor',
     'MultiThreadedExecutor',
     'ShutdownException',
     'SingleThreadedExecutor',
@@ -265,7 +267,7 @@ class Executor:
             for timer in list(node.timers):
                 if not timer._busy and timer.callback_group.can_execute(timer) and \
                         timer.is_ready():
-                    timer._mark_called()
+                    timer.call_timer()
                     work.append((timer, None))
             for entity in (*node.subscriptions, *node.services, *node.clients):
                 if entity._busy or entity.polled:
@@ -279,9 +281,8 @@ class Executor:
                     continue
                 work.extend((entity, item) for item in entity.take(dds))
             for guard in list(node.guards):
-                if guard._triggered and guard.callback_group.can_execute(guard):
-                    guard._triggered = False
-                    work.append((guard, None))
+                if guard.has_data_hint() and guard.callback_group.can_execute(guard):
+                    work.extend((guard, item) for item in guard.take())
         return work
 
     def _run(self, entity: Any, item: Any) -> None:
@@ -431,3 +432,88 @@ class MultiThreadedExecutor(Executor):
         super().shutdown(timeout_sec)
         self._pool.shutdown(wait=True, cancel_futures=True)
         return True
+
+
+class LockstepExecutor(Executor):
+    """Runs ready callbacks until none is left, in the calling thread and a fixed order, for a
+    DDS-less context on a clock that only its owner advances (lock-step: :class:`~mindgrasp_ros.
+    composition.LockstepRunner` steps the clock, then calls :meth:`spin_until_quiescent`).
+
+    It never waits: nothing arrives from outside the process, and time moves only between
+    steps. Readiness comes from the entities' own API, as rclpy's executors take it from the
+    wait set: ``Timer.is_ready``/``call_timer``, and ``has_data_hint``/``take`` of
+    subscriptions, services, clients and guard conditions. The entities looked at are those the
+    node reports as given work since the last round (``Node.take_ready_entities``, fed by
+    ``Node.wake_executor``), as a wait set reports what fired: most nodes get nothing in most
+    rounds, which is what makes lock-step cheaper than a generic scan.
+    """
+
+    def __init__(self, *, context: Context | None = None, max_rounds: int = 1000) -> None:
+        super().__init__(context=context)
+        self.max_rounds = max_rounds
+        #: wall seconds spent in each node's callbacks (by node name), and in collecting work
+        self.node_time: dict[str, float] = {}
+        self.collect_time = 0.0
+
+    def spin_until_quiescent(self) -> int:
+        """Run ready callbacks until none is ready; returns how many rounds ran.
+
+        A callback that raises ends the round with :class:`NodeCallbackError` naming its node;
+        a graph still busy after ``max_rounds`` rounds raises :class:`CompositionError`.
+        """
+        rounds = 0
+        clock = time.perf_counter
+        times = self.node_time
+        while rounds < self.max_rounds:
+            t0 = clock()
+            work = self._collect()
+            self.collect_time += clock() - t0
+            if not work:
+                return rounds
+            for entity, item in work:
+                t0 = clock()
+                try:
+                    entity.execute(item)
+                except (KeyboardInterrupt, SystemExit):
+                    raise
+                except Exception as exc:
+                    raise NodeCallbackError(entity.node.get_name(), exc) from exc
+                finally:
+                    name = entity.node.get_name()
+                    times[name] = times.get(name, 0.0) + clock() - t0
+            rounds += 1
+        msg = (f'The composed graph did not settle within {self.max_rounds} rounds: a callback '
+               'keeps producing work.')
+        raise CompositionError(msg)
+
+    def _spin_once_impl(self, timeout_sec: float | None) -> bool:
+        """One round of the ready work, without waiting (``spin_once`` of rclpy's API)."""
+        if not self._context.ok():
+            raise ExternalShutdownException()
+        if self._is_shutdown:
+            raise ShutdownException()
+        self._pending = self._collect()
+        return self._dispatch()
+
+    def _dispatch(self) -> bool:
+        work, self._pending = self._pending, []
+        for entity, item in work:
+            self._run(entity, item)
+        return bool(work)
+
+    def _collect(self, ready: set[int] | None = None) -> list[Work]:
+        """Ready work in the executor's order: timers, then subscriptions, services, clients
+        and guard conditions of each node."""
+        work: list[Work] = []
+        for node in self._nodes:
+            for timer in node.timers:
+                if timer.is_ready():
+                    timer.call_timer()
+                    work.append((timer, None))
+            ready = node.take_ready_entities()
+            if ready is None:   # entities changed: look at every one
+                ready = [*node.subscriptions, *node.services, *node.clients, *node.guards]
+            for entity in ready:
+                if entity.has_data_hint() and not entity.polled:
+                    work.extend((entity, item) for item in entity.take())
+        return work

@@ -74,8 +74,9 @@ class Node:
         from mindgrasp_ros.runtime.arguments import RosArguments, parse_ros_args
 
         self.context = context or get_default_context()
-        #: set by every delivery to this node (wake_executor), cleared by the lock-step runner
-        self.has_work = True
+        # what wake_executor collected for take_ready_entities: True means look at every entity
+        self._changed = True
+        self._ready_entities: dict[Entity, None] = {}   # in arrival order, each once
         if not self.context.ok():
             raise NotInitializedException('context')
         args = RosArguments()
@@ -172,13 +173,33 @@ class Node:
         return self
 
     # ------------------------------------------------------------------ executor hooks
-    def wake_executor(self) -> None:
-        # something arrived for one of this node's entities (or they changed): the lock-step
-        # runner looks at the node's queues only when this is set
-        self.has_work = True
+    def wake_executor(self, entity: Entity | None = None) -> None:
+        """Tell the executor that ``entity`` got in-process work (a delivery, a request, a
+        trigger), or with None that the node's entities changed."""
+        if entity is None:
+            self._changed = True
+        else:
+            self._ready_entities[entity] = None
         executor = self.executor
         if executor is not None:
             executor.wake()
+
+    def take_ready_entities(self) -> list[Entity] | None:
+        """The entities that got in-process work since the last call, in the order executors
+        take them (:attr:`Entity.take_order`); None when the entities changed since (look at
+        every one). For executors that run without a wait set (lock-step): a node with a dozen
+        services (the parameter services) gets work for one subscription in most rounds."""
+        if self._changed:
+            self._changed = False
+            self._ready_entities.clear()
+            return None
+        if not self._ready_entities:
+            return []
+        ready = list(self._ready_entities)
+        self._ready_entities.clear()
+        if len(ready) > 1:
+            ready.sort(key=_take_order)
+        return ready
 
     def _add(self, collection: list, entity: Entity) -> Any:
         with self._lock:
@@ -194,6 +215,7 @@ class Node:
                 return False
             collection.remove(entity)
             self.generation += 1
+            self._ready_entities.pop(entity, None)
         entity.destroy()
         self.context.publish_discovery_info()
         return True
@@ -608,3 +630,7 @@ class Node:
 
     def __repr__(self) -> str:
         return f'<Node {self.get_fully_qualified_name()}>'
+
+
+def _take_order(entity: Entity) -> tuple[int, int]:
+    return entity.take_order

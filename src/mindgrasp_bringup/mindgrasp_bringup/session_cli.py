@@ -18,15 +18,15 @@ import sys
 import time
 from pathlib import Path
 
-from mindgrasp_common.cli_checks import non_negative_int, positive_int, probability
-from mindgrasp_common.robot_description import RobotDescriptionError, load_robot
-from mindgrasp_trainer.session import (
+from mindgrasp_bringup.session import (
     Session,
     SessionError,
     calibration_plan,
     check_subject,
     load_plan,
 )
+from mindgrasp_common.cli_checks import non_negative_int, positive_int, probability
+from mindgrasp_common.robot_description import RobotDescriptionError, load_robot
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

@@ -58,7 +58,7 @@ from mindgrasp_trainer.protocol import TrainerError
 __all__ = ['PLAN_DIR', 'Phase', 'Plan', 'Session', 'SessionError', 'calibration_plan',
            'check_subject', 'load_plan']
 
-PLAN_DIR = resource_path('mindgrasp_trainer', 'plans')
+PLAN_DIR = resource_path('mindgrasp_bringup', 'plans')
 KINDS = {'graz': 'graz', 'trainer': 'trainer', 'test': 'demo'}   # phase kind -> launch profile
 #: the node whose end ends a phase's launch (on_exit=Shutdown), per phase kind
 PROMPTERS = {'graz': 'graz_prompter', 'trainer': 'trainer', 'test': 'trial_manager'}

@@ -13,8 +13,8 @@ from pathlib import Path
 import pytest
 import yaml
 
+from mindgrasp_bringup.session import SessionError, check_subject, load_plan
 from mindgrasp_common.robot_description import robot_names
-from mindgrasp_trainer.session import SessionError, check_subject, load_plan
 
 
 def mindgrasp(*args: str, cwd: Path) -> subprocess.CompletedProcess:
@@ -155,7 +155,7 @@ def test_calibrate_runs_in_lockstep_end_to_end(tmp_path):
 
 
 def test_calibration_plan_sets_trials_per_class_and_adds_a_heldout_run():
-    from mindgrasp_trainer.session import calibration_plan
+    from mindgrasp_bringup.session import calibration_plan
 
     plan = calibration_plan(load_plan('quick'), trials_per_class=5, virtual_accuracy=0.9)
     # quick prompts two classes; its test-free phases keep their order, the held-out run last
@@ -177,8 +177,8 @@ def test_grasp_figures_come_from_the_test_runs_bag(tmp_path):
     """Targets and results written to a real rosbag2 (MCAP) are read back per trial: a lift of
     the desired object, a lift of another one, and a trial that ended without a grasp."""
     from mindgrasp_bringup.bag.writer import BagWriter
+    from mindgrasp_bringup.session import _grasp_results
     from mindgrasp_ros.typesupport import typestore
-    from mindgrasp_trainer.session import _grasp_results
 
     store = typestore()
     target = store.types['mindgrasp_msgs/msg/TaskTarget']
