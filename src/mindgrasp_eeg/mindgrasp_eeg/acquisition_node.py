@@ -40,6 +40,7 @@ from mindgrasp_eeg.marker_inlet import MarkerInlet, marker_stream_name
 from mindgrasp_eeg.params import AcquisitionParams
 from mindgrasp_eeg.ros_conversions import ns_to_time_fields
 from mindgrasp_ros import rclpy
+from mindgrasp_ros.logs import log_at
 from mindgrasp_ros.node_main import end_after, fail, run_node
 from mindgrasp_ros.node_traits import NodeTraits
 from mindgrasp_ros.params import declare_params
@@ -159,7 +160,7 @@ class AcquisitionNode(rclpy.node.Node):
         assert self.markers is not None
         markers, news = self.markers.poll()
         for level, line in news:
-            getattr(self.get_logger(), level)(line)
+            log_at(self.get_logger(), level, line)
         if not markers:
             return
         lsl_now, ros_now = read_clocks(lambda: self.get_clock().now().nanoseconds)
@@ -185,9 +186,8 @@ class AcquisitionNode(rclpy.node.Node):
             return
         status = self.acq.status()
         if status.level != self._last_level:
-            log = {OK: self.get_logger().info, WARN: self.get_logger().warning,
-                   ERROR: self.get_logger().error}[status.level]
-            log(status.message)
+            log_at(self.get_logger(), {OK: 'info', WARN: 'warning', ERROR: 'error'}[status.level],
+                   status.message)
             self._last_level = status.level
         desc = self.acq.desc
         item = DiagnosticStatus(level=_LEVELS[status.level], name='eeg_acquisition',
