@@ -41,6 +41,11 @@ def test_real_ros2_cli_against_our_sim_node(spawn_node, ros2):
     call = ros2('service', 'call', '/sim/reset', 'mindgrasp_msgs/srv/ResetSim', '{seed: 3}')
     assert call.returncode == 0 and 'success=True' in call.stdout, call.stdout + call.stderr
     assert ros2('param', 'get', '/sim', 'camera_rate').stdout.strip() == 'Double value is: 1.0'
+    assert ros2('param', 'set', '/sim', 'use_sim_time', 'false').stdout.strip() == \
+        'Set parameter successful'
+    assert ros2('param', 'get', '/sim', 'use_sim_time').stdout.strip() == 'Boolean value is: False'
+    refused = ros2('param', 'set', '/sim', 'camera_rate', '2.0')      # read-only: refused
+    assert "Setting parameter failed: parameter 'camera_rate' is read-only" in refused.stderr
     echo = ros2('topic', 'echo', '--once', '/joint_states', 'sensor_msgs/msg/JointState')
     assert 'name:\n- joint_1' in echo.stdout, echo.stdout + echo.stderr
     # our verbs print what ros2's print
@@ -79,6 +84,21 @@ def test_our_verbs_against_a_real_rclpy_node(spawn_node, rclpy_env, tmp_path):
     assert '/toggle [std_srvs/srv/SetBool]' in listing
     call = mindgrasp('service', 'call', '/toggle', 'std_srvs/srv/SetBool', '{data: true}')
     assert "message='on=True gain=7.5'" in call.stdout, call.stdout + call.stderr
+
+
+def test_our_topic_verbs_against_a_real_rclpy_talker(spawn_node, rclpy_env, ros2):
+    talker = spawn_node(PEER, 'talker', env=rclpy_env)
+    listed = until(lambda: mindgrasp('topic', 'list', '-t'),
+                   lambda r: '/chatter [std_msgs/msg/String]' in r.stdout.splitlines())
+    assert '/chatter [std_msgs/msg/String]' in listed.stdout.splitlines(), \
+        listed.stdout + listed.stderr + talker.output()
+    echo = mindgrasp('topic', 'echo', '--once', '/chatter')
+    assert echo.returncode == 0 and echo.stdout.startswith('data:') and 'hello ' in echo.stdout, \
+        echo.stdout + echo.stderr
+    # the same lines as the real ros2 topic info
+    theirs = until(lambda: ros2('topic', 'info', '/chatter', '--no-daemon'),
+                   lambda r: 'Publisher count: 1' in r.stdout)
+    assert mindgrasp('topic', 'info', '/chatter').stdout == theirs.stdout
 
 
 def test_our_controller_on_real_rclpy(spawn_node, rclpy_env, ros2):
