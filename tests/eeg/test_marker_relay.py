@@ -1,7 +1,7 @@
 """An amplifier's LSL marker stream on record (issue 30): a real pylsl EEG outlet with its marker
 stream in one process, the acquisition node (``marker_stream:=auto``) and the bag recorder in
 others, over real DDS; the markers line up with their EEG samples on /eeg/markers, in the bag,
-and in the BIDS export's events."""
+in its replay and in the BIDS export's events."""
 
 from __future__ import annotations
 
@@ -121,6 +121,16 @@ def test_amplifier_markers_relayed_recorded_and_exported(
         if 0 <= k < len(data) and np.isfinite(data[k, 0]):
             window = data[max(0, k - 1):k + 2, 0]
             assert np.nanmax(window) > 0.5e-3, (desc, on)     # the spike is at the marker
+    # a replay of the bag publishes them again, stamps and all
+    replayed = MarkerListener(rclpy_ctx)
+    try:
+        spawn_node('mindgrasp_bringup', 'bag', 'play', str(bag), '--topics', '/eeg/markers',
+                   '--no-progress')
+        recorded = {(m.data, _ns(m.header.stamp)) for m in listener.markers}
+        assert replayed.spin_until(lambda: len(replayed.markers) >= len(anns)), anns
+        assert {(m.data, _ns(m.header.stamp)) for m in replayed.markers} <= recorded
+    finally:
+        replayed.node.destroy_node()
     root = tmp_path / 'bids'
     export_bids([bag], root, 'M01')
     events = next(root.glob('sub-M01/eeg/*_events.tsv'))
