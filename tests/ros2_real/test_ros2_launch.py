@@ -1,6 +1,7 @@
-"""``ros2 launch mindgrasp_bringup demo.launch.py`` from a colcon workspace of our packages: the
-real launch and launch_ros start our nodes, each on the real rclpy (``MINDGRASP_RMW=rclpy``),
-and the arm grasps the object the trial asks for (issue 32)."""
+"""Our packages in a colcon workspace on a real ROS 2: ``ros2 launch mindgrasp_bringup
+demo.launch.py`` starts our nodes with the real launch and launch_ros, each on the real rclpy
+(``MINDGRASP_RMW=rclpy``), and the arm grasps the object the trial asks for (issue 32); the
+amplifier's markers reach the real ``ros2 topic echo`` (issue 30)."""
 
 from __future__ import annotations
 
@@ -8,6 +9,7 @@ import csv
 import os
 import signal
 import subprocess
+import sys
 import uuid
 from pathlib import Path
 
@@ -15,6 +17,7 @@ import pytest
 import yaml
 
 pytestmark = [pytest.mark.slow, pytest.mark.ros2_real]
+LSL_SOURCE = Path(__file__).resolve().parents[1] / 'eeg' / 'lsl_source.py'
 
 #: every process of the demo profile without a display and the live view
 DEMO_NODES = {'recorder_node', 'trial_manager_node', 'sim_node', 'virtual_amp_node',
@@ -56,3 +59,28 @@ def test_ros2_launch_demo_grasps_on_real_rclpy(colcon_ws, tmp_path: Path) -> Non
                    for _topic, _t, data in bag.messages(['/task/result'])]
     assert [(r.desired_object, r.grasped_object, r.success) for r in results] == \
         [('red cube', 'red cube', True)], results
+
+
+def test_amplifier_markers_on_real_rclpy_seen_by_ros2_topic_echo(colcon_ws, spawn_node) -> None:
+    """The acquisition node on the real rclpy relays a real pylsl marker stream to /eeg/markers
+    (issue 30), and the real ``ros2 topic echo`` reads it with the colcon-built mindgrasp_msgs."""
+    name = f'mg-ros2-markers-{uuid.uuid4().hex[:8]}'
+    source = subprocess.Popen(
+        [sys.executable, str(LSL_SOURCE), '--name', name, '--n-channels', '4', '--duration',
+         '120', '--markers-every', '0.5'], stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
+        text=True)
+    try:
+        assert source.stdout is not None and source.stdout.readline().strip() == 'READY'
+        acq = spawn_node('mindgrasp_eeg.acquisition_node', env=colcon_ws, stream_name=name,
+                         n_channels=4, check_channel_names=False, marker_stream='auto')
+        assert acq.wait_for_output('Relaying the LSL marker stream', 60), acq.output()
+        echo = subprocess.run(['ros2', 'topic', 'echo', '--once', '/eeg/markers',
+                               'mindgrasp_msgs/msg/EEGMarker'], env=colcon_ws,
+                              capture_output=True, text=True, timeout=120, check=False)
+    finally:
+        source.kill()
+        source.wait(timeout=10)
+    assert echo.returncode == 0, echo.stdout + echo.stderr
+    fields = yaml.safe_load(echo.stdout.split('---')[0])
+    assert str(fields['data']).startswith('S') and fields['stream_name'] == f'{name}-markers'
+    assert fields['header']['stamp']['sec'] > 0 and fields['lsl_timestamp'] > 0
