@@ -49,3 +49,12 @@ def test_launch_eeg_records_a_played_dataset(tmp_path: Path, stream_name: str) -
         assert desc in near, (on, desc, k)
     if len(session.data) > 9 * 160:         # two annotation periods (4.2 s) recorded
         assert markers, session.annotations
+    # the classifier's bag loader labels epochs by those markers (T1 left, T2 right fist)
+    from mindgrasp_classifier.data import load_bag
+
+    labelled = load_bag(tmp_path / 'run', labels='markers', event_map={'T1': 0, 'T2': 1})
+    expected = [(round(on * 160), {'T1': 0, 'T2': 1}[desc]) for on, desc in markers
+                if desc != 'T0']
+    assert len(labelled.events) == len(expected)
+    for (onset, cls), (want_onset, want_cls) in zip(labelled.events, expected, strict=True):
+        assert cls == want_cls and abs(onset - want_onset) <= 1, (labelled.events, expected)
