@@ -74,7 +74,7 @@ def test_amplifier_markers_on_real_rclpy_seen_by_ros2_topic_echo(colcon_ws, spaw
         acq = spawn_node('mindgrasp_eeg.acquisition_node', env=colcon_ws, stream_name=name,
                          n_channels=4, check_channel_names=False, marker_stream='auto')
         assert acq.wait_for_output('Relaying the LSL marker stream', 60), acq.output()
-        echo = subprocess.run(['ros2', 'topic', 'echo', '--once', '/eeg/markers',
+        echo = subprocess.run(['ros2', 'topic', 'echo', '--once', '--no-daemon', '/eeg/markers',
                                'mindgrasp_msgs/msg/EEGMarker'], env=colcon_ws,
                               capture_output=True, text=True, timeout=120, check=False)
     finally:

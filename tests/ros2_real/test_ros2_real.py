@@ -40,13 +40,17 @@ def test_real_ros2_cli_against_our_sim_node(spawn_node, ros2):
     assert '/sim' in nodes.stdout.split(), nodes.stdout + nodes.stderr
     call = ros2('service', 'call', '/sim/reset', 'mindgrasp_msgs/srv/ResetSim', '{seed: 3}')
     assert call.returncode == 0 and 'success=True' in call.stdout, call.stdout + call.stderr
-    assert ros2('param', 'get', '/sim', 'camera_rate').stdout.strip() == 'Double value is: 1.0'
-    assert ros2('param', 'set', '/sim', 'use_sim_time', 'false').stdout.strip() == \
+    def param(*args: str) -> subprocess.CompletedProcess:
+        return ros2('param', *args, '--no-daemon')     # no daemon outlives the test
+
+    assert param('get', '/sim', 'camera_rate').stdout.strip() == 'Double value is: 1.0'
+    assert param('set', '/sim', 'use_sim_time', 'false').stdout.strip() == \
         'Set parameter successful'
-    assert ros2('param', 'get', '/sim', 'use_sim_time').stdout.strip() == 'Boolean value is: False'
-    refused = ros2('param', 'set', '/sim', 'camera_rate', '2.0')      # read-only: refused
+    assert param('get', '/sim', 'use_sim_time').stdout.strip() == 'Boolean value is: False'
+    refused = param('set', '/sim', 'camera_rate', '2.0')      # read-only: refused
     assert "Setting parameter failed: parameter 'camera_rate' is read-only" in refused.stderr
-    echo = ros2('topic', 'echo', '--once', '/joint_states', 'sensor_msgs/msg/JointState')
+    echo = ros2('topic', 'echo', '--once', '--no-daemon', '/joint_states',
+                'sensor_msgs/msg/JointState')
     assert 'name:\n- joint_1' in echo.stdout, echo.stdout + echo.stderr
     # our verbs print what ros2's print
     ours = mindgrasp('service', 'list', '-t').stdout
@@ -104,12 +108,12 @@ def test_our_topic_verbs_against_a_real_rclpy_talker(spawn_node, rclpy_env, ros2
 def test_our_controller_on_real_rclpy(spawn_node, rclpy_env, ros2):
     fsm = spawn_node('mindgrasp_fsm.fsm_node', env=rclpy_env)
     assert fsm.wait_for_output('Grasp controller ready', 60), fsm.output()
-    described = until(lambda: ros2('param', 'describe', '/fsm', 'lock_duration'),
+    described = until(lambda: ros2('param', 'describe', '/fsm', 'lock_duration', '--no-daemon'),
                       lambda r: r.returncode == 0 and 'Min value' in r.stdout)
     assert 'Min value: 0.001' in described.stdout, described.stdout + described.stderr
-    assert ros2('param', 'set', '/fsm', 'lock_duration', '2.5').stdout.strip() == \
+    assert ros2('param', 'set', '/fsm', 'lock_duration', '2.5', '--no-daemon').stdout.strip() == \
         'Set parameter successful'
-    refused = ros2('param', 'set', '/fsm', 'lock_duration', '-1.0')
+    refused = ros2('param', 'set', '/fsm', 'lock_duration', '-1.0', '--no-daemon')
     assert 'Setting parameter failed' in refused.stdout + refused.stderr
     assert mindgrasp('param', 'get', '/fsm', 'lock_duration').stdout.strip() == \
         'Double value is: 2.5'
