@@ -179,8 +179,10 @@ def test_intent_labels_tile_each_intent():
     assert intent_events(changes, 10.0, 0.0, 0.5) == [
         (1.0, 0), (1.5, 0), (2.0, 0), (2.5, 0), (3.0, 0), (3.5, 0), (4.0, 0), (4.5, 0),
         (5.0, 0), (5.5, 0), (6.2, 3)]
-    with pytest.raises(ClassifierError, match="--labels must be 'prompt' or 'intent'"):
+    with pytest.raises(ClassifierError, match='--labels must be one of prompt, intent, markers'):
         load_bag('x', labels='cue')
+    with pytest.raises(ClassifierError, match='--labels markers needs --event-map'):
+        load_bag('x', labels='markers')
 
 
 @pytest.mark.slow

@@ -2,7 +2,12 @@
 
 Streams synthetic EEG (32 g.Nautilus channels) or white noise (other channel counts) in real time
 with the amplifier's own sample clock, and can inject faults: NaN, a flat or a railed channel, a
-gap of skipped samples, a sample out of order. Prints ``READY`` once the outlet exists.
+gap of skipped samples, a sample out of order. With ``--markers-every S`` it also sends a marker
+stream ``<name>-markers`` (type Markers), as an amplifier app sends its triggers: once inlets
+are connected to both streams, every ``S`` s of samples the marker ``S<k>`` stamped with the LSL
+time of sample ``k``, whose channel 0 carries a 1 mV spike, so a test can find the sample a
+marker belongs to; ``--markers-until T`` closes that stream ``T`` s after the first marker (a
+lost marker stream; the EEG goes on). Prints ``READY`` once the outlets exist.
 """
 
 from __future__ import annotations
@@ -14,7 +19,7 @@ import time
 import numpy as np
 import pylsl
 
-from mindgrasp_eeg.lsl import EEGOutlet
+from mindgrasp_eeg.lsl import EEGOutlet, MarkerOutlet
 from mindgrasp_eeg.montage import NAUTILUS_32
 from mindgrasp_eeg.synthetic import SyntheticEEG
 
@@ -36,11 +41,17 @@ def main() -> int:
     p.add_argument('--disorder-at', type=float, default=-1.0)
     p.add_argument('--stall-at', type=float, default=-1.0, help='stop sending (outlet alive)')
     p.add_argument('--stall-len', type=float, default=0.0)
+    p.add_argument('--markers-every', type=float, default=0.0, help='marker period (s of samples)')
+    p.add_argument('--markers-until', type=float, default=-1.0, help='close the marker stream')
     a = p.parse_args()
     names = NAUTILUS_32 if a.n_channels == 32 else [f'E{k + 1}' for k in range(a.n_channels)]
     gen = SyntheticEEG(sample_rate=a.rate, seed=1) if a.n_channels == 32 else None
     rng = np.random.default_rng(0)
     outlet = EEGOutlet(a.name, names, a.rate, source_id=a.source_id or a.name, unit=a.unit)
+    markers = MarkerOutlet(f'{a.name}-markers') if a.markers_every > 0 else None
+    every = round(a.markers_every * a.rate)
+    first_marker_at = -1.0               # sample time (s) of the first marker sent
+    listened = False                     # inlets on both streams: markers can go out
     print('READY', flush=True)
     t0_wall, t0 = time.monotonic(), pylsl.local_clock()
     k = 0
@@ -68,7 +79,17 @@ def main() -> int:
                 outlet.push_volts(data[:1], t0 + (k - 20) / a.rate)   # a stale sample
                 disorder_done = True
             for i in range(n):                 # per-sample stamps from the sample clock
+                listened = listened or (markers is not None and markers.have_consumers()
+                                        and outlet.have_consumers())
+                if markers is not None and listened and (k + i) % every == 0:
+                    first_marker_at = t if first_marker_at < 0 else first_marker_at
+                    data[i, 0] = 1e-3
+                    markers.push(f'S{k + i}', t0 + (k + i) / a.rate)
                 outlet.push_volts(data[i:i + 1], t0 + (k + i) / a.rate)
+            if markers is not None and first_marker_at >= 0 and \
+                    0 <= a.markers_until <= t - first_marker_at:
+                markers.close()
+                markers = None
             k += n
         time.sleep(0.002)
     outlet.close()

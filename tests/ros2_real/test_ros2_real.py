@@ -40,8 +40,17 @@ def test_real_ros2_cli_against_our_sim_node(spawn_node, ros2):
     assert '/sim' in nodes.stdout.split(), nodes.stdout + nodes.stderr
     call = ros2('service', 'call', '/sim/reset', 'mindgrasp_msgs/srv/ResetSim', '{seed: 3}')
     assert call.returncode == 0 and 'success=True' in call.stdout, call.stdout + call.stderr
-    assert ros2('param', 'get', '/sim', 'camera_rate').stdout.strip() == 'Double value is: 1.0'
-    echo = ros2('topic', 'echo', '--once', '/joint_states', 'sensor_msgs/msg/JointState')
+    def param(*args: str) -> subprocess.CompletedProcess:
+        return ros2('param', *args, '--no-daemon')     # no daemon outlives the test
+
+    assert param('get', '/sim', 'camera_rate').stdout.strip() == 'Double value is: 1.0'
+    assert param('set', '/sim', 'use_sim_time', 'false').stdout.strip() == \
+        'Set parameter successful'
+    assert param('get', '/sim', 'use_sim_time').stdout.strip() == 'Boolean value is: False'
+    refused = param('set', '/sim', 'camera_rate', '2.0')      # read-only: refused
+    assert "Setting parameter failed: parameter 'camera_rate' is read-only" in refused.stderr
+    echo = ros2('topic', 'echo', '--once', '--no-daemon', '/joint_states',
+                'sensor_msgs/msg/JointState')
     assert 'name:\n- joint_1' in echo.stdout, echo.stdout + echo.stderr
     # our verbs print what ros2's print
     ours = mindgrasp('service', 'list', '-t').stdout
@@ -81,15 +90,30 @@ def test_our_verbs_against_a_real_rclpy_node(spawn_node, rclpy_env, tmp_path):
     assert "message='on=True gain=7.5'" in call.stdout, call.stdout + call.stderr
 
 
+def test_our_topic_verbs_against_a_real_rclpy_talker(spawn_node, rclpy_env, ros2):
+    talker = spawn_node(PEER, 'talker', env=rclpy_env)
+    listed = until(lambda: mindgrasp('topic', 'list', '-t'),
+                   lambda r: '/chatter [std_msgs/msg/String]' in r.stdout.splitlines())
+    assert '/chatter [std_msgs/msg/String]' in listed.stdout.splitlines(), \
+        listed.stdout + listed.stderr + talker.output()
+    echo = mindgrasp('topic', 'echo', '--once', '/chatter')
+    assert echo.returncode == 0 and echo.stdout.startswith('data:') and 'hello ' in echo.stdout, \
+        echo.stdout + echo.stderr
+    # the same lines as the real ros2 topic info
+    theirs = until(lambda: ros2('topic', 'info', '/chatter', '--no-daemon'),
+                   lambda r: 'Publisher count: 1' in r.stdout)
+    assert mindgrasp('topic', 'info', '/chatter').stdout == theirs.stdout
+
+
 def test_our_controller_on_real_rclpy(spawn_node, rclpy_env, ros2):
     fsm = spawn_node('mindgrasp_fsm.fsm_node', env=rclpy_env)
     assert fsm.wait_for_output('Grasp controller ready', 60), fsm.output()
-    described = until(lambda: ros2('param', 'describe', '/fsm', 'lock_duration'),
+    described = until(lambda: ros2('param', 'describe', '/fsm', 'lock_duration', '--no-daemon'),
                       lambda r: r.returncode == 0 and 'Min value' in r.stdout)
     assert 'Min value: 0.001' in described.stdout, described.stdout + described.stderr
-    assert ros2('param', 'set', '/fsm', 'lock_duration', '2.5').stdout.strip() == \
+    assert ros2('param', 'set', '/fsm', 'lock_duration', '2.5', '--no-daemon').stdout.strip() == \
         'Set parameter successful'
-    refused = ros2('param', 'set', '/fsm', 'lock_duration', '-1.0')
+    refused = ros2('param', 'set', '/fsm', 'lock_duration', '-1.0', '--no-daemon')
     assert 'Setting parameter failed' in refused.stdout + refused.stderr
     assert mindgrasp('param', 'get', '/fsm', 'lock_duration').stdout.strip() == \
         'Double value is: 2.5'

@@ -32,10 +32,11 @@ def add_data_arguments(parser: argparse.ArgumentParser) -> None:
     g.add_argument('--eeg-topic', default=EEG_RAW.name, help='EEG topic in bags (default /eeg/raw)')
     g.add_argument('--prompt-topic', default=TRAINER_PROMPT.name,
                    help='prompt topic in bags (default /trainer/prompt)')
-    g.add_argument('--labels', choices=('prompt', 'intent'), default='prompt',
-                   help='labels of bag runs: the trainer/Graz prompts (prompt, default), or the '
+    g.add_argument('--labels', choices=('prompt', 'intent', 'markers'), default='prompt',
+                   help='labels of bag runs: the trainer/Graz prompts (prompt, default), the '
                         "virtual subject's intent for demo and experiment runs (intent, from "
-                        '--intent-topic; epochs [tmin, tmax] tile each intent)')
+                        '--intent-topic; epochs [tmin, tmax] tile each intent), or the '
+                        "amplifier's LSL markers on /eeg/markers named in --event-map (markers)")
     g.add_argument('--intent-topic', default=VIRTUAL_SUBJECT_INTENT.name,
                    help='intent topic in bags for --labels intent (default '
                         '/virtual_subject/intent)')

@@ -23,7 +23,7 @@ from mindgrasp_common.errors import CommonError
 from mindgrasp_common.mi import NO_CLASS, REST
 from mindgrasp_common.mi import class_index as mi_class_index
 from mindgrasp_common.types import Recording
-from mindgrasp_ros.topics import EEG_RAW, TRAINER_PROMPT, VIRTUAL_SUBJECT_INTENT
+from mindgrasp_ros.topics import EEG_MARKERS, EEG_RAW, TRAINER_PROMPT, VIRTUAL_SUBJECT_INTENT
 
 #: EEGMMIDB run -> {annotation: MIndGrasp class} (../shared/data/EEGMMIDB-README.md).
 EEGMMIDB_RUNS: dict[int, dict[str, int]] = {
@@ -149,7 +149,7 @@ def eegbci_files(subject: int, runs: Sequence[int], path: str | None = None) -> 
 
 
 # --------------------------------------------------------------------------- bags
-LABELS = ('prompt', 'intent')
+LABELS = ('prompt', 'intent', 'markers')
 #: a phase that ends this much before its planned end was cut short (s)
 _CUT_TOLERANCE = 0.25   # prompts are stamped when published (timer ticks, load)
 
@@ -205,7 +205,8 @@ def intent_events(changes: Sequence[tuple[float, str]], end: float, tmin: float,
 def load_bag(path: str | Path, eeg_topic: str = EEG_RAW.name,
              prompt_topic: str = TRAINER_PROMPT.name, *, labels: str = 'prompt',
              keep_aborted: bool = False, intent_topic: str = VIRTUAL_SUBJECT_INTENT.name,
-             tmin: float = 0.5, tmax: float = 2.5) -> Recording:
+             tmin: float = 0.5, tmax: float = 2.5,
+             event_map: dict[str, int] | None = None) -> Recording:
     """Load a recorded run (rosbag2 folder) with EEG chunks and its labels.
 
     ``labels='prompt'``: the label of a trial is the prompt class; its onset is the first prompt
@@ -213,11 +214,17 @@ def load_bag(path: str | Path, eeg_topic: str = EEG_RAW.name,
     cut short (:func:`aborted_trials`) are left out unless ``keep_aborted``; their number is in
     ``n_aborted``. ``labels='intent'``: demo and experiment runs, labelled by the virtual
     subject's intent (``intent_topic``), epochs ``[tmin, tmax]`` tiling each intent
-    (:func:`intent_events`). Lost samples (gaps in ``first_sample_index``) are NaN, and windows
-    over them are skipped.
+    (:func:`intent_events`). ``labels='markers'``: the amplifier's (or a stimulus PC's) LSL
+    markers the acquisition node relayed to ``/eeg/markers`` (``marker_stream``), each named in
+    ``event_map`` an epoch onset of its class (``{'T1': 0, 'T2': 1}``), as in an EDF or XDF file.
+    Lost samples (gaps in ``first_sample_index``) are NaN, and windows over them are skipped.
     """
     if labels not in LABELS:
-        msg = f"--labels must be 'prompt' or 'intent'; {labels!r} is invalid."
+        msg = f"--labels must be one of {', '.join(LABELS)}; {labels!r} is invalid."
+        raise ClassifierError(msg)
+    if labels == 'markers' and not event_map:
+        msg = ("--labels markers needs --event-map naming the markers' classes, e.g. "
+               'T1=left_hand,T2=right_hand.')
         raise ClassifierError(msg)
     from rosbags.rosbag2 import Reader
 
@@ -229,8 +236,9 @@ def load_bag(path: str | Path, eeg_topic: str = EEG_RAW.name,
         raise ClassifierError(msg)
     bag_dir = _find_bag_dir(path)
     store = typestore()
-    chunks, prompts, intents = [], [], []
-    label_topic = prompt_topic if labels == 'prompt' else intent_topic
+    chunks, prompts, intents, markers = [], [], [], []
+    label_topic = {'prompt': prompt_topic, 'intent': intent_topic,
+                   'markers': EEG_MARKERS.name}[labels]
     try:
         with Reader(bag_dir) as reader:
             topics = {c.topic for c in reader.connections}
@@ -243,6 +251,11 @@ def load_bag(path: str | Path, eeg_topic: str = EEG_RAW.name,
                        'nothing to label with; it needs a run with the virtual subject (demo, '
                        'experiment), or use --labels prompt for trainer/graz runs.')
                 raise ClassifierError(msg)
+            if labels == 'markers' and label_topic not in topics:
+                msg = (f'The bag {bag_dir} has no {label_topic} topic, so --labels markers has '
+                       'nothing to label with; record with the acquisition node relaying the '
+                       'marker stream (marker_stream:=auto or its name).')
+                raise ClassifierError(msg)
             conns = [c for c in reader.connections if c.topic in (eeg_topic, label_topic)]
             for conn, t_ns, raw in reader.messages(connections=conns):
                 msg_obj = store.deserialize_cdr(raw, conn.msgtype)
@@ -250,6 +263,9 @@ def load_bag(path: str | Path, eeg_topic: str = EEG_RAW.name,
                     chunks.append(msg_obj)
                 elif labels == 'prompt':
                     prompts.append(msg_obj)
+                elif labels == 'markers':
+                    stamp = msg_obj.header.stamp
+                    markers.append((stamp.sec + 1e-9 * stamp.nanosec, str(msg_obj.data)))
                 else:
                     intents.append((t_ns * 1e-9, str(msg_obj.data)))
     except ClassifierError:
@@ -302,6 +318,8 @@ def load_bag(path: str | Path, eeg_topic: str = EEG_RAW.name,
     if labels == 'intent':
         end = offset + (base + data.shape[0]) / rate
         timed = intent_events(sorted(intents), end, tmin, tmax)
+    elif labels == 'markers':
+        timed = [(t, event_map[text]) for t, text in sorted(markers) if text in event_map]
     for t, k in timed:
         onset = round((t - offset) * rate) - base
         if 0 <= onset < data.shape[0] and k < len(CLASS_NAMES):
@@ -401,7 +419,8 @@ def load_inputs(edf: Iterable[str] = (), bags: Iterable[str] = (), event_map: st
         recs += [load_edf(p, rest=rest)
                  for p in eegbci_files(eegbci_subject, eegbci_runs or (4, 6, 8, 10))]
     recs += [load_bag(p, eeg_topic, prompt_topic, labels=labels, keep_aborted=keep_aborted,
-                      intent_topic=intent_topic, tmin=tmin, tmax=tmax) for p in bags]
+                      intent_topic=intent_topic, tmin=tmin, tmax=tmax, event_map=emap)
+             for p in bags]
     if not recs:
         msg = 'No input data; give --edf FILES, --xdf FILES, --bag RUNS or --eegbci SUBJECT.'
         raise ClassifierError(msg)

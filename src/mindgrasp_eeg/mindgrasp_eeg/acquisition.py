@@ -53,6 +53,7 @@ from .lsl import (
     StreamDescription,
     StreamFinder,
     check_stream,
+    clocksync_for,
     not_found_error,
     open_inlet,
     resolve_stream,
@@ -289,9 +290,7 @@ class EEGAcquisition:
         return desc
 
     def _clocksync_for(self, info: pylsl.StreamInfo) -> bool:
-        # a sender on this host shares our local_clock(): the offset is exactly 0, and skipping
-        # the estimate avoids its jumps (RTT/2 errors) on a loaded machine
-        return self.clocksync and info.hostname() != socket.gethostname()
+        return clocksync_for(info, self.clocksync)
 
     def _adopt(self, desc: StreamDescription) -> None:
         n_ch, rate, names = self.expected

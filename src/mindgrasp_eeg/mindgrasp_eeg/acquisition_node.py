@@ -14,6 +14,13 @@ The stream is looked for in a background thread (up to ``resolve_timeout`` s): m
 answers signals at once and says "Searching for the LSL stream ..." on /eeg/status (WARN). Not
 found in time, or a layout that does not match: exit 1 with the reason.
 
+Markers: with ``marker_stream:=auto`` (``<stream_name>-markers``, as ``mindgrasp eeg play`` names
+it) or ``marker_stream:=NAME`` the node also relays an LSL marker stream (type ``Markers``: an
+amplifier's triggers, a stimulus PC) to ``/eeg/markers`` (mindgrasp_msgs/EEGMarker), each stamped
+on the same LSL-to-ROS mapping as the EEG samples, so the recorder keeps them and the exports read
+them as events (:mod:`mindgrasp_eeg.marker_inlet`). Off by default; a marker stream not found or
+lost is one log line, never an exit.
+
 Which sender is trusted: by default any stream with the right name (a warning says so). Pin the
 amplifier with ``source_id`` and ``hostname`` (``hostname:=local`` means this host), so no other
 sender on the network can stand in for it.
@@ -25,17 +32,19 @@ import socket
 
 import numpy as np
 from mindgrasp_ros.interfaces.diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
-from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import EEGChunk
+from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import EEGChunk, EEGMarker
 
 from mindgrasp_eeg import EEGError
 from mindgrasp_eeg.acquisition import ERROR, OK, WARN, EEGAcquisition, read_clocks, ros_stamp_ns
+from mindgrasp_eeg.marker_inlet import MarkerInlet, marker_stream_name
 from mindgrasp_eeg.params import AcquisitionParams
 from mindgrasp_eeg.ros_conversions import ns_to_time_fields
 from mindgrasp_ros import rclpy
+from mindgrasp_ros.logs import log_at
 from mindgrasp_ros.node_main import end_after, fail, run_node
 from mindgrasp_ros.node_traits import NodeTraits
 from mindgrasp_ros.params import declare_params
-from mindgrasp_ros.topics import EEG_RAW, EEG_STATUS
+from mindgrasp_ros.topics import EEG_MARKERS, EEG_RAW, EEG_STATUS
 
 _LEVELS = {OK: DiagnosticStatus.OK, WARN: DiagnosticStatus.WARN, ERROR: DiagnosticStatus.ERROR}
 
@@ -69,6 +78,14 @@ class AcquisitionNode(rclpy.node.Node):
             hostname=socket.gethostname() if p.hostname == 'local' else p.hostname)
         self.pub_raw = self.create_publisher(EEGChunk, EEG_RAW.name, EEG_RAW.qos)
         self.pub_status = self.create_publisher(DiagnosticArray, EEG_STATUS.name, EEG_STATUS.qos)
+        markers = marker_stream_name(p.marker_stream, p.stream_name)
+        self.markers = MarkerInlet(markers, clocksync=p.clocksync,
+                                   resolve_timeout=p.resolve_timeout) if markers else None
+        if self.markers is not None:
+            self.pub_markers = self.create_publisher(EEGMarker, EEG_MARKERS.name,
+                                                     EEG_MARKERS.qos)
+            self.get_logger().info(f"Looking for the LSL marker stream '{markers}' (type "
+                                   f'Markers) to relay to {EEG_MARKERS.name}.')
         self._wanted = (f'name {p.stream_name!r}, type {p.stream_type!r}, source_id '
                         f'{p.source_id!r}, host {self.acq.hostname!r}')
         if not self.acq.pinned:
@@ -107,6 +124,8 @@ class AcquisitionNode(rclpy.node.Node):
         of the wrong layout ends the node with exit code 1 and the reason."""
         if self.done.done():
             return
+        if self.markers is not None:
+            self.relay_markers()
         try:
             connected = self._connected()
         except EEGError as exc:
@@ -135,6 +154,26 @@ class AcquisitionNode(rclpy.node.Node):
         if self.acq.status().level != self._last_level:
             self.status_callback()
 
+    def relay_markers(self) -> None:
+        """Publish the markers that arrived on /eeg/markers, stamped as the EEG samples are;
+        log the marker stream's news (found, not found yet, lost) one line each."""
+        assert self.markers is not None
+        markers, news = self.markers.poll()
+        for level, line in news:
+            log_at(self.get_logger(), level, line)
+        if not markers:
+            return
+        lsl_now, ros_now = read_clocks(lambda: self.get_clock().now().nanoseconds)
+        desc = self.markers.desc
+        for marker in markers:
+            msg = EEGMarker(data=marker.text, lsl_timestamp=marker.timestamp,
+                            stream_name=desc.name if desc else '',
+                            source_id=desc.source_id if desc else '')
+            msg.header.stamp.sec, msg.header.stamp.nanosec = ns_to_time_fields(
+                ros_stamp_ns(marker.timestamp, lsl_now, ros_now))
+            msg.header.frame_id = self.params.frame_id
+            self.pub_markers.publish(msg)
+
     def status_callback(self) -> None:
         """Publish /eeg/status; log level changes."""
         if self.acq.searching:
@@ -147,9 +186,8 @@ class AcquisitionNode(rclpy.node.Node):
             return
         status = self.acq.status()
         if status.level != self._last_level:
-            log = {OK: self.get_logger().info, WARN: self.get_logger().warning,
-                   ERROR: self.get_logger().error}[status.level]
-            log(status.message)
+            log_at(self.get_logger(), {OK: 'info', WARN: 'warning', ERROR: 'error'}[status.level],
+                   status.message)
             self._last_level = status.level
         desc = self.acq.desc
         item = DiagnosticStatus(level=_LEVELS[status.level], name='eeg_acquisition',
@@ -162,8 +200,10 @@ class AcquisitionNode(rclpy.node.Node):
         self.pub_status.publish(msg)
 
     def destroy_node(self) -> None:
-        """Close the inlet, then the node."""
+        """Close the inlets, then the node."""
         self.acq.close()
+        if self.markers is not None:
+            self.markers.close()
         super().destroy_node()
 
 

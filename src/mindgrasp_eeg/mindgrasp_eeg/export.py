@@ -15,7 +15,9 @@ Annotations (onset in seconds from the first sample, from the message header sta
 - ``/task/result`` -> ``result/success/<desired object>`` or ``result/failure/<desired object>``
   spanning the trial (onset = result stamp - trial duration),
 - ``/fsm/state`` -> ``state/<n> <name>`` at each change of the controller state, lasting until the
-  next change.
+  next change,
+- ``/eeg/markers`` (the amplifier's or a stimulus PC's LSL markers, relayed by the acquisition
+  node with ``marker_stream``) -> the marker string as sent (e.g. ``T1``), duration 0.
 
 MNE selects annotations by their ``/``-separated tags, so ``epochs['success']`` or
 ``epochs['target']`` epoch by trial outcome or target. The raw data get the standard 10-20
@@ -35,6 +37,7 @@ import numpy as np
 
 from mindgrasp_common.types import Recording
 from mindgrasp_ros.topics import (
+    EEG_MARKERS,
     EEG_RAW,
     FSM_STATE,
     TASK_RESULT,
@@ -97,7 +100,8 @@ def read_session(path: str | Path, eeg_topic: str = EEG_RAW.name) -> Recording:
     try:
         with Reader(bag) as reader:
             wanted = {eeg_topic, TRAINER_PROMPT.name, TASK_TARGET.name,
-                      VIRTUAL_SUBJECT_INTENT.name, TASK_RESULT.name, FSM_STATE.name}
+                      VIRTUAL_SUBJECT_INTENT.name, TASK_RESULT.name, FSM_STATE.name,
+                      EEG_MARKERS.name}
             conns = [c for c in reader.connections if c.topic in wanted]
             if not any(c.topic == eeg_topic for c in conns):
                 conns = []    # no EEG: reported below (rosbags reads every topic for [])
@@ -125,6 +129,8 @@ def read_session(path: str | Path, eeg_topic: str = EEG_RAW.name) -> Recording:
                 elif conn.topic == FSM_STATE.name:
                     states.append((_stamp_ns(msg.header) or t_log,
                                    state_marker(msg.state, msg.state_name)))
+                elif conn.topic == EEG_MARKERS.name:
+                    events.append((_stamp_ns(msg.header), 0.0, msg.data or 'marker'))
                 else:
                     events.append((t_log, 0.0, f'intent/{msg.data}'))
     except EEGError:

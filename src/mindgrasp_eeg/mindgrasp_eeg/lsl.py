@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import math
 import re
+import socket
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -181,6 +182,13 @@ class StreamFinder:
         self._resolver = None
 
 
+def clocksync_for(info: pylsl.StreamInfo, clocksync: bool = True) -> bool:
+    """Whether an inlet of ``info`` should apply LSL's clock offset (``time_correction``): a
+    sender on this host shares our ``local_clock()``, so its offset is exactly 0 and skipping the
+    estimate avoids its jumps (RTT/2 errors) on a loaded machine."""
+    return clocksync and info.hostname() != socket.gethostname()
+
+
 def open_inlet(info: pylsl.StreamInfo, *, max_buflen: float = 1.0, dejitter: bool = True,
                clocksync: bool = True, timeout: float = 5.0) -> tuple[pylsl.StreamInlet,
                                                                       StreamDescription]:
@@ -322,6 +330,10 @@ class MarkerOutlet:
     def push(self, marker: str, timestamp: float = 0.0) -> None:
         """Push one marker at ``timestamp`` (LSL s; 0 = now)."""
         self._outlet.push_sample([marker], timestamp)
+
+    def have_consumers(self) -> bool:
+        """True when at least one inlet is connected."""
+        return self._outlet.have_consumers()
 
     def close(self) -> None:
         """Withdraw the stream."""

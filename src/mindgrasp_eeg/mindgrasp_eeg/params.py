@@ -70,6 +70,9 @@ class AcquisitionParams:
     status_period: float = param(1.0, '/eeg/status period (also sent on every level change)',
                                  unit='s', min=1e-3, max=3600.0)
     frame_id: str = param('eeg', 'frame_id of /eeg/raw')
+    marker_stream: str = param('none', 'LSL marker stream relayed to /eeg/markers: none, auto '
+                               '(<stream_name>-markers, as `mindgrasp eeg play` names it) or its '
+                               'name')
     duration: float = param(0.0, 'end after this long (0 = until stopped)', unit='s', min=0.0)
 
 

@@ -45,6 +45,7 @@ from mindgrasp_fsm.types import (
     Prediction,
 )
 from mindgrasp_ros import rclpy
+from mindgrasp_ros.logs import log_at
 from mindgrasp_ros.node_main import declare_duration, run_node
 from mindgrasp_ros.node_traits import NodeTraits
 from mindgrasp_ros.params import declare_params
@@ -200,9 +201,8 @@ class FsmNode(rclpy.node.Node):
         self._publish_state(out, now)
         for event in out.events:
             # a sensor fault's latch and release are the lines a user must see
-            log = self.get_logger().warning if event.startswith(f'{SENSOR_FAULT}:') else \
-                self.get_logger().info
-            log(f'State: {event}')
+            log_at(self.get_logger(), 'warning' if event.startswith(f'{SENSOR_FAULT}:') else
+                   'info', f'State: {event}')
 
     def _publish_state(self, out: FsmOutput, now: float) -> None:
         """/fsm/state on every change, else at most once per second. A stop reason carries a
@@ -218,9 +218,8 @@ class FsmNode(rclpy.node.Node):
                                             not self._last_state_msg[2]):
             # a latch said why in its own line; waiting for a first input is how every start
             # begins (the nodes come up in any order): information, not a warning
-            log = self.get_logger().info if _WAITING in out.reason else \
-                self.get_logger().warning
-            log(out.reason)
+            log_at(self.get_logger(), 'info' if _WAITING in out.reason else 'warning',
+                   out.reason)
         self._last_state_msg, self._last_state_pub = key, now
         msg = FsmState(state=int(out.state), state_name=STATE_NAMES[out.state],
                        previous_state=int(out.previous_state),

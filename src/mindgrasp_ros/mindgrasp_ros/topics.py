@@ -96,6 +96,12 @@ EEG_RAW = _t('/eeg/raw', 'mindgrasp_msgs/msg/EEGChunk',
              'eeg_acquisition', 'classifier, recorder', 'volts')
 EEG_STATUS = _t('/eeg/status', 'diagnostic_msgs/msg/DiagnosticArray', RELIABLE,
                 'eeg_acquisition', 'all')
+#: latched with a queue: a recorder that starts after the acquisition node still gets the
+#: last 100 markers (a trigger sent at start-up is not lost)
+EEG_MARKERS = _t('/eeg/markers', 'mindgrasp_msgs/msg/EEGMarker',
+                 Qos(durability='transient_local', depth=100),
+                 'eeg_acquisition (marker_stream)', 'recorder, export',
+                 "the amplifier's LSL markers; stamp on the /eeg/raw clock")
 BCI_PREDICTION = _t('/bci/prediction', 'mindgrasp_msgs/msg/MIPrediction', RELIABLE,
                     'classifier', 'fsm, vision, graz')
 BCI_STATUS = _t('/bci/status', 'diagnostic_msgs/msg/DiagnosticArray', RELIABLE,
@@ -179,7 +185,7 @@ TRAINER_ROBOT_TOPICS = tuple(
 
 #: Every topic of the graph, by name.
 TOPICS: dict[str, Topic] = {t.name: t for t in (
-    EEG_RAW, EEG_STATUS, BCI_PREDICTION, BCI_STATUS, TRAINER_PROMPT, TRAINER_DISPLAY,
+    EEG_RAW, EEG_STATUS, EEG_MARKERS, BCI_PREDICTION, BCI_STATUS, TRAINER_PROMPT, TRAINER_DISPLAY,
     TRAINER_EE_DISTANCE, COLOR_IMAGE, DEPTH_IMAGE, COLOR_INFO, DEPTH_INFO, JOINT_STATES,
     ARM_COMMANDS, ARM_TRAJECTORY, SERVO_TWIST, GRIPPER_COMMANDS, GRIPPER_JOINT_STATES,
     GRIPPER_CONTACTS, EE_POSE,

@@ -39,6 +39,7 @@ from mindgrasp_bringup.bag.recorder import Recorder
 from mindgrasp_bringup.bag.ros_glue import message_class, qos_profile
 from mindgrasp_bringup.bag.writer import BagWriter
 from mindgrasp_ros import rclpy
+from mindgrasp_ros.logs import log_at
 from mindgrasp_ros.node_main import NodeFailure, end_after, run_node
 from mindgrasp_ros.node_traits import NodeTraits
 from mindgrasp_ros.params import ParameterError, declare_params, param
@@ -308,8 +309,8 @@ class RecorderNode(rclpy.node.Node):
                                f'{self.recorder.writer.path}; {dropped} dropped{fault}; '
                                f'{len(missing)} topic(s) not recorded.')
         for topic, why in missing.items():
-            log = self.get_logger().info if self._idle(topic) else self.get_logger().warning
-            log(f'Not recorded: {topic}: {why}')
+            log_at(self.get_logger(), 'info' if self._idle(topic) else 'warning',
+                   f'Not recorded: {topic}: {why}')
         return self.recorder.error
 
 

@@ -47,12 +47,14 @@ def main(args: argparse.Namespace) -> int:
                 time.sleep(0.1)
     except CliError as exc:
         return print_error(exc)
-    print(f'Type: {typename}\n')
-    print(f'Publisher count: {len(pubs)}\n')
+    # as ros2topic's info verb: one line each, a blank line after each only with --verbose
+    end = '\n\n' if args.verbose else '\n'
+    print(f'Type: {typename}', end=end)
+    print(f'Publisher count: {len(pubs)}', end=end)
     if args.verbose:
         for info in pubs:
             print(_describe(info))
-    print(f'Subscription count: {len(subs)}\n')
+    print(f'Subscription count: {len(subs)}', end=end)
     if args.verbose:
         for info in subs:
             print(_describe(info))

@@ -2,14 +2,15 @@
 
     mindgrasp launch eeg eeg_stream:=MyAmp                 # a real amplifier's LSL stream
     mindgrasp eeg play eegbci:1:4 --name eegmmidb &        # any LSL EEG source, e.g. EEGMMIDB
-    mindgrasp launch eeg eeg_stream:=eegmmidb
+    mindgrasp launch eeg eeg_stream:=eegmmidb marker_stream:=auto   # + its eegmmidb-markers
     mindgrasp launch eeg virtual_amp:=true subject:=noise  # with the virtual amplifier
     mindgrasp launch eeg --show-args
 
 The acquisition node publishes /eeg/raw and /eeg/status; the run directory records them. With
 adapt:=true (the default here) the node adopts the stream's channel count, rate and names with a
 warning; adapt:=false holds the stream to mindgrasp_eeg/param/eeg.yaml (32 ch, 250 Hz, g.Nautilus
-names).
+names). With marker_stream:=auto (``<eeg_stream>-markers``) or marker_stream:=NAME the node also
+relays that LSL marker stream (the amplifier's triggers) to /eeg/markers, which the run records.
 """
 
 from mindgrasp_bringup.launch_api import (
@@ -37,6 +38,9 @@ def generate_launch_description() -> LaunchDescription:
         DeclareLaunchArgument('adapt', default_value='true', choices=['true', 'false'],
                               description="adopt the stream's channel count/rate/names (with a "
                                           'warning) instead of failing on a mismatch'),
+        DeclareLaunchArgument('marker_stream', default_value='none',
+                              description='LSL marker stream to relay to /eeg/markers: none, '
+                                          'auto (<eeg_stream>-markers) or its name'),
         DeclareLaunchArgument('virtual_amp', default_value='false', choices=['true', 'false'],
                               description='also start the virtual amplifier as eeg_stream'),
         DeclareLaunchArgument('subject', default_value='noise',
@@ -59,5 +63,6 @@ def generate_launch_description() -> LaunchDescription:
                           'stream_type': LaunchConfiguration('stream_type'),
                           'source_id': LaunchConfiguration('source_id'),
                           'adapt_to_stream': LaunchConfiguration('adapt'),
+                          'marker_stream': LaunchConfiguration('marker_stream'),
                           'duration': duration}]),
     ])

@@ -74,12 +74,19 @@ _to_stderr = os.environ.get('RCUTILS_LOGGING_USE_STDOUT', '1') == '0'
 
 
 class RcutilsLogger:
-    """A named logger with rclpy's methods (``info``, ``warning``, ``once``, ``throttle``...)."""
+    """A named logger with rclpy's methods (``info``, ``warning``, ``once``, ``throttle``...).
+
+    As rclpy's, a call site (function, file, line, bytecode offset) keeps the severity of its
+    first message: logging at another severity from the same call raises ``ValueError('Logger
+    severity cannot be changed between calls.')`` (``mindgrasp_ros.logs.log_at`` logs at a level
+    chosen at run time).
+    """
 
     def __init__(self, name: str = '') -> None:
         self.name = name
         self._once: set[tuple[str, int]] = set()
         self._last: dict[tuple[str, int], float] = {}
+        self._severities: dict[tuple[str, str, int, int], LoggingSeverity] = {}
 
     def get_child(self, name: str) -> RcutilsLogger:
         return RcutilsLogger(f'{self.name}.{name}' if self.name else name)
@@ -98,9 +105,14 @@ class RcutilsLogger:
             **_kwargs: object) -> bool:
         if not self.is_enabled_for(severity):
             return False
-        frame = inspect.currentframe()
-        caller = frame.f_back.f_back if frame and frame.f_back else None
+        caller = inspect.currentframe()
+        while caller is not None and caller.f_code.co_filename == __file__:
+            caller = caller.f_back            # the first frame outside this module, as rclpy's
         key = (caller.f_code.co_filename, caller.f_lineno) if caller else ('', 0)
+        site = (*key, caller.f_code.co_name, caller.f_lasti) if caller else ('', 0, '', 0)
+        if self._severities.setdefault(site, severity) != severity:
+            msg = 'Logger severity cannot be changed between calls.'
+            raise ValueError(msg)
         if once:
             if key in self._once:
                 return False
