@@ -109,6 +109,11 @@ def test_services_and_parameters_across_processes(rclpy_ctx, spawn_node, tmp_pat
 
     toggle = node.create_client(SetBool, '/toggle')
     assert toggle.wait_for_service(timeout_sec=60)
+    # paired as rmw_cyclonedds pairs them: the server's request reader and reply writer say one
+    # serviceid, and the client's endpoints say a clientid (so a real rclpy server waits for
+    # this client's reply reader before it answers)
+    servers = toggle._writer.matched_user_data('serviceid')
+    assert len(servers) == 1 and servers == toggle._reader.matched_user_data('serviceid')
     future = toggle.call_async(SetBool.Request(data=True))
     rclpy.spin_until_future_complete(node, future, timeout_sec=60)
     assert future.result().message == 'on=True gain=7.0'

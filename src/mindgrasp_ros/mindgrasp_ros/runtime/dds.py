@@ -260,6 +260,11 @@ class DdsReader:
     def matched_count(self) -> int:
         return _matched(self.reader.get_matched_publications)
 
+    def matched_user_data(self, key: str) -> set[str]:
+        """The values of ``key`` in the USER_DATA of the matched writers."""
+        return _user_data_values(self.reader.get_matched_publications,
+                                 self.reader.get_matched_publication_data, key)
+
     def writer_participant(self, publication_handle: int) -> Any | None:
         """Participant GUID of a matched writer (a SampleInfo's ``publication_handle``), or None
         once that writer is gone."""
@@ -296,10 +301,41 @@ class DdsWriter:
     def matched_count(self) -> int:
         return _matched(self.writer.get_matched_subscriptions)
 
+    def matched_user_data(self, key: str) -> set[str]:
+        """The values of ``key`` in the USER_DATA of the matched readers."""
+        return _user_data_values(self.writer.get_matched_subscriptions,
+                                 self.writer.get_matched_subscription_data, key)
+
     def readers_of(self, participant: Any) -> int:
         """How many matched readers belong to ``participant`` (a participant GUID)."""
         return _count_in(self.writer.get_matched_subscriptions,
                          self.writer.get_matched_subscription_data, participant)
+
+
+def user_data(qos: Any) -> dict[str, str]:
+    """The ``key=value;`` pairs of an endpoint QoS's USER_DATA (rmw's ``typehash=``,
+    ``clientid=``, ``serviceid=``)."""
+    pairs: dict[str, str] = {}
+    for policy in qos or ():
+        if getattr(policy, '__scope__', '') == 'Userdata':
+            for part in bytes(policy.data).decode(errors='replace').split(';'):
+                name, sep, value = part.partition('=')
+                if sep:
+                    pairs[name] = value
+    return pairs
+
+
+def _user_data_values(handles: Callable[[], list[int]], data: Callable[[int], Any],
+                      key: str) -> set[str]:
+    """Values of ``key`` in the USER_DATA of matched endpoints (those that unmatch meanwhile
+    give None and are skipped)."""
+    values = set()
+    for handle in handles():
+        endpoint = data(handle)
+        value = user_data(endpoint.qos).get(key) if endpoint is not None else None
+        if value is not None:
+            values.add(value)
+    return values
 
 
 def _count_in(handles: Callable[[], list[int]], data: Callable[[int], Any],
@@ -366,10 +402,13 @@ class DdsParticipant:
             return topic
 
     def create_writer(self, dds_topic: str, ros_type: str, qos: QoSProfile, *,
-                      service_role: str | None = None, type_hash: str | None = None) -> DdsWriter:
+                      service_role: str | None = None, type_hash: str | None = None,
+                      extra_user_data: str = '') -> DdsWriter:
+        """``extra_user_data``: ``key=value;`` pairs before the type hash, as rmw_cyclonedds
+        puts a client's ``clientid=`` or a service's ``serviceid=`` there."""
         data_type = (_service_wire_type(ros_type, service_role) if service_role
                      else idl_struct(ros_type))
-        user_data = f'typehash={type_hash or rihs01(ros_type)};'.encode()
+        user_data = f'{extra_user_data}typehash={type_hash or rihs01(ros_type)};'.encode()
         with self._lock:
             writer = DataWriter(self.publisher, self._topic(dds_topic, data_type),
                                 qos=to_dds_qos(qos, user_data))
@@ -377,10 +416,10 @@ class DdsParticipant:
 
     def create_reader(self, dds_topic: str, ros_type: str, qos: QoSProfile, *,
                       service_role: str | None = None, ignore_local: bool = False,
-                      type_hash: str | None = None) -> DdsReader:
+                      type_hash: str | None = None, extra_user_data: str = '') -> DdsReader:
         data_type = (_service_wire_type(ros_type, service_role) if service_role
                      else idl_struct(ros_type))
-        user_data = f'typehash={type_hash or rihs01(ros_type)};'.encode()
+        user_data = f'{extra_user_data}typehash={type_hash or rihs01(ros_type)};'.encode()
         with self._lock:
             wrapper = DdsReader()
             wrapper.reader = DataReader(

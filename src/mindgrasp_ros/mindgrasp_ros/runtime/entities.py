@@ -424,6 +424,15 @@ def _unpack_service(data: bytes) -> tuple[int, int, bytes]:
     return guid, seq, data[:4] + data[20:]
 
 
+_pair_ids = itertools.count(1)
+
+
+def _endpoint_pair_id(dds: Any) -> str:
+    """An id unique on the domain for a client's or a service's two endpoints: the
+    participant's GUID and a counter (rmw_cyclonedds writes its own 16-byte id the same way)."""
+    return f'{dds.participant.guid.hex}.{next(_pair_ids)}'
+
+
 def _service_topics(name: str) -> tuple[str, str]:
     return f'rq{name}Request', f'rr{name}Reply'
 
@@ -449,10 +458,12 @@ class Service(Entity):
         # in-process requests (always used in DDS-less contexts): (request, future) pairs
         self._local: deque[tuple[Any, Future]] = deque()
         if dds is not None:
+            # rmw_cyclonedds pairs a service's request reader and reply writer by this id
+            ident = f'serviceid={_endpoint_pair_id(dds)};'
             self._reader = dds.create_reader(req_topic, self._req_type, qos,
-                                             service_role='request')
+                                             service_role='request', extra_user_data=ident)
             self._writer = dds.create_writer(rep_topic, self._res_type, qos,
-                                             service_role='reply')
+                                             service_role='reply', extra_user_data=ident)
         else:
             node.context.intra.services[name] = self
 
@@ -555,10 +566,13 @@ class Client(Entity):
         self._writer = self._reader = None
         self._guid = next(Client._guids)
         if dds is not None:
+            # as rmw_cyclonedds: with this id a server (real rclpy's too) waits for this
+            # client's reply reader before it answers, instead of answering into the void
+            ident = f'clientid={_endpoint_pair_id(dds)};'
             self._writer = dds.create_writer(req_topic, self._req_type, qos,
-                                             service_role='request')
+                                             service_role='request', extra_user_data=ident)
             self._reader = dds.create_reader(rep_topic, self._res_type, qos,
-                                             service_role='reply')
+                                             service_role='reply', extra_user_data=ident)
             # unique across processes: derived from the request writer's DDS GUID
             self._guid ^= int.from_bytes(self._writer.guid[:8], 'little')
         self._seq = itertools.count(1)
@@ -574,8 +588,14 @@ class Client(Entity):
         return self._reader.guid if self._reader else _local_gid(self)
 
     def service_is_ready(self) -> bool:
+        """A server's request reader and its reply writer are both matched (paired by their
+        ``serviceid``, as rmw_cyclonedds' ``rmw_service_server_is_available`` pairs them; any
+        reader and writer for servers that do not say their id)."""
         if self._writer is None:
             return self.srv_name in self.node.context.intra.services
+        servers = self._writer.matched_user_data('serviceid')
+        if servers:
+            return bool(servers & self._reader.matched_user_data('serviceid'))
         return self._writer.matched_count() > 0 and self._reader.matched_count() > 0
 
     def wait_for_service(self, timeout_sec: float | None = None) -> bool:

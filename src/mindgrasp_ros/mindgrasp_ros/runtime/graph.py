@@ -28,6 +28,7 @@ from mindgrasp_ros.runtime.dds import (
     DdsParticipant,
     ros_topic_name_from_dds,
     ros_type_name_from_dds,
+    user_data,
 )
 from mindgrasp_ros.runtime.duration import Duration
 from mindgrasp_ros.runtime.endpoint_info import TopicEndpointInfo
@@ -101,13 +102,7 @@ def _duration(ns: int) -> Duration:
 
 
 def _user_data_hash(qos: Any) -> str:
-    for policy in qos:
-        if getattr(policy, '__scope__', '') == 'Userdata':
-            text = bytes(policy.data).decode(errors='replace')
-            for part in text.split(';'):
-                if part.startswith('typehash='):
-                    return part[len('typehash='):]
-    return ''
+    return user_data(qos).get('typehash', '')
 
 
 class GraphCache:
