@@ -76,7 +76,7 @@ def test_xarm6_mounted_camera_and_tcp_are_frames_of_tf_static(rclpy_ctx, spawn_n
     np.testing.assert_allclose([q.x, q.y, q.z, q.w],
                                Rotation.from_euler('xyz', [0.45, 0.0, np.pi / 2]).as_quat(),
                                atol=1e-9)
-    assert tcp.transform.translation.z == pytest.approx(0.172)
+    assert tcp.transform.translation.z == pytest.approx(0.152)
     node.destroy_node()
     proc.stop()
 
