@@ -6,6 +6,7 @@ time goes per node (wall s in each node's callbacks) and per function (``--profi
     python benchmarks/experiment.py --protocol random_locations --subject autonomous
     python benchmarks/experiment.py --profile 25            # + the 25 costliest functions
     python benchmarks/experiment.py --sweep --trials 8      # trials/min: 1, 2 workers, Ray
+    python benchmarks/experiment.py --robot xarm6 --subject oracle --trials 3   # another arm
 
 The trials run in this process, one after the other (``--workers`` of the CLI multiplies the
 real-time factor by up to the number of free cores). The machine's load counts: the CPU figure
@@ -33,6 +34,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument('--trials', type=int, default=2)
     parser.add_argument('--seed', type=int, default=0)
     parser.add_argument('--step', type=float, default=0.02)
+    parser.add_argument('--robot', default='mindgrasp_arm', metavar='NAME|YAML',
+                        help='the arm (robot:= of the experiment profile): mindgrasp_arm, xarm6 '
+                             'or a robot description YAML path')
     parser.add_argument('--profile', type=int, default=0, metavar='N',
                         help='profile with cProfile and print the N costliest functions')
     parser.add_argument('--sweep', action='store_true',
@@ -44,7 +48,8 @@ def main(argv: list[str] | None = None) -> int:
     from mindgrasp_experiments.engine import lockstep_components, run_trial
 
     launch_args = {'protocol': args.protocol, 'subject': args.subject,
-                   'accuracy': str(args.accuracy), 'seed': str(args.seed)}
+                   'accuracy': str(args.accuracy), 'seed': str(args.seed),
+                   'robot': args.robot}
     if args.subject == 'noise':
         launch_args['model'] = noise_model_path(Path(tempfile.mkdtemp()))
     comps = lockstep_components('experiment', launch_args, Path(tempfile.mkdtemp()) / 'params',
@@ -68,9 +73,9 @@ def main(argv: list[str] | None = None) -> int:
     wall = time.perf_counter() - wall0
     sim = sum(r.sim_s for r in runs)
     cpu = sum(r.cpu_s for r in runs)
-    print(f'\n{args.protocol}, subject {args.subject}: {len(runs)} trials, {sim:.0f} simulated s '
-          f'in {wall:.0f} s wall: real-time factor {sim / wall:.1f}; {cpu / sim:.3f} CPU s per '
-          f'simulated s (= {sim / cpu:.1f}x real time per free core)')
+    print(f'\n{args.protocol}, subject {args.subject}, robot {args.robot}: {len(runs)} trials, '
+          f'{sim:.0f} simulated s in {wall:.0f} s wall: real-time factor {sim / wall:.1f}; '
+          f'{cpu / sim:.3f} CPU s per simulated s (= {sim / cpu:.1f}x real time per free core)')
     node_s: dict[str, float] = {}
     for r in runs:
         for name, sec in r.node_s.items():

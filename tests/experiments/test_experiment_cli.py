@@ -168,14 +168,15 @@ def test_random_locations_and_a_users_own_controller(tmp_path: Path) -> None:
 @pytest.mark.timeout(1800)   # whole experiments in subprocesses, on a loaded machine
 def test_random_locations_on_the_xarm6(tmp_path: Path) -> None:
     """--robot xarm6: the same experiment runs the simulator, vision and the controller on the
-    xArm6: its wrist camera finds the object, the controller centres it and approaches (the
-    parallel-jaw grasp is not tuned yet, issue 28)."""
+    xArm6: its wrist camera finds the object, the controller centres it, approaches, closes the
+    parallel jaws (grasp check by width) and lifts it above 0.22 m (about 14 simulated s)."""
     s = last_json(mindgrasp('experiment', 'random-locations', '--robot', 'xarm6', '--trials', '1',
-                            '--seed', '1', '--trial-timeout', '15', '--out', str(tmp_path),
+                            '--seed', '1', '--trial-timeout', '40', '--out', str(tmp_path),
                             '--json', '--no-progress'))
     assert s['trials'] == 1 and s['node_errors'] == 0
     (rec,) = read_records(tmp_path)
-    assert rec.states.startswith('1-2-3'), (rec.states, rec.reason)
+    assert rec.states == '1-2-3-4-5-6', (rec.states, rec.reason)
+    assert rec.success and rec.correct_choice, rec.reason
 
 
 @pytest.mark.slow

@@ -683,6 +683,35 @@ def test_an_object_carried_by_two_fingers_after_the_lift_is_held(params: FsmPara
             assert entered and '1 finger(s) push on something' in entered[0].reason
 
 
+#: a parallel-jaw gripper (the xArm's): six linkage joints, only the drive joint has a motor
+JAWS_ON_OBJECT = GripperState(opening=0.45, force=2.0, stamp=0.0, contact=False,
+                              fingers_in_contact=0, efforts=(2.0, 0.0, 0.0, 0.0, 0.0, 0.0))
+JAWS_SHUT = GripperState(opening=0.0, force=0.01, stamp=0.0, contact=False, fingers_in_contact=0,
+                         efforts=(0.01, 0.0, 0.0, 0.0, 0.0, 0.0))
+
+
+def test_width_check_holds_on_jaws_stopped_apart(params: FsmParams) -> None:
+    """grasp_check width (a parallel-jaw gripper's description): the jaws stopping apart on
+    the full closing command is a grasp (its one motor is the only loaded joint, which the
+    effort check took for a one-finger touch); jaws closing through after the lift are a slip."""
+    width = dataclasses.replace(params, grasp_check='width')
+    fsm = _grasp_fsm(width)
+    outs, q, t = _drive(fsm, _grasp_pose(), JAWS_ON_OBJECT, 1.2)
+    assert outs[-1].phase == 'lift'
+    # the jaws keep the full closing command (no squeeze hold just past the contact)
+    assert outs[-1].gripper.position == width.gripper_closed_position
+    outs, _, _ = _drive(fsm, q, JAWS_SHUT, 6.0, t0=t)
+    entered = [o for o in outs if o.state == State.FINAL_APPROACH]
+    assert entered and 'slipped after the lift: fingers closed on nothing' in entered[0].reason
+    fsm = _grasp_fsm(width)
+    _drive(fsm, _grasp_pose(), JAWS_ON_OBJECT, 8.0)
+    assert fsm.outcome == 'holding'
+    fsm = _grasp_fsm(params)                  # the effort check counts one loaded finger
+    outs, _, _ = _drive(fsm, _grasp_pose(), JAWS_ON_OBJECT, 8.0)
+    entered = [o for o in outs if o.state == State.FINAL_APPROACH]
+    assert entered and '1 finger(s) push on something' in entered[0].reason
+
+
 def test_contact_flags_are_used_without_efforts_or_when_asked(params: FsmParams) -> None:
     from mindgrasp_fsm.grasp_policy import fingers_loaded
 

@@ -42,10 +42,11 @@ def test_xarm6_kinematics_match_pybullet():
         c_pos, c_rot = kin.camera_pose(q)
         np.testing.assert_allclose(c_pos, cam_pos, atol=1e-6)
         np.testing.assert_allclose(c_rot, Rotation.from_quat(cam_quat).as_matrix(), atol=1e-6)
-    # the TCP 0.172 m below the gripper base at home (the gripper points down; the simulated
-    # arm's gravity sag is a few um)
-    base = sim.link_pose('xarm_gripper_base_link')[0]
-    np.testing.assert_allclose(kin.tool_position(sim.home_pose), base - [0, 0, 0.172], atol=1e-4)
+    # the TCP (the middle of the finger pads) 0.152 m along the tool axis from the gripper base
+    # at home (the simulated arm's gravity sag is a few um)
+    base, quat = sim.link_pose('xarm_gripper_base_link')
+    tcp = base + Rotation.from_quat(quat).as_matrix() @ [0, 0, 0.152]
+    np.testing.assert_allclose(kin.tool_position(sim.home_pose), tcp, atol=1e-4)
     sim.close()
 
 

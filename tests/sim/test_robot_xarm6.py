@@ -71,12 +71,12 @@ def test_xarm6_mounted_camera_and_tcp_are_frames_of_tf_static(rclpy_ctx, spawn_n
     cam, tcp = frames['camera_color_optical_frame'], frames['tcp']
     assert cam.header.frame_id == tcp.header.frame_id == 'xarm_gripper_base_link'
     v = cam.transform.translation
-    np.testing.assert_allclose([v.x, v.y, v.z], [-0.07, 0.0, 0.02], atol=1e-9)
+    np.testing.assert_allclose([v.x, v.y, v.z], [0.07, 0.0, 0.02], atol=1e-9)
     q = cam.transform.rotation
     np.testing.assert_allclose([q.x, q.y, q.z, q.w],
-                               Rotation.from_euler('xyz', [0.45, 0.0, np.pi / 2]).as_quat(),
+                               Rotation.from_euler('xyz', [0.0, 0.0, np.pi / 2]).as_quat(),
                                atol=1e-9)
-    assert tcp.transform.translation.z == pytest.approx(0.172)
+    assert tcp.transform.translation.z == pytest.approx(0.152)
     node.destroy_node()
     proc.stop()
 

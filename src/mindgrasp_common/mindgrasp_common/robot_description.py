@@ -73,7 +73,10 @@ class GripperDescription:
     one position per joint (rad or m); ``kind`` in :data:`GRIPPER_KINDS`; ``grasp_check`` in
     :data:`GRASP_CHECKS`; ``limits`` (one per joint) from the URDF; ``self_collision``: whether
     the gripper's links (and the links they hang from) collide with each other (false for a
-    linkage whose links overlap, as an SRDF's ``disable_collisions`` says)."""
+    linkage whose links overlap, as an SRDF's ``disable_collisions`` says); ``mimic``: the
+    gripper joints the URDF declares as ``<mimic>`` of another gripper joint, as
+    ``(joint, leader, multiplier, offset)`` (position = multiplier * leader + offset, rad or m):
+    a simulator couples them to their leader rather than driving them on their own."""
 
     kind: str
     joints: tuple[str, ...]
@@ -82,6 +85,7 @@ class GripperDescription:
     grasp_check: str
     limits: tuple[JointLimits, ...]
     self_collision: bool = True
+    mimic: tuple[tuple[str, str, float, float], ...] = ()
 
 
 @dataclass(frozen=True)
@@ -143,6 +147,7 @@ class _UrdfJoint:
     type: str
     child: str
     limits: JointLimits | None
+    mimic: tuple[str, float, float] | None = None   # leader joint, multiplier, offset
 
 
 def _read_urdf(path: Path, where: str) -> tuple[set[str], dict[str, _UrdfJoint]]:
@@ -165,9 +170,17 @@ def _read_urdf(path: Path, where: str) -> tuple[set[str], dict[str, _UrdfJoint]]
             except ValueError:
                 limits = None
         child = j.find('child')
+        mimic = j.find('mimic')
+        leader = None
+        if mimic is not None:
+            try:
+                leader = (mimic.get('joint', ''), float(mimic.get('multiplier', '1')),
+                          float(mimic.get('offset', '0')))
+            except ValueError:
+                leader = None
         joints[j.get('name', '')] = _UrdfJoint(j.get('type', ''),
                                               '' if child is None else child.get('link', ''),
-                                              limits)
+                                              limits, leader)
     return links, joints
 
 
@@ -329,9 +342,12 @@ def _load(path: Path) -> RobotDescription:
     if not isinstance(self_collision, bool):
         msg = f'{where}: gripper self_collision must be true or false, got {self_collision!r}.'
         raise RobotDescriptionError(msg)
+    # URDF mimic joints among the gripper joints (PyBullet does not enforce <mimic>)
+    mimic = tuple((j, *urdf_joints[j].mimic) for j in g_joints
+                  if urdf_joints[j].mimic is not None and urdf_joints[j].mimic[0] in g_joints)
     gripper = GripperDescription(kind=kind, joints=g_joints, open=g_open, closed=g_closed,
                                  grasp_check=check, limits=g_limits,
-                                 self_collision=self_collision)
+                                 self_collision=self_collision, mimic=mimic)
 
     tcp = _frame(_section(data, 'tcp', where), 'tcp', where, links, urdf)
     camera = _frame(_section(data, 'camera', where), 'camera', where, links, urdf)

@@ -17,7 +17,9 @@ measurement instead:
 5. ``descend``: straight down to the grasp height.
 6. ``close`` (state 5): force-limited closing until the fingers stall.
 7. ``check_contact``: every finger must push on something (finger effort; a real hand's contact
-   sensor cannot tell the object from the table) and the hand must not be fully closed.
+   sensor cannot tell the object from the table) and the hand must not be fully closed; with
+   ``grasp_check: width`` (a parallel-jaw gripper) the jaws, closing with the full command, must
+   have stopped apart.
 8. ``lift`` + ``check_lift``: lift and check the finger efforts and opening again (an object
    that slipped out unloads the fingers; ``min_fingers_holding`` still carry it); a slip or a
    miss opens the hand,
@@ -358,7 +360,9 @@ class GraspPolicy:
         where they touch the object, so the grip is a stiff position equilibrium. Closing on with
         full torque lets the stronger thumb push the object out between the two fingers."""
         p = self.params
-        if p.grip_squeeze <= 0:
+        if p.grip_squeeze <= 0 or p.grasp_check == 'width':
+            # jaws keep the full closing command: were they held just past the contact, an
+            # object slipping out would leave them apart, and the width check would not see it
             return
         closure = min((1.0 - gripper.opening) + p.grip_squeeze, p.gripper_closed_position)
         self._gripper = GripperCommand(closure, self._gripper.max_force)
@@ -372,6 +376,8 @@ class GraspPolicy:
             return True, 'no gripper feedback: grasp not verified'
         if gripper.opening <= self.params.closed_empty_opening:
             return False, f'fingers closed on nothing (opening {gripper.opening:.2f})'
+        if self.params.grasp_check == 'width':
+            return True, f'jaws stopped apart (opening {gripper.opening:.2f})'
         loaded = fingers_loaded(gripper, self.params.finger_contact_effort)
         if loaded is not None:
             # effort sensing: what a real hand knows (contact flags cannot tell the table apart)
@@ -429,6 +435,8 @@ class GraspPolicy:
                 n = fingers_loaded(gripper, p.finger_contact_effort)
                 if n is None:
                     n = gripper.fingers_in_contact
+                if p.grasp_check == 'width':
+                    n = None     # jaws: closing ends when they stall (on the object or shut)
                 if self._hold_since is None and n is not None and n >= p.min_fingers_in_contact:
                     # every finger touches: stop closing and hold a little past this point
                     self._contact_since = self._contact_since if self._contact_since is not None \

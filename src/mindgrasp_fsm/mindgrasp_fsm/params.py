@@ -24,7 +24,7 @@ from mindgrasp_common.robot import (
     HOME_POSE,
     URDF_URI,
 )
-from mindgrasp_common.robot_description import load_robot
+from mindgrasp_common.robot_description import GRASP_CHECKS, load_robot
 from mindgrasp_fsm.command_interface import COMMAND_INTERFACES, check_command_interface
 from mindgrasp_fsm.errors import FsmError
 from mindgrasp_ros.params import param
@@ -47,7 +47,8 @@ class FsmParams:
     autonomous: bool = param(False, 'no BCI: search left, approach and grasp on vision alone')
     robot: str = param('', "the arm: mindgrasp_arm, xarm6 or a robot description YAML path; its "
                        'URDF, TCP and camera links, joints, home pose, limits and velocity '
-                       "limits replace the eight parameters below; '' = those as given")
+                       "limits replace the eight parameters below (and grasp_check); '' = "
+                       'those as given')
     urdf_file: str = param(URDF_URI, 'URDF for forward / inverse kinematics: a path or a '
                            'package:// URI')
     tool_link: str = param('tcp', 'URDF link of the grasp point between the fingertips')
@@ -308,6 +309,12 @@ class FsmParams:
     finger_contact_effort: float = param(0.4, 'finger motor effort that means "this finger '
                                          'pushes on something"; 0 uses the contact flags',
                                          unit='N m', min=0.0, max=100.0, live=True)
+    # a parallel-jaw gripper (the xArm's) reports its jaw position, not an effort per finger:
+    # the jaws stopping apart on the full closing command is the grasp, closing through is a miss
+    grasp_check: str = param('effort', 'how a closed gripper is judged to hold: effort or '
+                             'contacts (loaded fingers, finger_contact_effort) or width (the '
+                             "jaws stop apart); the robot description's, with robot:=",
+                             live=True)
     closed_empty_opening: float = param(0.05, 'opening (0 closed .. 1 open) below which the hand '
                                         'is empty', min=0.0, max=1.0, live=True)
     lift_height: float = param(0.12, 'lift after closing', unit='m', min=0.0, max=1.0,
@@ -352,6 +359,7 @@ class FsmParams:
         self.joint_lower_limits = list(description.lower)
         self.joint_upper_limits = list(description.upper)
         self.max_joint_velocity = list(description.max_velocity)
+        self.grasp_check = description.gripper.grasp_check
 
     # ---------------------------------------------------------------------------------------
     def shape_value(self, shape: str, name: str) -> float:
@@ -362,6 +370,10 @@ class FsmParams:
     def validate(self) -> None:
         """Raise :class:`FsmError` naming the first bad parameter and how to fix it."""
         check_command_interface(self.command_interface)
+        if self.grasp_check not in GRASP_CHECKS:
+            msg = (f"The parameter 'grasp_check' is {self.grasp_check!r}; use one of "
+                   f"{', '.join(GRASP_CHECKS)}.")
+            raise FsmError(msg)
         for name in ('joint_names', 'home_position', 'joint_lower_limits', 'joint_upper_limits',
                      'max_joint_velocity', 'max_joint_acceleration'):
             values = getattr(self, name)

@@ -297,6 +297,13 @@ class Simulation:
             raise SimError(msg)
         self._arm_idx = [names[n] for n in self.joint_names]
         self._finger_idx = [names[n] for n in self.finger_names]
+        # (position in finger_names, joint index) of the gripper joints with a motor: the
+        # URDF's mimic joints follow their leader through a gear constraint instead
+        followers = {m[0] for m in self.robot.gripper.mimic}
+        self._finger_driven = [(k, j) for k, (j, n) in enumerate(
+            zip(self._finger_idx, self.finger_names, strict=True)) if n not in followers]
+        for r in self._robots.values():
+            self._couple_mimic_joints(p, r.body, names)
         self._tcp_idx = links[self.robot.tcp.link]
         # the base and the links welded to it (the xArm's link_base under its world link) stand
         # on the ground: their contact with it is no collision
@@ -410,6 +417,22 @@ class Simulation:
             for b in links:
                 if a < b:
                     p.setCollisionFilterPair(body, body, a, b, 0)
+
+    def _couple_mimic_joints(self, p: BulletClient, body: int, names: dict[str, int]) -> None:
+        """Tie each URDF mimic joint of the gripper to its leader with a gear constraint
+        (position = multiplier * leader + offset), its own motor off. PyBullet ignores
+        ``<mimic>``: driven one by one with soft motors, the xArm gripper's finger pads turned
+        out under load (past their limits) and the object slipped out at the lift."""
+        for joint, leader, multiplier, offset in self.robot.gripper.mimic:
+            j, lead = names[joint], names[leader]
+            p.setJointMotorControl2(body, j, pb.VELOCITY_CONTROL, force=0.0)
+            axis = p.getJointInfo(body, j)[13]
+            c = p.createConstraint(body, lead, body, j, pb.JOINT_GEAR, list(axis), [0, 0, 0],
+                                   [0, 0, 0])
+            # the gear holds q_j = multiplier * q_leader (+ offset, as a position target)
+            p.changeConstraint(c, gearRatio=-multiplier, gearAuxLink=-1, erp=0.8,
+                               relativePositionTarget=offset,
+                               maxForce=p.getJointInfo(body, j)[10])
 
     def _spawn(self, spec: ObjectSpec) -> int:
         p = self._p
@@ -591,7 +614,7 @@ class Simulation:
                 if r.gripper_dirty:
                     target = self._finger_open + (self._finger_closed - self._finger_open) \
                         * r.closure
-                    for k, j in enumerate(self._finger_idx):
+                    for k, j in self._finger_driven:
                         p.setJointMotorControl2(
                             r.body, j, pb.POSITION_CONTROL, targetPosition=float(target[k]),
                             force=self._finger_effort[k], maxVelocity=self._finger_velocity[k],

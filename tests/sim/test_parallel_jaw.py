@@ -1,0 +1,82 @@
+"""A parallel-jaw gripper from its description: the xArm6's gripper (a linkage whose five other
+joints are URDF mimics of its drive joint) picks each shape from above by friction alone and
+lifts it above 0.22 m. PyBullet ignores <mimic>: the simulation couples the mimic joints to
+their leader (gear constraints), or the finger pads turn out under load and the object slips."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from mindgrasp_common.robot_description import load_robot
+from mindgrasp_fsm.grasp_fsm import GraspFsm
+from mindgrasp_fsm.params import FsmParams
+from mindgrasp_sim.simulation import Simulation
+from mindgrasp_sim.task import SUCCESS_HEIGHT
+
+pytestmark = pytest.mark.slow
+
+
+def one_object_scene(shape: str, xy: tuple[float, float]) -> dict:
+    return {'name': 'one', 'objects': [{'shape': shape, 'colour': 'red', 'size': 0.05,
+                                        'position': list(xy), 'yaw_deg': 0.0}]}
+
+
+class Driver:
+    """Joint-velocity moves of the simulated arm through the controller's kinematics (as the
+    controller sends them at 60 Hz; nothing is teleported)."""
+
+    def __init__(self, sim: Simulation, robot: str) -> None:
+        self.sim = sim
+        self.kin = GraspFsm.from_params(FsmParams(robot=robot)).kinematics
+        self.vmax = np.asarray(load_robot(robot).max_velocity)
+
+    def _send(self, err: np.ndarray, gain: float) -> None:
+        v = gain * err
+        v = v / max(1.0, float(np.max(np.abs(v) / self.vmax)))
+        self.sim.set_joint_velocities(v)
+        self.sim.step(4)
+
+    def to_joints(self, q: np.ndarray, timeout: float = 8.0) -> None:
+        for _ in range(int(timeout * 60)):
+            err = q - self.sim.joint_positions()
+            if np.max(np.abs(err)) < 0.003:
+                break
+            self._send(err, 3.0)
+        self.sim.stop()
+
+    def line(self, p1: np.ndarray, yaw: float, speed: float = 0.05) -> None:
+        """Straight tool motion to ``p1`` (m), gripper pointing down at ``yaw`` (rad)."""
+        p0 = self.kin.tool_position(self.sim.joint_positions())
+        steps = int(np.linalg.norm(p1 - p0) / speed * 60) + 1
+        for k in range(1, steps + 1):
+            q = self.kin.grasp_ik(p0 + (p1 - p0) * k / steps, yaw, self.sim.joint_positions())
+            assert q is not None
+            self._send(q - self.sim.joint_positions(), 60.0)
+        self.sim.stop()
+        self.sim.step(10)
+
+
+@pytest.mark.parametrize('shape', ['cube', 'cylinder', 'sphere'])
+def test_xarm6_picks_each_shape_and_its_linkage_stays_coupled(shape):
+    xarm = load_robot('xarm6')
+    assert {m[0] for m in xarm.gripper.mimic} == set(xarm.gripper.joints[1:])
+    with Simulation(one_object_scene(shape, (0.45, -0.1)), robot='xarm6') as sim:
+        arm = Driver(sim, 'xarm6')
+        x, y, _ = sim.objects()[0].position
+        yaw = math.atan2(y, x) + math.pi
+        arm.to_joints(arm.kin.grasp_ik(np.array([x, y, 0.15]), yaw, sim.joint_positions()))
+        arm.line(np.array([x, y, 0.03]), yaw)
+        sim.set_gripper(1.0)
+        sim.step(240)
+        fingers = sim.finger_positions()
+        # stopped on the object, every joint of the linkage near the drive joint's angle
+        assert 0.2 < fingers[0] < 0.8 * xarm.gripper.closed[0], fingers
+        np.testing.assert_allclose(fingers, fingers[0], atol=0.2)
+        arm.line(np.array([x, y, 0.28]), yaw, speed=0.1)
+        sim.step(120)
+        held = sim.held_object()
+        assert held is not None and held.shape == shape
+        assert sim.objects()[0].position[2] > SUCCESS_HEIGHT
