@@ -32,7 +32,10 @@ def test_ros2_launch_demo_grasps_on_real_rclpy(colcon_ws, tmp_path: Path) -> Non
     proc = subprocess.Popen(
         ['ros2', 'launch', 'mindgrasp_bringup', 'demo.launch.py', 'trials:=1',
          'targets:=red cube', 'live_view:=false', f'eeg_stream:=mg-ros2-{uuid.uuid4().hex[:8]}',
-         f'run_dir:={run}'], env=colcon_ws, stdout=subprocess.PIPE,
+         f'run_dir:={run}',
+         # launch's own grace before SIGTERM (5 s): a loaded 2-core machine can take longer to
+         # close the bag and eight rclpy contexts, and a node then ends by signal, not cleanly
+         'sigterm_timeout:=60'], env=colcon_ws, stdout=subprocess.PIPE,
         stderr=subprocess.STDOUT, text=True, start_new_session=True)
     try:
         # the demo ends by itself when its trial is done (about 45 s here)
