@@ -166,6 +166,10 @@ class _Robot:
     v_applied: np.ndarray = field(default_factory=lambda: np.zeros(6))
     cmd_moving: bool = False
     applied_moving: bool = False
+    # getJointStates of the arm and the physics step it was read after: the tracker, the
+    # governor and every published reading want the same states in a step (one call, not 4)
+    states: tuple = ()
+    states_step: int = -1
 
     def command(self, v: np.ndarray) -> None:
         self.v_cmd = v
@@ -504,6 +508,7 @@ class Simulation:
         for robot in self._robots.values():
             for i, j in enumerate(self._arm_idx):
                 p.resetJointState(robot.body, j, self.home_pose[i], 0.0)
+            robot.states_step = -1
             for j, q in zip(self._finger_idx, self._finger_open, strict=True):
                 p.resetJointState(robot.body, j, q, 0.0)
             robot.q_ref = self.home_pose.copy()
@@ -575,6 +580,7 @@ class Simulation:
         r = self._robot(robot)
         for i, j in enumerate(self._arm_idx):
             self._p.resetJointState(r.body, j, q[i], 0.0)
+        r.states_step = -1
         r.q_ref = q.copy()
         r.command(np.zeros(6))
         r.apply(np.zeros(6))
@@ -603,7 +609,7 @@ class Simulation:
                     # stopping: hold the current reference (set once, then left alone), no
                     # further ahead of the joints than one step at the velocity limit: a lagging
                     # arm must not be pulled there faster than its limit
-                    q = np.array([st[0] for st in p.getJointStates(r.body, self._arm_idx)])
+                    q = np.array([st[0] for st in self._arm_states(r)])
                     reach = self.max_velocity * self._lag_scale
                     r.q_ref = np.minimum(np.maximum(r.q_ref, q - reach), q + reach)
                     p.setJointMotorControlArray(
@@ -635,7 +641,7 @@ class Simulation:
         so the target is the reference at the start of the step, with the correction of any
         lag bounded so that the aim stays within the joint's velocity limit.
         """
-        q = np.array([s[0] for s in p.getJointStates(r.body, self._arm_idx)])
+        q = np.array([s[0] for s in self._arm_states(r)])
         # keep the reference near the real joints (a blocked arm does not wind up); ufuncs
         # rather than np.clip, whose wrapper costs more than the arithmetic at 240 Hz
         q_ref = np.minimum(np.maximum(r.q_ref, q - 0.05), q + 0.05)
@@ -650,11 +656,19 @@ class Simulation:
             targetVelocities=v_ff, forces=self.max_effort,
             positionGains=_ARM_POSITION_GAINS, velocityGains=_ARM_VELOCITY_GAINS)
 
+    def _arm_states(self, r: _Robot) -> tuple:
+        """``getJointStates`` of the arm's joints after the latest physics step (read once per
+        step; a teleport or a governor reset reads them again)."""
+        if r.states_step != self._step_count:
+            r.states = self._p.getJointStates(r.body, self._arm_idx)
+            r.states_step = self._step_count
+        return r.states
+
     def _govern(self, p: BulletClient, r: _Robot) -> None:
         """The drive's velocity governor: a joint more than 5 % faster than its URDF limit after
         a step (the constraint solver's 50 iterations leave up to ~10 % where joints couple) is
         slowed to the limit, so that measured velocities stay within 5 % of it."""
-        v = np.array([st[1] for st in p.getJointStates(r.body, self._arm_idx)])
+        v = np.array([st[1] for st in self._arm_states(r)])
         # the tolerance: resetting a joint's state disturbs the contacts of a held object (a
         # small sphere slips), so the governor acts on the solver's gross errors only, not on
         # the few per cent a joint reads above its limit as a motion starts
@@ -664,17 +678,18 @@ class Simulation:
                 j = self._arm_idx[i]
                 q = p.getJointState(r.body, j)[0]
                 p.resetJointState(r.body, j, q, float(np.sign(v[i]) * self.max_velocity[i]))
+            r.states_step = -1
 
     # ------------------------------------------------------------------ state
     def joint_positions(self, robot: str = 'user') -> np.ndarray:
         """Arm joint positions (6,) rad."""
         r = self._robot(robot)
-        return np.array([s[0] for s in self._p.getJointStates(r.body, self._arm_idx)])
+        return np.array([s[0] for s in self._arm_states(r)])
 
     def joint_velocities(self, robot: str = 'user') -> np.ndarray:
         """Arm joint velocities (6,) rad/s."""
         r = self._robot(robot)
-        return np.array([s[1] for s in self._p.getJointStates(r.body, self._arm_idx)])
+        return np.array([s[1] for s in self._arm_states(r)])
 
     def joint_readings(self, robot: str = 'user') -> tuple[np.ndarray, np.ndarray]:
         """What the arm's encoders report: joint positions (6,) rad and velocities (6,) rad/s,
@@ -687,7 +702,7 @@ class Simulation:
     def joint_efforts(self, robot: str = 'user') -> np.ndarray:
         """Arm joint motor torques (6,) N m applied in the last step."""
         r = self._robot(robot)
-        return np.array([s[3] for s in self._p.getJointStates(r.body, self._arm_idx)])
+        return np.array([s[3] for s in self._arm_states(r)])
 
     def finger_positions(self, robot: str = 'user') -> np.ndarray:
         """Finger joint angles (3,) rad (thumb, left, right); larger is more closed."""
