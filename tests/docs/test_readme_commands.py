@@ -27,6 +27,7 @@ def _commands() -> list[tuple[str, str]]:
                 in_block = not in_block
                 continue
             text = re.split(r'\s#', line)[0].strip()          # drop the trailing comment
+            text = text.removesuffix('&').strip()        # a command sent to the background
             if not in_block or not text.startswith('mindgrasp '):
                 continue
             if re.search(r'[<>|\[\]]|\.\.\.|\b[A-Z][A-Z_]+\b', text):

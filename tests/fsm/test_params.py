@@ -11,9 +11,17 @@ from mindgrasp_fsm.params import FsmParams, default_params_path
 def test_parameter_file_holds_every_parameter_with_the_defaults() -> None:
     import yaml
 
+    from mindgrasp_common.robot_description import load_robot
+    from mindgrasp_fsm.params import ROBOT_PARAMETERS
+
     data = yaml.safe_load(default_params_path().read_text())
-    assert set(data['fsm']['ros__parameters']) == set(FsmParams.names())
+    # the robot's parameters come from its description, not from the controller's file
+    assert set(data['fsm']['ros__parameters']) == set(FsmParams.names()) - set(ROBOT_PARAMETERS)
+    assert not set(data['fsm']['ros__parameters']) & set(ROBOT_PARAMETERS)
     assert FsmParams.from_yaml(default_params_path()) == FsmParams()
+    shipped = FsmParams(robot='mindgrasp_arm')
+    assert all(getattr(FsmParams(), name) == getattr(shipped, name) for name in ROBOT_PARAMETERS)
+    assert FsmParams().joint_names == list(load_robot('mindgrasp_arm').arm_joints)
 
 
 @pytest.mark.parametrize(('values', 'match'), [

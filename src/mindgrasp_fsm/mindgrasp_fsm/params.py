@@ -35,6 +35,12 @@ RESUME_MODES = ('require_new_command', 'resume')
 PARADIGMS = ('paper', 'scan')
 
 
+#: what a robot description sets (:meth:`FsmParams.apply_robot`); their defaults are the shipped
+#: arm's description, so the parameter file leaves them out
+ROBOT_PARAMETERS = ('urdf_file', 'tool_link', 'camera_link', 'joint_names', 'home_position',
+                    'joint_lower_limits', 'joint_upper_limits', 'max_joint_velocity')
+
+
 @dataclass
 class FsmParams:
     """Parameters of :class:`mindgrasp_fsm.grasp_fsm.GraspFsm` (SI units: s, rad, rad/s, m, N).
@@ -346,8 +352,8 @@ class FsmParams:
         self.validate()
 
     def apply_robot(self) -> None:
-        """Set the robot parameters (``urdf_file`` .. ``max_joint_velocity``) from the robot
-        description ``robot``; a bad description raises its one-line error."""
+        """Set the robot parameters (:data:`ROBOT_PARAMETERS`) and ``grasp_check`` from the
+        robot description ``robot``; a bad description raises its one-line error."""
         description = load_robot(self.robot)
         # the description's package:// URI as it is (the node resolves it), else the file
         self.urdf_file = description.urdf_uri if description.urdf_uri.startswith('package://') \
