@@ -11,6 +11,9 @@ from mindgrasp_ros.runtime.logging import RcutilsLogger
 
 def test_one_call_site_one_severity_as_rclpy() -> None:
     logger = RcutilsLogger('logs_test')
+    # as in rclpy, a call site takes its severity only when that severity is enabled: the
+    # level is set here, not left to whatever default an earlier test in this process set
+    logger.set_level('info')
 
     def say(warn: bool) -> None:
         (logger.warning if warn else logger.info)('one call site')
@@ -26,6 +29,7 @@ def test_one_call_site_one_severity_as_rclpy() -> None:
 @pytest.mark.parametrize('levels', [('info', 'warning', 'error', 'info', 'debug', 'fatal')])
 def test_log_at_any_level_from_one_line(levels, capsys) -> None:
     logger = RcutilsLogger('logs_test_at')
+    logger.set_level('debug')
     for level in levels:
         log_at(logger, level, f'at {level}')
     err = capsys.readouterr().err
