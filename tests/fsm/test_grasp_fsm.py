@@ -19,6 +19,7 @@ from mindgrasp_fsm.types import (
     MiClass,
     Prediction,
     State,
+    StopKind,
 )
 
 from .conftest import HOME, inputs, observation, run
@@ -328,6 +329,9 @@ def test_watchdog_stops_every_joint(fsm: GraspFsm, kw: dict, match: str) -> None
     assert out.stopped
     assert np.all(out.joint_velocities == 0)
     assert re.search(match, out.reason), out.reason
+    # a missing first input is how a start begins; anything else is a fault (its log severity)
+    missing = None in kw.values()
+    assert out.stop_kind == (StopKind.AWAITING_INPUT if missing else StopKind.FAULT)
     # recovers when the inputs are good again (after a prediction loss or a joint-state fault,
     # which latches: a fresh decision first, tested below)
     if 'joints' in kw and kw['joints'] is not None:

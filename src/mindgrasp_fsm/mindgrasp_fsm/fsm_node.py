@@ -43,6 +43,7 @@ from mindgrasp_fsm.types import (
     FsmOutput,
     JointStateIn,
     Prediction,
+    StopKind,
 )
 from mindgrasp_ros import rclpy
 from mindgrasp_ros.logs import log_at
@@ -61,8 +62,6 @@ from mindgrasp_ros.topics import (
 )
 
 _NUMBER = re.compile(r'\d+(\.\d+)?')
-# the watchdog's reasons while a first input is awaited ('no joint states received yet')
-_WAITING = 'received yet'
 
 
 class FsmNode(rclpy.node.Node):
@@ -218,8 +217,8 @@ class FsmNode(rclpy.node.Node):
                                             not self._last_state_msg[2]):
             # a latch said why in its own line; waiting for a first input is how every start
             # begins (the nodes come up in any order): information, not a warning
-            log_at(self.get_logger(), 'info' if _WAITING in out.reason else 'warning',
-                   out.reason)
+            log_at(self.get_logger(), 'info' if out.stop_kind == StopKind.AWAITING_INPUT
+                   else 'warning', out.reason)
         self._last_state_msg, self._last_state_pub = key, now
         msg = FsmState(state=int(out.state), state_name=STATE_NAMES[out.state],
                        previous_state=int(out.previous_state),

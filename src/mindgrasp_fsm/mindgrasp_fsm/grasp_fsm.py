@@ -77,6 +77,7 @@ from mindgrasp_fsm.types import (
     MiClass,
     ObjectObservation,
     State,
+    StopKind,
     VisionFrame,
 )
 
@@ -261,8 +262,8 @@ class GraspFsm:
                 GripperCommand(self.params.gripper_open_position, 0.0)
 
     # ---------------------------------------------------------------------------- outputs
-    def _output(self, v: np.ndarray, *, stopped: bool = False, reason: str | None = None,
-                phase: str = '') -> FsmOutput:
+    def _output(self, v: np.ndarray, *, stopped: StopKind = StopKind.NONE,
+                reason: str | None = None, phase: str = '') -> FsmOutput:
         events, self._events = self._events, []
         if reason is None and self._pending is not None:
             reason = f'locked: {self._pending[1]}'
@@ -274,7 +275,8 @@ class GraspFsm:
         return FsmOutput(
             joint_velocities=v, gripper=self._gripper, state=self.state,
             previous_state=self.previous_state, locked=self._lock_until is not None,
-            stopped=stopped, reason=self.reason if reason is None else reason,
+            stopped=stopped != StopKind.NONE, stop_kind=stopped,
+            reason=self.reason if reason is None else reason,
             object_of_interest=self._ooi_label, phase=phase, grasp_attempts=self._attempt,
             grasp_outcome=self._outcome, events=events,
             paradigm='autonomous' if self.params.autonomous else self.params.paradigm,
@@ -291,8 +293,8 @@ class GraspFsm:
         return self._scan and self._committed and self.state in (
             State.CENTER_OBJECT, State.INITIAL_APPROACH, State.FINAL_APPROACH)
 
-    def _stop(self, why: str) -> FsmOutput:
-        return self._output(np.zeros(6), stopped=True, reason=why)
+    def _stop(self, kind: StopKind, why: str) -> FsmOutput:
+        return self._output(np.zeros(6), stopped=kind, reason=why)
 
     # ---------------------------------------------------------------------------- main tick
     def tick(self, inputs: FsmInputs) -> FsmOutput:
@@ -311,9 +313,11 @@ class GraspFsm:
         self._dt = p.control_period if first else min(dt, p.control_period)
 
         # --- watchdog: nothing moves on stale or broken inputs -------------------------------
-        why = self._watchdog(inputs, now) or self._await_fresh_decision(inputs)
+        kind, why = self._watchdog(inputs, now)
+        if not why:
+            kind, why = StopKind.FAULT, self._await_fresh_decision(inputs)
         if why:
-            return self._stop(why)    # the active clock does not advance while stopped
+            return self._stop(kind, why)    # the active clock does not advance while stopped
         self._clock += dt
         t = self._clock
         assert inputs.joints is not None
@@ -356,31 +360,35 @@ class GraspFsm:
             v = np.zeros(6)
         return self._output(clamp_to_limits(q, v, p), phase=phase)
 
-    def _watchdog(self, inputs: FsmInputs, now: float) -> str:
+    def _watchdog(self, inputs: FsmInputs, now: float) -> tuple[StopKind, str]:
+        """Why nothing may move at ``now`` (s), and what kind of stop that is; '' when all
+        inputs are fresh."""
         p = self.params
         if inputs.joints is None:
-            return 'stopped: no joint states received yet'
+            return StopKind.AWAITING_INPUT, 'stopped: no joint states received yet'
         why = self._sensor_latch(inputs, now)
         if why:
-            return why
+            return StopKind.FAULT, why
         if not p.autonomous:
             pred = inputs.prediction
             if pred is None:
-                return 'stopped: no MI prediction received yet'
+                return StopKind.AWAITING_INPUT, 'stopped: no MI prediction received yet'
             age = now - pred.stamp
             if age > p.watchdog_timeout:
                 self._stale_pred = True
                 self._back_at = self._fresh = None
                 self._loss = 'prediction loss'
-                return (f'stopped: the latest MI prediction is {age:.2f} s old (limit '
-                        f'{p.watchdog_timeout:.2f} s); check the classifier and EEG stream')
+                return StopKind.FAULT, (
+                    f'stopped: the latest MI prediction is {age:.2f} s old (limit '
+                    f'{p.watchdog_timeout:.2f} s); check the classifier and EEG stream')
         if inputs.vision is None:
-            return 'stopped: no camera images received yet; holding still'
+            return (StopKind.AWAITING_INPUT,
+                    'stopped: no camera images received yet; holding still')
         age = now - inputs.vision.stamp
         if age > p.camera_timeout:
-            return (f'stopped: no camera images for {age:.2f} s (limit {p.camera_timeout:.2f} s);'
-                    ' holding still')
-        return ''
+            return StopKind.FAULT, (f'stopped: no camera images for {age:.2f} s (limit '
+                                    f'{p.camera_timeout:.2f} s); holding still')
+        return StopKind.NONE, ''
 
     def _joint_fault(self, inputs: FsmInputs, now: float) -> str:
         """What is wrong with the joint states at ``now`` (s), '' when nothing."""

@@ -3,6 +3,7 @@ shared ones (predictions, camera model, states, MI classes) come from :mod:`mind
 
 from __future__ import annotations
 
+import enum
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -95,6 +96,14 @@ class GripperCommand:
     max_force: float
 
 
+class StopKind(enum.StrEnum):
+    """Why a stopped controller holds still, which decides how loudly a user is told."""
+
+    NONE = ''                         # not stopped
+    AWAITING_INPUT = 'awaiting_input'  # a first input not received yet: how every start begins
+    FAULT = 'fault'                   # an input went stale, broke, or a fresh decision is awaited
+
+
 @dataclass
 class FsmOutput:
     """Commands and state of one tick."""
@@ -115,6 +124,7 @@ class FsmOutput:
     offered: bool = False           # scan: the object of interest is offered for confirmation
     confirm_evidence: float = 0.0   # scan: confirmation evidence / confirm_threshold (0..1)
     cancel_evidence: float = 0.0    # scan: cancel evidence / cancel_threshold (0..1)
+    stop_kind: StopKind = StopKind.NONE   # why ``stopped`` holds (NONE when moving)
 
     @property
     def state_name(self) -> str:
