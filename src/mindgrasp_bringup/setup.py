@@ -49,8 +49,6 @@ setup(
         'console_scripts': [
             'foxglove_bridge_node = mindgrasp_bringup.foxglove_bridge_node:main',
             'replay_node = mindgrasp_bringup.replay.replay_node:main',
-            'recorder_node = mindgrasp_bringup.bag.recorder_node:main',
-            'player_node = mindgrasp_bringup.bag.player_node:main',
             'mindgrasp = mindgrasp_bringup.cli:main',
         ],
     },

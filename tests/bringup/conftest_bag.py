@@ -12,7 +12,7 @@ from mcap.reader import make_reader
 from rosbags.rosbag2 import StoragePlugin
 from rosbags.rosbag2 import Writer as RosbagsWriter
 
-from mindgrasp_bringup.bag.typestore import typestore
+from mindgrasp_bag.typestore import typestore
 
 EEG = 'mindgrasp_msgs/msg/EEGChunk'
 IMAGE = 'sensor_msgs/msg/Image'
@@ -190,7 +190,7 @@ def run_with_bag(tmp_path: Path, n: int = 30, chunk_size: int = 2000,
                  compression: str = 'none') -> Path:
     """A run directory with a finished bag of ``n`` EEG chunks and ``n`` strings at 10 Hz
     (bag time 1.0-3.9 s), in several MCAP chunks (``compression``: none, zstd or lz4)."""
-    from mindgrasp_bringup.bag import BagWriter
+    from mindgrasp_bag import BagWriter
 
     run = tmp_path / 'run'
     run.mkdir()

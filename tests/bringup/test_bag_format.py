@@ -11,9 +11,9 @@ from mcap.reader import make_reader
 from mcap_ros2.decoder import DecoderFactory
 from rosbags.rosbag2 import Reader as RosbagsReader
 
-from mindgrasp_bringup.bag import BagError, BagReader, BagWriter
-from mindgrasp_bringup.bag.metadata import rebuild_metadata
-from mindgrasp_bringup.bag.typestore import typestore
+from mindgrasp_bag import BagError, BagReader, BagWriter
+from mindgrasp_bag.metadata import rebuild_metadata
+from mindgrasp_bag.typestore import typestore
 
 QOS_SENSOR = {'history': 'keep_last', 'depth': 5, 'reliability': 'best_effort',
               'durability': 'volatile'}

@@ -18,7 +18,7 @@ import pytest
 from conftest_bag import EEG, IMAGE, STRING, eeg_chunk, image, string
 from rosbags.rosbag2 import Reader as RosbagsReader
 
-from mindgrasp_bringup.bag import BagReader, BagWriter, Recorder
+from mindgrasp_bag import BagReader, BagWriter, Recorder
 from mindgrasp_bringup.cli import main as cli_main
 from mindgrasp_testing import small_tmpfs
 
@@ -80,7 +80,7 @@ CHILD = textwrap.dedent('''
     import sys, time
     sys.path.insert(0, sys.argv[2])
     from conftest_bag import image
-    from mindgrasp_bringup.bag import BagWriter, Recorder
+    from mindgrasp_bag import BagWriter, Recorder
     recorder = Recorder(BagWriter(sys.argv[1], flush_interval=0.2))
     recorder.start()
     recorder.add_topic('/camera/color/image_raw', 'sensor_msgs/msg/Image')

@@ -25,11 +25,11 @@ COMMANDS: dict[str, str | dict[str, str]] = {
     'run': 'mindgrasp_bringup.commands.run',
     'replay': 'mindgrasp_bringup.commands.replay',
     'bag': {
-        'record': 'mindgrasp_bringup.commands.bag_record',
-        'play': 'mindgrasp_bringup.commands.bag_play',
-        'info': 'mindgrasp_bringup.commands.bag_info',
-        'reindex': 'mindgrasp_bringup.commands.bag_reindex',
-        'latency': 'mindgrasp_bringup.commands.bag_latency',
+        'record': 'mindgrasp_bag.commands.bag_record',
+        'play': 'mindgrasp_bag.commands.bag_play',
+        'info': 'mindgrasp_bag.commands.bag_info',
+        'reindex': 'mindgrasp_bag.commands.bag_reindex',
+        'latency': 'mindgrasp_bag.commands.bag_latency',
     },
     'topic': {
         'list': 'mindgrasp_bringup.commands.topic_list',
