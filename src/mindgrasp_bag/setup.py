@@ -23,5 +23,13 @@ setup(
             'recorder_node = mindgrasp_bag.recorder_node:main',
             'player_node = mindgrasp_bag.player_node:main',
         ],
+        # verbs of the mindgrasp command: 'COMMAND VERB = module' (add_arguments, main)
+        'mindgrasp.verb': [
+            'bag record = mindgrasp_bag.commands.bag_record',
+            'bag play = mindgrasp_bag.commands.bag_play',
+            'bag info = mindgrasp_bag.commands.bag_info',
+            'bag reindex = mindgrasp_bag.commands.bag_reindex',
+            'bag latency = mindgrasp_bag.commands.bag_latency',
+        ],
     },
 )

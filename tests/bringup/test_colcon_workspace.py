@@ -173,6 +173,17 @@ def test_colcon_installs_executables_and_share_files(workspace: Path) -> None:
                               capture_output=True, text=True, timeout=120, check=False)
     assert help_run.returncode == 0, help_run.stderr
     assert 'launch' in help_run.stdout
+    # each installed package brings its own commands and verbs (entry points in its setup.py)
+    registered = subprocess.run(
+        sourced(workspace, sys.executable, '-c',
+                'import importlib.metadata as m; print(sorted({(e.name, e.dist.name) for e in '
+                'm.entry_points(group="mindgrasp.verb")}))'),
+        env=workspace_env(), capture_output=True, text=True, timeout=120, check=True).stdout
+    for verb, package in [('bag record', 'mindgrasp_bag'), ('topic echo', 'mindgrasp_bringup'),
+                          ('train classifier', 'mindgrasp_classifier'),
+                          ('train vision', 'mindgrasp_vision'),
+                          ('eeg fit-virtual', 'mindgrasp_experiments')]:
+        assert repr((verb, package)) in registered, registered
     # an installed node executable (ros2 run mindgrasp_fsm fsm_node --help): its docstring and
     # the ROS arguments, without starting the node
     node_help = subprocess.run(

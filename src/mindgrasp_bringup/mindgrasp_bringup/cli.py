@@ -1,10 +1,14 @@
 """The ``mindgrasp`` command line: ``mindgrasp <command> [<verb>] ...``, in the manner of ``ros2``.
 
 Each command lives in a module that defines ``add_arguments(parser)`` and ``main(args) -> int``.
-Commands with verbs (``bag record``, ``train classifier``) map each verb to such a module, possibly
-in another package (``train classifier`` is :mod:`mindgrasp_classifier.train_cli`). Modules are
-imported only when their command runs, so ``mindgrasp --help`` stays fast and one broken package
-does not break the others.
+Packages register their commands themselves, as ros2cli's packages do (``ros2cli.command``,
+``ros2topic.verb``): entry points in their setup.py, group ``mindgrasp.command``
+(``'launch = mindgrasp_bringup.commands.launch'``) for a command without verbs, group
+``mindgrasp.verb`` (``'bag record = mindgrasp_bag.commands.bag_record'``) for a command's verb;
+several packages may add verbs to one command (``train classifier``, ``train vision``).
+Commands and verbs are listed in name order, as ``ros2 --help``. Modules are imported only when
+their command runs, so ``mindgrasp --help`` stays fast and one broken package does not break
+the others.
 """
 
 from __future__ import annotations
@@ -12,6 +16,7 @@ from __future__ import annotations
 import argparse
 import functools
 import importlib
+import importlib.metadata
 import importlib.util
 import sys
 from collections.abc import Sequence
@@ -19,78 +24,27 @@ from collections.abc import Sequence
 from mindgrasp_common.cli_checks import OneLineParser
 from mindgrasp_ros.process import handle_stop_signals
 
-#: command -> module, or command -> {verb: module}
-COMMANDS: dict[str, str | dict[str, str]] = {
-    'launch': 'mindgrasp_bringup.commands.launch',
-    'run': 'mindgrasp_bringup.commands.run',
-    'replay': 'mindgrasp_bringup.commands.replay',
-    'bag': {
-        'record': 'mindgrasp_bag.commands.bag_record',
-        'play': 'mindgrasp_bag.commands.bag_play',
-        'info': 'mindgrasp_bag.commands.bag_info',
-        'reindex': 'mindgrasp_bag.commands.bag_reindex',
-        'latency': 'mindgrasp_bag.commands.bag_latency',
-    },
-    'topic': {
-        'list': 'mindgrasp_bringup.commands.topic_list',
-        'echo': 'mindgrasp_bringup.commands.topic_echo',
-        'hz': 'mindgrasp_bringup.commands.topic_hz',
-        'info': 'mindgrasp_bringup.commands.topic_info',
-        'pub': 'mindgrasp_bringup.commands.topic_pub',
-    },
-    'node': {
-        'list': 'mindgrasp_bringup.commands.node_list',
-        'info': 'mindgrasp_bringup.commands.node_info',
-    },
-    'service': {
-        'list': 'mindgrasp_bringup.commands.service_list',
-        'type': 'mindgrasp_bringup.commands.service_type',
-        'call': 'mindgrasp_bringup.commands.service_call',
-    },
-    'interface': {
-        'list': 'mindgrasp_bringup.commands.interface_list',
-        'show': 'mindgrasp_bringup.commands.interface_show',
-        'proto': 'mindgrasp_bringup.commands.interface_proto',
-    },
-    'param': {
-        'list': 'mindgrasp_bringup.commands.param_list',
-        'get': 'mindgrasp_bringup.commands.param_get',
-        'set': 'mindgrasp_bringup.commands.param_set',
-        'describe': 'mindgrasp_bringup.commands.param_describe',
-        'dump': 'mindgrasp_bringup.commands.param_dump',
-        'load': 'mindgrasp_bringup.commands.param_load',
-    },
-    'eeg': {
-        'virtual-amp': 'mindgrasp_eeg.virtual_amp_cli',
-        'play': 'mindgrasp_eeg.player_cli',
-        'fit-virtual': 'mindgrasp_experiments.fit_virtual_cli',
-    },
-    'train': {
-        'classifier': 'mindgrasp_classifier.train_cli',
-        'vision': 'mindgrasp_vision.train_cli',
-    },
-    'evaluate': {
-        'classifier': 'mindgrasp_classifier.evaluate_cli',
-    },
-    'experiment': {
-        'set-locations': 'mindgrasp_experiments.commands.set_locations',
-        'random-locations': 'mindgrasp_experiments.commands.random_locations',
-        'report': 'mindgrasp_experiments.commands.report',
-        'sweep': 'mindgrasp_experiments.commands.sweep',
-    },
-    'export': {
-        'eeg': 'mindgrasp_eeg.export_cli',
-        'bids': 'mindgrasp_eeg.bids_cli',
-    },
-    'trainer': {
-        'schedule': 'mindgrasp_trainer.schedule_cli',
-    },
-    'session': {
-        'run': 'mindgrasp_bringup.session_cli',
-        'resume': 'mindgrasp_bringup.session_cli',
-        'calibrate': 'mindgrasp_bringup.session_cli',
-    },
-}
+#: entry point groups: command -> module, and 'command verb' -> module
+COMMAND_GROUP = 'mindgrasp.command'
+VERB_GROUP = 'mindgrasp.verb'
+
+
+@functools.cache
+def commands() -> dict[str, str | dict[str, str]]:
+    """Command -> module, or command -> {verb: module}, from the installed packages' entry
+    points, in name order. A name registered twice (an editable install and a colcon workspace
+    both on the path) keeps its first registration, as Python's import would."""
+    found: dict[str, str | dict[str, str]] = {}
+    points = importlib.metadata.entry_points()
+    for point in points.select(group=COMMAND_GROUP):
+        found.setdefault(point.name, point.module)
+    for point in points.select(group=VERB_GROUP):
+        command, _, verb = point.name.partition(' ')
+        verbs = found.setdefault(command, {})
+        if isinstance(verbs, dict) and verb:
+            verbs.setdefault(verb, point.module)
+    return {name: (target if isinstance(target, str) else dict(sorted(target.items())))
+            for name, target in sorted(found.items())}
 
 
 @functools.cache
@@ -146,7 +100,7 @@ def build_parser(argv: Sequence[str]) -> argparse.ArgumentParser:
                         help="print the project's version (and git revision) and exit")
     sub = parser.add_subparsers(dest='command', metavar='<command>')
     chosen = argv[0] if argv else None
-    for command, target in COMMANDS.items():
+    for command, target in commands().items():
         if isinstance(target, str):
             if command == chosen:
                 _add_command(sub, command, target)
@@ -186,7 +140,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         if not argv:
             parser.print_help()
             return 0
-        verbs = COMMANDS.get(args.command, {})  # a command given without its verb
+        verbs = commands().get(args.command, {})  # a command given without its verb
         print(f'mindgrasp {args.command}: error: a verb is required: {", ".join(verbs)} '
               f'(see mindgrasp {args.command} --help)', file=sys.stderr)
         return 2
