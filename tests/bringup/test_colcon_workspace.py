@@ -168,6 +168,20 @@ def test_colcon_installs_executables_and_share_files(workspace: Path) -> None:
             assert os.access(install / name / 'lib' / name / executable, os.X_OK), executable
     launch = install / 'mindgrasp_bringup' / 'share' / 'mindgrasp_bringup' / 'launch'
     assert (launch / 'demo.launch.py').is_file()  # ros2 launch mindgrasp_bringup demo.launch.py
+    # the top-level config/ (what a user edits) is the bringup package's share files, where the
+    # installed code finds it: no source tree, no ROS 2, only the sourced workspace
+    config = install / 'mindgrasp_bringup' / 'share' / 'mindgrasp_bringup' / 'config'
+    assert sorted(p.relative_to(config).as_posix() for p in config.rglob('*.yaml')) == sorted(
+        p.relative_to(REPO / 'config').as_posix() for p in (REPO / 'config').rglob('*.yaml'))
+    found = subprocess.run(
+        sourced(workspace, sys.executable, '-c',
+                'from mindgrasp_common.resources import resource_path as r; '
+                'print(r("mindgrasp_fsm", "param/fsm.yaml")); print(r("mindgrasp_sim", "scenes")); '
+                'print(r("mindgrasp_bringup", "param/demo.yaml"))'),
+        env=workspace_env(), capture_output=True, text=True, timeout=120, check=False)
+    assert found.returncode == 0, found.stderr
+    assert found.stdout.split() == [str(config / 'param' / 'fsm.yaml'), str(config / 'scenes'),
+                                    str(config / 'profiles' / 'demo.yaml')]
     cli = install / 'mindgrasp_bringup' / 'lib' / 'mindgrasp_bringup' / 'mindgrasp'
     help_run = subprocess.run(sourced(workspace, str(cli), '--help'), env=workspace_env(),
                               capture_output=True, text=True, timeout=120, check=False)
