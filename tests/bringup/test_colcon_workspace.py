@@ -77,6 +77,18 @@ def test_no_package_uses_a_package_that_depends_on_it() -> None:
     assert not cycles, '\n'.join(cycles)
 
 
+def test_readme_layout_shows_every_package() -> None:
+    """The root README's layout block names each package folder (and config/), and each package
+    has a README of its own."""
+    readme = (REPO / 'README.md').read_text(encoding='utf-8')
+    block = readme.split('## Layout', 1)[1].split('```')[1]
+    listed = re.findall(r'^(\S+)/\s', block, re.M)
+    packages = {f'src/{p.name}' for p in PACKAGES}
+    assert {name for name in listed if name.startswith('src/')} == packages, listed
+    assert 'config' in listed
+    assert [p.name for p in PACKAGES if not (p / 'README.md').is_file()] == []
+
+
 @pytest.mark.parametrize('package_dir', PYTHON_PACKAGES, ids=lambda p: p.name)
 def test_ament_python_layout(package_dir: Path) -> None:
     name = package_dir.name
