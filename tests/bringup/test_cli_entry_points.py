@@ -8,6 +8,7 @@ from __future__ import annotations
 import re
 import subprocess
 import sys
+import sysconfig
 from pathlib import Path
 
 import pytest
@@ -78,3 +79,22 @@ def test_help_lists_commands_and_verbs_in_order(argv: list[str], listed: list[st
     shown = re.findall(r'^    (\S+)', run.stdout.split('<command>' if argv == ['--help']
                                                     else '<verb>')[-1], re.M)
     assert shown == listed, run.stdout
+
+
+def test_an_install_without_entry_points_says_how_to_fix_it(tmp_path: Path) -> None:
+    """The sources and their libraries on the path but no package metadata (a checkout pulled
+    and not re-installed): one line naming the fix, not an empty command list."""
+    site = Path(sysconfig.get_paths()['purelib'])
+    libs = tmp_path / 'libs'      # numpy and yaml without their dist-info
+    libs.mkdir()
+    for name in ('numpy', 'numpy.libs', 'yaml', '_yaml'):
+        if (site / name).exists():
+            (libs / name).symlink_to(site / name)
+    code = ('import sys; sys.path[:0] = sys.argv[1:]; '
+            'from mindgrasp_bringup.cli import main; sys.exit(main(["launch", "demo"]))')
+    run = subprocess.run([sys.executable, '-S', '-c', code,
+                          *(str(p) for p in sorted(SRC.glob('mindgrasp_*'))), str(libs)],
+                         cwd=tmp_path, capture_output=True, text=True, timeout=120, check=False)
+    assert run.returncode == 2, run.stdout + run.stderr
+    (line,) = run.stderr.splitlines()
+    assert line.startswith('mindgrasp: no commands are installed') and 'scripts/setup.sh' in line

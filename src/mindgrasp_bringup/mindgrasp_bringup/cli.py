@@ -130,6 +130,12 @@ def version_text() -> str:
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``mindgrasp`` console script."""
     argv = list(sys.argv[1:] if argv is None else argv)
+    if not commands() and argv[:1] != ['--version']:
+        # an install older than the packages' setup.py files (pulled, not re-installed)
+        print(f'mindgrasp: no commands are installed (no {COMMAND_GROUP!r} or {VERB_GROUP!r} entry '
+              f'points on the Python path): run bash scripts/setup.sh in the checkout, or source '
+              f'the colcon workspace (install/setup.bash).', file=sys.stderr)
+        return 2
     parser = build_parser(argv)
     args = parser.parse_args(argv)
     module_name = getattr(args, '_module', None)
