@@ -98,3 +98,16 @@ def test_an_install_without_entry_points_says_how_to_fix_it(tmp_path: Path) -> N
     assert run.returncode == 2, run.stdout + run.stderr
     (line,) = run.stderr.splitlines()
     assert line.startswith('mindgrasp: no commands are installed') and 'scripts/setup.sh' in line
+
+
+def test_help_imports_no_command_package() -> None:
+    """``mindgrasp --help`` reads the commands' docstrings from their files: no package that
+    registers a verb is imported (the bag package's ``__init__`` alone costs 140 ms)."""
+    code = ('import sys; from mindgrasp_bringup import cli; cli.build_parser(["--help"]); '
+            'print(" ".join(sorted(m for m in sys.modules if m.startswith("mindgrasp_"))))')
+    run = subprocess.run([sys.executable, '-c', code], capture_output=True, text=True,
+                         timeout=120, check=True)
+    imported = set(run.stdout.split())
+    registering = {module.split('.')[0] for target in cli.commands().values()
+                   for module in ([target] if isinstance(target, str) else target.values())}
+    assert not imported & (registering - {'mindgrasp_bringup'}), sorted(imported)

@@ -20,6 +20,7 @@ import importlib.metadata
 import importlib.util
 import sys
 from collections.abc import Sequence
+from pathlib import Path
 
 from mindgrasp_common.cli_checks import OneLineParser
 from mindgrasp_ros.process import handle_stop_signals
@@ -47,20 +48,38 @@ def commands() -> dict[str, str | dict[str, str]]:
             for name, target in sorted(found.items())}
 
 
+def _module_file(module_name: str) -> Path | None:
+    """The source file of a module, found without importing it or its parent packages (find_spec
+    of ``a.b.c`` imports ``a`` and ``a.b``, whose ``__init__`` may pull in numpy and more: the bag
+    package's does); None when it is not installed."""
+    top, _, rest = module_name.partition('.')
+    try:
+        spec = importlib.util.find_spec(top)
+    except (ImportError, ValueError):
+        return None
+    if spec is None:
+        return None
+    if not rest:
+        return Path(spec.origin) if spec.origin else None
+    for location in spec.submodule_search_locations or []:
+        base = Path(location, *rest.split('.'))
+        for candidate in (base.with_suffix('.py'), base / '__init__.py'):
+            if candidate.is_file():
+                return candidate
+    return None
+
+
 @functools.cache
 def _module_doc(module_name: str) -> str:
     """Docstring of a command module, without importing heavy packages on --help (read once
     per process: in-process callers such as tests build the parser many times)."""
-    try:
-        spec = importlib.util.find_spec(module_name)
-    except (ImportError, ValueError):
-        spec = None
-    if spec is None or spec.origin is None:
+    origin = _module_file(module_name)
+    if origin is None:
         return '(not installed)'
     import ast
 
     try:
-        with open(spec.origin, encoding='utf-8') as f:
+        with open(origin, encoding='utf-8') as f:
             doc = ast.get_docstring(ast.parse(f.read())) or ''
     except (OSError, SyntaxError):
         return ''
