@@ -15,9 +15,9 @@ import uuid
 from pathlib import Path
 
 import pytest
-from conftest_bag import EEG, IMAGE, STRING, eeg_chunk, image, string
 from rosbags.rosbag2 import Reader as RosbagsReader
 
+from conftest_bag import EEG, IMAGE, STRING, eeg_chunk, image, string
 from mindgrasp_bag import BagReader, BagWriter, Recorder
 from mindgrasp_bringup.cli import main as cli_main
 from mindgrasp_testing import small_tmpfs
@@ -105,7 +105,8 @@ def on_disk(bag: Path) -> int:
 @pytest.mark.slow
 def test_sigkill_during_recording_leaves_a_readable_bag(tmp_path, capsys):
     bag = tmp_path / 'killed'
-    proc = subprocess.Popen([sys.executable, '-c', CHILD, str(bag), str(Path(__file__).parent)],
+    tests = str(Path(__file__).parents[1])    # conftest_bag
+    proc = subprocess.Popen([sys.executable, '-c', CHILD, str(bag), tests],
                             stdout=subprocess.PIPE, text=True)
     lines, flushed = [], 0
     deadline = time.monotonic() + 120

@@ -1,4 +1,5 @@
-"""Helpers for the bag tests (imported by tests/bringup/test_bag*.py): sample messages, bags."""
+"""Helpers for the bag tests (imported by tests/bag/test_bag_*.py, and by bringup tests that
+write bags): sample messages, bags."""
 
 from __future__ import annotations
 

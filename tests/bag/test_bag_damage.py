@@ -11,8 +11,8 @@ from pathlib import Path
 
 import pytest
 import yaml
-from conftest_bag import cut_in_half, damage_chunks, mindgrasp_cli, run_with_bag
 
+from conftest_bag import cut_in_half, damage_chunks, mindgrasp_cli, run_with_bag
 from mindgrasp_bag import BagReader
 from mindgrasp_bag.damage import assess_bag
 from mindgrasp_testing import small_tmpfs

@@ -14,18 +14,18 @@ import uuid
 from pathlib import Path
 
 import pytest
+from mcap.reader import make_reader
+from rosbags.rosbag2 import Reader as RosbagsReader
+
 from conftest_bag import (
     PUBLISHER,
     cli_env,
     mindgrasp_cli,
     run_with_bag,
 )
-from mcap.reader import make_reader
-from rosbags.rosbag2 import Reader as RosbagsReader
-
 from mindgrasp_bag.mcap_scan import read_mcap_contents
 
-HERE = Path(__file__).parent
+HERE = Path(__file__).parents[1]  # tests/: conftest_bag, for the child processes
 
 
 def _plain_mcap_count(path: Path) -> int:

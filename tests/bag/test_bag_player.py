@@ -8,9 +8,9 @@ import time
 
 import numpy as np
 import pytest
-from conftest_bag import EEG, IMAGE, STRING, eeg_chunk, image, string, write_rosbags_bag
 from rosbags.rosbag2 import StoragePlugin
 
+from conftest_bag import EEG, IMAGE, STRING, eeg_chunk, image, string, write_rosbags_bag
 from mindgrasp_bag import BagError, BagReader, BagWriter, Player, Recorder
 from mindgrasp_bag.player import parse_remaps
 

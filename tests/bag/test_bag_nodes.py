@@ -15,13 +15,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from conftest_bag import EEG, PROBE, PUBLISHER, STRING, eeg_chunk, string
 
+from conftest_bag import EEG, PROBE, PUBLISHER, STRING, eeg_chunk, string
 from mindgrasp_bag import BagReader
 
 pytestmark = pytest.mark.slow
 
-HERE = Path(__file__).parent
+HERE = Path(__file__).parents[1]  # tests/: conftest_bag, for the child processes
 N_EEG = 20
 
 
