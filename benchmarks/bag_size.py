@@ -6,7 +6,7 @@ Run: ``.venv/bin/python benchmarks/bag_size.py [RUN_OR_BAG] [--duration 60] [--p
 Without a bag it records one first (``mindgrasp launch <profile> duration:=<duration>
 record_compression:=none record_exclude_regex:=`` into a temporary run directory, so every topic
 is kept). The bag's messages are then read into memory once and written again by the project's
-:class:`~mindgrasp_bringup.bag.BagWriter` (what the recorder node runs) with each compression,
+:class:`~mindgrasp_bag.BagWriter` (what the recorder node runs) with each compression,
 with every topic and without the topics the default ``record_exclude_regex`` leaves out. Printed
 per setting: bag size (MiB and MiB per recorded minute) and the writer's CPU time per recorded
 minute (``time.process_time`` around the writes only, so reading the source bag is not counted),
@@ -31,7 +31,7 @@ from pathlib import Path
 
 import psutil
 
-from mindgrasp_bringup.bag import BagReader, BagWriter
+from mindgrasp_bag import BagReader, BagWriter
 from mindgrasp_bringup.launch_system.run_extras import DEFAULT_RECORD_EXCLUDE
 
 COMPRESSIONS = ('none', 'lz4', 'zstd')

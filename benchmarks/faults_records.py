@@ -36,7 +36,7 @@ sys.path.insert(0, str(REPO / 'tests' / 'bringup'))
 
 from conftest_bag import cut_in_half, damage_chunks  # noqa: E402
 
-from mindgrasp_bringup.bag import BagReader  # noqa: E402
+from mindgrasp_bag import BagReader  # noqa: E402
 from mindgrasp_common.safe_files import fallback_folder  # noqa: E402
 from mindgrasp_experiments.records import read_records  # noqa: E402
 

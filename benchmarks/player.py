@@ -33,7 +33,7 @@ sys.path.insert(0, str(REPO / 'tests' / 'bringup'))
 
 from conftest_bag import EEG, PROBE, STRING, eeg_chunk, string  # noqa: E402
 
-from mindgrasp_bringup.bag import BagReader, BagWriter  # noqa: E402
+from mindgrasp_bag import BagReader, BagWriter  # noqa: E402
 
 T0 = 1_750_000_000_000_000_000
 MS = 1_000_000
@@ -41,8 +41,8 @@ MS = 1_000_000
 BLOCKING = '''
 import sys
 sys.setswitchinterval(0.0005)   # as player_node.main
-from mindgrasp_bringup.bag.errors import BagError
-from mindgrasp_bringup.bag.player_node import PlayerNode
+from mindgrasp_bag.errors import BagError
+from mindgrasp_bag.player_node import PlayerNode
 from mindgrasp_ros.node_main import run_node
 sys.exit(run_node(PlayerNode, sys.argv, errors=(BagError,)))
 '''
@@ -92,7 +92,7 @@ def play(mode: str, bag: Path, prefix: str) -> tuple[int, float, float, float]:
     try:
         probe.wait_ready()
         args = ['--ros-args', '-p', f'bag:={bag}', '-p', 'delay:=1.0']
-        cmd = ([sys.executable, '-m', 'mindgrasp_bringup.bag.player_node', *args]
+        cmd = ([sys.executable, '-m', 'mindgrasp_bag.player_node', *args]
                if mode == 'poll' else [sys.executable, '-c', BLOCKING, *args])
         subprocess.run(cmd, check=True, capture_output=True, timeout=300)
         time.sleep(0.5)

@@ -32,14 +32,14 @@ sys.path.insert(0, str(REPO / 'tests' / 'bringup'))
 
 from conftest_bag import eeg_chunk, image  # noqa: E402
 
-from mindgrasp_bringup.bag import BagReader, BagWriter, Recorder  # noqa: E402
+from mindgrasp_bag import BagReader, BagWriter, Recorder  # noqa: E402
 
 PUBLISHER = r'''
 import sys, time, json
 sys.path.insert(0, sys.argv[1])
 import numpy as np
 from conftest_bag import eeg_chunk, joints
-from mindgrasp_bringup.bag.typestore import typestore
+from mindgrasp_bag.typestore import typestore
 from mindgrasp_ros import rclpy
 prefix, scenario = sys.argv[2], sys.argv[3]
 duration, max_rate = float(sys.argv[4]), float(sys.argv[5])
@@ -151,7 +151,7 @@ def dds(scenario: str, out: Path, duration: float, rate: float = 0.0) -> tuple[i
     prefix = f'/bench_{uuid.uuid4().hex[:6]}'
     bag = out / f'{scenario}_{uuid.uuid4().hex[:6]}'
     recorder = subprocess.Popen(
-        [sys.executable, '-m', 'mindgrasp_bringup.bag.recorder_node', '--ros-args',
+        [sys.executable, '-m', 'mindgrasp_bag.recorder_node', '--ros-args',
          '-p', f'output:={bag}', '-p', f'regex:="^{prefix}/"', '-p', 'discovery_period:=0.2'],
         env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     try:

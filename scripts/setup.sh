@@ -9,7 +9,9 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 PY=${PYTHON:-python3}
 stamp=.venv/.mindgrasp-installed
-want=$(cat pyproject.toml constraints.txt | sha256sum | cut -d' ' -f1)
+# the packages' setup.py files too: their mindgrasp.* entry points (the mindgrasp command's
+# commands and verbs) are installed by the root setup.py, so a changed one re-installs
+want=$(cat pyproject.toml constraints.txt setup.py src/mindgrasp_*/setup.py | sha256sum | cut -d' ' -f1)
 if [ -f "$stamp" ] && [ "$(cat "$stamp")" = "$want" ]; then
   exit 0
 fi

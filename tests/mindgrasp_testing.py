@@ -6,7 +6,6 @@ sys.path when several test folders have one.
 
 from __future__ import annotations
 
-import ast
 import contextlib
 import struct
 import subprocess
@@ -53,18 +52,22 @@ def small_tmpfs(path: Path, size: str) -> Iterator[Path]:
         subprocess.run(['umount', '-l', str(path)], check=False)
 
 
+def root_setup():
+    """The repository's setup.py as a module (its ``setup()`` call runs only as ``__main__``):
+    the one reader of the packages' entry points, :func:`package_entry_points`."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location('mindgrasp_root_setup',
+                                                  Path(__file__).resolve().parents[1] / 'setup.py')
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
 def console_scripts(package_dir: Path) -> dict[str, str]:
     """``{executable: 'module:function'}`` of a package's setup.py (read, not executed)."""
-    tree = ast.parse((package_dir / 'setup.py').read_text(encoding='utf-8'))
-    scripts: dict[str, str] = {}
-    for node in ast.walk(tree):
-        if isinstance(node, ast.Dict):
-            for key, value in zip(node.keys, node.values, strict=True):
-                if isinstance(key, ast.Constant) and key.value == 'console_scripts':
-                    for item in ast.literal_eval(value):
-                        name, _, target = (s.strip() for s in item.partition('='))
-                        scripts[name] = target
-    return scripts
+    items = root_setup().package_entry_points(package_dir / 'setup.py').get('console_scripts', [])
+    return dict((s.strip() for s in item.partition('=')[::2]) for item in items)
 
 
 def _chunk(tag: int, content: bytes) -> bytes:

@@ -1,5 +1,6 @@
 """ament_python package for colcon build; the root pyproject.toml also installs it."""
 
+import os
 import re
 from pathlib import Path
 
@@ -12,18 +13,21 @@ DESCRIPTION = re.search(r'<description>(.*?)</description>',
                         (here / 'package.xml').read_text(encoding='utf-8'), re.S).group(1)
 
 
-def share_files() -> list[tuple[str, list[str]]]:
-    """Data files of the Python package (parameter YAML, scenes, URDF, models, launch files) also
-    installed to share/<package>/<same path>, where ament_index and ``ros2 launch`` find them."""
+def share_files(root: Path = here / package_name, share: Path = Path('share', package_name),
+                subfolders_only: bool = True) -> list[tuple[str, list[str]]]:
+    """Data files of the Python package (launch files, the Foxglove layouts) also installed to
+    share/<package>/<same path>, where ament_index and ``ros2 launch`` find them; with ``root``
+    the repository's top-level config/ (parameter files, profiles, scenes, plans: what a user
+    edits) to share/<package>/config/, where ``mindgrasp_common.resources`` looks for it."""
     groups: dict[str, list[str]] = {}
-    for path in sorted((here / package_name).rglob('*')):
-        rel = path.relative_to(here / package_name)
+    for path in sorted(root.rglob('*')):
+        rel = path.relative_to(root)
         if (not path.is_file() or '__pycache__' in rel.parts or rel.parts[0].startswith('.')
                 or (path.suffix == '.py' and not path.name.endswith('.launch.py'))
-                or len(rel.parts) == 1):
+                or (subfolders_only and len(rel.parts) == 1)):
             continue
-        groups.setdefault(str(Path('share', package_name, rel.parent)), []).append(
-            str(path.relative_to(here)))
+        # relative to this folder (colcon requires it), config/ by '../../config/...'
+        groups.setdefault(str(share / rel.parent), []).append(os.path.relpath(path, here))
     return sorted(groups.items())
 
 
@@ -38,6 +42,7 @@ setup(
         ('share/ament_index/resource_index/packages', ['resource/' + package_name]),
         ('share/' + package_name, ['package.xml']),
         *share_files(),
+        *share_files(here.parents[1] / 'config', Path('share', package_name, 'config'), False),
     ],
     install_requires=['setuptools'],
     zip_safe=False,
@@ -49,9 +54,37 @@ setup(
         'console_scripts': [
             'foxglove_bridge_node = mindgrasp_bringup.foxglove_bridge_node:main',
             'replay_node = mindgrasp_bringup.replay.replay_node:main',
-            'recorder_node = mindgrasp_bringup.bag.recorder_node:main',
-            'player_node = mindgrasp_bringup.bag.player_node:main',
             'mindgrasp = mindgrasp_bringup.cli:main',
+        ],
+        # the mindgrasp command's own commands and verbs (cli.py discovers them, as ros2cli does)
+        'mindgrasp.command': [
+            'launch = mindgrasp_bringup.commands.launch',
+            'run = mindgrasp_bringup.commands.run',
+            'replay = mindgrasp_bringup.commands.replay',
+        ],
+        'mindgrasp.verb': [
+            'topic list = mindgrasp_bringup.commands.topic_list',
+            'topic echo = mindgrasp_bringup.commands.topic_echo',
+            'topic hz = mindgrasp_bringup.commands.topic_hz',
+            'topic info = mindgrasp_bringup.commands.topic_info',
+            'topic pub = mindgrasp_bringup.commands.topic_pub',
+            'node list = mindgrasp_bringup.commands.node_list',
+            'node info = mindgrasp_bringup.commands.node_info',
+            'service list = mindgrasp_bringup.commands.service_list',
+            'service type = mindgrasp_bringup.commands.service_type',
+            'service call = mindgrasp_bringup.commands.service_call',
+            'interface list = mindgrasp_bringup.commands.interface_list',
+            'interface show = mindgrasp_bringup.commands.interface_show',
+            'interface proto = mindgrasp_bringup.commands.interface_proto',
+            'param list = mindgrasp_bringup.commands.param_list',
+            'param get = mindgrasp_bringup.commands.param_get',
+            'param set = mindgrasp_bringup.commands.param_set',
+            'param describe = mindgrasp_bringup.commands.param_describe',
+            'param dump = mindgrasp_bringup.commands.param_dump',
+            'param load = mindgrasp_bringup.commands.param_load',
+            'session run = mindgrasp_bringup.session_cli',
+            'session resume = mindgrasp_bringup.session_cli',
+            'session calibrate = mindgrasp_bringup.session_cli',
         ],
     },
 )

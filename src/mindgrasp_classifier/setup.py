@@ -49,5 +49,10 @@ setup(
         'console_scripts': [
             'classifier_node = mindgrasp_classifier.classifier_node:main',
         ],
+        # verbs of the mindgrasp command: 'COMMAND VERB = module' (add_arguments, main)
+        'mindgrasp.verb': [
+            'train classifier = mindgrasp_classifier.train_cli',
+            'evaluate classifier = mindgrasp_classifier.evaluate_cli',
+        ],
     },
 )

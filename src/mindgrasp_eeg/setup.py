@@ -51,5 +51,12 @@ setup(
             'virtual_amp_node = mindgrasp_eeg.virtual_amp_node:main',
             'marker_node = mindgrasp_eeg.marker_node:main',
         ],
+        # verbs of the mindgrasp command: 'COMMAND VERB = module' (add_arguments, main)
+        'mindgrasp.verb': [
+            'eeg virtual-amp = mindgrasp_eeg.virtual_amp_cli',
+            'eeg play = mindgrasp_eeg.player_cli',
+            'export eeg = mindgrasp_eeg.export_cli',
+            'export bids = mindgrasp_eeg.bids_cli',
+        ],
     },
 )

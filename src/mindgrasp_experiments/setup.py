@@ -50,5 +50,13 @@ setup(
             'trial_manager_node = mindgrasp_experiments.trial_manager_node:main',
             'oracle_subject_node = mindgrasp_experiments.oracle_subject_node:main',
         ],
+        # verbs of the mindgrasp command: 'COMMAND VERB = module' (add_arguments, main)
+        'mindgrasp.verb': [
+            'eeg fit-virtual = mindgrasp_experiments.fit_virtual_cli',
+            'experiment set-locations = mindgrasp_experiments.commands.set_locations',
+            'experiment random-locations = mindgrasp_experiments.commands.random_locations',
+            'experiment report = mindgrasp_experiments.commands.report',
+            'experiment sweep = mindgrasp_experiments.commands.sweep',
+        ],
     },
 )

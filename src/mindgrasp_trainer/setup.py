@@ -51,5 +51,9 @@ setup(
             'graz_node = mindgrasp_trainer.graz_node:main',
             'trainer_node = mindgrasp_trainer.trainer_node:main',
         ],
+        # verbs of the mindgrasp command: 'COMMAND VERB = module' (add_arguments, main)
+        'mindgrasp.verb': [
+            'trainer schedule = mindgrasp_trainer.schedule_cli',
+        ],
     },
 )

@@ -49,5 +49,9 @@ setup(
         'console_scripts': [
             'vision_node = mindgrasp_vision.vision_node:main',
         ],
+        # verbs of the mindgrasp command: 'COMMAND VERB = module' (add_arguments, main)
+        'mindgrasp.verb': [
+            'train vision = mindgrasp_vision.train_cli',
+        ],
     },
 )

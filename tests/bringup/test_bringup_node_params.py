@@ -14,14 +14,14 @@ import sys
 
 import pytest
 
-from mindgrasp_bringup.bag.player_node import PlayerParams
-from mindgrasp_bringup.bag.recorder_node import RecorderParams
+from mindgrasp_bag.player_node import PlayerParams
+from mindgrasp_bag.recorder_node import RecorderParams
 from mindgrasp_bringup.launch_system import LaunchService
 from mindgrasp_bringup.replay.replay_node import ReplayParams
 from mindgrasp_ros.params import ParameterError, describe, from_mapping
 
-PARAMS = {'mindgrasp_bringup.bag.recorder_node': RecorderParams,
-          'mindgrasp_bringup.bag.player_node': PlayerParams,
+PARAMS = {'mindgrasp_bag.recorder_node': RecorderParams,
+          'mindgrasp_bag.player_node': PlayerParams,
           'mindgrasp_bringup.replay.replay_node': ReplayParams}
 
 
@@ -41,9 +41,9 @@ def test_launch_profiles_pass_only_declared_parameters(tmp_path, monkeypatch) ->
         if module in modules:
             names = {f.name for f in dataclasses.fields(cls)}
             assert set(modules[module].parameters) <= names, module
-    assert {'mindgrasp_bringup.bag.recorder_node', 'mindgrasp_bringup.replay.replay_node'} \
+    assert {'mindgrasp_bag.recorder_node', 'mindgrasp_bringup.replay.replay_node'} \
         <= set(modules)
-    recorder = modules['mindgrasp_bringup.bag.recorder_node'].parameters
+    recorder = modules['mindgrasp_bag.recorder_node'].parameters
     assert from_mapping(RecorderParams, recorder).topics == ['/a', '/b']
 
 
@@ -55,18 +55,18 @@ def test_dataclass_checks_name_the_parameter() -> None:
 
 
 @pytest.mark.parametrize(('module', 'params', 'match'), [
-    ('mindgrasp_bringup.bag.recorder_node', ['regex:=(', 'output:={tmp}/bag'],
+    ('mindgrasp_bag.recorder_node', ['regex:=(', 'output:={tmp}/bag'],
      'The topic regular expression is not valid'),
-    ('mindgrasp_bringup.bag.recorder_node', ['compression:=bz2', 'output:={tmp}/bag'],
+    ('mindgrasp_bag.recorder_node', ['compression:=bz2', 'output:={tmp}/bag'],
      "The parameter 'compression' is 'bz2'; use one of none, zstd, lz4."),
-    ('mindgrasp_bringup.bag.recorder_node', ['max_queue_mb:=0', 'output:={tmp}/bag'],
+    ('mindgrasp_bag.recorder_node', ['max_queue_mb:=0', 'output:={tmp}/bag'],
      "'max_queue_mb'"),
-    ('mindgrasp_bringup.bag.recorder_node', ['custom_data:=["robot"]', 'output:={tmp}/bag'],
+    ('mindgrasp_bag.recorder_node', ['custom_data:=["robot"]', 'output:={tmp}/bag'],
      "custom_data entry 'robot' is not KEY=VALUE"),
-    ('mindgrasp_bringup.bag.player_node', [], 'The parameter bag is empty'),
-    ('mindgrasp_bringup.bag.player_node', ['bag:={tmp}/nope'],
+    ('mindgrasp_bag.player_node', [], 'The parameter bag is empty'),
+    ('mindgrasp_bag.player_node', ['bag:={tmp}/nope'],
      'nope does not exist; pass a run directory'),
-    ('mindgrasp_bringup.bag.player_node', ['bag:={tmp}', 'rate:=0.0'], "'rate' must be > 0"),
+    ('mindgrasp_bag.player_node', ['bag:={tmp}', 'rate:=0.0'], "'rate' must be > 0"),
     ('mindgrasp_bringup.replay.replay_node', [], 'No bag given'),
     ('mindgrasp_bringup.replay.replay_node', ['bag:={tmp}/nope'],
      'nope does not exist; pass a run directory'),

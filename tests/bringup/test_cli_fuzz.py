@@ -1,7 +1,7 @@
 """Bad input to any command or node ends in ONE stderr line naming the problem, no traceback, and
 a non-zero exit code (2 for usage errors, as argparse and ros2cli give it).
 
-The cases are made from the CLI's own table (:data:`mindgrasp_bringup.cli.COMMANDS`, so verbs added
+The cases are made from the CLI's own table (:func:`mindgrasp_bringup.cli.commands`, so verbs added
 later are covered) and from every package's console scripts (the node executables): unknown
 flags, missing values, values of the wrong type or out of their choices, missing arguments,
 malformed ``--ros-args`` and parameter files. They run in-process and fail before any DDS traffic
@@ -46,7 +46,7 @@ OUT_OF_RANGE = {non_negative_int: '-1', positive_int: '0', non_negative_float: '
 
 def _verbs() -> list[tuple[str, ...]]:
     return [(command,) if isinstance(target, str) else (command, verb)
-            for command, target in cli.COMMANDS.items()
+            for command, target in cli.commands().items()
             for verb in ([None] if isinstance(target, str) else target)]
 
 
@@ -143,7 +143,7 @@ def _cli_parser(prefix: tuple[str, ...]) -> argparse.ArgumentParser:
 
 @pytest.mark.parametrize(('argv', 'named'), _usage_cases())
 def test_usage_errors_are_one_line_exit_2(argv, named, capsys):
-    prefix = tuple(argv[:1]) if isinstance(cli.COMMANDS[argv[0]], str) else tuple(argv[:2])
+    prefix = tuple(argv[:1]) if isinstance(cli.commands()[argv[0]], str) else tuple(argv[:2])
     with pytest.raises(SystemExit) as exc:
         args = _cli_parser(prefix).parse_args(argv)
         pytest.fail(f'argparse accepted the bad input: {args}')
@@ -209,7 +209,7 @@ SEMANTIC = [
     (['run', 'no_such_package', 'node'], "package 'no_such_package' not found"),
     (['run', 'mindgrasp_fsm', 'no_such_node'], "'mindgrasp_fsm.no_such_node' does not exist"),
     (['eeg', 'virtual-amp', '--no-ros', '--ros-args', '-p', 'seed:=1'], '--ros-args needs'),
-    (['topic'], 'a verb is required: list, echo'),
+    (['topic'], 'a verb is required: echo, hz, info, list, pub'),
     # files and parameters of the offline commands
     (['experiment', 'report', '/no/such/run'], '/no/such/run'),
     (['experiment', 'set-locations', '--trials', '1', '--param', 'no_equals'], 'no_equals'),

@@ -77,6 +77,18 @@ def test_no_package_uses_a_package_that_depends_on_it() -> None:
     assert not cycles, '\n'.join(cycles)
 
 
+def test_readme_layout_shows_every_package() -> None:
+    """The root README's layout block names each package folder (and config/), and each package
+    has a README of its own."""
+    readme = (REPO / 'README.md').read_text(encoding='utf-8')
+    block = readme.split('## Layout', 1)[1].split('```')[1]
+    listed = re.findall(r'^(\S+)/\s', block, re.M)
+    packages = {f'src/{p.name}' for p in PACKAGES}
+    assert {name for name in listed if name.startswith('src/')} == packages, listed
+    assert 'config' in listed
+    assert [p.name for p in PACKAGES if not (p / 'README.md').is_file()] == []
+
+
 @pytest.mark.parametrize('package_dir', PYTHON_PACKAGES, ids=lambda p: p.name)
 def test_ament_python_layout(package_dir: Path) -> None:
     name = package_dir.name
@@ -114,7 +126,8 @@ def test_launch_files_name_installed_executables() -> None:
     for path in files:
         text = path.read_text(encoding='utf-8')
         pairs |= set(re.findall(r"package='(\w+)',\s*executable='(\w+)'", text))
-        assert "package='mindgrasp_bringup.bag'" not in text
+        # a package name, not a subpackage's module path (package='mindgrasp_bringup.replay')
+        assert not re.search(r"package='mindgrasp_\w+\.", text)
     assert len(pairs) >= 8
     for package, executable in sorted(pairs):
         assert executable in scripts[package], f'{package} has no console script {executable}'
@@ -167,11 +180,36 @@ def test_colcon_installs_executables_and_share_files(workspace: Path) -> None:
             assert os.access(install / name / 'lib' / name / executable, os.X_OK), executable
     launch = install / 'mindgrasp_bringup' / 'share' / 'mindgrasp_bringup' / 'launch'
     assert (launch / 'demo.launch.py').is_file()  # ros2 launch mindgrasp_bringup demo.launch.py
+    # the top-level config/ (what a user edits) is the bringup package's share files, where the
+    # installed code finds it: no source tree, no ROS 2, only the sourced workspace
+    config = install / 'mindgrasp_bringup' / 'share' / 'mindgrasp_bringup' / 'config'
+    assert sorted(p.relative_to(config).as_posix() for p in config.rglob('*.yaml')) == sorted(
+        p.relative_to(REPO / 'config').as_posix() for p in (REPO / 'config').rglob('*.yaml'))
+    found = subprocess.run(
+        sourced(workspace, sys.executable, '-c',
+                'from mindgrasp_common.resources import resource_path as r; '
+                'print(r("mindgrasp_fsm", "param/fsm.yaml")); print(r("mindgrasp_sim", "scenes")); '
+                'print(r("mindgrasp_bringup", "param/demo.yaml"))'),
+        env=workspace_env(), capture_output=True, text=True, timeout=120, check=False)
+    assert found.returncode == 0, found.stderr
+    assert found.stdout.split() == [str(config / 'param' / 'fsm.yaml'), str(config / 'scenes'),
+                                    str(config / 'profiles' / 'demo.yaml')]
     cli = install / 'mindgrasp_bringup' / 'lib' / 'mindgrasp_bringup' / 'mindgrasp'
     help_run = subprocess.run(sourced(workspace, str(cli), '--help'), env=workspace_env(),
                               capture_output=True, text=True, timeout=120, check=False)
     assert help_run.returncode == 0, help_run.stderr
     assert 'launch' in help_run.stdout
+    # each installed package brings its own commands and verbs (entry points in its setup.py)
+    registered = subprocess.run(
+        sourced(workspace, sys.executable, '-c',
+                'import importlib.metadata as m; print(sorted({(e.name, e.dist.name) for e in '
+                'm.entry_points(group="mindgrasp.verb")}))'),
+        env=workspace_env(), capture_output=True, text=True, timeout=120, check=True).stdout
+    for verb, package in [('bag record', 'mindgrasp_bag'), ('topic echo', 'mindgrasp_bringup'),
+                          ('train classifier', 'mindgrasp_classifier'),
+                          ('train vision', 'mindgrasp_vision'),
+                          ('eeg fit-virtual', 'mindgrasp_experiments')]:
+        assert repr((verb, package)) in registered, registered
     # an installed node executable (ros2 run mindgrasp_fsm fsm_node --help): its docstring and
     # the ROS arguments, without starting the node
     node_help = subprocess.run(

@@ -22,7 +22,7 @@ import pytest
 import yaml
 from launch_fixtures.runner import kill_group, launch_env, start_launch
 
-from mindgrasp_bringup.bag import BagReader
+from mindgrasp_bag import BagReader
 from mindgrasp_common.safe_files import fallback_folder
 from mindgrasp_experiments.records import read_records
 from mindgrasp_testing import small_tmpfs

@@ -19,8 +19,8 @@ import pytest
 from conftest_bag import EEG, JOINTS, eeg_chunk, joints
 from launch_fixtures.runner import fixture, launch_env, run_launch
 
-from mindgrasp_bringup.bag import BagWriter
-from mindgrasp_bringup.bag.latency import LatencyError, RunStamps, latency_report
+from mindgrasp_bag import BagWriter
+from mindgrasp_bag.latency import LatencyError, RunStamps, latency_report
 from mindgrasp_bringup.launch_system.run_report import write_run_report
 
 MS = 1_000_000

@@ -66,7 +66,7 @@ def test_demo_runs_headless_ends_cleanly_and_records_the_session(tmp_path: Path)
     assert f'Trial 1 (red cube): {verdict}' in log, (record, log[-2000:])
     for label in ('sim', 'eeg_acquisition', 'classifier', 'vision', 'fsm'):
         assert (run_dir / 'logs' / f'{label}.log').stat().st_size > 0, label
-    from mindgrasp_bringup.bag.reader import BagReader
+    from mindgrasp_bag.reader import BagReader
 
     with BagReader(run_dir / 'bag') as reader:
         reader.open()

@@ -301,7 +301,7 @@ def test_recorder_is_first_and_gets_the_bag_and_topics() -> None:
              'record_regex:=^/camera/', record=True)
     recorder, a = p.processes
     assert recorder.label == 'recorder' and recorder.daemon and not a.daemon
-    assert recorder.module == 'mindgrasp_bringup.bag.recorder_node'
+    assert recorder.module == 'mindgrasp_bag.recorder_node'
     assert recorder.parameters['topics'] == ['/eeg/raw', '/fsm/state']
     assert recorder.parameters['regex'] == '^/camera/'
     # the run's bag: zstd chunks, without the display frames drawn from recorded topics

@@ -35,7 +35,7 @@ def test_topics_flow_between_launched_nodes_and_are_recorded(tmp_path: Path) -> 
         ('recorder', 'stopped by SIGINT', True), ('talker', 'finished', True),
         ('listener', 'finished', True)]
     # the recorder started first, stopped last and wrote the bag into the run directory
-    from mindgrasp_bringup.bag.reader import BagReader
+    from mindgrasp_bag.reader import BagReader
 
     with BagReader(run_dir / 'bag') as reader:
         reader.open()

@@ -15,10 +15,10 @@ from pathlib import Path
 import pytest
 from launch_fixtures.runner import fixture, kill_group, launch_env, start_launch
 
-from mindgrasp_bringup.bag import BagReader
-from mindgrasp_bringup.bag.mcap_scan import read_mcap_contents
-from mindgrasp_bringup.bag.param_changes import ParameterChangeLog, read_changes
-from mindgrasp_bringup.bag.typestore import typestore
+from mindgrasp_bag import BagReader
+from mindgrasp_bag.mcap_scan import read_mcap_contents
+from mindgrasp_bag.param_changes import ParameterChangeLog, read_changes
+from mindgrasp_bag.typestore import typestore
 
 pytestmark = pytest.mark.slow
 

@@ -47,8 +47,8 @@ CASES = [
      'waiting for /trainer_robot/joint_states'),
     ('graz session running', 'mindgrasp_trainer.graz_node', {'n_trials': 40},
      'Graz-BCI session'),
-    ('recorder recording', 'mindgrasp_bringup.bag.recorder_node', {}, 'Recording to'),
-    ('player waiting for the next message', 'mindgrasp_bringup.bag.player_node', {}, 'Playing'),
+    ('recorder recording', 'mindgrasp_bag.recorder_node', {}, 'Recording to'),
+    ('player waiting for the next message', 'mindgrasp_bag.player_node', {}, 'Playing'),
 ]
 
 
@@ -69,7 +69,7 @@ def start(spawn_node, tmp_path, module: str, params: dict, ready: str):
     if module.endswith('player_node'):   # two messages 10 min apart: it waits for the second
         from conftest_bag import STRING, string
 
-        from mindgrasp_bringup.bag import BagWriter
+        from mindgrasp_bag import BagWriter
 
         with BagWriter(tmp_path / 'bag') as writer:
             writer.add_topic(f'/{STREAM}/chatter', STRING)

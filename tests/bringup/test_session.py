@@ -131,7 +131,7 @@ def test_calibrate_runs_in_lockstep_end_to_end(tmp_path):
     bag like a live run; the model is trained from the first bag and scored on the held-out one."""
     import json
 
-    from mindgrasp_bringup.bag import BagReader
+    from mindgrasp_bag import BagReader
 
     res = subprocess.run(
         [sys.executable, '-m', 'mindgrasp_bringup', 'session', 'calibrate', '--subject', 'V1',
@@ -176,7 +176,7 @@ def test_calibration_plan_sets_trials_per_class_and_adds_a_heldout_run():
 def test_grasp_figures_come_from_the_test_runs_bag(tmp_path):
     """Targets and results written to a real rosbag2 (MCAP) are read back per trial: a lift of
     the desired object, a lift of another one, and a trial that ended without a grasp."""
-    from mindgrasp_bringup.bag.writer import BagWriter
+    from mindgrasp_bag.writer import BagWriter
     from mindgrasp_bringup.session import _grasp_results
     from mindgrasp_ros.typesupport import typestore
 

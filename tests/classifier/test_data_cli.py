@@ -61,7 +61,7 @@ def write_run_bag(path, rec, t0=500.0, chunk=4, drop=(40, 41), writer_kind='rosb
     topics = (('/eeg/raw', eeg_t), ('/trainer/prompt', prompt_t)) + (
         (('/virtual_subject/intent', string_t),) if intent else ())
     if writer_kind == 'mindgrasp':        # the project's recorder (mindgrasp bag record)
-        from mindgrasp_bringup.bag.writer import BagWriter
+        from mindgrasp_bag.writer import BagWriter
 
         with BagWriter(path) as writer:
             for topic, typ in topics:

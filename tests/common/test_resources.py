@@ -82,3 +82,51 @@ def test_share_directory_of_an_ament_install_wins(tmp_path, monkeypatch):
     (share / 'types.py').write_text('')
     monkeypatch.setenv('AMENT_PREFIX_PATH', os.pathsep.join([str(prefix)]))
     assert resource_path('mindgrasp_common', 'types.py') == share / 'types.py'
+
+
+# -- config/: what a user edits, in one place -------------------------------------------------
+
+REPO = Path(__file__).resolve().parents[2]
+
+
+@pytest.mark.parametrize(('package', 'rel', 'in_config'), [
+    ('mindgrasp_fsm', 'param/fsm.yaml', 'param/fsm.yaml'),
+    ('mindgrasp_eeg', 'param/eeg.yaml', 'param/eeg.yaml'),
+    ('mindgrasp_bringup', 'param/demo.yaml', 'profiles/demo.yaml'),
+    ('mindgrasp_sim', 'scenes/set_locations.yaml', 'scenes/set_locations.yaml'),
+    ('mindgrasp_bringup', 'plans/graded.yaml', 'plans/graded.yaml'),
+    ('mindgrasp_bringup', 'config/plans/graded.yaml', 'plans/graded.yaml'),
+])
+def test_config_files_are_found_in_config_by_their_package(package, rel, in_config):
+    expected = REPO / 'config' / in_config
+    assert resource_path(package, rel) == expected
+    assert resolve_path(f'package://{package}/{rel}', 'x') == expected
+
+
+def test_no_package_keeps_a_file_that_belongs_in_config():
+    left = sorted(str(p.relative_to(REPO)) for folder in ('param', 'scenes', 'plans')
+                  for p in REPO.glob(f'src/mindgrasp_*/mindgrasp_*/{folder}/*.yaml'))
+    assert not left, f'move to config/ (config/README.md): {left}'
+
+
+def test_installed_config_wins_without_ros(tmp_path, monkeypatch):
+    """A sourced colcon workspace without ROS 2 (no ament_index_python): the share directory of
+    ``AMENT_PREFIX_PATH`` is found as ament_index finds it."""
+    prefix = tmp_path / 'install' / 'mindgrasp_bringup'
+    index = prefix / 'share' / 'ament_index' / 'resource_index' / 'packages'
+    index.mkdir(parents=True)
+    (index / 'mindgrasp_bringup').write_text('')
+    installed = prefix / 'share' / 'mindgrasp_bringup' / 'config' / 'param' / 'fsm.yaml'
+    installed.parent.mkdir(parents=True)
+    installed.write_text('fsm: {}\n')
+    monkeypatch.setenv('AMENT_PREFIX_PATH', f'{tmp_path / "nothing"}{os.pathsep}{prefix}')
+    assert resource_path('mindgrasp_fsm', 'param', 'fsm.yaml') == installed
+    # a file the install lacks: the checkout's
+    assert resource_path('mindgrasp_sim', 'scenes') == REPO / 'config' / 'scenes'
+
+
+def test_missing_config_file_names_where_it_looked():
+    with pytest.raises(ResourceNotFoundError,
+                       match=r"'param/nope.yaml' of 'mindgrasp_fsm' is a config file, looked for "
+                             r"as config/param/nope.yaml: .*config/param holds \[.*'fsm.yaml'"):
+        resource_path('mindgrasp_fsm', 'param', 'nope.yaml')

@@ -14,7 +14,8 @@ from pathlib import Path
 import pytest
 
 REPO = Path(__file__).resolve().parents[2]
-READMES = [REPO / 'README.md', *sorted(REPO.glob('src/*/README.md'))]
+READMES = [REPO / 'README.md', REPO / 'config' / 'README.md',
+           *sorted(REPO.glob('src/*/README.md'))]
 
 
 def _commands() -> list[tuple[str, str]]:

@@ -7,7 +7,7 @@ import re
 
 import pytest
 
-from mindgrasp_bringup.bag.recorder_node import RecorderNode, RecorderParams
+from mindgrasp_bag.recorder_node import RecorderNode, RecorderParams
 from mindgrasp_bringup.launch_system import LaunchError, lockstep
 from mindgrasp_bringup.launch_system.lockstep import check_left_out_nodes, node_traits
 from mindgrasp_eeg.acquisition_node import AcquisitionNode

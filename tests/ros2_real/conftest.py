@@ -79,7 +79,8 @@ def _workspace_key(ros2_env: dict[str, str], packages: list[Path]) -> str:
     """What a ``colcon build --symlink-install`` of ``packages`` depends on: the ROS 2 it builds
     against, this clone's path (the install links into it), each package's build files and
     interface files, and the names of its files (setup.py installs the data files one by one;
-    the Python modules are linked as a folder, so a change of their code needs no rebuild)."""
+    the Python modules are linked as a folder, so a change of their code needs no rebuild), and
+    the names of the files of the top-level config/ (installed as mindgrasp_bringup's)."""
     digest = hashlib.sha256(f'{REPO}\0{ros2_env.get("AMENT_PREFIX_PATH", "")}'.encode())
     for package in packages:
         for path in sorted(p for p in package.rglob('*') if p.is_file()
@@ -88,6 +89,9 @@ def _workspace_key(ros2_env: dict[str, str], packages: list[Path]) -> str:
             if path.name in ('package.xml', 'setup.py', 'setup.cfg', 'CMakeLists.txt') or \
                     path.suffix in ('.msg', '.srv'):
                 digest.update(path.read_bytes())
+    # the top-level config/, which mindgrasp_bringup's setup.py installs file by file
+    for path in sorted(p for p in (REPO / 'config').rglob('*') if p.is_file()):
+        digest.update(str(path.relative_to(REPO)).encode() + b'\0')
     return digest.hexdigest()[:16]
 
 

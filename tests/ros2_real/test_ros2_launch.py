@@ -25,8 +25,8 @@ DEMO_NODES = {'recorder_node', 'trial_manager_node', 'sim_node', 'virtual_amp_no
 
 
 def test_ros2_launch_demo_grasps_on_real_rclpy(colcon_ws, tmp_path: Path) -> None:
-    from mindgrasp_bringup.bag.reader import BagReader
-    from mindgrasp_bringup.bag.typestore import typestore
+    from mindgrasp_bag.reader import BagReader
+    from mindgrasp_bag.typestore import typestore
 
     run = tmp_path / 'run'
     proc = subprocess.Popen(

@@ -20,7 +20,7 @@ pytestmark = pytest.mark.slow
 
 @pytest.mark.timeout(600)
 def test_a_trainer_session_runs_on_two_xarm6(tmp_path: Path) -> None:
-    from mindgrasp_bringup.bag import BagReader
+    from mindgrasp_bag import BagReader
     from mindgrasp_ros.typesupport import typestore
 
     xarm = load_robot('xarm6')

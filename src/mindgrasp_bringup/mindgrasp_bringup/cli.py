@@ -1,10 +1,14 @@
 """The ``mindgrasp`` command line: ``mindgrasp <command> [<verb>] ...``, in the manner of ``ros2``.
 
 Each command lives in a module that defines ``add_arguments(parser)`` and ``main(args) -> int``.
-Commands with verbs (``bag record``, ``train classifier``) map each verb to such a module, possibly
-in another package (``train classifier`` is :mod:`mindgrasp_classifier.train_cli`). Modules are
-imported only when their command runs, so ``mindgrasp --help`` stays fast and one broken package
-does not break the others.
+Packages register their commands themselves, as ros2cli's packages do (``ros2cli.command``,
+``ros2topic.verb``): entry points in their setup.py, group ``mindgrasp.command``
+(``'launch = mindgrasp_bringup.commands.launch'``) for a command without verbs, group
+``mindgrasp.verb`` (``'bag record = mindgrasp_bag.commands.bag_record'``) for a command's verb;
+several packages may add verbs to one command (``train classifier``, ``train vision``).
+Commands and verbs are listed in name order, as ``ros2 --help``. Modules are imported only when
+their command runs, so ``mindgrasp --help`` stays fast and one broken package does not break
+the others.
 """
 
 from __future__ import annotations
@@ -12,101 +16,70 @@ from __future__ import annotations
 import argparse
 import functools
 import importlib
+import importlib.metadata
 import importlib.util
 import sys
 from collections.abc import Sequence
+from pathlib import Path
 
 from mindgrasp_common.cli_checks import OneLineParser
 from mindgrasp_ros.process import handle_stop_signals
 
-#: command -> module, or command -> {verb: module}
-COMMANDS: dict[str, str | dict[str, str]] = {
-    'launch': 'mindgrasp_bringup.commands.launch',
-    'run': 'mindgrasp_bringup.commands.run',
-    'replay': 'mindgrasp_bringup.commands.replay',
-    'bag': {
-        'record': 'mindgrasp_bringup.commands.bag_record',
-        'play': 'mindgrasp_bringup.commands.bag_play',
-        'info': 'mindgrasp_bringup.commands.bag_info',
-        'reindex': 'mindgrasp_bringup.commands.bag_reindex',
-        'latency': 'mindgrasp_bringup.commands.bag_latency',
-    },
-    'topic': {
-        'list': 'mindgrasp_bringup.commands.topic_list',
-        'echo': 'mindgrasp_bringup.commands.topic_echo',
-        'hz': 'mindgrasp_bringup.commands.topic_hz',
-        'info': 'mindgrasp_bringup.commands.topic_info',
-        'pub': 'mindgrasp_bringup.commands.topic_pub',
-    },
-    'node': {
-        'list': 'mindgrasp_bringup.commands.node_list',
-        'info': 'mindgrasp_bringup.commands.node_info',
-    },
-    'service': {
-        'list': 'mindgrasp_bringup.commands.service_list',
-        'type': 'mindgrasp_bringup.commands.service_type',
-        'call': 'mindgrasp_bringup.commands.service_call',
-    },
-    'interface': {
-        'list': 'mindgrasp_bringup.commands.interface_list',
-        'show': 'mindgrasp_bringup.commands.interface_show',
-        'proto': 'mindgrasp_bringup.commands.interface_proto',
-    },
-    'param': {
-        'list': 'mindgrasp_bringup.commands.param_list',
-        'get': 'mindgrasp_bringup.commands.param_get',
-        'set': 'mindgrasp_bringup.commands.param_set',
-        'describe': 'mindgrasp_bringup.commands.param_describe',
-        'dump': 'mindgrasp_bringup.commands.param_dump',
-        'load': 'mindgrasp_bringup.commands.param_load',
-    },
-    'eeg': {
-        'virtual-amp': 'mindgrasp_eeg.virtual_amp_cli',
-        'play': 'mindgrasp_eeg.player_cli',
-        'fit-virtual': 'mindgrasp_experiments.fit_virtual_cli',
-    },
-    'train': {
-        'classifier': 'mindgrasp_classifier.train_cli',
-        'vision': 'mindgrasp_vision.train_cli',
-    },
-    'evaluate': {
-        'classifier': 'mindgrasp_classifier.evaluate_cli',
-    },
-    'experiment': {
-        'set-locations': 'mindgrasp_experiments.commands.set_locations',
-        'random-locations': 'mindgrasp_experiments.commands.random_locations',
-        'report': 'mindgrasp_experiments.commands.report',
-        'sweep': 'mindgrasp_experiments.commands.sweep',
-    },
-    'export': {
-        'eeg': 'mindgrasp_eeg.export_cli',
-        'bids': 'mindgrasp_eeg.bids_cli',
-    },
-    'trainer': {
-        'schedule': 'mindgrasp_trainer.schedule_cli',
-    },
-    'session': {
-        'run': 'mindgrasp_bringup.session_cli',
-        'resume': 'mindgrasp_bringup.session_cli',
-        'calibrate': 'mindgrasp_bringup.session_cli',
-    },
-}
+#: entry point groups: command -> module, and 'command verb' -> module
+COMMAND_GROUP = 'mindgrasp.command'
+VERB_GROUP = 'mindgrasp.verb'
+
+
+@functools.cache
+def commands() -> dict[str, str | dict[str, str]]:
+    """Command -> module, or command -> {verb: module}, from the installed packages' entry
+    points, in name order. A name registered twice (an editable install and a colcon workspace
+    both on the path) keeps its first registration, as Python's import would."""
+    found: dict[str, str | dict[str, str]] = {}
+    points = importlib.metadata.entry_points()
+    for point in points.select(group=COMMAND_GROUP):
+        found.setdefault(point.name, point.module)
+    for point in points.select(group=VERB_GROUP):
+        command, _, verb = point.name.partition(' ')
+        verbs = found.setdefault(command, {})
+        if isinstance(verbs, dict) and verb:
+            verbs.setdefault(verb, point.module)
+    return {name: (target if isinstance(target, str) else dict(sorted(target.items())))
+            for name, target in sorted(found.items())}
+
+
+def _module_file(module_name: str) -> Path | None:
+    """The source file of a module, found without importing it or its parent packages (find_spec
+    of ``a.b.c`` imports ``a`` and ``a.b``, whose ``__init__`` may pull in numpy and more: the bag
+    package's does); None when it is not installed."""
+    top, _, rest = module_name.partition('.')
+    try:
+        spec = importlib.util.find_spec(top)
+    except (ImportError, ValueError):
+        return None
+    if spec is None:
+        return None
+    if not rest:
+        return Path(spec.origin) if spec.origin else None
+    for location in spec.submodule_search_locations or []:
+        base = Path(location, *rest.split('.'))
+        for candidate in (base.with_suffix('.py'), base / '__init__.py'):
+            if candidate.is_file():
+                return candidate
+    return None
 
 
 @functools.cache
 def _module_doc(module_name: str) -> str:
     """Docstring of a command module, without importing heavy packages on --help (read once
     per process: in-process callers such as tests build the parser many times)."""
-    try:
-        spec = importlib.util.find_spec(module_name)
-    except (ImportError, ValueError):
-        spec = None
-    if spec is None or spec.origin is None:
+    origin = _module_file(module_name)
+    if origin is None:
         return '(not installed)'
     import ast
 
     try:
-        with open(spec.origin, encoding='utf-8') as f:
+        with open(origin, encoding='utf-8') as f:
             doc = ast.get_docstring(ast.parse(f.read())) or ''
     except (OSError, SyntaxError):
         return ''
@@ -146,7 +119,7 @@ def build_parser(argv: Sequence[str]) -> argparse.ArgumentParser:
                         help="print the project's version (and git revision) and exit")
     sub = parser.add_subparsers(dest='command', metavar='<command>')
     chosen = argv[0] if argv else None
-    for command, target in COMMANDS.items():
+    for command, target in commands().items():
         if isinstance(target, str):
             if command == chosen:
                 _add_command(sub, command, target)
@@ -176,6 +149,12 @@ def version_text() -> str:
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``mindgrasp`` console script."""
     argv = list(sys.argv[1:] if argv is None else argv)
+    if not commands() and argv[:1] != ['--version']:
+        # an install older than the packages' setup.py files (pulled, not re-installed)
+        print(f'mindgrasp: no commands are installed (no {COMMAND_GROUP!r} or {VERB_GROUP!r} entry '
+              f'points on the Python path): run bash scripts/setup.sh in the checkout, or source '
+              f'the colcon workspace (install/setup.bash).', file=sys.stderr)
+        return 2
     parser = build_parser(argv)
     args = parser.parse_args(argv)
     module_name = getattr(args, '_module', None)
@@ -186,7 +165,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         if not argv:
             parser.print_help()
             return 0
-        verbs = COMMANDS.get(args.command, {})  # a command given without its verb
+        verbs = commands().get(args.command, {})  # a command given without its verb
         print(f'mindgrasp {args.command}: error: a verb is required: {", ".join(verbs)} '
               f'(see mindgrasp {args.command} --help)', file=sys.stderr)
         return 2

@@ -34,8 +34,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from mindgrasp_bringup.bag.qos import adapted_qos, qos_to_dict, resubscribe_qos
-from mindgrasp_bringup.bag.ros_glue import message_class, qos_profile
+from mindgrasp_bag.qos import adapted_qos, qos_to_dict, resubscribe_qos
+from mindgrasp_bag.ros_glue import message_class, qos_profile
 from mindgrasp_bringup.live_layout import write_layouts
 from mindgrasp_bringup.live_view import DEFAULT_PORT, FoxgloveServer, LiveViewError
 from mindgrasp_common.robot import DEFAULT_ROBOT

@@ -538,7 +538,7 @@ def _grasp_results(bag: Path) -> list[dict[str, Any]]:
     grasped and whether it was lifted (/task/result; none: no grasp before the trial ended)."""
     if not bag.is_dir():
         return []
-    from mindgrasp_bringup.bag.reader import BagReader
+    from mindgrasp_bag.reader import BagReader
     from mindgrasp_ros.typesupport import typestore
 
     store = typestore()

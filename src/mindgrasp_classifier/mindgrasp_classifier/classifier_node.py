@@ -2,7 +2,7 @@
 
     python -m mindgrasp_classifier.classifier_node --ros-args -p model:=models/my_model.json
     python -m mindgrasp_classifier.classifier_node --ros-args \
-        --params-file src/mindgrasp_classifier/mindgrasp_classifier/param/classifier.yaml
+        --params-file config/param/classifier.yaml
 
 One prediction per window step (1/16 s by default), stamped with the ROS time of the window's last
 sample. While the window fills, or when the window holds NaN or flat channels, no prediction is

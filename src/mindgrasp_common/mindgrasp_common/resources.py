@@ -1,21 +1,27 @@
 """Data files shipped with the MIndGrasp packages: the one way to find them.
 
-Every parameter file, scene, robot description and model is package data of the package that owns
-it (``mindgrasp_fsm/config/fsm.yaml``, ``mindgrasp_sim/scenes/set_locations.yaml``, ...), found by
+Models, URDFs and robot descriptions are package data of the package that owns them
+(``mindgrasp_sim/robots/xarm6.yaml``, ``mindgrasp_classifier/models/...``). What a user edits is in
+the top-level ``config/`` of the checkout: the nodes' parameter files (``config/param/``), the
+launch profiles' overlays (``config/profiles/``), scenes (``config/scenes/``) and session plans
+(``config/plans/``); a colcon build installs it as ``share/mindgrasp_bringup/config/``. Code
+asks for both kinds the same way, by the package the file belongs to, found by
 :func:`resource_path`::
 
     from mindgrasp_common.resources import resource_path
-    fsm_yaml = resource_path('mindgrasp_fsm', 'param', 'fsm.yaml')
+    fsm_yaml = resource_path('mindgrasp_fsm', 'param', 'fsm.yaml')     # config/param/fsm.yaml
 
 Lookup order:
 
-1. With ROS 2 sourced (``ament_index_python`` importable) and the package in the ament index (a
-   colcon install), the file under the package's share directory ``share/<package>/<parts>``.
-2. Otherwise the package data next to the Python package, through :mod:`importlib.resources`
-   (source checkouts, ``pip install``, editable installs).
+1. A colcon install (``ament_index_python`` when ROS 2 is sourced, else the workspace's
+   ``AMENT_PREFIX_PATH``): the file under the package's share directory ``share/<package>/<parts>``
+   (for config files, ``share/mindgrasp_bringup/config/...``).
+2. Otherwise, config files in the checkout's ``config/`` and package data next to the Python
+   package, through :mod:`importlib.resources` (source checkouts, editable installs).
 
 Values given by users (parameters, command-line arguments) go through :func:`resolve_path`, which
-also understands ROS ``package://<package>/<path>`` URIs, as URDF and RViz files write them.
+also understands ROS ``package://<package>/<path>`` URIs, as URDF and RViz files write them
+(``package://mindgrasp_sim/scenes/set_locations.yaml`` is ``config/scenes/set_locations.yaml``).
 """
 
 from __future__ import annotations
@@ -24,14 +30,30 @@ import atexit
 import contextlib
 import importlib.resources
 import importlib.util
+import os
 from pathlib import Path
 
 from mindgrasp_common.errors import ResourceNotFoundError
 
-__all__ = ['PACKAGE_URI', 'ResourceNotFoundError', 'resolve_path', 'resource_path']
+__all__ = ['CONFIG_FOLDERS', 'CONFIG_PACKAGE', 'PACKAGE_URI', 'ResourceNotFoundError', 'config_dir',
+           'resolve_path', 'resource_path']
 
 #: prefix of ROS package URIs (``package://mindgrasp_sim/urdf/mindgrasp_arm.urdf``)
 PACKAGE_URI = 'package://'
+
+#: the package whose share directory holds ``config/`` in a colcon install (its setup.py puts it)
+CONFIG_PACKAGE = 'mindgrasp_bringup'
+#: (package, folder) -> the folder of ``config/`` that holds that package's files of that folder;
+#: ``(CONFIG_PACKAGE, 'config')`` is config/ itself, as installed (``package://mindgrasp_bringup/
+#: config/scenes/x.yaml``)
+CONFIG_FOLDERS: dict[tuple[str, str], str] = {
+    **{(f'mindgrasp_{name}', 'param'): 'param'
+       for name in ('eeg', 'classifier', 'vision', 'fsm', 'sim', 'trainer')},
+    (CONFIG_PACKAGE, 'param'): 'profiles',
+    ('mindgrasp_sim', 'scenes'): 'scenes',
+    (CONFIG_PACKAGE, 'plans'): 'plans',
+    (CONFIG_PACKAGE, 'config'): '',
+}
 
 # keeps files extracted from zipped packages alive until the interpreter exits
 _extracted = contextlib.ExitStack()
@@ -39,15 +61,48 @@ atexit.register(_extracted.close)
 
 
 def _share_dir(package: str) -> Path | None:
-    """``share/<package>`` of a colcon install, when ROS 2 is sourced and knows the package."""
+    """``share/<package>`` of a colcon install: asked of ament_index when ROS 2 is sourced, else
+    found as ament_index finds it, by the package's marker in a prefix of ``AMENT_PREFIX_PATH``
+    (a sourced workspace of our packages without ROS 2)."""
     try:
         from ament_index_python.packages import PackageNotFoundError, get_package_share_directory
     except ImportError:
+        for prefix in os.environ.get('AMENT_PREFIX_PATH', '').split(os.pathsep):
+            marker = Path(prefix, 'share', 'ament_index', 'resource_index', 'packages', package)
+            if prefix and marker.is_file():
+                return Path(prefix, 'share', package)
         return None
     try:
         return Path(get_package_share_directory(package))
     except (PackageNotFoundError, ValueError, LookupError):
         return None
+
+
+def config_dir() -> Path | None:
+    """The top-level ``config/`` of this source checkout (editable installs), or None."""
+    checkout = Path(__file__).resolve().parents[3]  # src/mindgrasp_common/mindgrasp_common/
+    config = checkout / 'config'
+    return config if config.is_dir() and (checkout / 'src' / 'mindgrasp_common').is_dir() else None
+
+
+def _config_file(package: str, segments: list[str]) -> Path:
+    """The file ``segments`` (``['param', 'fsm.yaml']``) of ``package``, a folder that lives in
+    ``config/`` (:data:`CONFIG_FOLDERS`): the installed ``share/mindgrasp_bringup/config/...``,
+    else the checkout's. Raises ResourceNotFoundError naming where it looked and what is there."""
+    folder = CONFIG_FOLDERS[(package, segments[0])]
+    rel = [folder, *segments[1:]] if folder else segments[1:]
+    share = _share_dir(CONFIG_PACKAGE)
+    bases = [base for base in (share / 'config' if share else None, config_dir()) if base]
+    for base in bases:
+        if base.joinpath(*rel).exists():
+            return base.joinpath(*rel)
+    where = bases[0].joinpath(*rel[:-1]) if bases else None
+    known = sorted(c.name for c in where.iterdir()) if where and where.is_dir() else []
+    msg = (f"The file {'/'.join(segments)!r} of {package!r} is a config file, looked for as "
+           f"config/{'/'.join(rel)}: " + (f'{where} holds {known}' if where else
+           f'no config/ found (a source checkout has it at its top; a colcon install at '
+           f'share/{CONFIG_PACKAGE}/config/)') + '.')
+    raise ResourceNotFoundError(msg)
 
 
 def _package_dir(package: str) -> importlib.resources.abc.Traversable:
@@ -90,6 +145,8 @@ def resource_path(package: str, *parts: str) -> Path:
         msg = (f'A data file of {package!r} must be a relative path inside the package without '
                f"'..', got {rel!r}; e.g. resource_path('mindgrasp_fsm', 'config/fsm.yaml').")
         raise ResourceNotFoundError(msg)
+    if segments and (package, segments[0]) in CONFIG_FOLDERS:
+        return _config_file(package, segments)
     share = _share_dir(package)
     if share is not None and share.joinpath(*segments).exists():
         return share.joinpath(*segments)

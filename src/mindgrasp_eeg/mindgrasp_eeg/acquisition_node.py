@@ -2,7 +2,7 @@
 
     python -m mindgrasp_eeg.acquisition_node --ros-args -p stream_name:=MyAmp
     python -m mindgrasp_eeg.acquisition_node --ros-args \
-        --params-file src/mindgrasp_eeg/mindgrasp_eeg/param/eeg.yaml
+        --params-file config/param/eeg.yaml
 
 Publishes ``/eeg/raw`` (sensor-data QoS, depth 100) every ``chunk_period`` seconds with the
 samples that arrived, in volts, stamped with the ROS time of the first sample (see

@@ -1,7 +1,6 @@
 """The ``fsm`` node: the six-state MIndGrasp controller on ROS topics.
 
-Run: ``python -m mindgrasp_fsm.fsm_node --ros-args --params-file
-src/mindgrasp_fsm/mindgrasp_fsm/param/fsm.yaml``
+Run: ``python -m mindgrasp_fsm.fsm_node --ros-args --params-file config/param/fsm.yaml``
 
 Subscribes ``/bci/prediction`` (mindgrasp_msgs/MIPrediction), ``/vision/detections``
 (DetectionArray), ``/joint_states``, ``/gripper/joint_states`` + ``/gripper/contacts`` (finger

@@ -4,7 +4,7 @@ RGB-D camera driver, served by :class:`~mindgrasp_sim.simulation.Simulation`.
     python -m mindgrasp_sim.sim_node --ros-args -p scene:=random_locations -p seed:=3
     python -m mindgrasp_sim.sim_node --ros-args -p time_mode:=fast -p sim_duration:=60.0
     python -m mindgrasp_sim.sim_node --ros-args \
-        --params-file src/mindgrasp_sim/mindgrasp_sim/param/sim.yaml
+        --params-file config/param/sim.yaml
 
 Subscribes ``/arm_controller/commands`` (std_msgs/Float64MultiArray, 6 joint velocities, rad/s;
 older than ``command_timeout`` s means zero; clipped to the velocity limits of the loaded URDF;

@@ -3,7 +3,7 @@
 Run::
 
     python -m mindgrasp_trainer.graz_node --ros-args -p n_trials:=40 -p seed:=1 \
-        --params-file src/mindgrasp_trainer/mindgrasp_trainer/param/trainer.yaml
+        --params-file config/param/trainer.yaml
 
 Publishes ``/trainer/prompt`` (mindgrasp_msgs/Prompt, reliable, transient local, depth 1: a late
 joiner gets the current phase) and ``/trainer/display`` (sensor_msgs/Image rgb8, when

@@ -3,7 +3,7 @@
 Run::
 
     python -m mindgrasp_vision.vision_node --ros-args \
-        --params-file src/mindgrasp_vision/mindgrasp_vision/param/vision.yaml
+        --params-file config/param/vision.yaml
 
 Subscribes /camera/color/image_raw (rgb8), /camera/depth/image_raw (32FC1 m), /camera/color/
 camera_info, /bci/prediction (a left/right hand prediction shifts the ranking focus) and /fsm/state

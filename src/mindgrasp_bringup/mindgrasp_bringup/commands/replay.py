@@ -18,7 +18,7 @@ import sys
 
 import yaml
 
-from mindgrasp_bringup.bag.damage import ALLOW_DAMAGED_HELP
+from mindgrasp_bag.damage import ALLOW_DAMAGED_HELP
 from mindgrasp_common.cli_checks import probability
 
 
@@ -46,7 +46,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def parse_params(items: list[str]) -> dict[str, dict[str, object]]:
     """``['classifier.min_certainty:=0.6']`` -> ``{'classifier': {'min_certainty': 0.6}}``."""
-    from mindgrasp_bringup.bag import BagError
+    from mindgrasp_bag import BagError
     from mindgrasp_bringup.replay.engine import NODES
 
     out: dict[str, dict[str, object]] = {}
@@ -63,7 +63,7 @@ def parse_params(items: list[str]) -> dict[str, dict[str, object]]:
 
 def main(args: argparse.Namespace) -> int:
     """Replay, write the report, print the summary line; 2 on bad arguments."""
-    from mindgrasp_bringup.bag import BagError
+    from mindgrasp_bag import BagError
     from mindgrasp_bringup.replay import ReplayConfig, damage_lines, run_replay, summary_line
 
     try:

@@ -15,7 +15,7 @@ The task, as in the paper's set-locations experiment: the trial manager names th
 on /task/target (latched), where the virtual subject (subject:=pursue) reads what to imagine and
 the simulator which grasp counts; after each grasp it resets the scene and starts the next trial.
 
-Parameters: param/<package>.yaml of each package, then mindgrasp_bringup/param/demo.yaml (the
+Parameters: config/param/<package>.yaml of each package, then config/profiles/demo.yaml (the
 demo's own settings), then the launch arguments below (later entries win).
 """
 
@@ -68,7 +68,7 @@ def generate_launch_description() -> LaunchDescription:
         file_argument('model', default_value='',
                       description='classifier model (.json written by mindgrasp train '
                                   'classifier); empty: the one in '
-                                  'mindgrasp_classifier/param/classifier.yaml'),
+                                  'config/param/classifier.yaml'),
         DeclareLaunchArgument('targets', default_value='red cube, blue cylinder, yellow sphere',
                               description='objects to grasp in turn, comma-separated ("red cube, '
                                           'blue sphere"); empty: drawn at random from the scene'),

@@ -8,7 +8,7 @@
 
 The acquisition node publishes /eeg/raw and /eeg/status; the run directory records them. With
 adapt:=true (the default here) the node adopts the stream's channel count, rate and names with a
-warning; adapt:=false holds the stream to mindgrasp_eeg/param/eeg.yaml (32 ch, 250 Hz, g.Nautilus
+warning; adapt:=false holds the stream to config/param/eeg.yaml (32 ch, 250 Hz, g.Nautilus
 names). With marker_stream:=auto (``<eeg_stream>-markers``) or marker_stream:=NAME the node also
 relays that LSL marker stream (the amplifier's triggers) to /eeg/markers, which the run records.
 """

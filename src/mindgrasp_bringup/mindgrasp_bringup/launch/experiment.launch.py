@@ -14,8 +14,8 @@ seed), ``oracle`` (no EEG: the subject's intended class is published as the pred
 With ``--lockstep`` every node runs in one process on simulated time; the virtual amplifier then
 publishes /eeg/raw itself and the LSL acquisition node is left out.
 
-Parameters: <package>/param/<package>.yaml, then mindgrasp_bringup/param/experiment.yaml, then
-the launch arguments below.
+Parameters: config/param/<package>.yaml, then config/profiles/experiment.yaml, then the launch
+arguments below.
 """
 
 from mindgrasp_bringup.launch_api import (

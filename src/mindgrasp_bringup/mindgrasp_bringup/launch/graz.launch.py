@@ -46,7 +46,7 @@ def generate_launch_description() -> LaunchDescription:
         file_argument('model', default_value='',
                       description='classifier model for feedback:=true (.json written '
                                   'by mindgrasp train classifier); empty: the one in '
-                                  'mindgrasp_classifier/param/classifier.yaml'),
+                                  'config/param/classifier.yaml'),
         robot_argument(description='the arm this calibration is for: no arm moves in a Graz '
                                    "session; the value is recorded with the run's launch "
                                    'arguments (mindgrasp_arm, xarm6 or a robot description YAML '

@@ -9,7 +9,7 @@ the arm contract of a ros2_control forward velocity controller (drive it from ou
     mindgrasp launch sim robot:=xarm6                      # UFactory xArm6 (or a robot YAML path)
     mindgrasp topic hz /joint_states                       # in another shell
 
-Parameters: mindgrasp_sim/param/sim.yaml, then the launch arguments below.
+Parameters: config/param/sim.yaml, then the launch arguments below.
 """
 
 from mindgrasp_bringup.launch_api import (
@@ -31,8 +31,7 @@ def generate_launch_description() -> LaunchDescription:
     width, height, rate = (CameraSpec(camera, field) for field in ('width', 'height', 'rate'))
     return LaunchDescription([
         DeclareLaunchArgument('scene', default_value='set_locations',
-                              description='scene name in mindgrasp_sim/scenes/ or a scene YAML '
-                                          'path'),
+                              description='scene name in config/scenes/ or a scene YAML path'),
         number_argument('seed', default_value='0', minimum=0,
                         description='layout seed of random scenes'),
         DeclareLaunchArgument('time_mode', default_value='realtime',

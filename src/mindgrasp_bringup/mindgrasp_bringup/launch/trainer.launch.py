@@ -48,7 +48,7 @@ def generate_launch_description() -> LaunchDescription:
         file_argument('model', default_value='',
                       description='classifier model (.json written by mindgrasp train '
                                   'classifier); empty: the one in '
-                                  'mindgrasp_classifier/param/classifier.yaml'),
+                                  'config/param/classifier.yaml'),
         robot_argument(description="the user's arm and the training robot, a second copy of "
                                    'it: mindgrasp_arm, xarm6 or a robot description YAML path'),
         *run_directory_actions(),  # ros2 launch: run directory, recorder, duration

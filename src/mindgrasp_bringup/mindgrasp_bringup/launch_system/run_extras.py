@@ -22,7 +22,7 @@ from mindgrasp_bringup.launch_system.conditions import evaluate_bool
 from mindgrasp_bringup.launch_system.errors import LaunchError
 from mindgrasp_common.safe_files import DeferredWriter
 
-RECORDER_PACKAGE = 'mindgrasp_bringup'
+RECORDER_PACKAGE = 'mindgrasp_bag'
 RECORDER_EXECUTABLE = 'recorder_node'
 RECORDER_NAME = 'recorder'
 

@@ -1,6 +1,6 @@
 """``report.md`` of a launch's run directory: written when the launch ends, from its bag.
 
-Today it holds the timing section (:mod:`mindgrasp_bringup.bag.latency`): per hop and end to end
+Today it holds the timing section (:mod:`mindgrasp_bag.latency`): per hop and end to end
 latency of the BCI loop, the display's cue-to-flip delay, and the jitter of periodic topics. A
 run that cannot give latencies (no EEG, no classifier or controller, no bag) says why in one line,
 so every run directory has a report.
@@ -12,9 +12,9 @@ import json
 import logging
 from pathlib import Path
 
-from mindgrasp_bringup.bag import BagError
-from mindgrasp_bringup.bag.latency import LatencyError, format_markdown, latency_report
-from mindgrasp_bringup.bag.run_stamps import read_run_stamps
+from mindgrasp_bag import BagError
+from mindgrasp_bag.latency import LatencyError, format_markdown, latency_report
+from mindgrasp_bag.run_stamps import read_run_stamps
 from mindgrasp_common.safe_files import write_atomic
 
 __all__ = ['write_run_report']

@@ -16,7 +16,7 @@ __all__ = ['ReplayConfig', 'ReplayResult', 'compare', 'damage_lines', 'replay', 
 
 def run_replay(cfg: ReplayConfig) -> ReplayResult:
     """Replay and write the comparison report (``result.summary``, ``result.report_path``)."""
-    from mindgrasp_bringup.bag.typestore import typestore
+    from mindgrasp_bag.typestore import typestore
 
     result = replay(cfg)
     write_report(result, typestore())

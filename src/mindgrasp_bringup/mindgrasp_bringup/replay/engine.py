@@ -28,15 +28,15 @@ from typing import Any
 
 import yaml
 
-from mindgrasp_bringup.bag.damage import assess_bag
-from mindgrasp_bringup.bag.errors import BagError
-from mindgrasp_bringup.bag.param_changes import PARAMETER_EVENTS
-from mindgrasp_bringup.bag.paths import resolve_bag, run_dir_of
-from mindgrasp_bringup.bag.qos import adapted_qos
-from mindgrasp_bringup.bag.reader import BagReader
-from mindgrasp_bringup.bag.ros_glue import qos_profile
-from mindgrasp_bringup.bag.typestore import typestore as default_typestore
-from mindgrasp_bringup.bag.writer import BagWriter
+from mindgrasp_bag.damage import assess_bag
+from mindgrasp_bag.errors import BagError
+from mindgrasp_bag.param_changes import PARAMETER_EVENTS
+from mindgrasp_bag.paths import resolve_bag, run_dir_of
+from mindgrasp_bag.qos import adapted_qos
+from mindgrasp_bag.reader import BagReader
+from mindgrasp_bag.ros_glue import qos_profile
+from mindgrasp_bag.typestore import typestore as default_typestore
+from mindgrasp_bag.writer import BagWriter
 from mindgrasp_bringup.replay.param_changes import ParameterChange, apply_change, recorded_changes
 from mindgrasp_ros.topics import BCI_PREDICTION, BCI_STATUS, CLOCK, EEG_RAW, FSM_STATE
 

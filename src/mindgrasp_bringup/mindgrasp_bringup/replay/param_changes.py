@@ -13,7 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from mindgrasp_bringup.bag.param_changes import EVENT_TYPE
+from mindgrasp_bag.param_changes import EVENT_TYPE
 
 __all__ = ['ParameterChange', 'apply_change', 'recorded_changes']
 

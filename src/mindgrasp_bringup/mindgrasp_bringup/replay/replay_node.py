@@ -14,8 +14,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from mindgrasp_bringup.bag.errors import BagError
-from mindgrasp_bringup.bag.paths import resolve_bag
+from mindgrasp_bag.errors import BagError
+from mindgrasp_bag.paths import resolve_bag
 from mindgrasp_bringup.replay import ReplayConfig, damage_lines, run_replay, summary_line
 from mindgrasp_common.robot_description import RobotDescriptionError, load_robot
 from mindgrasp_ros import rclpy

@@ -45,7 +45,7 @@ def node_module(package: str, executable: str) -> str | None:
     """The Python module of a node of one of our packages, as its console script names it.
 
     ``<package>.<executable>`` (``mindgrasp_fsm.fsm_node``), else one subpackage down
-    (``mindgrasp_bringup.bag.player_node``): where ``setup.py`` points the console script
+    (``mindgrasp_bringup.replay.replay_node``): where ``setup.py`` points the console script
     ``<executable> = <module>:main``. None when neither exists.
     """
     module = f'{package}.{executable}'

@@ -15,10 +15,10 @@ import uuid
 from pathlib import Path
 
 import pytest
-from conftest_bag import EEG, IMAGE, STRING, eeg_chunk, image, string
 from rosbags.rosbag2 import Reader as RosbagsReader
 
-from mindgrasp_bringup.bag import BagReader, BagWriter, Recorder
+from conftest_bag import EEG, IMAGE, STRING, eeg_chunk, image, string
+from mindgrasp_bag import BagReader, BagWriter, Recorder
 from mindgrasp_bringup.cli import main as cli_main
 from mindgrasp_testing import small_tmpfs
 
@@ -80,7 +80,7 @@ CHILD = textwrap.dedent('''
     import sys, time
     sys.path.insert(0, sys.argv[2])
     from conftest_bag import image
-    from mindgrasp_bringup.bag import BagWriter, Recorder
+    from mindgrasp_bag import BagWriter, Recorder
     recorder = Recorder(BagWriter(sys.argv[1], flush_interval=0.2))
     recorder.start()
     recorder.add_topic('/camera/color/image_raw', 'sensor_msgs/msg/Image')
@@ -105,7 +105,8 @@ def on_disk(bag: Path) -> int:
 @pytest.mark.slow
 def test_sigkill_during_recording_leaves_a_readable_bag(tmp_path, capsys):
     bag = tmp_path / 'killed'
-    proc = subprocess.Popen([sys.executable, '-c', CHILD, str(bag), str(Path(__file__).parent)],
+    tests = str(Path(__file__).parents[1])    # conftest_bag
+    proc = subprocess.Popen([sys.executable, '-c', CHILD, str(bag), tests],
                             stdout=subprocess.PIPE, text=True)
     lines, flushed = [], 0
     deadline = time.monotonic() + 120

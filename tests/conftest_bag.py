@@ -1,4 +1,5 @@
-"""Helpers for the bag tests (imported by tests/bringup/test_bag*.py): sample messages, bags."""
+"""Helpers for the bag tests (imported by tests/bag/test_bag_*.py, and by bringup tests that
+write bags): sample messages, bags."""
 
 from __future__ import annotations
 
@@ -12,7 +13,7 @@ from mcap.reader import make_reader
 from rosbags.rosbag2 import StoragePlugin
 from rosbags.rosbag2 import Writer as RosbagsWriter
 
-from mindgrasp_bringup.bag.typestore import typestore
+from mindgrasp_bag.typestore import typestore
 
 EEG = 'mindgrasp_msgs/msg/EEGChunk'
 IMAGE = 'sensor_msgs/msg/Image'
@@ -190,7 +191,7 @@ def run_with_bag(tmp_path: Path, n: int = 30, chunk_size: int = 2000,
                  compression: str = 'none') -> Path:
     """A run directory with a finished bag of ``n`` EEG chunks and ``n`` strings at 10 Hz
     (bag time 1.0-3.9 s), in several MCAP chunks (``compression``: none, zstd or lz4)."""
-    from mindgrasp_bringup.bag import BagWriter
+    from mindgrasp_bag import BagWriter
 
     run = tmp_path / 'run'
     run.mkdir()

@@ -11,10 +11,10 @@ from pathlib import Path
 
 import pytest
 import yaml
-from conftest_bag import cut_in_half, damage_chunks, mindgrasp_cli, run_with_bag
 
-from mindgrasp_bringup.bag import BagReader
-from mindgrasp_bringup.bag.damage import assess_bag
+from conftest_bag import cut_in_half, damage_chunks, mindgrasp_cli, run_with_bag
+from mindgrasp_bag import BagReader
+from mindgrasp_bag.damage import assess_bag
 from mindgrasp_testing import small_tmpfs
 
 N = 30          # messages per topic of run_with_bag; 2 topics

@@ -14,18 +14,18 @@ import uuid
 from pathlib import Path
 
 import pytest
+from mcap.reader import make_reader
+from rosbags.rosbag2 import Reader as RosbagsReader
+
 from conftest_bag import (
     PUBLISHER,
     cli_env,
     mindgrasp_cli,
     run_with_bag,
 )
-from mcap.reader import make_reader
-from rosbags.rosbag2 import Reader as RosbagsReader
+from mindgrasp_bag.mcap_scan import read_mcap_contents
 
-from mindgrasp_bringup.bag.mcap_scan import read_mcap_contents
-
-HERE = Path(__file__).parent
+HERE = Path(__file__).parents[1]  # tests/: conftest_bag, for the child processes
 
 
 def _plain_mcap_count(path: Path) -> int:
@@ -40,7 +40,7 @@ def test_reindex_makes_a_sigkilled_recording_readable_by_the_plain_mcap_reader(t
     run = tmp_path / 'run'
     bag = run / 'bag'
     recorder = subprocess.Popen(
-        [sys.executable, '-m', 'mindgrasp_bringup.bag.recorder_node', '--ros-args',
+        [sys.executable, '-m', 'mindgrasp_bag.recorder_node', '--ros-args',
          '-p', f'output:={bag}', '-p', f'regex:="^{prefix}/"', '-p', 'discovery_period:=0.2',
          '-p', 'flush_interval:=0.2'], env=cli_env(), stdout=subprocess.DEVNULL,
         stderr=subprocess.DEVNULL)

@@ -20,9 +20,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def main(args: argparse.Namespace) -> int:
     """Reindex; 2 when the path does not exist, 1 when it is not an MCAP bag."""
-    from mindgrasp_bringup.bag import BagError
-    from mindgrasp_bringup.bag.integrity import reindex, verify_bag
-    from mindgrasp_bringup.bag.paths import resolve_bag
+    from mindgrasp_bag import BagError
+    from mindgrasp_bag.integrity import reindex, verify_bag
+    from mindgrasp_bag.paths import resolve_bag
 
     try:
         bag = resolve_bag(args.bag)

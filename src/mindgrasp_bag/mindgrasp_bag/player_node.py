@@ -1,6 +1,6 @@
 """Player node: publishes a bag's messages with their original timing (like ``ros2 bag play``).
 
-Run: ``python -m mindgrasp_bringup.bag.player_node --ros-args -p bag:=runs/x/bag -p rate:=2.0
+Run: ``python -m mindgrasp_bag.player_node --ros-args -p bag:=runs/x/bag -p rate:=2.0
 -p clock:=true`` (parameters: :class:`PlayerParams`). Publishes the recorded CDR bytes unchanged
 (raw publishers) with the QoS the recording offered; topics whose type the client layer cannot
 publish are skipped and named.
@@ -20,14 +20,14 @@ import traceback
 from dataclasses import dataclass
 from typing import Any
 
-from mindgrasp_bringup.bag.damage import assess_bag
-from mindgrasp_bringup.bag.errors import BagError
-from mindgrasp_bringup.bag.paths import resolve_bag
-from mindgrasp_bringup.bag.player import Player, PlayStats, parse_remaps, type_problem
-from mindgrasp_bringup.bag.qos import adapted_qos
-from mindgrasp_bringup.bag.reader import BagReader, TopicInfo
-from mindgrasp_bringup.bag.ros_glue import message_class, qos_profile
-from mindgrasp_bringup.bag.typestore import typestore
+from mindgrasp_bag.damage import assess_bag
+from mindgrasp_bag.errors import BagError
+from mindgrasp_bag.paths import resolve_bag
+from mindgrasp_bag.player import Player, PlayStats, parse_remaps, type_problem
+from mindgrasp_bag.qos import adapted_qos
+from mindgrasp_bag.reader import BagReader, TopicInfo
+from mindgrasp_bag.ros_glue import message_class, qos_profile
+from mindgrasp_bag.typestore import typestore
 from mindgrasp_ros import rclpy
 from mindgrasp_ros.node_main import fail, run_node
 from mindgrasp_ros.params import ParameterError, declare_params, param

@@ -11,11 +11,11 @@ import sys
 
 import yaml
 
-from mindgrasp_bringup.bag import BagError, BagReader
-from mindgrasp_bringup.bag.damage import ALLOW_DAMAGED_HELP, assess_bag
-from mindgrasp_bringup.bag.info import format_info, summarize
-from mindgrasp_bringup.bag.integrity import reindex
-from mindgrasp_bringup.bag.paths import resolve_bag
+from mindgrasp_bag import BagError, BagReader
+from mindgrasp_bag.damage import ALLOW_DAMAGED_HELP, assess_bag
+from mindgrasp_bag.info import format_info, summarize
+from mindgrasp_bag.integrity import reindex
+from mindgrasp_bag.paths import resolve_bag
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

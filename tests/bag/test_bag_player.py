@@ -8,11 +8,11 @@ import time
 
 import numpy as np
 import pytest
-from conftest_bag import EEG, IMAGE, STRING, eeg_chunk, image, string, write_rosbags_bag
 from rosbags.rosbag2 import StoragePlugin
 
-from mindgrasp_bringup.bag import BagError, BagReader, BagWriter, Player, Recorder
-from mindgrasp_bringup.bag.player import parse_remaps
+from conftest_bag import EEG, IMAGE, STRING, eeg_chunk, image, string, write_rosbags_bag
+from mindgrasp_bag import BagError, BagReader, BagWriter, Player, Recorder
+from mindgrasp_bag.player import parse_remaps
 
 T0 = 1_750_000_000_000_000_000
 MS = 1_000_000

@@ -1,9 +1,9 @@
 """Recorder node: records all topics (or a pattern list) to a rosbag2 MCAP bag.
 
-Run: ``python -m mindgrasp_bringup.bag.recorder_node --ros-args -p output:=runs/x/bag
+Run: ``python -m mindgrasp_bag.recorder_node --ros-args -p output:=runs/x/bag
 -p topics:="['/eeg/raw']" -p duration:=10.0`` (parameters: :class:`RecorderParams`). New topics
 are discovered while it runs; the subscriptions take raw CDR bytes, and a
-:class:`~mindgrasp_bringup.bag.recorder.Recorder` writes them from its own thread, so callbacks
+:class:`~mindgrasp_bag.recorder.Recorder` writes them from its own thread, so callbacks
 never wait for the disk.
 
 QoS as rosbag2 does it: a topic is subscribed once it has a publisher (a topic that only has
@@ -31,13 +31,13 @@ import time
 from dataclasses import dataclass
 from typing import Any
 
-from mindgrasp_bringup.bag.errors import BagError
-from mindgrasp_bringup.bag.param_changes import PARAMETER_EVENTS, ParameterChangeLog
-from mindgrasp_bringup.bag.param_watch import ParameterWatch
-from mindgrasp_bringup.bag.qos import adapted_qos, qos_to_dict, resubscribe_qos
-from mindgrasp_bringup.bag.recorder import Recorder
-from mindgrasp_bringup.bag.ros_glue import message_class, qos_profile
-from mindgrasp_bringup.bag.writer import BagWriter
+from mindgrasp_bag.errors import BagError
+from mindgrasp_bag.param_changes import PARAMETER_EVENTS, ParameterChangeLog
+from mindgrasp_bag.param_watch import ParameterWatch
+from mindgrasp_bag.qos import adapted_qos, qos_to_dict, resubscribe_qos
+from mindgrasp_bag.recorder import Recorder
+from mindgrasp_bag.ros_glue import message_class, qos_profile
+from mindgrasp_bag.writer import BagWriter
 from mindgrasp_ros import rclpy
 from mindgrasp_ros.logs import log_at
 from mindgrasp_ros.node_main import NodeFailure, end_after, run_node

@@ -12,7 +12,7 @@ import pytest
 import yaml
 from mcap.reader import make_reader
 
-from mindgrasp_bringup.bag import BagReader
+from mindgrasp_bag import BagReader
 from mindgrasp_bringup.launch_system.run_extras import DEFAULT_RECORD_EXCLUDE
 from mindgrasp_trainer.graz import GrazProtocol
 
@@ -62,7 +62,7 @@ def test_intra_graph_and_raw_subscriptions_in_lockstep() -> None:
 def test_lockstep_components_compose_the_launchs_recorder(tmp_path: Path) -> None:
     """The recorder of a live launch (same topics argument), writing the given bag; none without
     a bag (the experiments) or with record:=false."""
-    from mindgrasp_bringup.bag.recorder_node import RecorderNode
+    from mindgrasp_bag.recorder_node import RecorderNode
     from mindgrasp_bringup.launch_system.lockstep import lockstep_components
 
     def recorders(args: dict, bag: Path | None) -> list:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from mindgrasp_bringup.bag.ros_glue import param_args
+from mindgrasp_bag.ros_glue import param_args
 from mindgrasp_common.cli_checks import (
     non_negative_float,
     non_negative_int,
@@ -40,7 +40,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def main(args: argparse.Namespace) -> int:
     """Run the recorder node in this process until Ctrl-C or ``--duration``."""
-    from mindgrasp_bringup.bag import recorder_node
+    from mindgrasp_bag import recorder_node
 
     params = {
         'output': args.output, 'topics': list(args.topics) or [''], 'regex': args.regex,

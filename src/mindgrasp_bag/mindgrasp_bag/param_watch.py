@@ -1,4 +1,4 @@
-"""The recorder's ROS side of :class:`~mindgrasp_bringup.bag.param_changes.ParameterChangeLog`:
+"""The recorder's ROS side of :class:`~mindgrasp_bag.param_changes.ParameterChangeLog`:
 decodes the recorded ``/parameter_events`` and reads each new node's parameters once (its
 ``list_parameters`` / ``get_parameters`` services), so that each change has its old value."""
 
@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from mindgrasp_bringup.bag.param_changes import EVENT_TYPE, ParameterChangeLog
+from mindgrasp_bag.param_changes import EVENT_TYPE, ParameterChangeLog
 
 
 def _values(params: Any) -> dict[str, Any]:

@@ -6,14 +6,14 @@ import shutil
 
 import pytest
 import yaml
-from conftest_bag import EEG, IMAGE, JOINTS, STRING, eeg_chunk, image, joints, string
 from mcap.reader import make_reader
 from mcap_ros2.decoder import DecoderFactory
 from rosbags.rosbag2 import Reader as RosbagsReader
 
-from mindgrasp_bringup.bag import BagError, BagReader, BagWriter
-from mindgrasp_bringup.bag.metadata import rebuild_metadata
-from mindgrasp_bringup.bag.typestore import typestore
+from conftest_bag import EEG, IMAGE, JOINTS, STRING, eeg_chunk, image, joints, string
+from mindgrasp_bag import BagError, BagReader, BagWriter
+from mindgrasp_bag.metadata import rebuild_metadata
+from mindgrasp_bag.typestore import typestore
 
 QOS_SENSOR = {'history': 'keep_last', 'depth': 5, 'reliability': 'best_effort',
               'durability': 'volatile'}
@@ -172,8 +172,9 @@ def test_truncated_file_recovers_every_complete_chunk(tmp_path):
 
 
 def test_rosbags_written_bags_are_read_sqlite3_and_mcap(tmp_path):
-    from conftest_bag import write_rosbags_bag
     from rosbags.rosbag2 import StoragePlugin
+
+    from conftest_bag import write_rosbags_bag
 
     messages = _messages(5)
     for storage in (StoragePlugin.SQLITE3, StoragePlugin.MCAP):

@@ -5,8 +5,8 @@ from __future__ import annotations
 import argparse
 import sys
 
-from mindgrasp_bringup.bag.damage import ALLOW_DAMAGED_HELP
-from mindgrasp_bringup.bag.ros_glue import param_args
+from mindgrasp_bag.damage import ALLOW_DAMAGED_HELP
+from mindgrasp_bag.ros_glue import param_args
 from mindgrasp_common.cli_checks import non_negative_float, positive_float
 
 
@@ -41,8 +41,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def main(args: argparse.Namespace) -> int:
     """Run the player node in this process until the bag ends (or Ctrl-C)."""
-    from mindgrasp_bringup.bag import BagError
-    from mindgrasp_bringup.bag.player import parse_remaps
+    from mindgrasp_bag import BagError
+    from mindgrasp_bag.player import parse_remaps
 
     try:  # option errors before any ROS set-up
         parse_remaps(args.remap)
@@ -52,7 +52,7 @@ def main(args: argparse.Namespace) -> int:
     except BagError as exc:
         print(f'mindgrasp bag play: {exc}', file=sys.stderr)
         return 2
-    from mindgrasp_bringup.bag import player_node
+    from mindgrasp_bag import player_node
 
     params = {
         'bag': args.bag, 'rate': float(args.rate), 'loop': bool(args.loop),

@@ -20,7 +20,7 @@ from pathlib import Path
 import pytest
 import yaml
 
-from mindgrasp_bringup.bag import BagReader
+from mindgrasp_bag import BagReader
 
 pytestmark = pytest.mark.slow
 
@@ -107,7 +107,7 @@ class _Proc:
 
 
 def _recorder(bag: Path, prefix: str, declared: str) -> _Proc:
-    return _Proc([sys.executable, '-m', 'mindgrasp_bringup.bag.recorder_node', '--ros-args',
+    return _Proc([sys.executable, '-m', 'mindgrasp_bag.recorder_node', '--ros-args',
                   '-p', f'output:={bag}', '-p', f'regex:="^{prefix}/"',
                   '-p', f'topics:=["{declared}"]', '-p', 'discovery_period:=0.2'])
 
@@ -117,7 +117,7 @@ def _publisher(topic: str, reliability: str, tag: str) -> _Proc:
 
 
 def _count(bag: Path, topic: str, tag: str) -> int:
-    from mindgrasp_bringup.bag.typestore import typestore
+    from mindgrasp_bag.typestore import typestore
 
     store = typestore()
     with BagReader(bag) as reader:

@@ -15,13 +15,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from conftest_bag import EEG, PROBE, PUBLISHER, STRING, eeg_chunk, string
 
-from mindgrasp_bringup.bag import BagReader
+from conftest_bag import EEG, PROBE, PUBLISHER, STRING, eeg_chunk, string
+from mindgrasp_bag import BagReader
 
 pytestmark = pytest.mark.slow
 
-HERE = Path(__file__).parent
+HERE = Path(__file__).parents[1]  # tests/: conftest_bag, for the child processes
 N_EEG = 20
 
 
@@ -80,7 +80,7 @@ def recorded(tmp_path_factory):
     prefix = f'/bagtest_{uuid.uuid4().hex[:8]}'
     bag = tmp_path_factory.mktemp('nodes') / 'session'
     recorder, rec_out = _start([
-        sys.executable, '-m', 'mindgrasp_bringup.bag.recorder_node', '--ros-args',
+        sys.executable, '-m', 'mindgrasp_bag.recorder_node', '--ros-args',
         '-p', f'output:={bag}', '-p', f'regex:="^{prefix}/"', '-p', 'discovery_period:=0.2'])
     publisher = None
     try:

@@ -1,4 +1,4 @@
-"""The one exception class of :mod:`mindgrasp_bringup.bag`."""
+"""The one exception class of :mod:`mindgrasp_bag`."""
 
 from __future__ import annotations
 

@@ -8,10 +8,10 @@ import argparse
 import json
 import sys
 
-from mindgrasp_bringup.bag import BagError
-from mindgrasp_bringup.bag.latency import LatencyError, format_report, latency_report
-from mindgrasp_bringup.bag.paths import resolve_bag
-from mindgrasp_bringup.bag.run_stamps import read_run_stamps
+from mindgrasp_bag import BagError
+from mindgrasp_bag.latency import LatencyError, format_report, latency_report
+from mindgrasp_bag.paths import resolve_bag
+from mindgrasp_bag.run_stamps import read_run_stamps
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
