@@ -43,10 +43,20 @@ def noise_model_path(fallback_dir: Path) -> str:
 def subject_launch_args(subject: str, out: Path) -> dict[str, str]:
     """The experiment profile's launch arguments for ``subject``: a replay subject
     (``eegmmidb:<n>`` or a subject file) is the pursuing virtual subject streaming that subject's
-    real EEG, decoded by a model calibrated on its calibration recordings; the noise subject gets
-    the noise-trained model."""
+    real EEG, decoded by a model calibrated on its calibration recordings; a fitted virtual subject
+    (``virtual:FILE.yaml``) is the virtual subject decoded by a model calibrated on its head
+    (:func:`~mindgrasp_experiments.fitted_subject.fitted_model`, cached); the noise subject
+    gets the noise-trained model."""
+    from mindgrasp_experiments.fitted_subject import fitted_model, is_fitted, load_fitted
     from mindgrasp_experiments.subjects import is_replay, replay_model
 
+    if is_fitted(subject):
+        import shutil
+
+        model = fitted_model(load_fitted(subject))
+        for suffix in ('.json', '.npz'):    # a copy in the run: it names the decoder it used
+            shutil.copy2(model.with_suffix(suffix), out / model.with_suffix(suffix).name)
+        return {'subject': 'virtual', 'model': str(out / model.name)}
     if is_replay(subject):
         from mindgrasp_eeg.subject_file import replay_subject
 
@@ -60,16 +70,18 @@ def subject_launch_args(subject: str, out: Path) -> dict[str, str]:
 
 
 def subject_type(text: str) -> str:
-    """argparse type of --subject: noise, virtual, oracle, eegmmidb:<subject> or a subject file
-    (``*.yaml``, checked when the experiment starts)."""
+    """argparse type of --subject: noise, virtual, oracle, eegmmidb:<subject>, a subject file
+    (``*.yaml``) or ``virtual:FILE.yaml`` (files checked when the experiment starts)."""
     import argparse
 
+    from mindgrasp_experiments.fitted_subject import is_fitted
     from mindgrasp_experiments.subjects import is_replay
 
-    if text in ('noise', 'virtual', 'oracle') or is_replay(text):
+    if text in ('noise', 'virtual', 'oracle') or is_replay(text) or is_fitted(text):
         return text
     msg = (f'unknown subject {text!r}; use noise, virtual, oracle, eegmmidb:<subject> (real '
-           'EEG of an EEGMMIDB subject, e.g. eegmmidb:1) or a replay subject file (.yaml)')
+           'EEG of an EEGMMIDB subject, e.g. eegmmidb:1), a replay subject file (.yaml) or '
+           'virtual:FILE.yaml (a head fitted by mindgrasp eeg fit-virtual)')
     raise argparse.ArgumentTypeError(msg)
 
 

@@ -46,7 +46,9 @@ class Experiment:
         ``'set_locations'`` or ``'random_locations'``.
     subject : str
         ``noise``, ``virtual``, ``oracle``, ``autonomous`` (random locations),
-        ``eegmmidb:<n>`` or a replay subject file (real EEG).
+        ``eegmmidb:<n>`` or a replay subject file (real EEG), ``virtual:FILE.yaml`` (the
+        virtual subject on a head fitted by ``mindgrasp eeg fit-virtual``, calibrated on it
+        first: :mod:`~mindgrasp_experiments.fitted_subject`).
     trials, seed, workers : int
         Trials 1..``trials``; the same seed gives the same records whatever ``workers``.
     accuracy : float | None
@@ -100,7 +102,11 @@ class Experiment:
             if is_trial_manager(comp):
                 comp.ros_args += ['-p', f'stall_timeout:={self.stall_timeout_s}',
                                   '-p', f'trial_timeout:={self.trial_timeout_s}']
-        given = [(*full.split('.', 1), [_text(value)]) for full, value in self.params.items()]
+        from mindgrasp_experiments.fitted_subject import head_params
+
+        # a fitted subject's head first, so that --param can still override a setting of it
+        params = {**head_params(self.subject), **self.params}
+        given = [(*full.split('.', 1), [_text(value)]) for full, value in params.items()]
         typed = check_params(given, comps)
         return apply_params(comps, {f'{node}.{name}': values[0]
                                     for node, name, values in typed}, run_dir / 'params')
@@ -174,6 +180,7 @@ class Experiment:
             'protocol': self.protocol, 'subject': self.subject, 'seed': self.seed,
             'accuracy': self.accuracy, 'params': dict(self.params), 'workers': self.workers,
             'ray': self.ray, 'realism': self.realism, 'robot': self.robot,
+            'subject_args': dict(subject_args),     # the decoder (model) and EEG it ran with
             'trials_requested': self.trials, 'interrupted': interrupted,
             'launch_overlay': self.launch, 'step_s': self.step_s,
             'trial_timeout_s': self.trial_timeout_s, 'stall_timeout_s': self.stall_timeout_s,

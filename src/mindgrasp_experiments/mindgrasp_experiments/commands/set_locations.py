@@ -5,6 +5,8 @@ trial, the subject drives the arm through EEG -> classifier -> controller (lock-
     mindgrasp experiment set-locations --trials 160 --subject virtual --accuracy 0.8
     mindgrasp experiment set-locations --trials 6 --subject oracle --json
     mindgrasp experiment set-locations --trials 10 --subject eegmmidb:1 --accuracy 0.9
+    mindgrasp experiment set-locations --trials 30 \
+        --subject virtual:docs/subjects/eegmmidb_s001_virtual.yaml
     mindgrasp experiment set-locations --trials 90 --subject virtual --realism default
     mindgrasp experiment set-locations --trials 18 --subject eegmmidb:1 \
         --param fsm.paradigm=paper,scan
@@ -32,7 +34,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              'virtual subject pursues the target at --accuracy), oracle (its '
                              'intent is the prediction), eegmmidb:<subject> or a replay subject '
                              'file (.yaml; it pursues the target with real EEG of that EEGMMIDB '
-                             'subject or of the file\'s recordings); default virtual')
+                             'subject or of the file\'s recordings), virtual:FILE.yaml (the '
+                             'virtual subject on a head fitted by mindgrasp eeg fit-virtual, '
+                             'calibrated on it first); default virtual')
     parser.add_argument('--accuracy', type=probability, default=0.8,
                         help='virtual subject: probability of imagining the right class '
                              '(default 0.8)')

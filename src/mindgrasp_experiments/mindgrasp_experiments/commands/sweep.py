@@ -58,6 +58,7 @@ def main(args: argparse.Namespace) -> int:
     from mindgrasp_eeg import EEGError
     from mindgrasp_experiments import ExperimentError
     from mindgrasp_experiments.cli import experiment_from, subject_launch_args
+    from mindgrasp_experiments.fitted_subject import is_fitted
     from mindgrasp_experiments.subjects import is_replay
     from mindgrasp_experiments.sweep import (
         check_params,
@@ -89,7 +90,7 @@ def main(args: argparse.Namespace) -> int:
     except LaunchError as exc:
         return fail(COMMAND, str(exc))
     for subject in subjects:
-        if subject != 'virtual' and not is_replay(subject):
+        if subject != 'virtual' and not is_replay(subject) and not is_fitted(subject):
             return fail(COMMAND, f'--subject {subject}: a sweep varies the accuracy of a '
                                  'pursuing subject; use virtual, eegmmidb:<subject> or a subject '
                                  'file (.yaml).')
