@@ -35,7 +35,6 @@ REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / 'tests' / 'bringup'))
 
 from conftest_bag import cut_in_half, damage_chunks  # noqa: E402
-
 from mindgrasp_bag import BagReader  # noqa: E402
 from mindgrasp_common.safe_files import fallback_folder  # noqa: E402
 from mindgrasp_experiments.records import read_records  # noqa: E402

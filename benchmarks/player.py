@@ -32,7 +32,6 @@ REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / 'tests' / 'bringup'))
 
 from conftest_bag import EEG, PROBE, STRING, eeg_chunk, string  # noqa: E402
-
 from mindgrasp_bag import BagReader, BagWriter  # noqa: E402
 
 T0 = 1_750_000_000_000_000_000

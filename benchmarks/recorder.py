@@ -31,7 +31,6 @@ REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / 'tests' / 'bringup'))
 
 from conftest_bag import eeg_chunk, image  # noqa: E402
-
 from mindgrasp_bag import BagReader, BagWriter, Recorder  # noqa: E402
 
 PUBLISHER = r'''

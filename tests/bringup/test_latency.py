@@ -16,9 +16,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest_bag import EEG, JOINTS, eeg_chunk, joints
 from launch_fixtures.runner import fixture, launch_env, run_launch
 
+from conftest_bag import EEG, JOINTS, eeg_chunk, joints
 from mindgrasp_bag import BagWriter
 from mindgrasp_bag.latency import LatencyError, RunStamps, latency_report
 from mindgrasp_bringup.launch_system.run_report import write_run_report

@@ -68,7 +68,6 @@ def start(spawn_node, tmp_path, module: str, params: dict, ready: str):
         params = {'output': str(tmp_path / 'bag'), 'topics': '[/chatter]', **params}
     if module.endswith('player_node'):   # two messages 10 min apart: it waits for the second
         from conftest_bag import STRING, string
-
         from mindgrasp_bag import BagWriter
 
         with BagWriter(tmp_path / 'bag') as writer:

@@ -17,9 +17,9 @@ from pathlib import Path
 
 import pytest
 import yaml
-from conftest_bag import EEG, cut_in_half, damage_chunks, eeg_chunk
 from launch_fixtures.runner import launch_cmd, launch_env, run_launch
 
+from conftest_bag import EEG, cut_in_half, damage_chunks, eeg_chunk
 from mindgrasp_bag import BagWriter
 from mindgrasp_bag.mcap_scan import read_mcap_contents
 from mindgrasp_common.robot_description import load_robot
