@@ -144,6 +144,17 @@ def test_calibrate_runs_in_lockstep_end_to_end(tmp_path):
     # chance is 25 %; the virtual subject imagines the prompted class 90 % of the time
     assert result['cv_accuracy'] > 0.5 and result['heldout_accuracy'] > 0.5
     assert Path(result['model_path']).is_file() and result['wall_time_s'] > 0
+    # the final model is the trained one with its probabilities calibrated on the held-out run
+    from mindgrasp_classifier.model import MiModel
+
+    temp = result['temperature']
+    final, trained = MiModel.load(result['model_path']), MiModel.load(result['trained_model_path'])
+    assert Path(result['model_path']).name.startswith('calibrated_on_heldout')
+    assert final.temperature == pytest.approx(temp['after']) and temp['fitted_on'] == '02_heldout'
+    assert trained.temperature == pytest.approx(temp['before'])
+    assert final.provenance['heldout_temperature'] == temp
+    assert temp['nll_after'] <= temp['nll_before'] + 1e-9     # the fit minimises the NLL
+    assert 'probabilities calibrated on the held-out run' in res.stdout
     folder = tmp_path / 'subjects' / 'V1' / 's1'
     for run in ('01_graz', '02_heldout'):
         with BagReader(folder / run / 'bag') as reader:

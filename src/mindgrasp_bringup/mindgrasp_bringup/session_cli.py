@@ -84,15 +84,21 @@ def _calibrate_result(session: Session, args: argparse.Namespace, t0: float) -> 
         return 1
     cv = next(e['cv_accuracy'] for e in reversed(log['phases']) if 'cv_accuracy' in e)
     wall = time.monotonic() - t0
+    temp = held['temperature']
     print(f'Calibrated {session.dir}: cross-validated accuracy {100 * cv:.1f} %, held-out '
           f"accuracy {100 * held['heldout_accuracy']:.1f} % on {held['heldout_trials']} trials "
-          f'(virtual subject {100 * args.virtual_accuracy:.0f} %), model '
+          f'(virtual subject {100 * args.virtual_accuracy:.0f} %); probabilities calibrated on '
+          f"the held-out run (temperature {temp['before']:.2f} -> {temp['after']:.2f}, expected "
+          f"calibration error {temp['ece_before']:.3f} -> {temp['ece_after']:.3f}), model "
           f"{session.dir / held['model_path']}, {wall:.0f} s.")
     if args.json:
         print(json.dumps({'cv_accuracy': cv, 'heldout_accuracy': held['heldout_accuracy'],
                           'virtual_accuracy': args.virtual_accuracy,
                           'model_path': str((session.dir / held['model_path']).resolve()),
                           'heldout_trials': held['heldout_trials'],
+                          'trained_model_path': str((session.dir / held['trained_model_path'])
+                                                    .resolve()),
+                          'temperature': temp,
                           'session_dir': str(session.dir.resolve()),
                           'wall_time_s': round(wall, 1)}))
     return 0

@@ -49,7 +49,7 @@ CALIBRATION: dict[str, Any] = {'trials_per_class': 20, 'seed': 0, 'accuracy': 1.
 #: the session plan the calibration runs (mindgrasp_bringup/plans/calibrate.yaml)
 PLAN = 'calibrate'
 #: part of the digest: a change to how the calibration is made recalibrates every cached subject
-FITTED_TAG = 'graz_calibrate_v1'
+FITTED_TAG = 'graz_calibrate_v2'   # v2: temperature refit on the held-out run
 
 
 def is_fitted(subject: str) -> bool:
@@ -233,6 +233,7 @@ def fitted_model(subject: FittedSubject, cache: Path | None = None,
         generator=f'mindgrasp_experiments.fitted_subject.fitted_model({subject.path})',
         virtual_head=dict(subject.head), fitted_calibration=dict(cal),
         fitted_digest=digest, calibration_session=str(session.dir),
-        heldout={'accuracy': held['heldout_accuracy'], 'trials': held['heldout_trials']})
+        heldout={'accuracy': held['heldout_accuracy'], 'trials': held['heldout_trials'],
+                 'temperature': held['temperature']})
     target.parent.mkdir(parents=True, exist_ok=True)
     return Path(model.save(target.with_suffix('')))
