@@ -213,4 +213,6 @@ def test_applied_params_are_the_ones_in_the_run_directory(tmp_path: Path) -> Non
     assert values['paradigm'] == 'paper' and values['confirm_threshold'] == 2.0
     assert (tmp_path / 'vision.yaml').read_text() == before      # untouched nodes stay as written
     fsm_comp = next(c for c in comps if c.label == 'fsm')
-    assert fsm_comp.ros_args[-4:] == ['-p', 'paradigm:=paper', '-p', 'confirm_threshold:=2.0']
+    assert fsm_comp.parameters['paradigm'] == 'paper'             # typed, never -p text
+    assert fsm_comp.parameters['confirm_threshold'] == 2.0
+    assert not any(a.startswith('paradigm:=') for a in fsm_comp.ros_args)

@@ -40,11 +40,12 @@ def test_a_composed_graph_fails_when_a_node_ends_with_a_code(spawn_node, tmp_pat
 
 
 def test_a_lockstep_graph_fails_when_a_node_ends_with_a_code(monkeypatch):
-    from mindgrasp_bringup.launch_system.lockstep import LockstepComponent, run_lockstep
+    from mindgrasp_bringup.launch_system.lockstep import run_lockstep
+    from mindgrasp_ros.node_spec import NodeSpec
 
     monkeypatch.syspath_prepend(str(HERE))
     lines: list[str] = []
-    comp = LockstepComponent('ticker', 'skeleton_node', ENDS_WITH_3[1:])
+    comp = NodeSpec('ticker', 'skeleton_node', ros_args=ENDS_WITH_3[1:])
     assert run_lockstep([comp], step_s=0.02, duration_s=30.0, log=lines.append) == 1
     assert LINE in lines, lines
 

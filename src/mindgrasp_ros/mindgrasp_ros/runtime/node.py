@@ -85,7 +85,10 @@ class Node:
         if cli_args:
             args.extend(parse_ros_args(['--ros-args', *cli_args]
                                        if '--ros-args' not in cli_args else cli_args))
-        from mindgrasp_ros.composition import pending_component_arguments
+        from mindgrasp_ros.composition import (
+            pending_component_arguments,
+            pending_component_parameters,
+        )
 
         component_args = pending_component_arguments()
         if component_args:  # a node loaded as a component gets its own --ros-args
@@ -117,6 +120,8 @@ class Node:
         self._overrides: dict[str, Any] = dict(args.parameters_for(self._name, self._namespace))
         for p in parameter_overrides or []:
             self._overrides[p.name] = p.value
+        # a component's typed parameters (NodeSpec.parameters) win, as its -p would
+        self._overrides.update(pending_component_parameters())
 
         self.context.add_node(self)
         self._clock = ROSClock()
