@@ -112,3 +112,24 @@ def test_a_node_reports_the_entities_given_work_in_the_executors_order():
         pub_b.publish(String(data='b again'))
         assert node.take_ready_entities() == [first, second, guard]
         assert node.take_ready_entities() == []
+
+
+def test_the_lockstep_executor_reads_every_parameter_it_takes():
+    """No parameter of LockstepExecutor's methods is ignored or overwritten before it is read
+    (``_collect(self, ready=None)`` took a readiness set and replaced it unread)."""
+    import ast
+    import inspect
+    import textwrap
+
+    tree = ast.parse(textwrap.dedent(inspect.getsource(LockstepExecutor)))
+    unread = []
+    for func in (n for n in ast.walk(tree) if isinstance(n, ast.FunctionDef)):
+        params = [a.arg for a in func.args.args[1:] + func.args.kwonlyargs]
+        names = sorted((n for n in ast.walk(func) if isinstance(n, ast.Name)),
+                       key=lambda n: (n.lineno, n.col_offset))
+        for name in params:
+            first = next((n for n in names if n.id == name), None)
+            if first is None or not isinstance(first.ctx, ast.Load):
+                unread.append(f'{func.name}({name})')
+    # _spin_once_impl(timeout_sec) is rclpy's signature: lock-step never waits
+    assert unread == ['_spin_once_impl(timeout_sec)'], unread

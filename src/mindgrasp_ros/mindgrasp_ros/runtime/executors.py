@@ -466,7 +466,7 @@ class LockstepExecutor(Executor):
         times = self.node_time
         while rounds < self.max_rounds:
             t0 = clock()
-            work = self._collect()
+            work = self._collect_ready()
             self.collect_time += clock() - t0
             if not work:
                 return rounds
@@ -492,7 +492,7 @@ class LockstepExecutor(Executor):
             raise ExternalShutdownException()
         if self._is_shutdown:
             raise ShutdownException()
-        self._pending = self._collect()
+        self._pending = self._collect_ready()
         return self._dispatch()
 
     def _dispatch(self) -> bool:
@@ -501,9 +501,10 @@ class LockstepExecutor(Executor):
             self._run(entity, item)
         return bool(work)
 
-    def _collect(self, ready: set[int] | None = None) -> list[Work]:
+    def _collect_ready(self) -> list[Work]:
         """Ready work in the executor's order: timers, then subscriptions, services, clients
-        and guard conditions of each node."""
+        and guard conditions of each node. Not an override of :meth:`Executor._collect`: there
+        is no wait set, each node names the entities given work (``take_ready_entities``)."""
         work: list[Work] = []
         for node in self._nodes:
             for timer in node.timers:
