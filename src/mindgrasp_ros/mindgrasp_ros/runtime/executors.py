@@ -265,14 +265,14 @@ class Executor:
         work: list[Work] = []
         for node in list(self._nodes):
             for timer in list(node.timers):
-                if not timer._busy and timer.callback_group.can_execute(timer) and \
+                if not timer.busy and timer.callback_group.can_execute(timer) and \
                         timer.is_ready():
                     timer.call_timer()
                     work.append((timer, None))
             for entity in (*node.subscriptions, *node.services, *node.clients):
-                if entity._busy or entity.polled:
+                if entity.busy or entity.polled:
                     continue
-                dds = ready is None or id(entity._reader) in ready
+                dds = ready is None or id(entity.dds_reader) in ready
                 if isinstance(entity, Client):
                     # replies complete futures; never hold them back behind a busy group
                     work.extend((entity, item) for item in entity.take(dds))
@@ -408,7 +408,7 @@ class MultiThreadedExecutor(Executor):
                 with self._lock:
                     self._pending.extend(batch)  # its group is busy: try again next round
                 continue
-            entity._busy = True
+            entity.busy = True
             self._pool.submit(self._run_batch, batch)
             ran = True
         if self._errors:
@@ -423,7 +423,7 @@ class MultiThreadedExecutor(Executor):
         except BaseException as exc:
             self._errors.append(exc)
         finally:
-            entity._busy = False
+            entity.busy = False
             if not isinstance(entity, Client):
                 entity.callback_group.ending_execution(entity)
             self.wake()
