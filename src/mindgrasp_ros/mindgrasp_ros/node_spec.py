@@ -4,8 +4,8 @@ Every graph host takes the same spec (:mod:`mindgrasp_ros.graph_host`): the laun
 resolved by the launcher (``lockstep_components``), the ``--composed`` container's plan, the
 experiment engine's trial graph and the replayed nodes::
 
-    spec = NodeSpec('classifier', 'mindgrasp_classifier.classifier_node',
-                    parameters={'min_certainty': 0.6}, remaps={'/eeg/raw': '/eeg/filtered'})
+    spec = NodeSpec('listener', 'my_pkg.listener_node', parameters={'min_certainty': 0.6},
+                    remaps={'/eeg/raw': '/eeg/filtered'})
     spec.with_parameters({'seed': 7})      # a copy with more parameters (later ones win)
 
 Parameters stay typed (a dict, never ``-p name:=value`` text) until a host starts the node in a
