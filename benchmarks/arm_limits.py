@@ -72,12 +72,12 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument('--seed', type=int, default=0)
     args = parser.parse_args(argv)
 
-    from mindgrasp_bringup.launch_system.lockstep import LockstepComponent
     from mindgrasp_experiments.engine import lockstep_components, run_trial
+    from mindgrasp_ros.node_spec import NodeSpec
 
     comps = lockstep_components('experiment', {'subject': args.subject, 'seed': str(args.seed)},
                                 Path(tempfile.mkdtemp()) / 'params', log=lambda _text: None)
-    comps.append(LockstepComponent('arm_limits_probe', f'{__name__}:CommandProbe', []))
+    comps.append(NodeSpec('arm_limits_probe', f'{__name__}:CommandProbe'))
     worst = dict.fromkeys(accelerations([]), 0.0)
     for trial in range(1, args.trials + 1):
         HEARD.clear()

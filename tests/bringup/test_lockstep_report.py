@@ -4,8 +4,9 @@ CPU s per simulated s")."""
 
 from __future__ import annotations
 
-from mindgrasp_bringup.launch_system.lockstep import LockstepComponent, run_lockstep
+from mindgrasp_bringup.launch_system.lockstep import run_lockstep
 from mindgrasp_ros import rclpy
+from mindgrasp_ros.node_spec import NodeSpec
 
 
 class CtrlCWhileComposing(rclpy.node.Node):
@@ -23,7 +24,7 @@ class Idle(rclpy.node.Node):
 
 def _last_line(node_class: type, duration_s: float) -> tuple[int, str]:
     lines: list[str] = []
-    component = LockstepComponent('n', f'{__name__}:{node_class.__name__}', [])
+    component = NodeSpec('n', f'{__name__}:{node_class.__name__}')
     code = run_lockstep([component], duration_s=duration_s, log=lines.append)
     return code, lines[-1]
 

@@ -213,4 +213,26 @@ def test_applied_params_are_the_ones_in_the_run_directory(tmp_path: Path) -> Non
     assert values['paradigm'] == 'paper' and values['confirm_threshold'] == 2.0
     assert (tmp_path / 'vision.yaml').read_text() == before      # untouched nodes stay as written
     fsm_comp = next(c for c in comps if c.label == 'fsm')
-    assert fsm_comp.ros_args[-4:] == ['-p', 'paradigm:=paper', '-p', 'confirm_threshold:=2.0']
+    assert fsm_comp.parameters['paradigm'] == 'paper'             # typed, never -p text
+    assert fsm_comp.parameters['confirm_threshold'] == 2.0
+    assert not any(a.startswith('paradigm:=') for a in fsm_comp.ros_args)
+
+
+def test_experiment_params_stay_typed_to_the_node(monkeypatch) -> None:
+    """Experiment.params reach the node typed (they went through text and back: a string that
+    reads as a number became a double the node refused), and a typed value of the wrong kind is
+    one clear line before any trial."""
+    from mindgrasp_experiments.sweep import apply_params, check_params
+    from mindgrasp_ros.graph_host import GraphRunner, Lockstep
+    from mindgrasp_ros.node_spec import NodeSpec
+
+    monkeypatch.syspath_prepend(str(Path(__file__).resolve().parents[1] / 'ros'))
+    spec = NodeSpec('ticker', 'skeleton_node', parameters={'label': 'tick', 'rate': 20.0})
+    typed = check_params([('ticker', 'label', ['0.5']), ('ticker', 'rate', [50])], [spec])
+    assert typed == [('ticker', 'label', ['0.5']), ('ticker', 'rate', [50.0])]
+    [spec] = apply_params([spec], {f'{node}.{name}': values[0] for node, name, values in typed})
+    with GraphRunner(Lockstep()) as graph:
+        node = graph.add(spec)
+    assert node.params.label == '0.5' and node.params.rate == 50.0
+    with pytest.raises(ExperimentError, match=r"--param ticker\.label=True: .* not a bool"):
+        check_params([('ticker', 'label', [True])], [spec])

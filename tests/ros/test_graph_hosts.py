@@ -40,11 +40,12 @@ def test_a_composed_graph_fails_when_a_node_ends_with_a_code(spawn_node, tmp_pat
 
 
 def test_a_lockstep_graph_fails_when_a_node_ends_with_a_code(monkeypatch):
-    from mindgrasp_bringup.launch_system.lockstep import LockstepComponent, run_lockstep
+    from mindgrasp_bringup.launch_system.lockstep import run_lockstep
+    from mindgrasp_ros.node_spec import NodeSpec
 
     monkeypatch.syspath_prepend(str(HERE))
     lines: list[str] = []
-    comp = LockstepComponent('ticker', 'skeleton_node', ENDS_WITH_3[1:])
+    comp = NodeSpec('ticker', 'skeleton_node', ros_args=ENDS_WITH_3[1:])
     assert run_lockstep([comp], step_s=0.02, duration_s=30.0, log=lines.append) == 1
     assert LINE in lines, lines
 
@@ -111,3 +112,24 @@ def test_a_node_reports_the_entities_given_work_in_the_executors_order():
         pub_b.publish(String(data='b again'))
         assert node.take_ready_entities() == [first, second, guard]
         assert node.take_ready_entities() == []
+
+
+def test_the_lockstep_executor_reads_every_parameter_it_takes():
+    """No parameter of LockstepExecutor's methods is ignored or overwritten before it is read
+    (``_collect(self, ready=None)`` took a readiness set and replaced it unread)."""
+    import ast
+    import inspect
+    import textwrap
+
+    tree = ast.parse(textwrap.dedent(inspect.getsource(LockstepExecutor)))
+    unread = []
+    for func in (n for n in ast.walk(tree) if isinstance(n, ast.FunctionDef)):
+        params = [a.arg for a in func.args.args[1:] + func.args.kwonlyargs]
+        names = sorted((n for n in ast.walk(func) if isinstance(n, ast.Name)),
+                       key=lambda n: (n.lineno, n.col_offset))
+        for name in params:
+            first = next((n for n in names if n.id == name), None)
+            if first is None or not isinstance(first.ctx, ast.Load):
+                unread.append(f'{func.name}({name})')
+    # _spin_once_impl(timeout_sec) is rclpy's signature: lock-step never waits
+    assert unread == ['_spin_once_impl(timeout_sec)'], unread

@@ -25,8 +25,9 @@ from pathlib import Path
 from typing import Any
 
 from mindgrasp_experiments import ExperimentError
-from mindgrasp_experiments.engine import LockstepComponent, TrialRun
+from mindgrasp_experiments.engine import TrialRun
 from mindgrasp_experiments.records import TrialRecord
+from mindgrasp_ros.node_spec import NodeSpec
 
 __all__ = ['Experiment', 'Results']
 
@@ -90,7 +91,7 @@ class Experiment:
         return args
 
     def components(self, run_dir: Path, subject_args: Mapping[str, str],
-                   log: Callable[[str], None] = print) -> list[LockstepComponent]:
+                   log: Callable[[str], None] = print) -> list[NodeSpec]:
         """The nodes of one trial, their parameter files written to ``run_dir/params``, with
         the trial manager's timeouts and :attr:`params` applied."""
         from mindgrasp_experiments.engine import is_trial_manager, lockstep_components
@@ -98,16 +99,15 @@ class Experiment:
 
         comps = lockstep_components('experiment', self.launch_arguments(subject_args),
                                     run_dir / 'params', overlay=self.launch, log=log)
-        for comp in comps:
-            if is_trial_manager(comp):
-                comp.ros_args += ['-p', f'stall_timeout:={self.stall_timeout_s}',
-                                  '-p', f'trial_timeout:={self.trial_timeout_s}']
+        timeouts = {'stall_timeout': float(self.stall_timeout_s),
+                    'trial_timeout': float(self.trial_timeout_s)}
+        comps = [c.with_parameters(timeouts) if is_trial_manager(c) else c for c in comps]
         from mindgrasp_experiments.fitted_subject import head_params
 
         # a fitted subject's head first, so that --param can still override a setting of it
         params = {**head_params(self.subject), **self.params}
-        given = [(*full.split('.', 1), [_text(value)]) for full, value in params.items()]
-        typed = check_params(given, comps)
+        typed = check_params([(*full.split('.', 1), [value]) for full, value in params.items()],
+                             comps)
         return apply_params(comps, {f'{node}.{name}': values[0]
                                     for node, name, values in typed}, run_dir / 'params')
 
@@ -243,7 +243,3 @@ class Results:
                        'wall_s': self.info['wall_s'], 'sim_s': self.info['sim_s'],
                        'interrupted': self.interrupted})
 
-
-def _text(value: Any) -> str:
-    """A parameter value as ``--param`` gives it (booleans lower-case, as ROS writes them)."""
-    return str(value).lower() if isinstance(value, bool) else str(value)

@@ -36,6 +36,7 @@ from mindgrasp_experiments import ExperimentError
 from mindgrasp_experiments.records import TrialRecord
 from mindgrasp_experiments.report import finite
 from mindgrasp_experiments.summary import counted, summarise
+from mindgrasp_ros.node_spec import NodeSpec
 
 __all__ = ['SUMMARY_KEYS', 'Param', 'apply_params', 'check_params', 'combinations',
            'parse_accuracies', 'parse_param', 'parse_seeds', 'parse_subjects', 'point_figures',
@@ -110,8 +111,12 @@ def parse_param(text: str) -> Param:
     return match.group(1), match.group(2), values
 
 
-def _typed(value: str, like: Any, name: str) -> Any:
-    """``value`` (text) as the type of the parameter's value in the parameter files."""
+def _typed(value: Any, like: Any, name: str) -> Any:
+    """``value`` (text, as ``--param`` gives it, or already typed, as
+    :attr:`Experiment.params <mindgrasp_experiments.experiment.Experiment.params>` holds it) as
+    the type of the parameter's value in the parameter files."""
+    if not isinstance(value, str):
+        return _typed_value(value, like, name)
     try:
         if isinstance(like, bool):
             if value.lower() not in ('true', 'false'):
@@ -131,7 +136,24 @@ def _typed(value: str, like: Any, name: str) -> Any:
     raise ExperimentError(msg)
 
 
-def check_params(params: Sequence[Param], components: Sequence[Any]) -> list[Param]:
+def _typed_value(value: Any, like: Any, name: str) -> Any:
+    """A typed ``value`` checked against the parameter file's type (an int where a float is
+    taken becomes that float)."""
+    if isinstance(like, bool) or isinstance(value, bool):
+        ok = isinstance(like, bool) and isinstance(value, bool)
+    elif isinstance(like, float):
+        ok = isinstance(value, (int, float))
+        value = float(value) if ok else value
+    else:
+        ok = type(value) is type(like) and isinstance(like, (int, str))
+    if not ok:
+        msg = (f'--param {name}={value!r}: {name} takes a value like {like!r} (its parameter '
+               f'file), not a {type(value).__name__}.')
+        raise ExperimentError(msg)
+    return value
+
+
+def check_params(params: Sequence[Param], components: Sequence[NodeSpec]) -> list[Param]:
     """The params with values typed as their parameter files have them; raises
     :class:`ExperimentError` for an unknown node or parameter, a repeated one or a bad value."""
     nodes = {c.label: c for c in components}
@@ -158,16 +180,14 @@ def check_params(params: Sequence[Param], components: Sequence[Any]) -> list[Par
     return out
 
 
-def _check_range(component: Any, name: str, values: Sequence[Any], full: str) -> None:
+def _check_range(component: NodeSpec, name: str, values: Sequence[Any], full: str) -> None:
     """ExperimentError for a value outside the range or choices that the node class declares
     (:attr:`NodeTraits.parameters`), before any trial runs."""
     import dataclasses
 
-    from mindgrasp_ros.composition import load_node_class
-    from mindgrasp_ros.node_traits import traits_of
     from mindgrasp_ros.params import ParameterError, check_value
 
-    cls = traits_of(load_node_class(component.module)).parameters
+    cls = component.traits.parameters
     if cls is None or name not in {f.name for f in dataclasses.fields(cls)}:
         return
     for value in values:
@@ -186,35 +206,35 @@ def combinations(params: Sequence[Param]) -> list[dict[str, Any]]:
             for combo in itertools.product(*(values for _, _, values in params))]
 
 
-def apply_params(components: Sequence[Any], combo: Mapping[str, Any],
-                 params_dir: str | Path | None = None) -> list[Any]:
-    """Copies of ``components`` with the combination's parameters set (``-p name:=value`` after
-    the parameter file, so they win, as on a ``ros2 run`` command line). With ``params_dir``
-    (where :func:`~mindgrasp_experiments.engine.lockstep_components` wrote the run's parameter
-    files), each changed node's ``<node>.yaml`` there is written again with the values used."""
-    import copy
-
+def apply_params(components: Sequence[NodeSpec], combo: Mapping[str, Any],
+                 params_dir: str | Path | None = None) -> list[NodeSpec]:
+    """Copies of ``components`` with the combination's typed parameters set (on top of the
+    parameter file's, so they win, as ``-p`` on a ``ros2 run`` command line). With
+    ``params_dir`` (where :func:`~mindgrasp_experiments.engine.lockstep_components` wrote the
+    run's parameter files), each changed node's ``<node>.yaml`` there is written again with the
+    values used."""
     from mindgrasp_bringup.launch_system import params as ros_params
     from mindgrasp_bringup.launch_system import rundir
 
     out = []
     for comp in components:
-        comp = copy.deepcopy(comp)
-        changed = []
-        for full, value in combo.items():
-            node, name = full.split('.', 1)
-            if comp.label == node:
-                text = str(value).lower() if isinstance(value, bool) else str(value)
-                comp.ros_args += ['-p', f'{name}:={text}']
-                comp.parameters[name] = value
-                changed.append(f'{name}:={text}')
-        if changed and params_dir is not None:
+        given = {full.split('.', 1)[1]: value for full, value in combo.items()
+                 if full.split('.', 1)[0] == comp.label}
+        if given:
+            comp = comp.with_parameters(given)
+        if given and params_dir is not None:
+            changed = ' '.join(f'{name}:={_text(value)}' for name, value in given.items())
             rundir.write_yaml(Path(params_dir) / f'{comp.label}.yaml',
                               ros_params.dump_parameters({'/**': dict(comp.parameters)}),
                               header=f'parameters of {comp.label} (lock-step; set with --param '
-                                     f'{" ".join(changed)})')
+                                     f'{changed})')
         out.append(comp)
     return out
+
+
+def _text(value: Any) -> str:
+    """A parameter value as ``--param`` gives it (booleans lower-case, as ROS writes them)."""
+    return str(value).lower() if isinstance(value, bool) else str(value)
 
 
 def point_name(accuracy: float, combo: Mapping[str, Any]) -> str:

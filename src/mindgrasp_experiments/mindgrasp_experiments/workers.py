@@ -17,7 +17,8 @@ import socket
 from collections.abc import Iterator, Sequence
 
 from mindgrasp_experiments import ExperimentError
-from mindgrasp_experiments.engine import LockstepComponent, TrialRun, run_trial
+from mindgrasp_experiments.engine import TrialRun, run_trial
+from mindgrasp_ros.node_spec import NodeSpec
 
 __all__ = ['check_ray_address', 'run_trials']
 
@@ -55,7 +56,7 @@ def check_ray_address(address: str) -> None:
         raise ExperimentError(msg) from None
 
 
-def _ray_trials(components: Sequence[LockstepComponent], trials: Sequence[int], *, seed: int,
+def _ray_trials(components: Sequence[NodeSpec], trials: Sequence[int], *, seed: int,
                 address: str, step_s: float, log_level: str) -> Iterator[TrialRun]:
     import ray
 
@@ -87,7 +88,7 @@ def _ray_trials(components: Sequence[LockstepComponent], trials: Sequence[int], 
                 ray.cancel(ref, force=True)
 
 
-def run_trials(components: Sequence[LockstepComponent], trials: Sequence[int], *, seed: int,
+def run_trials(components: Sequence[NodeSpec], trials: Sequence[int], *, seed: int,
                workers: int = 1, step_s: float = 0.02, log_level: str = 'warn',
                ray: str | None = None) -> Iterator[TrialRun]:
     """Run ``trials`` (numbers) and yield each :class:`TrialRun` as it finishes (``workers``

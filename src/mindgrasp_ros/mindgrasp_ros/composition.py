@@ -4,9 +4,11 @@ Messages between nodes of one process go through in-process delivery (the object
 no serialisation); DDS still carries them to other processes unless the context is DDS-less.
 
 Node code stays unchanged: a node module is loaded by name, and the Node subclass it defines is
-constructed with its own ``--ros-args`` (name, namespace, parameters, remappings), which
-:class:`Component` passes through :func:`component_arguments` so that ``Node.__init__`` picks them
-up without the class having to forward ``cli_args``.
+constructed with its own ``--ros-args`` (name, namespace, remappings) and typed parameters (a
+:class:`~mindgrasp_ros.node_spec.NodeSpec`), which :func:`component_arguments` hands to
+``Node.__init__`` without the class having to forward ``cli_args`` or ``parameter_overrides``.
+:func:`run_composed` and :class:`LockstepRunner` are the schedulers of the one graph host
+(:mod:`mindgrasp_ros.graph_host`).
 
 Lock-step (:class:`LockstepRunner`): a DDS-less context, every node on sim time, and a runner that
 owns /clock. ``step(dt)`` advances the clock and runs callbacks until the graph is quiescent, in
@@ -19,32 +21,42 @@ import contextlib
 import contextvars
 import importlib
 import inspect
-from collections.abc import Iterator, Sequence
-from dataclasses import dataclass, field
+from collections.abc import Iterator, Mapping, Sequence
 from typing import Any
 
 from mindgrasp_ros.errors import CompositionError, NodeCallbackError
+from mindgrasp_ros.node_spec import NodeSpec
 
-__all__ = ['Component', 'CompositionError', 'LockstepRunner', 'NodeCallbackError',
+__all__ = ['CompositionError', 'LockstepRunner', 'NodeCallbackError', 'NodeSpec',
            'component_arguments', 'load_node_class', 'run_composed']
 
-_pending_args: contextvars.ContextVar[list[str] | None] = contextvars.ContextVar(
-    'mindgrasp_component_args', default=None)
+_pending: contextvars.ContextVar[tuple[list[str], dict[str, Any]] | None] = \
+    contextvars.ContextVar('mindgrasp_component_args', default=None)
 
 
 def pending_component_arguments() -> list[str] | None:
     """ROS arguments set by :func:`component_arguments` for the node being constructed."""
-    return _pending_args.get()
+    pending = _pending.get()
+    return None if pending is None else pending[0]
+
+
+def pending_component_parameters() -> dict[str, Any]:
+    """Typed parameter values set by :func:`component_arguments` (they win over the
+    arguments' parameter files and ``-p``)."""
+    pending = _pending.get()
+    return {} if pending is None else pending[1]
 
 
 @contextlib.contextmanager
-def component_arguments(args: Sequence[str]) -> Iterator[None]:
-    """Nodes constructed inside this block also take ``args`` (``--ros-args ...``)."""
-    token = _pending_args.set(list(args))
+def component_arguments(args: Sequence[str],
+                        parameters: Mapping[str, Any] | None = None) -> Iterator[None]:
+    """Nodes constructed inside this block also take ``args`` (``--ros-args ...``) and the
+    typed ``parameters`` (as rclpy's ``parameter_overrides``)."""
+    token = _pending.set((list(args), dict(parameters or {})))
     try:
         yield
     finally:
-        _pending_args.reset(token)
+        _pending.reset(token)
 
 
 def load_node_class(module_name: str) -> type:
@@ -74,66 +86,28 @@ def load_node_class(module_name: str) -> type:
     return classes[0]
 
 
-@dataclass
-class Component:
-    """A node to load: module (``pkg.mod[:Class]``) and its ROS arguments."""
-
-    module: str
-    ros_args: list[str] = field(default_factory=list)
-
-    def create(self) -> Any:
-        cls = load_node_class(self.module)
-        args = list(self.ros_args)
-        if args and args[0] != '--ros-args':
-            args = ['--ros-args', *args]
-        with component_arguments(args):
-            return cls()
-
-
-def run_composed(components: Sequence[Component], *, num_threads: int | None = None,
+def run_composed(specs: Sequence[NodeSpec], *, num_threads: int | None = None,
                  duration_s: float = 0.0) -> int:
-    """Create every component in this process and spin them with a MultiThreadedExecutor.
+    """Every node of ``specs`` in this process under one MultiThreadedExecutor
+    (:class:`~mindgrasp_ros.graph_host.InProcess`), until a node ends, ``duration_s`` (> 0)
+    or Ctrl-C, as a launch ends when one of its processes ends. Returns the graph's exit code
+    (:func:`~mindgrasp_ros.node_main.graph_exit_code`: 1 when a node failed)."""
+    from mindgrasp_ros.graph_host import GraphRunner, InProcess
 
-    Ends on Ctrl-C, after ``duration_s`` (> 0), or when a node ends (:func:`~mindgrasp_ros.
-    node_main.is_done`), as a launch ends when one of its processes ends. Returns the graph's
-    exit code (:func:`~mindgrasp_ros.node_main.graph_exit_code`: 1 when a node failed).
-    """
-    import time
-
-    from mindgrasp_ros import rclpy
-    from mindgrasp_ros.node_main import end_graph, graph_exit_code, is_done
-
-    if not rclpy.ok():
-        rclpy.init()
-    nodes = []
-    executor = rclpy.executors.MultiThreadedExecutor(num_threads=num_threads)
-    try:
-        for comp in components:
-            node = comp.create()
-            nodes.append(node)
-            executor.add_node(node)
-        deadline = time.monotonic() + duration_s if duration_s > 0 else None
-        while rclpy.ok() and (deadline is None or time.monotonic() < deadline):
-            executor.spin_once(timeout_sec=0.1)
-            if any(is_done(node) for node in nodes):
-                break
-    except KeyboardInterrupt:
-        pass
-    finally:
-        end_graph(executor, nodes)
-        rclpy.try_shutdown()
-    return graph_exit_code(nodes, print)
+    return GraphRunner(InProcess(num_threads)).run(specs, duration_s=duration_s)
 
 
 class LockstepRunner:
     """Runs nodes in one DDS-less process on a clock the caller advances.
 
     >>> runner = LockstepRunner()
-    >>> sim = runner.add(SimNode)              # classes or Components; constructed on sim time
+    >>> sim = runner.add(SimNode)              # classes or NodeSpecs; constructed on sim time
     >>> runner.step(1 / 240)                   # advance 1/240 s and run until quiescent
     """
 
-    def __init__(self, *, start_time_s: float = 0.0, max_rounds: int = 1000) -> None:
+    def __init__(self, *, start_time_s: float = 0.0, start_time_ns: int | None = None,
+                 max_rounds: int = 1000) -> None:
+        """``start_time_ns`` (ns, exactly: a bag's clock) takes the place of ``start_time_s``."""
         from mindgrasp_ros.runtime import context as context_mod
         from mindgrasp_ros.runtime.executors import LockstepExecutor
         from mindgrasp_ros.runtime.node import Node
@@ -144,7 +118,7 @@ class LockstepRunner:
         self.context = context_mod.Context()
         self.context.init([], transport='intra')
         self.executor = LockstepExecutor(context=self.context, max_rounds=max_rounds)
-        self._time_ns = round(start_time_s * 1e9)
+        self._time_ns = round(start_time_s * 1e9) if start_time_ns is None else int(start_time_ns)
         self._clock_node = Node('lockstep_clock', context=self.context,
                                 start_parameter_services=False, enable_rosout=False)
         self._clock_cls = get_message_class('rosgraph_msgs/msg/Clock')
@@ -160,6 +134,11 @@ class LockstepRunner:
         return self._time_ns / 1e9
 
     @property
+    def time_ns(self) -> int:
+        """The simulated clock (ns)."""
+        return self._time_ns
+
+    @property
     def node_time(self) -> dict[str, float]:
         """Wall seconds spent in each node's callbacks, by node name."""
         return self.executor.node_time
@@ -169,17 +148,21 @@ class LockstepRunner:
         """Wall seconds the executor spent collecting ready work."""
         return self.executor.collect_time
 
-    def add(self, node_class: type | Component, *args: Any, ros_args: Sequence[str] = (),
-            **kwargs: Any) -> Any:
-        """Construct a node in the lock-step context (``use_sim_time`` forced on)."""
+    def add(self, node_class: type | NodeSpec, *args: Any, ros_args: Sequence[str] = (),
+            parameters: Mapping[str, Any] | None = None, **kwargs: Any) -> Any:
+        """Construct a node in the lock-step context (``use_sim_time`` forced on): a class
+        (built with ``args``/``kwargs``) or a :class:`NodeSpec`; ``parameters`` (typed) win
+        over the spec's."""
         from mindgrasp_ros.runtime import default_context
 
-        if isinstance(node_class, Component):
-            ros_args = [*node_class.ros_args, *ros_args]
-            node_class = load_node_class(node_class.module)
-        extra = ['--ros-args', *[a for a in ros_args if a != '--ros-args'],
-                 '-p', 'use_sim_time:=true']
-        with component_arguments(extra), default_context(self.context):
+        params = dict(parameters or {})
+        if isinstance(node_class, NodeSpec):
+            ros_args = [*node_class.ros_arguments(), *ros_args]
+            params = {**node_class.parameters, **params}
+            node_class = node_class.node_class()
+        params['use_sim_time'] = True
+        extra = ['--ros-args', *[a for a in ros_args if a != '--ros-args']]
+        with component_arguments(extra, params), default_context(self.context):
             node = node_class(*args, **kwargs)
         self._publish_clock()
         self.executor.add_node(node)

@@ -21,9 +21,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 2
     with open(argv[0], encoding='utf-8') as f:
         plan = yaml.safe_load(f)
-    from mindgrasp_ros.composition import Component, CompositionError, run_composed
+    from mindgrasp_ros.composition import CompositionError, NodeSpec, run_composed
 
-    components = [Component(module=c['module'], ros_args=list(c['ros_args']))
+    components = [NodeSpec(c['label'], c['module'], ros_args=list(c['ros_args']))
                   for c in plan['components']]
     print(f'container: composing {len(components)} node(s): '
           + ', '.join(f"{c['label']} ({c['module']})" for c in plan['components']), flush=True)

@@ -9,53 +9,46 @@ publishes ``/eeg/raw`` itself (``output:=ros``) and the LSL acquisition node is 
 in a live run; it discovers the topics from the in-process graph and stamps messages with
 simulated time); without one (the experiments, which write records) the launch runs with
 ``record:=false``.
-:func:`run_lockstep` steps them with :class:`mindgrasp_ros.composition.LockstepRunner` until a
-node is done. The experiments (:mod:`mindgrasp_experiments.engine`) build on these.
+Each node is a :class:`~mindgrasp_ros.node_spec.NodeSpec` (its resolved parameters typed, also
+written to ``params_dir/<label>.yaml``). :func:`run_lockstep` runs them with the one graph host
+(:class:`~mindgrasp_ros.graph_host.GraphRunner` under the ``Lockstep`` scheduler) until a node is
+done. The experiments (:mod:`mindgrasp_experiments.engine`) build on these.
 """
 
 from __future__ import annotations
 
-import math
 import time
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from mindgrasp_bringup.launch_system import params as ros_params
 from mindgrasp_bringup.launch_system import rundir
+from mindgrasp_ros.node_spec import NodeSpec
 from mindgrasp_ros.node_traits import NodeTraits, traits_of
 
-__all__ = ['LockstepComponent', 'check_left_out_nodes', 'lockstep_components', 'node_traits',
-           'run_lockstep', 'set_log_level']
+__all__ = ['check_left_out_nodes', 'lockstep_components', 'node_traits', 'run_lockstep',
+           'set_log_level']
 
 #: the runner's own /clock is not a topic of the launch (a live run has none): a recorder
 #: leaves it out beside the launch's record_exclude_regex (NodeTraits.lockstep_exclude_parameter)
 _CLOCK_EXCLUDE = '^/clock$'
 
 
-@dataclass
-class LockstepComponent:
-    """A node of the composed graph: its label, module and ROS arguments."""
-
-    label: str
-    module: str
-    ros_args: list[str]
-    parameters: dict[str, Any] = field(default_factory=dict)
-
-
 def lockstep_components(launch: str | Path, arguments: Sequence[str] | Mapping[str, Any],
                         params_dir: Path, *, overlay: str | Path | None = None,
-                        log: Any = None, bag: Path | None = None) -> list[LockstepComponent]:
+                        log: Any = None, bag: Path | None = None) -> list[NodeSpec]:
     """The nodes of ``launch`` (a profile or a launch file) to compose in lock-step.
 
     ``overlay``: a user's launch file whose nodes replace the profile's nodes of the same name
     (another classifier, another controller) or are added. ``bag``: the directory the launch's
     recorder writes (as ``<run dir>/bag`` of a live run; the launch's ``record:=false`` still
     leaves it out); None runs without the recorder. Parameter files of every node are written to
-    ``params_dir``. Raises :class:`LaunchError` naming the problem and the fix.
+    ``params_dir`` (the run's record of them); each spec holds them typed, as the node reads that
+    file. Raises :class:`LaunchError` naming the problem and the fix.
     """
     from mindgrasp_bringup.launch_system import LaunchError, LaunchService
+    from mindgrasp_ros.runtime.arguments import load_params_file
 
     args = dict(arguments) if isinstance(arguments, Mapping) else \
         dict(a.split(':=', 1) for a in arguments)
@@ -100,9 +93,12 @@ def lockstep_components(launch: str | Path, arguments: Sequence[str] | Mapping[s
             msg = (f"'{spec.label}' has command-line arguments {spec.arguments}; composed nodes "
                    'take ROS arguments only: give them as parameters.')
             raise LaunchError(msg)
-        cmd = spec.command(path)
-        ros_args = cmd[cmd.index('--ros-args') + 1:]
-        component = LockstepComponent(spec.label, spec.module, ros_args, params)
+        # typed as the node would read them from that file (tuples become lists, ...)
+        component = NodeSpec(spec.label, spec.module, name=spec.node_name or '',
+                             parameters=load_params_file(path, None),
+                             remaps=dict(spec.remappings),
+                             ros_args=[*(['-r', f'__ns:={spec.namespace}'] if spec.namespace
+                                         else []), *spec.ros_arguments])
         (last if traits.lockstep_output_parameter else out).append(component)
     # The recorder is composed last: its first discovery, when it is constructed, sees every
     # node's topics, so the bag starts at the first step (a live recorder, started first, finds
@@ -156,31 +152,20 @@ def set_log_level(level: str) -> None:
     set_logger_level('', level)
 
 
-def run_lockstep(components: Sequence[LockstepComponent], *, step_s: float = 0.02,
+def run_lockstep(components: Sequence[NodeSpec], *, step_s: float = 0.02,
                  duration_s: float = 0.0, log: Any = print) -> int:
-    """``mindgrasp launch <profile> --lockstep``: compose every node, step until a node is done
-    (``done``), ``duration_s`` simulated seconds (> 0) or Ctrl-C. Returns 1 when a node raised
-    or did not end well (:func:`~mindgrasp_ros.node_main.graph_exit_code`), else 0."""
-    from mindgrasp_ros.composition import LockstepRunner, NodeCallbackError, load_node_class
-    from mindgrasp_ros.node_main import graph_exit_code, is_done
+    """``mindgrasp launch <profile> --lockstep``: the graph host under the lock-step scheduler,
+    until a node is done (``done``), ``duration_s`` simulated seconds (> 0) or Ctrl-C; then one
+    line with the real-time factor. Returns the graph's exit code
+    (:meth:`~mindgrasp_ros.graph_host.GraphRunner.run`)."""
+    from mindgrasp_ros.graph_host import GraphRunner, Lockstep
 
-    runner = LockstepRunner(start_time_s=0.0)   # nodes start with the clock at 0: no jump
+    scheduler = Lockstep(step_s)                # nodes start with the clock at 0: no jump
     wall0, cpu0 = time.perf_counter(), time.process_time()
-    code = 0
     try:
-        nodes = [runner.add(load_node_class(c.module), ros_args=c.ros_args) for c in components]
-        end = runner.time_s + duration_s if duration_s > 0 else math.inf
-        while runner.time_s < end and not any(is_done(n) for n in nodes):
-            runner.step(step_s)
-        code = graph_exit_code(nodes, log)
-    except NodeCallbackError as exc:
-        log(f'[{exc.node}] ERROR: {type(exc.error).__name__}: {exc.error}')
-        code = 1
-    except KeyboardInterrupt:
-        pass
+        return GraphRunner(scheduler, log=log).run(components, duration_s=duration_s)
     finally:
-        wall = time.perf_counter() - wall0
-        sim = runner.time_s
+        wall, sim = time.perf_counter() - wall0, scheduler.time_s
         cpu = time.process_time() - cpu0
         if sim > 0:
             log(f'lock-step: simulated {sim:.1f} s in {wall:.1f} s wall time (real-time factor '
@@ -188,5 +173,3 @@ def run_lockstep(components: Sequence[LockstepComponent], *, step_s: float = 0.0
         else:   # stopped (Ctrl-C) while composing: no rate to report (it read 8e8 CPU s per s)
             log(f'lock-step: stopped after {wall:.1f} s wall time, before the first simulated '
                 'step.')
-        runner.close()
-    return code

@@ -4,7 +4,8 @@
     result.report_path      # runs/<run>/replays/<time>/report.md
 
 Why it reproduces exactly: the chosen nodes (the classifier; the controller when asked) run in
-one process under :class:`~mindgrasp_ros.composition.LockstepRunner` on the bag's clock. Every
+one process under the one graph host (:class:`~mindgrasp_ros.graph_host.GraphRunner`, ``Lockstep``
+scheduler) on the bag's clock. Every
 recorded input message (the /eeg/raw chunks with their stamps and sample indices, exactly as
 recorded, never re-chunked) is published at its recorded time, and the graph runs until it is
 quiescent before the next one, so nothing is lost or reordered and no wall-clock time enters a
@@ -144,7 +145,9 @@ def replay(cfg: ReplayConfig) -> ReplayResult:
         BagError: the run or bag cannot be read, or has nothing to replay.
     """
     from mindgrasp_ros import rclpy
-    from mindgrasp_ros.composition import Component, LockstepRunner
+    from mindgrasp_ros.graph_host import GraphRunner, Lockstep
+    from mindgrasp_ros.node_spec import NodeSpec
+    from mindgrasp_ros.runtime.arguments import load_params_file
 
     bag = resolve_bag(cfg.run)
     run_dir = run_dir_of(bag)
@@ -163,9 +166,9 @@ def replay(cfg: ReplayConfig) -> ReplayResult:
             raise BagError(msg)
         output.mkdir(parents=True, exist_ok=False)
         (output / 'params').mkdir()
-        runner = LockstepRunner(start_time_s=0.0)
         # the bag's clock: ns exactly (start_time_s would round through a float)
-        runner._time_ns = reader.start_ns
+        graph = GraphRunner(Lockstep(start_time_ns=reader.start_ns))
+        runner = graph.scheduler.runner
         try:
             nodes = []
             for key in keys:
@@ -179,8 +182,9 @@ def replay(cfg: ReplayConfig) -> ReplayResult:
                 path = output / 'params' / f'{name}.yaml'
                 path.write_text(yaml.safe_dump({f'/{name}': {'ros__parameters': params}},
                                                sort_keys=True))
+                spec = NodeSpec(name, module, parameters=load_params_file(path, f'/{name}'))
                 try:
-                    nodes.append(runner.add(Component(module, ['--params-file', str(path)])))
+                    nodes.append(graph.add(spec))
                 except Exception as exc:  # each node package raises its own error type
                     msg = (f'The {key} node cannot start with the parameters of the run '
                            f'({type(exc).__name__}: {exc}); override the parameter with '
@@ -196,7 +200,7 @@ def replay(cfg: ReplayConfig) -> ReplayResult:
             replayed: dict[str, list[tuple[int, bytes]]] = {t: [] for t in collect}
             for topic in collect:
                 def keep(data: bytes, _info: Any = None, topic: str = topic) -> None:
-                    replayed[topic].append((runner._time_ns, bytes(data)))
+                    replayed[topic].append((runner.time_ns, bytes(data)))
                 io.create_subscription(COMPARED_TOPICS[topic], topic, keep,
                                        qos_profile(rclpy, {'reliability': 'reliable',
                                                            'durability': 'volatile',
@@ -238,7 +242,7 @@ def replay(cfg: ReplayConfig) -> ReplayResult:
             _feed(runner, inputs, pubs, store, starts, result, max_step, cfg.progress,
                   changes, by_name)
         finally:
-            runner.close()
+            graph.close()
     finally:
         reader.close()
     result.notes += [n for n in reader.notes if n not in result.notes]
@@ -265,7 +269,7 @@ def _feed(runner: Any, inputs: list[tuple[str, int, bytes]], pubs: dict[str, Any
         while pending and pending[0].time_ns <= t_ns:
             change = pending.pop(0)
             advance(change.time_ns)
-            row = apply_change(nodes[change.node], change, runner._time_ns)
+            row = apply_change(nodes[change.node], change, runner.time_ns)
             result.parameter_changes.append(row)
             at_s = (row['applied_ns'] - result.start_ns) / 1e9
             result.notes.append(
@@ -273,8 +277,8 @@ def _feed(runner: Any, inputs: list[tuple[str, int, bytes]], pubs: dict[str, Any
                 f'{change.name}={change.value!r}'
                 + ('' if row['successful'] else f' (refused: {row["reason"]})'))
             runner.spin_until_quiescent()
-        while runner._time_ns < t_ns:
-            runner.step(min(max_step_ns, t_ns - runner._time_ns) / 1e9)
+        while runner.time_ns < t_ns:
+            runner.step(min(max_step_ns, t_ns - runner.time_ns) / 1e9)
 
     pending = list(changes)
 

@@ -17,6 +17,7 @@ subjects or seeds, ``subject`` and ``seed`` are columns of the table like a swep
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import sys
 import time
@@ -100,11 +101,14 @@ def main(args: argparse.Namespace) -> int:
         return fail(COMMAND, str(exc))
     log = [] if args.json else None
 
+    # every point is the options' experiment with its own accuracy, subject, seed and params
+    base_experiment = experiment_from(argparse.Namespace(**{**vars(args), 'accuracy': None}),
+                                      'set_locations')
+
     def experiment_at(accuracy: float, subject: str, seed: int,
                       combo: dict[str, object]) -> Experiment:
-        return experiment_from(argparse.Namespace(**{**vars(args), 'subject': subject,
-                                                     'seed': seed, 'accuracy': accuracy}),
-                               'set_locations', combo)
+        return dataclasses.replace(base_experiment, accuracy=accuracy, subject=subject,
+                                   seed=seed, params=combo)
 
     try:
         # the names of --param are checked against the profile's nodes before any trial runs

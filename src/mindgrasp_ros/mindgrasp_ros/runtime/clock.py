@@ -44,7 +44,9 @@ class Clock:
     def ros_time_is_active(self) -> bool:
         return self._override_ns is not None
 
-    def _set_ros_time_override(self, nanoseconds: int | None) -> None:
+    def set_ros_time_override_ns(self, nanoseconds: int | None) -> None:
+        """ROS time from now on (ns; None: system time again), as the time source sets it
+        for ``use_sim_time`` (rclpy's ``set_ros_time_override`` takes a Time)."""
         with self._cond:
             self._override_ns = nanoseconds
             self._cond.notify_all()

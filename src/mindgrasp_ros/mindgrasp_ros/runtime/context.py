@@ -56,9 +56,10 @@ class IntraProcess:
 
         if sub.qos_profile.durability == DurabilityPolicy.TRANSIENT_LOCAL:
             for pub in pubs:
-                if pub._history and self._compatible(pub, sub):
-                    for delivery in list(pub._history):
-                        sub._enqueue(delivery)
+                retained = pub.retained()
+                if retained and self._compatible(pub, sub):
+                    for delivery in retained:
+                        sub.enqueue(delivery)
 
     def remove_subscription(self, sub: Subscription) -> None:
         with self._lock:
@@ -86,7 +87,7 @@ class IntraProcess:
                     # serialised now (once per publish, shared by every raw receiver), so the
                     # bytes are the message as published even if the publisher reuses the object
                     delivery.raw()
-                sub._enqueue(delivery)
+                sub.enqueue(delivery)
 
     def count_subscriptions(self, topic: str) -> int:
         return len(self._subs.get(topic, []))
@@ -172,7 +173,7 @@ class Context:
                 get_logger('mindgrasp_ros').error(f'Shutdown callback failed: {exc}')
         for node in list(self.nodes):
             node.wake_executor()
-            node._context_shutdown()
+            node.context_shutdown()
         with self._lock:
             self.nodes.clear()
             self.intra = IntraProcess()
@@ -195,6 +196,11 @@ class Context:
     def add_node(self, node: Node) -> None:
         with self._lock:
             self.nodes.append(node)
+
+    def node_list(self) -> list[Node]:
+        """The nodes of this context now (a copy, taken under the context's lock)."""
+        with self._lock:
+            return list(self.nodes)
 
     def remove_node(self, node: Node) -> None:
         with self._lock:

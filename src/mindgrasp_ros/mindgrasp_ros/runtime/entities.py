@@ -46,6 +46,7 @@ class Entity:
     #: where executors take this kind in a node's round: subscriptions, services, clients, guard
     #: conditions (timers come first, on their own)
     take_rank = 0
+    _reader: DdsReader | None = None   # a subscription's, a service's requests, a client's replies
 
     def __init__(self, node: Node, callback_group: CallbackGroup | None) -> None:
         self.node = node
@@ -54,7 +55,15 @@ class Entity:
         self.take_order = (self.take_rank, next(_creation_numbers))
         self.callback_group = callback_group or node.default_callback_group
         self.callback_group.add_entity(self)
-        self._busy = False  # set by executors while a callback of this entity runs
+        #: set by executors while a callback of this entity runs
+        self.busy = False
+        self._gid: bytes | None = None   # a local GID, made when first asked (_local_gid)
+
+    @property
+    def dds_reader(self) -> DdsReader | None:
+        """The DDS reader whose samples :meth:`take` reads (None in a DDS-less context and for
+        entities without one): what an executor's wait set watches."""
+        return self._reader
 
     def has_data_hint(self) -> bool:
         """Whether in-process work is waiting for :meth:`take` (DDS samples are announced by the
@@ -102,6 +111,16 @@ class Publisher(Entity):
     @property
     def gid(self) -> bytes:
         return self._writer.guid if self._writer else _local_gid(self)
+
+    @property
+    def on_dds(self) -> bool:
+        """Whether the publisher has a DDS writer (False in a DDS-less context)."""
+        return self._writer is not None
+
+    def retained(self) -> list[_Delivery]:
+        """What a transient-local publisher keeps for late-joining subscriptions, oldest
+        first (empty for a volatile one)."""
+        return list(self._history or ())
 
     def publish(self, msg: Any) -> None:
         """Publish a message (or CDR bytes, for a publisher created with ``raw=True``)."""
@@ -218,7 +237,8 @@ class Subscription(Entity):
     def gid(self) -> bytes:
         return self._reader.guid if self._reader else _local_gid(self)
 
-    def _enqueue(self, delivery: _Delivery) -> None:
+    def enqueue(self, delivery: _Delivery) -> None:
+        """Queue an in-process delivery for the callback (the context's intra-process path)."""
         if self._queue.maxlen is not None and len(self._queue) == self._queue.maxlen:
             self._local_lost += 1  # KEEP_LAST: the oldest undelivered message is dropped
         self._queue.append(delivery)
@@ -299,11 +319,11 @@ def _accepts_two_args(callback: Callable) -> bool:
 _local_ids = itertools.count(1)
 
 
-def _local_gid(entity: object) -> bytes:
-    gid = getattr(entity, '_gid', None)
+def _local_gid(entity: Entity) -> bytes:
+    gid = entity._gid
     if gid is None:
         gid = os.getpid().to_bytes(4, 'little') + next(_local_ids).to_bytes(12, 'little')
-        entity._gid = gid  # type: ignore[attr-defined]
+        entity._gid = gid
     return gid
 
 
@@ -475,6 +495,11 @@ class Service(Entity):
     def reply_gid(self) -> bytes:
         return self._writer.guid if self._writer else _local_gid(self)
 
+    @property
+    def request_type_name(self) -> str:
+        """The request's type name (``pkg/srv/Name_Request``)."""
+        return self._req_type
+
     def _enqueue_local(self, request: Any, future: Future) -> None:
         self._local.append((request, future))
         self.node.wake_executor(self)
@@ -586,6 +611,11 @@ class Client(Entity):
     @property
     def reply_gid(self) -> bytes:
         return self._reader.guid if self._reader else _local_gid(self)
+
+    @property
+    def request_type_name(self) -> str:
+        """The request's type name (``pkg/srv/Name_Request``)."""
+        return self._req_type
 
     def service_is_ready(self) -> bool:
         """A server's request reader and its reply writer are both matched (paired by their

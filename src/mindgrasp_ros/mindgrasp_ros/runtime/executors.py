@@ -265,14 +265,14 @@ class Executor:
         work: list[Work] = []
         for node in list(self._nodes):
             for timer in list(node.timers):
-                if not timer._busy and timer.callback_group.can_execute(timer) and \
+                if not timer.busy and timer.callback_group.can_execute(timer) and \
                         timer.is_ready():
                     timer.call_timer()
                     work.append((timer, None))
             for entity in (*node.subscriptions, *node.services, *node.clients):
-                if entity._busy or entity.polled:
+                if entity.busy or entity.polled:
                     continue
-                dds = ready is None or id(entity._reader) in ready
+                dds = ready is None or id(entity.dds_reader) in ready
                 if isinstance(entity, Client):
                     # replies complete futures; never hold them back behind a busy group
                     work.extend((entity, item) for item in entity.take(dds))
@@ -408,7 +408,7 @@ class MultiThreadedExecutor(Executor):
                 with self._lock:
                     self._pending.extend(batch)  # its group is busy: try again next round
                 continue
-            entity._busy = True
+            entity.busy = True
             self._pool.submit(self._run_batch, batch)
             ran = True
         if self._errors:
@@ -423,7 +423,7 @@ class MultiThreadedExecutor(Executor):
         except BaseException as exc:
             self._errors.append(exc)
         finally:
-            entity._busy = False
+            entity.busy = False
             if not isinstance(entity, Client):
                 entity.callback_group.ending_execution(entity)
             self.wake()
@@ -466,7 +466,7 @@ class LockstepExecutor(Executor):
         times = self.node_time
         while rounds < self.max_rounds:
             t0 = clock()
-            work = self._collect()
+            work = self._collect_ready()
             self.collect_time += clock() - t0
             if not work:
                 return rounds
@@ -492,7 +492,7 @@ class LockstepExecutor(Executor):
             raise ExternalShutdownException()
         if self._is_shutdown:
             raise ShutdownException()
-        self._pending = self._collect()
+        self._pending = self._collect_ready()
         return self._dispatch()
 
     def _dispatch(self) -> bool:
@@ -501,9 +501,10 @@ class LockstepExecutor(Executor):
             self._run(entity, item)
         return bool(work)
 
-    def _collect(self, ready: set[int] | None = None) -> list[Work]:
+    def _collect_ready(self) -> list[Work]:
         """Ready work in the executor's order: timers, then subscriptions, services, clients
-        and guard conditions of each node."""
+        and guard conditions of each node. Not an override of :meth:`Executor._collect`: there
+        is no wait set, each node names the entities given work (``take_ready_entities``)."""
         work: list[Work] = []
         for node in self._nodes:
             for timer in node.timers:

@@ -36,8 +36,7 @@ class IntraGraph:
         """Nothing to free (the DDS graph closes its readers)."""
 
     def _nodes(self) -> list:
-        with self._context._lock:
-            return list(self._context.nodes)
+        return self._context.node_list()
 
     def node_names_and_namespaces(self) -> list[tuple[str, str]]:
         """``(name, namespace)`` of every node, sorted by namespace then name."""
@@ -57,7 +56,7 @@ class IntraGraph:
         table: dict[str, set[str]] = defaultdict(set)
         for node in self._nodes():
             for entity in (*node.services, *node.clients):
-                table[entity.srv_name].add(_service_type(entity._req_type))
+                table[entity.srv_name].add(_service_type(entity.request_type_name))
         return sorted((k, sorted(v)) for k, v in table.items())
 
     def endpoints(self, topic: str, kind: str) -> list[TopicEndpointInfo]:
@@ -84,6 +83,8 @@ class IntraGraph:
                 continue
             out['publishers'] |= {(p.topic_name, p.type_name) for p in node.publishers}
             out['subscribers'] |= {(s.topic_name, s.type_name) for s in node.subscriptions}
-            out['services'] |= {(s.srv_name, _service_type(s._req_type)) for s in node.services}
-            out['clients'] |= {(c.srv_name, _service_type(c._req_type)) for c in node.clients}
+            out['services'] |= {(s.srv_name, _service_type(s.request_type_name))
+                                for s in node.services}
+            out['clients'] |= {(c.srv_name, _service_type(c.request_type_name))
+                               for c in node.clients}
         return {k: sorted(v) for k, v in out.items() if v}

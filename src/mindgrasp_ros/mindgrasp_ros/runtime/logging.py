@@ -29,6 +29,18 @@ _lock = threading.Lock()
 _sinks: list[Callable[[LoggingSeverity, str, str, str, str, int], None]] = []
 
 
+def add_sink(sink: Callable[[LoggingSeverity, str, str, str, str, int], None]) -> None:
+    """Call ``sink(severity, name, message, file, function, line)`` for every emitted record
+    (a node's ``/rosout`` publisher)."""
+    _sinks.append(sink)
+
+
+def remove_sink(sink: Callable[[LoggingSeverity, str, str, str, str, int], None]) -> None:
+    """Stop calling ``sink`` (nothing happens when it was not added)."""
+    if sink in _sinks:
+        _sinks.remove(sink)
+
+
 def parse_severity(level: str | int) -> LoggingSeverity:
     if isinstance(level, int):
         return LoggingSeverity(level)

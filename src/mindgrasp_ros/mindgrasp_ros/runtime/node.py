@@ -85,7 +85,10 @@ class Node:
         if cli_args:
             args.extend(parse_ros_args(['--ros-args', *cli_args]
                                        if '--ros-args' not in cli_args else cli_args))
-        from mindgrasp_ros.composition import pending_component_arguments
+        from mindgrasp_ros.composition import (
+            pending_component_arguments,
+            pending_component_parameters,
+        )
 
         component_args = pending_component_arguments()
         if component_args:  # a node loaded as a component gets its own --ros-args
@@ -117,6 +120,8 @@ class Node:
         self._overrides: dict[str, Any] = dict(args.parameters_for(self._name, self._namespace))
         for p in parameter_overrides or []:
             self._overrides[p.name] = p.value
+        # a component's typed parameters (NodeSpec.parameters) win, as its -p would
+        self._overrides.update(pending_component_parameters())
 
         self.context.add_node(self)
         self._clock = ROSClock()
@@ -127,7 +132,7 @@ class Node:
         if enable_rosout:
             self._rosout_pub = self.create_publisher(
                 _interfaces('Log'), '/rosout', qos_profile_rosout_default)
-            rlog._sinks.append(self._rosout_sink)
+            rlog.add_sink(self._rosout_sink)
         self.declare_parameter('use_sim_time', False)
         self._apply_use_sim_time(self.get_parameter('use_sim_time').value)
         self.add_on_set_parameters_callback(self._on_use_sim_time)
@@ -226,17 +231,17 @@ class Node:
         writers: list[bytes] = []
         with self._lock:
             for s in self.subscriptions:
-                if s._reader is not None:
+                if s.dds_reader is not None:
                     readers.append(s.gid)
             for p in self.publishers:
-                if p._writer is not None:
+                if p.on_dds:
                     writers.append(p.gid)
             for srv in self.services:
-                if srv._reader is not None:
+                if srv.dds_reader is not None:
                     readers.append(srv.gid)
                     writers.append(srv.reply_gid)
             for cli in self.clients:
-                if cli._reader is not None:
+                if cli.dds_reader is not None:
                     writers.append(cli.gid)
                     readers.append(cli.reply_gid)
         return readers, writers
@@ -335,18 +340,17 @@ class Node:
     def destroy_guard_condition(self, guard: GuardCondition) -> bool:
         return self._remove(self.guards, guard)
 
-    def _context_shutdown(self) -> None:
-        """The context ended: the node is dead; its DDS entities go with the participant."""
+    def context_shutdown(self) -> None:
+        """Called by the context when it ends: the node is dead; its DDS entities go with
+        the participant."""
         self._destroyed = True
-        if self._rosout_sink in rlog._sinks:
-            rlog._sinks.remove(self._rosout_sink)
+        rlog.remove_sink(self._rosout_sink)
 
     def destroy_node(self) -> None:
         if self._destroyed:
             return
         self._destroyed = True
-        if self._rosout_sink in rlog._sinks:
-            rlog._sinks.remove(self._rosout_sink)
+        rlog.remove_sink(self._rosout_sink)
         if self.executor is not None:
             self.executor.remove_node(self)
         if self.context.ok():
@@ -373,17 +377,17 @@ class Node:
     # ------------------------------------------------------------------ time
     def _apply_use_sim_time(self, enabled: bool) -> None:
         if enabled and self._clock_sub is None:
-            self._clock._set_ros_time_override(0)
+            self._clock.set_ros_time_override_ns(0)
             self._clock_sub = self.create_subscription(
                 get_message_class('rosgraph_msgs/msg/Clock'), '/clock', self._on_clock,
                 qos_profile_clock)
         elif not enabled and self._clock_sub is not None:
             self.destroy_subscription(self._clock_sub)
             self._clock_sub = None
-            self._clock._set_ros_time_override(None)
+            self._clock.set_ros_time_override_ns(None)
 
     def _on_clock(self, msg: Any) -> None:
-        self._clock._set_ros_time_override(
+        self._clock.set_ros_time_override_ns(
             int(msg.clock.sec) * 1_000_000_000 + int(msg.clock.nanosec))
 
     def _on_use_sim_time(self, params: list[Parameter]) -> Any:

@@ -59,7 +59,7 @@ class ParameterService:
         return response
 
     def _list(self, request: Any, response: Any) -> Any:
-        names = sorted(self._node._parameters)
+        names = sorted(self._node.get_parameters_by_prefix(''))
         prefixes = list(request.prefixes)
         depth = int(request.depth)
         selected = []

@@ -1,0 +1,63 @@
+"""One graph host, three schedulers: the same NodeSpec graph run a process per node (real DDS
+between real processes), all in one process, and lock-step on simulated time ends the same way,
+with one exit code; parameters reach the node typed (never through ``-p name:=value`` text)."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pytest
+
+from mindgrasp_ros.graph_host import GraphRunner, InProcess, Lockstep, Processes
+from mindgrasp_ros.node_spec import NodeSpec
+
+HERE = Path(__file__).resolve().parent
+#: the fixture node ends after 3 ticks with exit code 3; its label is text that reads as a number
+TICKER = NodeSpec('ticker', 'skeleton_node', parameters={
+    'cycles': 3, 'end_code': 3, 'rate': 50.0, 'label': '0.5'})
+
+
+@pytest.fixture
+def on_path(monkeypatch) -> dict[str, str]:
+    """skeleton_node importable here and in child processes."""
+    monkeypatch.syspath_prepend(str(HERE))
+    path = os.pathsep.join([str(HERE), os.environ.get('PYTHONPATH', '')])
+    return {**os.environ, 'PYTHONPATH': path}
+
+
+def test_every_scheduler_ends_the_graph_with_one_exit_code(on_path, tmp_path):
+    for scheduler in (Lockstep(0.02), InProcess(), Processes(tmp_path, env=on_path)):
+        lines: list[str] = []
+        code = GraphRunner(scheduler, log=lines.append).run([TICKER], duration_s=60.0)
+        assert code == 1, (type(scheduler).__name__, lines)
+        assert any(line.endswith('ERROR: ended with exit code 3') for line in lines), lines
+        assert scheduler.time_s < 60.0, type(scheduler).__name__   # ended by the node, not time
+
+
+def test_a_process_per_node_writes_typed_parameters_and_logs(on_path, tmp_path):
+    """A str parameter whose text reads as a float stays a str in the node's own process (as
+    ``-p label:=0.5`` it would be refused as a double): the label is on each tick's line."""
+    scheduler = Processes(tmp_path, env=on_path)
+    assert GraphRunner(scheduler, log=lambda _l: None).run([TICKER], duration_s=60.0) == 1
+    log = (tmp_path / 'ticker.log').read_text()
+    assert ' 0.5 1 total 1' in log, log
+    assert "label: '0.5'" in (tmp_path / 'params' / 'ticker.yaml').read_text()
+
+
+def test_lockstep_gives_the_parameters_typed_and_they_win(on_path):
+    spec = TICKER.with_parameters({'cycles': 0, 'gain': 2})
+    with GraphRunner(Lockstep(0.02)) as graph:
+        node = graph.add(NodeSpec(spec.label, spec.module, parameters=spec.parameters,
+                                  ros_args=['-p', 'label:=from_text', '-p', 'rate:=10.0']))
+        graph.spin_until(lambda: node.ticks >= 2, limit_s=10.0)
+    assert node.params.label == '0.5' and node.params.rate == 50.0
+    assert node.params.gain == 2.0 and node.total == 2.0 * node.ticks
+    assert TICKER.parameters['cycles'] == 3                    # with_parameters copies
+
+
+def test_a_graph_stops_after_its_duration_on_the_schedulers_clock(on_path):
+    forever = TICKER.with_parameters({'cycles': 0})
+    scheduler = Lockstep(0.05)
+    assert GraphRunner(scheduler, log=lambda _l: None).run([forever], duration_s=2.0) == 0
+    assert scheduler.time_s == pytest.approx(2.0)
