@@ -80,3 +80,29 @@ def test_xarm6_picks_each_shape_and_its_linkage_stays_coupled(shape):
         held = sim.held_object()
         assert held is not None and held.shape == shape
         assert sim.objects()[0].position[2] > SUCCESS_HEIGHT
+
+
+@pytest.mark.parametrize('shape', ['cube', 'sphere'])
+def test_panda_picks_with_its_two_fingers_moving_as_one(shape):
+    """The Franka Hand: panda_finger_joint2 mimics panda_finger_joint1 (prismatic, 0.04 m open);
+    both stop on the object at the same travel, and the seven-joint arm lifts it straight up
+    through the redundant grasp IK."""
+    panda = load_robot('panda')
+    assert panda.gripper.mimic == (('panda_finger_joint2', 'panda_finger_joint1', 1.0, 0.0),)
+    with Simulation(one_object_scene(shape, (0.45, -0.1)), robot='panda') as sim:
+        arm = Driver(sim, 'panda')
+        x, y, _ = sim.objects()[0].position
+        yaw = math.atan2(y, x) + math.pi
+        arm.to_joints(arm.kin.grasp_ik(np.array([x, y, 0.15]), yaw, sim.joint_positions()))
+        arm.line(np.array([x, y, 0.03]), yaw)
+        sim.set_gripper(1.0)
+        sim.step(240)
+        fingers = sim.finger_positions()
+        # each finger stopped on the 5 cm object, about 25 mm from the closed position
+        assert 0.02 < fingers[0] < 0.035, fingers
+        assert abs(fingers[0] - fingers[1]) < 0.001, fingers
+        arm.line(np.array([x, y, 0.28]), yaw, speed=0.1)
+        sim.step(120)
+        held = sim.held_object()
+        assert held is not None and held.shape == shape
+        assert sim.objects()[0].position[2] > SUCCESS_HEIGHT
