@@ -181,6 +181,22 @@ def test_random_locations_on_the_xarm6(tmp_path: Path) -> None:
 
 @pytest.mark.slow
 @pytest.mark.timeout(1800)   # whole experiments in subprocesses, on a loaded machine
+def test_random_locations_on_the_panda(tmp_path: Path) -> None:
+    """--robot panda: the seven-joint Franka Emika Panda with its two-finger hand: the camera on
+    its hand finds the object, the controller centres it (joint 1 and the wrist pitch joint 6,
+    turned the other way round from the six-joint arms' joint 5), approaches through the
+    redundant grasp IK, closes the jaws (grasp check by width) and lifts it above 0.22 m."""
+    s = last_json(mindgrasp('experiment', 'random-locations', '--robot', 'panda', '--trials', '1',
+                            '--seed', '1', '--trial-timeout', '40', '--out', str(tmp_path),
+                            '--json', '--no-progress'))
+    assert s['trials'] == 1 and s['node_errors'] == 0
+    (rec,) = read_records(tmp_path)
+    assert rec.states == '1-2-3-4-5-6', (rec.states, rec.reason)
+    assert rec.success and rec.correct_choice, rec.reason
+
+
+@pytest.mark.slow
+@pytest.mark.timeout(1800)   # whole experiments in subprocesses, on a loaded machine
 def test_a_node_raising_fails_its_trial_and_the_experiment_goes_on(tmp_path: Path) -> None:
     out = tmp_path / 'faulty'
     s = last_json(mindgrasp('experiment', 'random-locations', '--trials', '2', '--seed', '1',

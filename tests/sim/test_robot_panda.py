@@ -54,3 +54,20 @@ def test_panda_fingers_close_together_on_command(rclpy_ctx, spawn_node):
         (fingers[-1].position, proc.output())
     assert list(fingers[-1].name) == list(panda.gripper.joints)
     proc.stop()
+
+
+def test_the_hand_and_link_7_never_collide():
+    """panda_hand hangs from panda_link7 through the virtual panda_link8 (two fixed joints) and
+    their meshes overlap: welded links do not collide, so turning the wrist reports no
+    self-collision (PyBullet's EXCLUDE_PARENT alone spared only link 8)."""
+    from mindgrasp_sim.simulation import Simulation
+
+    with Simulation(robot='panda', n_objects=0) as sim:
+        seen: set[str] = set()
+        for step in range(400):
+            v = np.zeros(7)
+            v[5], v[6] = (0.5, 1.5) if step < 200 else (-0.5, -1.5)
+            sim.set_joint_velocities(v)
+            sim.step(2)
+            seen |= set(sim.collisions())
+        assert not seen

@@ -409,6 +409,8 @@ class Simulation:
                                  jointDamping=0.05)
         if not ghost and not self.robot.gripper.self_collision:
             self._disable_gripper_self_collision(p, body)
+        if not ghost:
+            self._disable_welded_self_collision(p, body)
         # velocity motors off: joints are driven by the PD reference in step()
         return _Robot(body=body, q_ref=self.home_pose.copy(), v_cmd=np.zeros(self.n_joints),
                       v_applied=np.zeros(self.n_joints))
@@ -425,6 +427,28 @@ class Simulation:
             for b in links:
                 if a < b:
                     p.setCollisionFilterPair(body, body, a, b, 0)
+
+    def _disable_welded_self_collision(self, p: BulletClient, body: int) -> None:
+        """No contacts between links welded by fixed joints, nor between such a group and the
+        link its moving joint turns on. PyBullet's EXCLUDE_PARENT spares a link and its direct
+        parent only; the Panda's hand hangs from link 7 through a virtual link 8, and their
+        meshes overlap by design (the hand's collision with link 7 braked joint 7)."""
+        n = p.getNumJoints(body)
+        info = [p.getJointInfo(body, j) for j in range(n)]
+        # the rigid group of each link: the link its chain of fixed joints hangs from (-1: base)
+        root = {-1: -1}
+        for j in range(n):      # PyBullet numbers a parent link before its children
+            root[j] = root[info[j][16]] if info[j][2] == pb.JOINT_FIXED else j
+        for a in range(n):
+            if root[a] == a:
+                continue
+            # welded to its group's root, and to the link that root turns on
+            hinge = info[root[a]][16] if root[a] >= 0 else None
+            for b in {root[a], hinge} - {None, info[a][16]}:
+                p.setCollisionFilterPair(body, body, a, b, 0)
+            for c in range(a):
+                if root[c] == root[a] and c != info[a][16]:
+                    p.setCollisionFilterPair(body, body, a, c, 0)
 
     def _couple_mimic_joints(self, p: BulletClient, body: int, names: dict[str, int]) -> None:
         """Tie each URDF mimic joint of the gripper to its leader with a gear constraint
