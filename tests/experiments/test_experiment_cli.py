@@ -166,27 +166,14 @@ def test_random_locations_and_a_users_own_controller(tmp_path: Path) -> None:
 
 @pytest.mark.slow
 @pytest.mark.timeout(1800)   # whole experiments in subprocesses, on a loaded machine
-def test_random_locations_on_the_xarm6(tmp_path: Path) -> None:
+@pytest.mark.parametrize('robot', ['xarm6', 'panda'])
+def test_random_locations_on_another_arm(robot: str, tmp_path: Path) -> None:
     """--robot xarm6: the same experiment runs the simulator, vision and the controller on the
     xArm6: its wrist camera finds the object, the controller centres it, approaches, closes the
-    parallel jaws (grasp check by width) and lifts it above 0.22 m (about 14 simulated s)."""
-    s = last_json(mindgrasp('experiment', 'random-locations', '--robot', 'xarm6', '--trials', '1',
-                            '--seed', '1', '--trial-timeout', '40', '--out', str(tmp_path),
-                            '--json', '--no-progress'))
-    assert s['trials'] == 1 and s['node_errors'] == 0
-    (rec,) = read_records(tmp_path)
-    assert rec.states == '1-2-3-4-5-6', (rec.states, rec.reason)
-    assert rec.success and rec.correct_choice, rec.reason
-
-
-@pytest.mark.slow
-@pytest.mark.timeout(1800)   # whole experiments in subprocesses, on a loaded machine
-def test_random_locations_on_the_panda(tmp_path: Path) -> None:
-    """--robot panda: the seven-joint Franka Emika Panda with its two-finger hand: the camera on
-    its hand finds the object, the controller centres it (joint 1 and the wrist pitch joint 6,
-    turned the other way round from the six-joint arms' joint 5), approaches through the
-    redundant grasp IK, closes the jaws (grasp check by width) and lifts it above 0.22 m."""
-    s = last_json(mindgrasp('experiment', 'random-locations', '--robot', 'panda', '--trials', '1',
+    parallel jaws (grasp check by width) and lifts it above 0.22 m (about 14 simulated s).
+    --robot panda: the same on the seven-joint Panda with its two-finger hand (centring with
+    joint 6, turned the other way round; approach through the redundant grasp IK)."""
+    s = last_json(mindgrasp('experiment', 'random-locations', '--robot', robot, '--trials', '1',
                             '--seed', '1', '--trial-timeout', '40', '--out', str(tmp_path),
                             '--json', '--no-progress'))
     assert s['trials'] == 1 and s['node_errors'] == 0
