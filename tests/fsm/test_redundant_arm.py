@@ -79,6 +79,10 @@ def test_the_grasp_ik_reaches_and_the_redundant_joint_returns_home(panda: GraspF
         assert np.linalg.norm(kin.tool_position(q) - p) < 0.01
         assert np.all(q > kin.lower + 0.01) and np.all(q < kin.upper - 0.01), q
     np.testing.assert_allclose(q, q0, atol=0.05)
+    # the null-space pull leaves the tool still: the solver meets its tolerances (0.2 mm,
+    # 2 mrad) as a six-joint arm's does, not after all its iterations short of them
+    _, ep, er = kin.solve(path[-1], kin.down_rotation(yaw), q0)
+    assert ep < 2e-4 and er < 2e-3, (ep, er)
 
 
 def test_the_null_space_step_leaves_the_tool_still() -> None:
@@ -86,13 +90,13 @@ def test_the_null_space_step_leaves_the_tool_still() -> None:
     jac = rng.normal(size=(6, 7))
     lower, upper = -np.full(7, 2.0), np.full(7, 2.0)
     q, home = rng.uniform(-1.5, 1.5, 7), np.zeros(7)
-    step = redundancy_step(jac, q, home, lower, upper, damping=1e-4)
+    step = redundancy_step(jac, q, home, lower, upper)
     assert np.linalg.norm(step) > 0.1
-    np.testing.assert_allclose(jac @ step, 0.0, atol=1e-6)
+    np.testing.assert_allclose(jac @ step, 0.0, atol=1e-12)
     # towards home: the step goes downhill on the distance to it
     assert step @ (home - q) > 0
     # six joints: no null space, nothing added
-    assert not np.any(redundancy_step(jac[:, :6], q[:6], home[:6], lower[:6], upper[:6], 1e-4))
+    assert not np.any(redundancy_step(jac[:, :6], q[:6], home[:6], lower[:6], upper[:6]))
 
 
 def test_the_twist_input_moves_the_tool_and_never_moves_a_still_arm(panda: GraspFsm) -> None:

@@ -218,7 +218,7 @@ class UrdfKinematics:
             jw = jac * w[:, None]
             step = jw.T @ np.linalg.solve(jw @ jw.T + lam ** 2 * np.eye(6), e * w)
             if self.n_joints > 6:
-                step = step + redundancy_step(jw, q, self.home, self.lower, self.upper, lam)
+                step = step + redundancy_step(jw, q, self.home, self.lower, self.upper)
             n = np.linalg.norm(step)
             if n > 0.3:
                 step *= 0.3 / n

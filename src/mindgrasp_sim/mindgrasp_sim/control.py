@@ -82,7 +82,7 @@ def velocities_from_twist(jacobian: np.ndarray, linear: np.ndarray, angular: np.
     j = np.asarray(jacobian, dtype=float)
     v = j.T @ np.linalg.solve(j @ j.T + damping ** 2 * np.eye(6), twist)
     if posture is not None and j.shape[1] > 6 and twist.any():
-        v = v + redundancy_step(j, *posture, damping)
+        v = v + redundancy_step(j, *posture)
     return v
 
 
