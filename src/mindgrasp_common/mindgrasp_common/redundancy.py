@@ -20,7 +20,8 @@ def redundancy_step(jac: np.ndarray, q: np.ndarray, q_home: np.ndarray, lower: n
                     upper: np.ndarray, gain: float = 0.5) -> np.ndarray:
     """Joint step (n,) rad (or rad/s) in the null space of ``jac`` (6, n) that moves the joints
     ``q`` (n,) rad towards ``q_home`` (n,) rad, each joint weighted up near its limits
-    ``lower``/``upper`` (n,) rad; zero for a six-joint arm (no null space).
+    ``lower``/``upper`` (n,) rad, all but joint 1 (the base yaw, which faces the task); zero for
+    a six-joint arm (no null space).
 
     The projection is onto the exact null space (the right singular vectors of ``jac`` beyond
     its rank), so the step moves the tool not at all and an IK that adds it to its task step
@@ -36,6 +37,10 @@ def redundancy_step(jac: np.ndarray, q: np.ndarray, q_home: np.ndarray, lower: n
     span = np.maximum(upper - lower, 1e-6)
     room = np.maximum(np.minimum(q - lower, upper - q) / span, 0.02)   # 0 at a limit, 0.5 mid
     pull = (q_home - q) * (0.5 / room)
+    # joint 1 turns the arm towards the task (the controller's search and turns drive it;
+    # objects lie all round): pulled to home, it swung a grasp behind the base over the
+    # shoulder, with joints 3 and 5 turned half round
+    pull[0] = 0.0
     _, sv, vt = np.linalg.svd(jac)
     rank = int(np.sum(sv > 1e-9 * max(float(sv[0]), 1e-300)))
     null = vt[rank:]                                          # (n - rank, n)
