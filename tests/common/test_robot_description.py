@@ -13,7 +13,7 @@ from mindgrasp_common.robot_description import RobotDescriptionError, load_robot
 
 
 def test_shipped_robots():
-    assert robot_names() == ['mindgrasp_arm', 'xarm6']
+    assert robot_names() == ['mindgrasp_arm', 'panda', 'xarm6']
     arm = load_robot()
     assert arm.arm_joints == robot.ARM_JOINTS and arm.home_pose == robot.HOME_POSE
     assert arm.gripper.kind == 'multi_finger' and arm.tcp_link == 'tcp'
@@ -24,6 +24,13 @@ def test_shipped_robots():
     assert xarm.lower[1] == pytest.approx(-2.059) and xarm.max_velocity[0] == 1.0
     assert 'BSD-3-Clause' in xarm.licence
     assert load_robot(xarm.path) is xarm     # a path works as well as a name
+    panda = load_robot('panda')
+    assert len(panda.arm_joints) == 7 and panda.urdf.name == 'panda.urdf'
+    # the hand's two prismatic fingers: the second a URDF mimic of the first
+    assert panda.gripper.joints == ('panda_finger_joint1', 'panda_finger_joint2')
+    assert panda.gripper.mimic == (('panda_finger_joint2', 'panda_finger_joint1', 1.0, 0.0),)
+    assert panda.gripper.open == (0.04, 0.04) and panda.gripper.closed == (0.0, 0.0)
+    assert 'Apache-2.0' in panda.licence and (panda.urdf.parent / 'LICENSE.txt').is_file()
 
 
 def test_the_shipped_arm_constants_are_the_description():
@@ -96,7 +103,7 @@ def test_a_gripper_without_limits(tmp_path):
 
 
 @pytest.mark.parametrize(('spec', 'message'), [
-    ('ur5', r"No robot is named 'ur5'; use one of \['mindgrasp_arm', 'xarm6'\]"),
+    ('ur5', r"No robot is named 'ur5'; use one of \['mindgrasp_arm', 'panda', 'xarm6'\]"),
     ('missing/arm.yaml', "The robot description 'missing/arm.yaml' does not exist"),
 ])
 def test_unknown_robots(spec, message):

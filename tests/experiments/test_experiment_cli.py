@@ -166,11 +166,14 @@ def test_random_locations_and_a_users_own_controller(tmp_path: Path) -> None:
 
 @pytest.mark.slow
 @pytest.mark.timeout(1800)   # whole experiments in subprocesses, on a loaded machine
-def test_random_locations_on_the_xarm6(tmp_path: Path) -> None:
+@pytest.mark.parametrize('robot', ['xarm6', 'panda'])
+def test_random_locations_on_another_arm(robot: str, tmp_path: Path) -> None:
     """--robot xarm6: the same experiment runs the simulator, vision and the controller on the
     xArm6: its wrist camera finds the object, the controller centres it, approaches, closes the
-    parallel jaws (grasp check by width) and lifts it above 0.22 m (about 14 simulated s)."""
-    s = last_json(mindgrasp('experiment', 'random-locations', '--robot', 'xarm6', '--trials', '1',
+    parallel jaws (grasp check by width) and lifts it above 0.22 m (about 14 simulated s).
+    --robot panda: the same on the seven-joint Panda with its two-finger hand (centring with
+    joint 6, turned the other way round; approach through the redundant grasp IK)."""
+    s = last_json(mindgrasp('experiment', 'random-locations', '--robot', robot, '--trials', '1',
                             '--seed', '1', '--trial-timeout', '40', '--out', str(tmp_path),
                             '--json', '--no-progress'))
     assert s['trials'] == 1 and s['node_errors'] == 0

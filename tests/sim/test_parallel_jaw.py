@@ -58,6 +58,25 @@ class Driver:
         self.sim.stop()
         self.sim.step(10)
 
+    def grasp(self) -> tuple[np.ndarray, float]:
+        """Above the scene's one object, straight down, close: finger positions and the yaw."""
+        x, y, _ = self.sim.objects()[0].position
+        yaw = math.atan2(y, x) + math.pi
+        self.to_joints(self.kin.grasp_ik(np.array([x, y, 0.15]), yaw, self.sim.joint_positions()))
+        self.line(np.array([x, y, 0.03]), yaw)
+        self.sim.set_gripper(1.0)
+        self.sim.step(240)
+        return self.sim.finger_positions(), yaw
+
+    def lift(self, shape: str, yaw: float) -> None:
+        """Straight up to 0.28 m; the object held and above the success height."""
+        x, y, _ = self.sim.objects()[0].position
+        self.line(np.array([x, y, 0.28]), yaw, speed=0.1)
+        self.sim.step(120)
+        held = self.sim.held_object()
+        assert held is not None and held.shape == shape
+        assert self.sim.objects()[0].position[2] > SUCCESS_HEIGHT
+
 
 @pytest.mark.parametrize('shape', ['cube', 'cylinder', 'sphere'])
 def test_xarm6_picks_each_shape_and_its_linkage_stays_coupled(shape):
@@ -65,18 +84,24 @@ def test_xarm6_picks_each_shape_and_its_linkage_stays_coupled(shape):
     assert {m[0] for m in xarm.gripper.mimic} == set(xarm.gripper.joints[1:])
     with Simulation(one_object_scene(shape, (0.45, -0.1)), robot='xarm6') as sim:
         arm = Driver(sim, 'xarm6')
-        x, y, _ = sim.objects()[0].position
-        yaw = math.atan2(y, x) + math.pi
-        arm.to_joints(arm.kin.grasp_ik(np.array([x, y, 0.15]), yaw, sim.joint_positions()))
-        arm.line(np.array([x, y, 0.03]), yaw)
-        sim.set_gripper(1.0)
-        sim.step(240)
-        fingers = sim.finger_positions()
+        fingers, yaw = arm.grasp()
         # stopped on the object, every joint of the linkage near the drive joint's angle
         assert 0.2 < fingers[0] < 0.8 * xarm.gripper.closed[0], fingers
         np.testing.assert_allclose(fingers, fingers[0], atol=0.2)
-        arm.line(np.array([x, y, 0.28]), yaw, speed=0.1)
-        sim.step(120)
-        held = sim.held_object()
-        assert held is not None and held.shape == shape
-        assert sim.objects()[0].position[2] > SUCCESS_HEIGHT
+        arm.lift(shape, yaw)
+
+
+@pytest.mark.parametrize('shape', ['cube', 'sphere'])
+def test_panda_picks_with_its_two_fingers_moving_as_one(shape):
+    """The Franka Hand: panda_finger_joint2 mimics panda_finger_joint1 (prismatic, 0.04 m open);
+    both stop on the object at the same travel, and the seven-joint arm lifts it straight up
+    through the redundant grasp IK."""
+    panda = load_robot('panda')
+    assert panda.gripper.mimic == (('panda_finger_joint2', 'panda_finger_joint1', 1.0, 0.0),)
+    with Simulation(one_object_scene(shape, (0.45, -0.1)), robot='panda') as sim:
+        arm = Driver(sim, 'panda')
+        fingers, yaw = arm.grasp()
+        # each finger stopped on the 5 cm object, about 25 mm from the closed position
+        assert 0.02 < fingers[0] < 0.035, fingers
+        assert abs(fingers[0] - fingers[1]) < 0.001, fingers
+        arm.lift(shape, yaw)

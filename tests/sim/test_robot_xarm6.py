@@ -14,42 +14,48 @@ from mindgrasp_common.robot_description import load_robot
 pytestmark = pytest.mark.slow
 
 
-def test_xarm6_starts_at_home_and_follows_velocity_commands(rclpy_ctx, spawn_node):
-    xarm = load_robot('xarm6')
-    proc = start(spawn_node, 'robot:=xarm6')
-    assert "with the robot 'xarm6'" in proc.output()
+@pytest.mark.parametrize(('robot', 'n_joints'), [('xarm6', 6), ('panda', 7)])
+def test_the_arm_starts_at_home_and_follows_velocity_commands(rclpy_ctx, spawn_node, robot,
+                                                              n_joints):
+    """Also the seven-joint Panda (tests/sim/test_robot_panda.py): one velocity per joint."""
+    arm = load_robot(robot)
+    proc = start(spawn_node, f'robot:={robot}')
+    assert f"with the robot '{robot}'" in proc.output()
     probe = Probe(rclpy_ctx)
     rclpy, node = rclpy_ctx, probe.node
     assert spin_until(rclpy, node, lambda: len(probe.joints) > 20, 120), proc.output()
     js = probe.joints[-1]
-    assert list(js.name) == list(xarm.arm_joints) == [f'joint{i}' for i in range(1, 7)]
-    np.testing.assert_allclose(probe.q(), xarm.home_pose, atol=0.01)
+    assert list(js.name) == list(arm.arm_joints) and len(js.name) == n_joints
+    np.testing.assert_allclose(probe.q(), arm.home_pose, atol=0.01)
     assert probe.matched(), proc.output()
-    # base yaw and wrist roll move at the commanded rate, the others hold
-    v = np.array([0.3, 0.0, 0.0, 0.0, 0.0, -0.4])
-    assert probe.drive(v, lambda: probe.q()[0] > xarm.home_pose[0] + 0.3), proc.output()
+    # base yaw and wrist roll (the last joint) move at the commanded rate, the others hold
+    v = np.zeros(n_joints)
+    v[0], v[-1] = 0.3, -0.4
+    assert probe.drive(v, lambda: probe.q()[0] > arm.home_pose[0] + 0.3), proc.output()
     moving = probe.joints[-1]
     np.testing.assert_allclose(np.asarray(moving.velocity), v, atol=0.05)
-    assert probe.q()[5] < xarm.home_pose[5] - 0.3
-    np.testing.assert_allclose(probe.q()[1:5], xarm.home_pose[1:5], atol=0.01)
+    assert probe.q()[-1] < arm.home_pose[-1] - 0.3
+    np.testing.assert_allclose(probe.q()[1:-1], arm.home_pose[1:-1], atol=0.01)
     proc.stop()
 
 
-def test_xarm6_gripper_closes_on_command(rclpy_ctx, spawn_node):
+@pytest.mark.parametrize(('robot', 'atol'), [('xarm6', 0.02), ('panda', 0.002)])
+def test_the_gripper_closes_on_command(rclpy_ctx, spawn_node, robot, atol):
     """/gripper_controller/commands [1.0] closes all six joints of the xArm's gripper linkage
     to the description's closed position (self_collision: false keeps its links from jamming
-    each other half way); /gripper/joint_states names them."""
+    each other half way), and both prismatic fingers of the Panda's hand (atol in rad and m);
+    /gripper/joint_states names them."""
     from mindgrasp_ros.interfaces.sensor_msgs.msg import JointState
 
-    xarm = load_robot('xarm6')
-    proc = start(spawn_node, 'robot:=xarm6')
+    xarm = load_robot(robot)
+    proc = start(spawn_node, f'robot:={robot}')
     probe = Probe(rclpy_ctx)
     fingers: list = []
     probe.node.create_subscription(JointState, '/gripper/joint_states', fingers.append, 100)
     assert probe.matched(), proc.output()
     probe.grip_pub.publish(probe.Float64MultiArray(data=[1.0]))
     assert spin_until(rclpy_ctx, probe.node, lambda: bool(fingers) and np.allclose(
-        fingers[-1].position, xarm.gripper.closed, atol=0.02), 60), \
+        fingers[-1].position, xarm.gripper.closed, atol=atol), 60), \
         (fingers[-1].position if fingers else None, proc.output())
     assert list(fingers[-1].name) == list(xarm.gripper.joints)
     proc.stop()
@@ -95,5 +101,5 @@ def test_unknown_robot_exits_with_one_line_naming_the_fix(spawn_node):
     proc = spawn_node('mindgrasp_sim.sim_node', '--ros-args', '-p', 'robot:=ur5')
     assert proc.wait(60) == 2
     out = proc.output()
-    assert "No robot is named 'ur5'; use one of ['mindgrasp_arm', 'xarm6']" in out
+    assert "No robot is named 'ur5'; use one of ['mindgrasp_arm', 'panda', 'xarm6']" in out
     assert 'Traceback' not in out

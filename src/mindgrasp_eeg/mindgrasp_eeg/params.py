@@ -1,7 +1,7 @@
 """Parameters of the EEG nodes, declared once (units, ranges, descriptions).
 
 Each field is a ROS parameter of its node (:func:`mindgrasp_ros.params.param`);
-``mindgrasp_eeg/param/eeg.yaml`` holds the same names and defaults under ``eeg_acquisition:`` and
+``config/param/eeg.yaml`` holds the same names and defaults under ``eeg_acquisition:`` and
 ``virtual_amp:``. All are read-only: the inlet, outlet, generator and subject are built from them
 at start, so a change needs a restart.
 """

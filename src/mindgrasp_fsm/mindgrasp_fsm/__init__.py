@@ -3,7 +3,7 @@
 Layers (no ROS below the node):
 
 - :mod:`~mindgrasp_fsm.types`, :mod:`~mindgrasp_fsm.params`: inputs/outputs and every gain and
-  threshold (``mindgrasp_fsm/param/fsm.yaml``).
+  threshold (``config/param/fsm.yaml``).
 - :mod:`~mindgrasp_fsm.grasp_fsm`: :class:`GraspFsm`, the paper's six states, locks, watchdog,
   joint-limit clamping.
 - :mod:`~mindgrasp_fsm.grasp_policy`: the autonomous final approach and grasp (depth + camera model

@@ -23,9 +23,10 @@ from  to    when                                                                
 ====  ====  ==========================================================================  =====
 
 BCI input is used in states 1-3 only; its velocities scale with the certainty. Centring is
-proportional on the pixel error, joint 1 from x and joint 5 from y. A watchdog stops every joint
-when predictions (BCI mode) or joint states are older than ``watchdog_timeout``, when joint states
-hold NaN, or when no camera frames arrive; the output says why. Commands never drive a joint past
+proportional on the pixel error, joint 1 from x and the wrist pitch joint (joint 5 of six, 6 of
+seven) from y. A watchdog stops every joint when predictions (BCI mode) or joint states are older
+than ``watchdog_timeout``, when joint states hold NaN, or when no camera frames arrive; the output
+says why. Commands never drive a joint past
 its limits, and no joint speeds up faster than ``max_joint_acceleration`` (``return_acceleration``
 in state 6); slowing down is never limited, so stops and locks act at once.
 
@@ -87,7 +88,7 @@ _CLASS_WORDS = {0: 'left hand', 1: 'right hand', 2: 'both hands', 3: 'both feet'
 
 
 def clamp_to_limits(q: np.ndarray, v: np.ndarray, params: FsmParams) -> np.ndarray:
-    """Joint velocities (6,) limited to ``max_joint_velocity`` and so that one control period
+    """Joint velocities (n,) limited to ``max_joint_velocity`` and so that one control period
     cannot carry a joint past ``limit -/+ joint_limit_margin``; moving away from a limit is
     allowed."""
     # np.minimum(np.maximum()) is np.clip's arithmetic without its wrapper (this runs at the
@@ -103,10 +104,26 @@ def clamp_to_limits(q: np.ndarray, v: np.ndarray, params: FsmParams) -> np.ndarr
 
 
 def _cap(v: np.ndarray, vmax: np.ndarray | float) -> np.ndarray:
-    """Joint velocities (6,) scaled down as one vector so that none exceeds ``vmax`` (rad/s):
+    """Joint velocities (n,) scaled down as one vector so that none exceeds ``vmax`` (rad/s):
     the direction of motion in joint space is kept."""
     scale = float(np.max(np.abs(v) / vmax))
     return v / scale if scale > 1.0 else v
+
+
+def tilt_direction(kinematics: ArmKinematics | None, home: list[float] | np.ndarray,
+                   joint: int) -> float:
+    """+1.0 when turning ``joint`` (0-based) positively from ``home`` (n,) rad tilts the camera's
+    optical axis back towards the base (as joint 5 of the six-joint arms does), -1.0 when it tilts
+    it forward (the Panda's joint 6); +1.0 without a kinematics model."""
+    if kinematics is None:
+        return 1.0
+    q = np.asarray(home, dtype=float)
+    dq = np.zeros(q.size)
+    dq[joint] = 0.01
+    # forward tilt: the optical axis's horizontal component along the direction the arm faces
+    (_, r0), (_, r1) = kinematics.camera_pose(q), kinematics.camera_pose(q + dq)
+    facing = np.array([math.cos(q[0]), math.sin(q[0])])
+    return 1.0 if float(facing @ (r1[:2, 2] - r0[:2, 2])) <= 0.0 else -1.0
 
 
 class GraspFsm:
@@ -115,7 +132,7 @@ class GraspFsm:
     Parameters
     ----------
     params : FsmParams
-        Gains and thresholds (``mindgrasp_fsm/param/fsm.yaml``).
+        Gains and thresholds (``config/param/fsm.yaml``).
     kinematics : ArmKinematics or None
         Robot model for the autonomous final approach (camera pose and grasp IK). Without it the
         controller aborts state 4 and returns to start.
@@ -124,7 +141,15 @@ class GraspFsm:
     def __init__(self, params: FsmParams | None = None,
                  kinematics: ArmKinematics | None = None) -> None:
         self.params = params or FsmParams()
+        #: arm joints (6 or 7); every velocity this controller sends has this many
+        self.n_joints = len(self.params.joint_names)
+        # the wrist pitch joint that tilts the camera (0-based): the second to last, joint 5
+        # of a six-joint arm, joint 6 of a seven-joint one (the last joint rolls the hand)
+        self.tilt_joint = self.n_joints - 2
         self.kinematics = kinematics
+        # +1 when a positive tilt-joint velocity tilts the camera down towards the base (the
+        # gains' and the search tilts' convention), -1 when the arm's joint turns the other way
+        self.tilt_sign = tilt_direction(kinematics, self.params.home_position, self.tilt_joint)
         self.policy = GraspPolicy(self.params, kinematics)
         self.reset()
 
@@ -148,7 +173,7 @@ class GraspFsm:
             msg = f'Cannot read the robot description {params.urdf_file}: {exc}'
             raise FsmError(msg) from None
         kinematics = UrdfKinematics(str(urdf), params.joint_names, params.tool_link,
-                                    params.camera_link, **offsets)
+                                    params.camera_link, **offsets, home=params.home_position)
         return cls(params, kinematics)
 
     # ---------------------------------------------------------------------------- lifecycle
@@ -185,7 +210,7 @@ class GraspFsm:
         self._fault_at: float | None = None
         self._fault_why = ''
         self._dt = 0.0
-        self._limiter = AccelerationLimiter()
+        self._limiter = AccelerationLimiter(self.n_joints)
         self._return_lift: bool | None = None
         # scan paradigm: when the current offer began (None: no offer), whether the person
         # committed to the object of interest, and the evidence of each decision
@@ -294,7 +319,7 @@ class GraspFsm:
             State.CENTER_OBJECT, State.INITIAL_APPROACH, State.FINAL_APPROACH)
 
     def _stop(self, kind: StopKind, why: str) -> FsmOutput:
-        return self._output(np.zeros(6), stopped=kind, reason=why)
+        return self._output(np.zeros(self.n_joints), stopped=kind, reason=why)
 
     # ---------------------------------------------------------------------------- main tick
     def tick(self, inputs: FsmInputs) -> FsmOutput:
@@ -328,7 +353,7 @@ class GraspFsm:
         # --- lock between states ------------------------------------------------------------
         if self._lock_until is not None:
             if t < self._lock_until:
-                return self._output(np.zeros(6))
+                return self._output(np.zeros(self.n_joints))
             self._lock_until = None
             assert self._pending is not None
             new, reason = self._pending
@@ -341,7 +366,7 @@ class GraspFsm:
             if self._cancel.update(inputs.prediction):
                 self._cancel_approach(q, f'cancelled the approach to the {self._ooi_label} '
                                       f'(both-feet evidence {self._cancel.value:.2f} nat s)')
-                return self._output(np.zeros(6), phase='cancelled')
+                return self._output(np.zeros(self.n_joints), phase='cancelled')
             if self._cancel.rejected and not self._affirmed:
                 self._affirmed = True
                 self._events.append(f'go on with the {self._ooi_label} (both-hands evidence '
@@ -357,7 +382,7 @@ class GraspFsm:
         }[self.state]
         v, phase = handler(t, q, inputs)
         if self._lock_until is not None:   # a transition asked for a lock: stop this tick
-            v = np.zeros(6)
+            v = np.zeros(self.n_joints)
         return self._output(clamp_to_limits(q, v, p), phase=phase)
 
     def _watchdog(self, inputs: FsmInputs, now: float) -> tuple[StopKind, str]:
@@ -400,8 +425,8 @@ class GraspFsm:
             return (f'joint states are {age:.2f} s old (limit {p.watchdog_timeout:.2f} s); '
                     'check the arm driver')
         pos = np.asarray(joints.position, dtype=float)
-        if pos.shape != (6,):
-            return f'joint states hold {pos.size} positions, 6 expected'
+        if pos.shape != (self.n_joints,):
+            return f'joint states hold {pos.size} positions, {self.n_joints} expected'
         if not np.isfinite(pos).all() or not np.isfinite(np.asarray(joints.velocity)).all():
             return 'joint states contain NaN or infinite values; check the arm driver'
         return ''
@@ -499,9 +524,10 @@ class GraspFsm:
                   ) -> np.ndarray:
         p = self.params
         ex, ey = self._errors(ooi, vision)
-        v = np.zeros(6)
+        v = np.zeros(self.n_joints)
         v[0] = p.center_sign_joint1 * p.center_gain_joint1 * gain_scale * ex
-        v[4] = p.center_sign_joint5 * p.center_gain_joint5 * gain_scale * ey
+        v[self.tilt_joint] = (self.tilt_sign * p.center_sign_joint5 * p.center_gain_joint5
+                              * gain_scale * ey)
         return v
 
     def _certainty(self, inputs: FsmInputs) -> tuple[int, float]:
@@ -523,7 +549,7 @@ class GraspFsm:
     # ---------------------------------------------------------------------------- state 1
     def _search(self, t: float, q: np.ndarray, inputs: FsmInputs) -> tuple[np.ndarray, str]:
         p = self.params
-        v = np.zeros(6)
+        v = np.zeros(self.n_joints)
         g = inputs.gripper
         loaded = fingers_loaded(g, p.finger_contact_effort) if g is not None else None
         empty = loaded == 0 if loaded is not None else \
@@ -582,7 +608,7 @@ class GraspFsm:
     def _sweep_step(self, q: np.ndarray) -> np.ndarray:
         """Autonomous search: turn left; at a joint-1 limit change the camera tilt, turn back."""
         p = self.params
-        v = np.zeros(6)
+        v = np.zeros(self.n_joints)
         tilts = p.autonomous_search_tilts or [0.0]
         tilt = tilts[self._sweep % len(tilts)]
         lo = p.joint_lower_limits[0] + p.joint_limit_margin + 0.05
@@ -598,9 +624,9 @@ class GraspFsm:
                 self._limits_reached.clear()
         v[0] = self._sweep_dir * p.autonomous_search_velocity
         home = np.asarray(p.home_position)
-        # keep the other joints at home, joint 5 at this sweep's tilt
+        # keep the other joints at home, the wrist pitch joint at this sweep's tilt
         target = home.copy()
-        target[4] = home[4] + tilt
+        target[self.tilt_joint] = home[self.tilt_joint] + self.tilt_sign * tilt
         err = target - q
         err[0] = 0.0
         v[1:] = np.clip(p.return_gain * err[1:], -0.5, 0.5)
@@ -613,7 +639,7 @@ class GraspFsm:
         if ooi is None:
             if self._lost(t):
                 self._goto(State.OBJECT_SEARCH, 'object of interest lost while centring')
-            return np.zeros(6), 'object not in this frame'
+            return np.zeros(self.n_joints), 'object not in this frame'
         assert inputs.vision is not None
         ex, ey = self._errors(ooi, inputs.vision)
         v = self._centring(ooi, inputs.vision, 1.0)
@@ -626,7 +652,7 @@ class GraspFsm:
                         self._center_next == State.INITIAL_APPROACH:
                     return self._offer(t, q, inputs, ooi, v)
                 self._goto(self._center_next, f'{ooi.label} centred')
-                return np.zeros(6), 'centred'
+                return np.zeros(self.n_joints), 'centred'
         else:
             self._centred_since = None
         blocked = self._blocked_joint(q, v)
@@ -634,7 +660,7 @@ class GraspFsm:
             # the object lies beyond a joint limit this way round: search the other way
             self._give_up_on_object(q, v, f'joint {blocked} is at its limit, the {ooi.label} '
                                     'cannot be centred; searching the other way')
-            return np.zeros(6), 'limit'
+            return np.zeros(self.n_joints), 'limit'
         if t - self._state_since > p.center_timeout:
             if max(abs(ex), abs(ey)) <= p.recenter_threshold:
                 self._goto(self._center_next, f'centring timed out after {p.center_timeout:.1f} s'
@@ -642,7 +668,7 @@ class GraspFsm:
             else:
                 self._give_up_on_object(q, v, f'the {ooi.label} could not be centred in '
                                         f'{p.center_timeout:.1f} s; searching again')
-            return np.zeros(6), 'timeout'
+            return np.zeros(self.n_joints), 'timeout'
         return v, f'error x {ex:+.3f} y {ey:+.3f}'
 
     def _blocked_joint(self, q: np.ndarray, v: np.ndarray) -> int:
@@ -687,7 +713,7 @@ class GraspFsm:
             self._cancel.reset(self._now + p.offer_delay)
             self._goto(self._center_next, f'confirmed the {ooi.label} (both-hands evidence '
                        f'{self._confirm.value:.2f} nat s)')
-            return np.zeros(6), 'confirmed'
+            return np.zeros(self.n_joints), 'confirmed'
         declined = self._confirm.rejected
         if declined or t - self._offer_since > p.offer_timeout:
             self._offer_since = None
@@ -695,7 +721,7 @@ class GraspFsm:
             why = (f'declined (both-feet evidence {-self._confirm.value:.2f} nat s)' if declined
                    else f'not confirmed in {p.offer_timeout:.1f} s')
             self._goto(State.OBJECT_SEARCH, f'passed the {ooi.label}: {why}')
-            return np.zeros(6), 'passed'
+            return np.zeros(self.n_joints), 'passed'
         return v, f'offering the {ooi.label}: evidence {self._confirm.fraction:.0%}'
 
     def _bearing(self, ooi: ObjectObservation, q: np.ndarray, inputs: FsmInputs) -> float:
@@ -729,7 +755,7 @@ class GraspFsm:
     def _initial_approach(self, t: float, q: np.ndarray, inputs: FsmInputs
                           ) -> tuple[np.ndarray, str]:
         p = self.params
-        v = np.zeros(6)
+        v = np.zeros(self.n_joints)
         ooi = self._visible(inputs)
         if ooi is None:
             if self._lost(t):
@@ -793,7 +819,7 @@ class GraspFsm:
             if max(abs(ex), abs(ey)) > p.recenter_threshold:
                 self._center_next = State.FINAL_APPROACH
                 self._goto(State.CENTER_OBJECT, f'{ooi.label} off centre before the final approach')
-                return np.zeros(6), 'recentre'
+                return np.zeros(self.n_joints), 'recentre'
         step = self.policy.approach_step(t, q, inputs.vision, inputs.camera, inputs.gripper)
         self._gripper = step.gripper
         if step.event == 'at_grasp_pose':
@@ -837,10 +863,10 @@ class GraspFsm:
         err = np.asarray(p.home_position) - q
         if np.max(np.abs(err)) < p.return_tolerance:
             self._goto(State.OBJECT_SEARCH, 'returned to the start position')
-            return np.zeros(6), 'home'
+            return np.zeros(self.n_joints), 'home'
         if t - self._state_since > p.return_timeout:
             self._goto(State.OBJECT_SEARCH, f'return timed out after {p.return_timeout:.1f} s')
-            return np.zeros(6), 'timeout'
+            return np.zeros(self.n_joints), 'timeout'
         v = p.return_gain * err
         vmax = np.asarray(p.max_joint_velocity)
         if holding:

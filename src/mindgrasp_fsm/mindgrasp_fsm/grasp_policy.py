@@ -43,7 +43,7 @@ from mindgrasp_fsm.types import CameraModel, GripperCommand, GripperState, Visio
 
 @dataclass
 class PolicyStep:
-    """One tick of the policy: joint velocities (6,) rad/s, gripper command, event, phase."""
+    """One tick of the policy: joint velocities (n,) rad/s, gripper command, event, phase."""
 
     velocities: np.ndarray
     gripper: GripperCommand
@@ -124,7 +124,7 @@ class GraspPolicy:
         return self._gripper
 
     def _zeros(self) -> np.ndarray:
-        return np.zeros(6)
+        return np.zeros(len(self.params.joint_names))
 
     def _track(self, q: np.ndarray, q_target: np.ndarray) -> tuple[np.ndarray, bool]:
         """Proportional joint-space tracking, scaled so the velocity direction is kept."""
@@ -341,7 +341,7 @@ class GraspPolicy:
     def lift_step(self, t: float, q: np.ndarray) -> tuple[np.ndarray, bool]:
         """One tick of :meth:`start_lift`; returns (velocities, done)."""
         v, done, failed = self._follow_line(t, q)
-        return (np.zeros(6), True) if failed else (v, done)
+        return (self._zeros(), True) if failed else (v, done)
 
     # ------------------------------------------------------------------ state 5
     def begin_grasp(self, t: float) -> None:

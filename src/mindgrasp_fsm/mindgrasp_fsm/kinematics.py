@@ -5,6 +5,12 @@ a depth into a point on the table it needs where the camera is (forward kinemati
 gripper there it needs inverse kinematics. Both are properties of the robot model, not of the scene,
 so a real arm offers the same. :class:`ArmKinematics` is the interface; implementations wrap a
 URDF model or the simulator's kinematic solver.
+
+Arms of 6 or 7 joints: a six-joint arm has (away from singularities) one joint solution per
+pose near the seed, and the grasp IK is plain damped least squares. A seven-joint arm has one
+joint more than the pose needs; its free motion (the Jacobian's null space) is spent pulling the
+arm towards its home pose and away from its joint limits (``redundancy_step``), so that the
+solution is repeatable and the elbow does not drift into a limit over a long approach.
 """
 
 from __future__ import annotations
@@ -13,6 +19,8 @@ from typing import Protocol
 
 import numpy as np
 from scipy.spatial.transform import Rotation
+
+from mindgrasp_common.redundancy import redundancy_step
 
 
 class ArmKinematics(Protocol):
@@ -30,7 +38,7 @@ class ArmKinematics(Protocol):
         ...
 
     def grasp_ik(self, position: np.ndarray, yaw: float, q_seed: np.ndarray) -> np.ndarray | None:
-        """Joints (6,) rad that put the grasp point at ``position`` (m, base frame) with the
+        """Joints (n,) rad that put the grasp point at ``position`` (m, base frame) with the
         gripper pointing straight down and the finger closing axis turned by ``yaw`` (rad) about
         the vertical; ``None`` when no solution within 1 cm exists."""
         ...
@@ -57,19 +65,23 @@ class UrdfKinematics:
     urdf_path : str or Path
         Robot description (e.g. ``mindgrasp_sim/urdf/mindgrasp_arm.urdf``).
     joint_names : sequence of str
-        The six arm joints, base to wrist.
+        The arm joints (6 or 7), base to wrist.
     tool_link, camera_link : str
         Grasp point link (``tcp``) and camera optical frame link.
     tool_offset, camera_offset : ndarray, shape (4, 4), optional
         The grasp point and the camera optical frame in their links (a robot description's TCP
         offset and eye-in-hand camera mount, :mod:`mindgrasp_common.robot_description`); None:
         the link's own frame.
+    home : sequence of float, optional
+        Home pose (n,) rad: a seven-joint arm's IK pulls its free motion towards it
+        (``redundancy_step``); None: mid-range of the joint limits. Unused for six joints.
     """
 
     def __init__(self, urdf_path: str, joint_names: tuple[str, ...] | list[str],
                  tool_link: str = 'tcp', camera_link: str = 'camera_color_optical_frame',
                  tool_offset: np.ndarray | None = None,
-                 camera_offset: np.ndarray | None = None) -> None:
+                 camera_offset: np.ndarray | None = None,
+                 home: np.ndarray | tuple[float, ...] | list[float] | None = None) -> None:
         import xml.etree.ElementTree as ET
 
         from mindgrasp_fsm.errors import FsmError
@@ -95,7 +107,8 @@ class UrdfKinematics:
                 'parent': j.find('parent').get('link'),
                 # URDF rpy: fixed-axis roll, pitch, yaw (Rz(yaw) Ry(pitch) Rx(roll))
                 'origin': _transform(xyz, Rotation.from_euler('xyz', rpy).as_matrix()),
-                'axis': axis / np.linalg.norm(axis),
+                # a fixed joint may say axis 0 0 0 (the Panda's): it never turns
+                'axis': axis / (np.linalg.norm(axis) or 1.0),
                 'lower': float(limit.get('lower', -np.pi)) if limit is not None else -np.pi,
                 'upper': float(limit.get('upper', np.pi)) if limit is not None else np.pi,
             }
@@ -124,6 +137,9 @@ class UrdfKinematics:
         self.lower = np.array([by_name[n]['lower'] for n in joint_names])
         self.upper = np.array([by_name[n]['upper'] for n in joint_names])
         self._index = {n: i for i, n in enumerate(joint_names)}
+        self.n_joints = len(self.joint_names)
+        self.home = ((self.lower + self.upper) / 2 if home is None
+                     else np.asarray(home, dtype=float).reshape(self.n_joints))
 
     def link_pose(self, q: np.ndarray, link: str) -> np.ndarray:
         """4x4 pose of ``link`` in the base frame at joints ``q`` (rad)."""
@@ -158,12 +174,12 @@ class UrdfKinematics:
         return np.array([[c, s, 0.0], [s, -c, 0.0], [0.0, 0.0, -1.0]])
 
     def jacobian(self, q: np.ndarray) -> np.ndarray:
-        """Geometric Jacobian (6, 6) of the tool at joints ``q`` (rad): rows linear (m/s) and
+        """Geometric Jacobian (6, n) of the tool at joints ``q`` (n,) rad: rows linear (m/s) and
         angular (rad/s) velocity in the base frame per rad/s of each joint."""
         return self._fk_jacobian(np.asarray(q, dtype=float))[1]
 
     def _fk_jacobian(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Tool pose (4x4) and the geometric Jacobian (6, 6) [linear; angular] at ``q``."""
+        """Tool pose (4x4) and the geometric Jacobian (6, n) [linear; angular] at ``q``."""
         t = np.eye(4)
         axes = []
         rotations = iter(self._joint_rotations(q, self.tool_link))
@@ -174,7 +190,7 @@ class UrdfKinematics:
                              t[:3, 3].copy()))
                 t[:3, :3] = t[:3, :3] @ next(rotations)
         t = t @ self._tool_offset
-        jac = np.zeros((6, 6))
+        jac = np.zeros((6, self.n_joints))
         p = t[:3, 3]
         for i, z, o in axes:
             r = p - o
@@ -186,7 +202,8 @@ class UrdfKinematics:
 
     def solve(self, position: np.ndarray, rotation: np.ndarray, q_seed: np.ndarray,
               iterations: int = 100) -> tuple[np.ndarray, float, float]:
-        """Damped least squares on position + orientation, inside joint limits.
+        """Damped least squares on position + orientation, inside joint limits; a seven-joint
+        arm's null-space motion goes towards the home pose (``redundancy_step``).
 
         Returns ``(q, position error m, orientation error rad)``.
         """
@@ -200,6 +217,8 @@ class UrdfKinematics:
                 break
             jw = jac * w[:, None]
             step = jw.T @ np.linalg.solve(jw @ jw.T + lam ** 2 * np.eye(6), e * w)
+            if self.n_joints > 6:
+                step = step + redundancy_step(jw, q, self.home, self.lower, self.upper)
             n = np.linalg.norm(step)
             if n > 0.3:
                 step *= 0.3 / n

@@ -1,6 +1,6 @@
 """Gains and thresholds of the grasp controller, loadable from a ROS-format parameter file.
 
-Every number the controller uses lives here, with its unit; ``mindgrasp_fsm/param/fsm.yaml`` holds
+Every number the controller uses lives here, with its unit; ``config/param/fsm.yaml`` holds
 the same names under ``fsm: ros__parameters:``. Per-shape values are flat names prefixed by the
 shape (``cube_approach_height``), so they are plain ROS parameters.
 """
@@ -60,10 +60,10 @@ class FsmParams:
     tool_link: str = param('tcp', 'URDF link of the grasp point between the fingertips')
     camera_link: str = param('camera_color_optical_frame',
                              'URDF link of the camera optical frame')
-    joint_names: list[str] = param(list(ARM_JOINTS), 'the 6 arm joints in /joint_states')
+    joint_names: list[str] = param(list(ARM_JOINTS), 'the arm joints (6 or 7) in /joint_states')
     # start pose of the URDF: long arm up, short arm forward, wrist pitched so the camera looks
     # down at the objects (the paper: all straight except joint 5)
-    home_position: list[float] = param(list(HOME_POSE), 'start pose, 6 joints', unit='rad')
+    home_position: list[float] = param(list(HOME_POSE), 'start pose, one per arm joint', unit='rad')
     joint_lower_limits: list[float] = param(list(ARM_LOWER_LIMITS), 'lower joint limits',
                                             unit='rad')
     joint_upper_limits: list[float] = param(list(ARM_UPPER_LIMITS), 'upper joint limits',
@@ -200,7 +200,7 @@ class FsmParams:
     center_timeout: float = param(10.0, 'then go on anyway (object still visible)', unit='s',
                                   min=0.1, max=120.0, live=True)
     # --- state 3: initial approach -------------------------------------------------------------
-    approach_joint: int = param(2, 'joint (1-based) that moves the long arm', min=1, max=6)
+    approach_joint: int = param(2, 'joint (1-based) that moves the long arm', min=1, max=7)
     approach_sign: float = param(1.0, 'sign of the approach joint velocity that goes forward',
                                  min=-1.0, max=1.0, live=True)
     approach_gain: float = param(0.2, 'approach joint velocity per unit certainty',
@@ -365,6 +365,10 @@ class FsmParams:
         self.joint_lower_limits = list(description.lower)
         self.joint_upper_limits = list(description.upper)
         self.max_joint_velocity = list(description.max_velocity)
+        if len(self.max_joint_acceleration) != len(self.joint_names) \
+                and len(set(self.max_joint_acceleration)) == 1:
+            # one limit for every joint (the default): as many entries as the arm has joints
+            self.max_joint_acceleration = self.max_joint_acceleration[:1] * len(self.joint_names)
         self.grasp_check = description.gripper.grasp_check
 
     # ---------------------------------------------------------------------------------------
@@ -380,12 +384,17 @@ class FsmParams:
             msg = (f"The parameter 'grasp_check' is {self.grasp_check!r}; use one of "
                    f"{', '.join(GRASP_CHECKS)}.")
             raise FsmError(msg)
-        for name in ('joint_names', 'home_position', 'joint_lower_limits', 'joint_upper_limits',
+        n = len(self.joint_names)
+        if n not in (6, 7):
+            msg = (f"The parameter 'joint_names' lists {n} joints; the controller drives arms of "
+                   '6 or 7 joints: list them base to wrist (or set robot:= a description).')
+            raise FsmError(msg)
+        for name in ('home_position', 'joint_lower_limits', 'joint_upper_limits',
                      'max_joint_velocity', 'max_joint_acceleration'):
             values = getattr(self, name)
-            if len(values) != 6:
-                msg = (f"The parameter '{name}' must have 6 entries (one per arm joint), got "
-                       f'{len(values)}; list all six joints in mindgrasp_fsm/param/fsm.yaml.')
+            if len(values) != n:
+                msg = (f"The parameter '{name}' must have {n} entries (one per arm joint in "
+                       f"'joint_names'), got {len(values)}; give one per joint.")
                 raise FsmError(msg)
         for i, (lo, hi) in enumerate(zip(self.joint_lower_limits, self.joint_upper_limits,
                                          strict=True)):
@@ -407,8 +416,8 @@ class FsmParams:
             if not all(math.isfinite(v) and v > 0 for v in values):
                 msg = f"Every entry of '{name}' must be > 0 {unit}, got {values}."
                 raise FsmError(msg)
-        if not 1 <= self.approach_joint <= 6:
-            msg = (f"The parameter 'approach_joint' must be a joint number 1..6, got "
+        if not 1 <= self.approach_joint <= n:
+            msg = (f"The parameter 'approach_joint' must be a joint number 1..{n}, got "
                    f'{self.approach_joint}.')
             raise FsmError(msg)
         if self.recenter_threshold <= self.center_tolerance:
@@ -446,7 +455,7 @@ class FsmParams:
         unknown = sorted(set(values) - known)
         if unknown:
             msg = (f'Unknown controller parameter(s) {unknown}; check the spelling against '
-                   'mindgrasp_fsm/param/fsm.yaml.')
+                   'config/param/fsm.yaml.')
             raise FsmError(msg)
         defaults = cls()
         kwargs: dict[str, Any] = {}
@@ -481,7 +490,7 @@ class FsmParams:
             if isinstance(section, dict) and 'ros__parameters' in section:
                 return cls.from_dict(section['ros__parameters'] or {})
         msg = (f"{path} has no '{node_name}: ros__parameters:' section; add one (see "
-               'mindgrasp_fsm/param/fsm.yaml).')
+               'config/param/fsm.yaml).')
         raise FsmError(msg)
 
 

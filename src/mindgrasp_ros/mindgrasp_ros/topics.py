@@ -124,7 +124,7 @@ DEPTH_INFO = _t('/camera/depth/camera_info', 'sensor_msgs/msg/CameraInfo', SENSO
 JOINT_STATES = _t('/joint_states', 'sensor_msgs/msg/JointState', RELIABLE,
                   'sim (or arm driver)', 'fsm, virtual subject', 'rad, rad/s')
 ARM_COMMANDS = _t('/arm_controller/commands', 'std_msgs/msg/Float64MultiArray', RELIABLE,
-                  'fsm', 'sim (or arm driver)', '6 joint velocities, rad/s')
+                  'fsm', 'sim (or arm driver)', 'one velocity per arm joint, rad/s')
 ARM_TRAJECTORY = _t('/arm_controller/joint_trajectory', 'trajectory_msgs/msg/JointTrajectory',
                     RELIABLE, 'fsm (command_interface trajectory)',
                     'sim (or JointTrajectoryController)',

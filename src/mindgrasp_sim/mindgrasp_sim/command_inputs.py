@@ -10,7 +10,7 @@
   Jacobian. As in MoveIt Servo, twists move the arm only after ``/servo_node/switch_command_type``
   (moveit_msgs/srv/ServoCommandType) selected TWIST (1).
 
-Both become joint velocities (6,) rad/s that go through the node's one command path
+Both become joint velocities (n_joints,) rad/s that go through the node's one command path
 (:meth:`SimNode.accept_arm_command`): the same command timeout (a stale driver input stops the
 arm), velocity clipping, and refusal of bad commands with one warning per burst.
 """
@@ -85,13 +85,14 @@ class ArmCommandInputs:
             return
 
         def velocities() -> np.ndarray:
-            frames = ('', self.node.tf_tree.root, self.node.p['frame_id'])
+            frames = ('', self.node.tf_tree.root, self.node.params.frame_id)
             if msg.header.frame_id not in frames:
                 msg_ = (f'twist frame_id {msg.header.frame_id!r} is not the arm base frame; '
                         f'send twists in {self.node.tf_tree.root!r}.')
                 raise SimError(msg_)
-            jac = sim.tool_jacobian(sim.joint_positions(io.name))
-            return velocities_from_twist(jac, linear, angular)
+            q = sim.joint_positions(io.name)
+            return velocities_from_twist(sim.tool_jacobian(q), linear, angular,
+                                         posture=(q, sim.home_pose, sim.lower, sim.upper))
 
         self.node.accept_arm_command(velocities, io, self.twist_topic)
 

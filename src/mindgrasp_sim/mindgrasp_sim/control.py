@@ -9,6 +9,7 @@ import math
 
 import numpy as np
 
+from mindgrasp_common.redundancy import redundancy_step
 from mindgrasp_sim.errors import SimError
 
 
@@ -63,17 +64,26 @@ def velocities_from_trajectory(joint_names: list[str], arm_joints: list[str] | t
 
 
 def velocities_from_twist(jacobian: np.ndarray, linear: np.ndarray, angular: np.ndarray,
-                          damping: float = 0.01) -> np.ndarray:
+                          damping: float = 0.01,
+                          posture: tuple[np.ndarray, ...] | None = None) -> np.ndarray:
     """Joint velocities (n,) rad/s that move the tool at ``linear`` (3,) m/s and ``angular``
     (3,) rad/s, by damped least squares on the tool ``jacobian`` (6, n), as MoveIt Servo does
     with its inverse Jacobian (the damping keeps a near-singular arm from racing). SimError for
-    NaN/inf."""
+    NaN/inf.
+
+    ``posture``: ``(q, home, lower, upper)`` (n,) rad each; a seven-joint arm moving at a
+    non-zero twist spends its null-space motion on going back towards ``home`` and away from
+    its limits (:func:`~mindgrasp_common.redundancy.redundancy_step`); a zero twist stops the arm
+    (it never moves by itself). Ignored for six joints."""
     twist = np.concatenate([np.asarray(linear, dtype=float), np.asarray(angular, dtype=float)])
     if not np.isfinite(twist).all():
         msg = f'Twist contains NaN or inf ({twist.tolist()}); send finite m/s and rad/s.'
         raise SimError(msg)
     j = np.asarray(jacobian, dtype=float)
-    return j.T @ np.linalg.solve(j @ j.T + damping ** 2 * np.eye(6), twist)
+    v = j.T @ np.linalg.solve(j @ j.T + damping ** 2 * np.eye(6), twist)
+    if posture is not None and j.shape[1] > 6 and twist.any():
+        v = v + redundancy_step(j, *posture)
+    return v
 
 
 def gripper_closure(values: object) -> float:

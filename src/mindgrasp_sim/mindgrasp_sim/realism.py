@@ -374,13 +374,16 @@ class Realism:
         The profile, or its name / path for :meth:`RealismProfile.load`.
     seed : int
         Seed of every draw (per trial with :meth:`begin_trial`).
+    n_joints : int
+        Arm joints that get an encoder offset (6 or 7; the robot description's).
 
     Per-trial draws (set by :meth:`begin_trial`): ``mount_offset`` (3,) m and ``mount_rotation``
-    (3, 3) in the camera's optical frame, ``lighting`` (3,) channel gains, ``encoder_offset`` (6,)
-    rad. Per-reading noise comes from a second generator of the same trial.
+    (3, 3) in the camera's optical frame, ``lighting`` (3,) channel gains, ``encoder_offset``
+    (n_joints,) rad. Per-reading noise comes from a second generator of the same trial.
     """
 
-    def __init__(self, profile: RealismProfile | str | Path | None = None, seed: int = 0) -> None:
+    def __init__(self, profile: RealismProfile | str | Path | None = None, seed: int = 0,
+                 n_joints: int = 6) -> None:
         if not isinstance(profile, RealismProfile):
             profile = RealismProfile.load(profile)
         if not isinstance(seed, (int, np.integer)):
@@ -388,6 +391,7 @@ class Realism:
             raise SimError(msg)
         self.profile = profile
         self.seed = int(seed)
+        self.n_joints = int(n_joints)
         self.begin_trial(0, 0)
 
     @property
@@ -410,7 +414,7 @@ class Realism:
         gain = rng.uniform(*c.lighting_gain)
         self.lighting = gain * (1.0 + rng.uniform(-c.tint, c.tint, 3))
         j = self.profile.joints
-        self.encoder_offset = rng.uniform(-j.encoder_offset, j.encoder_offset, 6)
+        self.encoder_offset = rng.uniform(-j.encoder_offset, j.encoder_offset, self.n_joints)
         # objects are spread from their own generator, so the number of objects does not
         # change the other draws
         self._object_rng = np.random.default_rng(rng.integers(2 ** 63))

@@ -1,6 +1,6 @@
 """Scene descriptions: which objects stand where (ROS-free).
 
-A scene is a YAML file (``mindgrasp_sim/scenes/<name>.yaml``, or any path)::
+A scene is a YAML file (``config/scenes/<name>.yaml``, or any path)::
 
     name: set_locations
     seed: 0
@@ -59,7 +59,7 @@ _DEFAULTS = {
 
 
 def scenes_dir() -> Path:
-    """The scenes shipped with this package (``mindgrasp_sim/scenes/*.yaml``)."""
+    """The scenes shipped with this package (``config/scenes/*.yaml``)."""
     return resource_path('mindgrasp_sim', 'scenes')
 
 

@@ -36,7 +36,7 @@ class GraspOutcome:
 def move_joints(sim: Simulation, q_target: np.ndarray, robot: str = 'user', gain: float = 3.0,
                 tolerance: float = 0.005, timeout: float = 6.0,
                 max_speed: float | None = None) -> bool:
-    """Drive the arm to joint positions ``q_target`` (6,) rad with proportional velocity
+    """Drive the arm to joint positions ``q_target`` (n_joints,) rad with proportional velocity
     commands (rad/s, within the joint limits). Returns True when within ``tolerance`` rad."""
     q_target = np.clip(np.asarray(q_target, dtype=float), sim.lower, sim.upper)
     vmax = sim.max_velocity if max_speed is None else np.minimum(sim.max_velocity, max_speed)

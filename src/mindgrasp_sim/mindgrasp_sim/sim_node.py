@@ -6,7 +6,7 @@ RGB-D camera driver, served by :class:`~mindgrasp_sim.simulation.Simulation`.
     python -m mindgrasp_sim.sim_node --ros-args \
         --params-file config/param/sim.yaml
 
-Subscribes ``/arm_controller/commands`` (std_msgs/Float64MultiArray, 6 joint velocities, rad/s;
+Subscribes ``/arm_controller/commands`` (std_msgs/Float64MultiArray, per arm joint, rad/s;
 older than ``command_timeout`` s means zero; clipped to the velocity limits of the loaded URDF;
 NaN/inf or a wrong length is refused and holds the arm until no refused command came for
 ``bad_command_hold`` s; one warning per burst of bad commands), and, with the same timeout,
@@ -15,7 +15,7 @@ JointTrajectoryController) and ``/servo_node/delta_twist_cmds`` (geometry_msgs/T
 MoveIt Servo, after ``/servo_node/switch_command_type``; see
 :mod:`mindgrasp_sim.command_inputs`), ``/gripper_controller/commands``
 (Float64MultiArray: [closure] 0 open .. 1 closed, or [thumb, left, right]) and ``/task/target``.
-Publishes ``/joint_states`` (6 arm joints), ``/gripper/joint_states`` (3 fingers: angles, efforts
+Publishes ``/joint_states`` (the arm joints), ``/gripper/joint_states`` (3 fingers: angles, efforts
 in N m), ``/gripper/contacts`` (std_msgs/UInt8MultiArray, 1 = finger touches an object; with
 realism, any surface), ``/ee_pose``
 (geometry_msgs/PoseStamped, TCP in ``world``), ``/camera/color/image_raw`` (rgb8),
@@ -115,7 +115,7 @@ class SimParams:
     """ROS parameters of the sim node (``param/sim.yaml``); read-only: the simulation is built at
     start, restart the node (or call /sim/load_scene) to change them."""
 
-    scene: str = param('set_locations', 'scene name in mindgrasp_sim/scenes/ '
+    scene: str = param('set_locations', 'scene name in config/scenes/ '
                        '(set_locations, random_locations) or a path')
     seed: int = param(0, 'random scenes: layout seed (same seed, same layout)', min=0)
     n_objects: int = param(-1, "random scenes: number of objects, -1 = the scene file's",
@@ -182,8 +182,8 @@ class _RobotIO:
     prefix: str
     gate: CommandGate
     bursts: CommandBursts
+    applied: np.ndarray           #: the velocities in force (n_joints,) rad/s
     pubs: dict = field(default_factory=dict)
-    applied: np.ndarray = field(default_factory=lambda: np.zeros(6))
     inputs: object = None     #: its ArmCommandInputs (trajectory, servo twist)
 
 
@@ -215,44 +215,44 @@ class SimNode(rclpy.node.Node):
     def __init__(self, **kwargs) -> None:
         super().__init__('sim', **kwargs)
         self.params = declare_params(self, SimParams)
-        p = self.p = dataclasses.asdict(self.params)
+        p = self.params
         try:
-            gui = bool(p['gui'])
+            gui = bool(p.gui)
             if gui and not os.environ.get('DISPLAY') and sys.platform.startswith('linux'):
                 self.get_logger().warning(
                     'gui:=true needs a display (DISPLAY is not set); running headless instead.')
                 gui = False
             self.sim = Simulation(
-                scene=p['scene'], seed=int(p['seed']),
-                camera=CameraConfig(int(p['camera_width']), int(p['camera_height']),
-                                    float(p['camera_rate']), float(p['camera_fov_deg']),
-                                    renderer=str(p['camera_renderer'])),
-                physics_hz=float(p['physics_hz']),
-                solver_iterations=int(p['solver_iterations']),
-                trainer_robot=bool(p['trainer_robot']), gui=gui,
-                n_objects=None if int(p['n_objects']) < 0 else int(p['n_objects']),
-                realism=str(p['realism']), realism_seed=int(p['realism_seed']),
-                robot=str(p['robot']))
+                scene=p.scene, seed=int(p.seed),
+                camera=CameraConfig(int(p.camera_width), int(p.camera_height),
+                                    float(p.camera_rate), float(p.camera_fov_deg),
+                                    renderer=str(p.camera_renderer)),
+                physics_hz=float(p.physics_hz),
+                solver_iterations=int(p.solver_iterations),
+                trainer_robot=bool(p.trainer_robot), gui=gui,
+                n_objects=None if int(p.n_objects) < 0 else int(p.n_objects),
+                realism=str(p.realism), realism_seed=int(p.realism_seed),
+                robot=str(p.robot))
         except SimError as err:
             self.get_logger().error(str(err))
             raise
-        self.mode = p['time_mode']
+        self.mode = p.time_mode
         self.done = rclpy.task.Future()
-        self.monitor = TaskMonitor(success_height=float(p['success_height']))
+        self.monitor = TaskMonitor(success_height=float(p.success_height))
         self.monitor.new_trial(0.0)
         self.desired = ''
         self.task_trial = 0       # /task/target's trial: the number /task/result reports
         self.total_steps = 0
-        self.js_every = self.sim.physics_hz / float(p['joint_state_rate'])
+        self.js_every = self.sim.physics_hz / float(p.joint_state_rate)
         # /tf at most at tf_publish_frequency, as robot_state_publisher's publish_frequency
-        self.tf_every = self.sim.physics_hz / min(float(p['tf_publish_frequency']),
-                                                  float(p['joint_state_rate']))
+        self.tf_every = self.sim.physics_hz / min(float(p.tf_publish_frequency),
+                                                  float(p.joint_state_rate))
         self._next_tf_step = 0.0
         self.cam_every = self.sim.physics_hz / self.sim.camera.rate_hz
-        self.obj_every = self.sim.physics_hz / float(p['objects_rate'])
+        self.obj_every = self.sim.physics_hz / float(p.objects_rate)
         self.task_every = max(1, round(self.sim.physics_hz / 20.0))
         self.status_every = max(1, round(self.sim.physics_hz))     # 1 s of simulated time
-        scene_rate = float(p['scene_camera_rate'])
+        scene_rate = float(p.scene_camera_rate)
         self.scene_every = self.sim.physics_hz / scene_rate if scene_rate > 0 else math.inf
         # the scene camera's first frame is due at once; never when it is off
         self._next = {'js': 0.0, 'cam': 0.0, 'obj': 0.0,
@@ -265,8 +265,9 @@ class SimNode(rclpy.node.Node):
         self.robots: dict[str, _RobotIO] = {}
         for name in self.sim.robots:
             prefix = '' if name == 'user' else TRAINER_ROBOT
-            io = _RobotIO(name, prefix, CommandGate(float(p['command_timeout'])),
-                          CommandBursts(float(p['bad_command_hold'])))
+            io = _RobotIO(name, prefix,
+                          CommandGate(float(p.command_timeout), self.sim.n_joints),
+                          CommandBursts(float(p.bad_command_hold)), np.zeros(self.sim.n_joints))
             js, fingers, contacts, ee, arm, gripper = (t.in_namespace(prefix) for t in (
                 JOINT_STATES, GRIPPER_JOINT_STATES, GRIPPER_CONTACTS, EE_POSE, ARM_COMMANDS,
                 GRIPPER_COMMANDS))
@@ -303,7 +304,7 @@ class SimNode(rclpy.node.Node):
         self._t0 = self._clock_s() if self.mode == 'realtime' else 0.0
         self._set_t0(self._t0)
         if self.mode == 'realtime':
-            self.create_timer(1.0 / float(p['joint_state_rate']), self.realtime_callback)
+            self.create_timer(1.0 / float(p.joint_state_rate), self.realtime_callback)
         elif self.mode == 'fast':
             # always ready; each call steps for ~2 ms of wall time, then lets the executor take
             # commands and requests (works under main() and in a composed process alike)
@@ -375,14 +376,14 @@ class SimNode(rclpy.node.Node):
                 self.publish_status()
         if self.clock_pub is not None:
             self.clock_pub.publish(Clock(clock=self._stamp()))
-        limit = float(self.p['sim_duration'])
+        limit = float(self.params.sim_duration)
         if limit > 0 and self.total_steps * sim.dt >= limit:
             self._finish()
 
     def realtime_callback(self) -> None:
         """Catch up with the node's clock (wall, or /clock with use_sim_time)."""
         due = self._clock_s() - self.sim_now()
-        cap = float(self.p['max_catch_up'])
+        cap = float(self.params.max_catch_up)
         if due > cap:
             # the machine is too slow (or the clock jumped): drop the lag instead of racing
             self.get_logger().warning(
@@ -411,7 +412,7 @@ class SimNode(rclpy.node.Node):
             self.fast_iteration()
 
     def duration_callback(self) -> None:
-        limit = float(self.p['duration'])
+        limit = float(self.params.duration)
         if limit > 0 and time.monotonic() - self._wall_start >= limit:
             self._finish()
 
@@ -423,7 +424,7 @@ class SimNode(rclpy.node.Node):
 
     def accept_arm_command(self, velocities: Callable[[], np.ndarray], io: _RobotIO,
                            topic: str) -> None:
-        """The joint velocities (6,) rad/s that ``velocities()`` reads from a command of any
+        """The joint velocities (n_joints,) rad/s that ``velocities()`` reads from a command of any
         interface. A refused command (``velocities()`` raises SimError) stops the arm, which then
         holds until the commands were valid for ``bad_command_hold`` s; a command beyond the
         URDF's velocity limits is clipped to them. One warning per burst of each."""
@@ -466,7 +467,7 @@ class SimNode(rclpy.node.Node):
     def _after_reset(self) -> None:
         for io in self.robots.values():
             io.gate.clear()
-            io.applied = np.zeros(6)
+            io.applied = np.zeros(self.sim.n_joints)
         self.monitor.new_trial(self.sim.time)
         self.publish_all()
 
@@ -530,8 +531,8 @@ class SimNode(rclpy.node.Node):
         # the arm stands at the world origin (the simulation loads it there); a URDF whose root
         # is that frame already (the xArm's 'world') gets no transform: tf2 refuses a frame that
         # is its own parent
-        base = [] if self.tf_tree.root == self.p['frame_id'] else [
-            Transform(self.p['frame_id'], self.tf_tree.root, np.zeros(3),
+        base = [] if self.tf_tree.root == self.params.frame_id else [
+            Transform(self.params.frame_id, self.tf_tree.root, np.zeros(3),
                       np.array([0.0, 0.0, 0.0, 1.0]))]
         self.tf_static_pub = self.create_publisher(TFMessage, TF_STATIC.name, TF_STATIC.qos)
         self.tf_static_pub.publish(msgs.tf_message(
@@ -560,7 +561,7 @@ class SimNode(rclpy.node.Node):
         """Joint states, finger states and contacts, and the TCP pose of every robot."""
         self._last_state_step = self.total_steps
         sim = self.sim
-        hdr, world = self._header(), self._header(self.p['frame_id'])
+        hdr, world = self._header(), self._header(self.params.frame_id)
         for io in self.robots.values():
             q, v = sim.joint_readings(io.name)     # encoder readings (noisy with realism)
             io.pubs['js'].publish(msgs.joint_state(hdr, sim.joint_names, q, v,
@@ -595,19 +596,19 @@ class SimNode(rclpy.node.Node):
 
     def publish_scene(self) -> None:
         """/scene/image_raw (rgb8): the third-person view for the participant's display."""
-        rgb = self.sim.render_scene(int(self.p['scene_camera_width']),
-                                    int(self.p['scene_camera_height']))
+        rgb = self.sim.render_scene(int(self.params.scene_camera_width),
+                                    int(self.params.scene_camera_height))
         self.scene_pub.publish(msgs.rgb_image(self._header('scene_camera'), rgb))
 
     def publish_objects(self) -> None:
-        self.objects_pub.publish(msgs.object_markers(self._header(self.p['frame_id']),
+        self.objects_pub.publish(msgs.object_markers(self._header(self.params.frame_id),
                                                      self.sim.objects()))
 
     def check_task(self) -> None:
         """Publish /task/result on a lift or a drop; report new arm collisions."""
         event = self.monitor.update(self.sim)
         if event is not None:
-            result = msgs.grasp_result(self._header(self.p['frame_id']), event, self.desired,
+            result = msgs.grasp_result(self._header(self.params.frame_id), event, self.desired,
                                        self.task_trial)
             self.result_pub.publish(result)
             self.get_logger().info(

@@ -34,7 +34,7 @@ import math
 import os
 import sys
 from collections.abc import Iterator
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -58,8 +58,6 @@ from mindgrasp_sim.scene import ObjectSpec, SceneSpec, load_scene
 
 #: PD motor position gain (pybullet's per-step error fraction): stiff, so gravity sag < 1 mrad
 ARM_POSITION_GAIN = 0.8
-_ARM_POSITION_GAINS = (ARM_POSITION_GAIN,) * 6
-_ARM_VELOCITY_GAINS = (1.0,) * 6
 _GOVERNOR_TOLERANCE = 1.05
 GROUND_RGBA = (0.78, 0.77, 0.74, 1.0)
 TRAINER_RGBA = (0.1, 0.85, 0.1, 0.35)
@@ -156,14 +154,14 @@ class CameraConfig:
 class _Robot:
     body: int
     q_ref: np.ndarray
+    # the velocity command and the velocity the motors follow after the lag (n_joints,) rad/s,
+    # set through command() and apply(), which note whether they are non-zero: the physics loop
+    # asks at every step, and ndarray.any() there cost more than the rest of an idle step
+    v_cmd: np.ndarray
+    v_applied: np.ndarray
     closure: float = 0.0
     gripper_dirty: bool = True
     holding: bool = False     # zero command already given to the motors: nothing to update
-    # the velocity command and the velocity the motors follow after the lag (6,) rad/s, set
-    # through command() and apply(), which note whether they are non-zero: the physics loop asks
-    # at every step, and ndarray.any() there cost more than the rest of an idle step
-    v_cmd: np.ndarray = field(default_factory=lambda: np.zeros(6))
-    v_applied: np.ndarray = field(default_factory=lambda: np.zeros(6))
     cmd_moving: bool = False
     applied_moving: bool = False
     # getJointStates of the arm and the physics step it was read after: the tracker, the
@@ -186,7 +184,7 @@ class Simulation:
     Parameters
     ----------
     scene : str | Path
-        ``'set_locations'``, ``'random_locations'`` (names in ``mindgrasp_sim/scenes``) or a
+        ``'set_locations'``, ``'random_locations'`` (names in ``config/scenes``) or a
         YAML path.
     seed : int
         Seed of the random object layout (random scenes); same seed, same layout.
@@ -233,7 +231,6 @@ class Simulation:
             msg = f'n_objects must be None or an integer >= 0, got {n_objects!r}.'
             raise SimError(msg)
         self.camera = camera or CameraConfig()
-        self.realism = Realism(realism, realism_seed)
         self._trial = 0
         self.physics_hz = float(physics_hz)
         self.dt = 1.0 / self.physics_hz
@@ -245,6 +242,12 @@ class Simulation:
             raise SimError(str(exc)) from None
         #: arm joints (n,) base to wrist, and the gripper joints, as the description names them
         self.joint_names: tuple[str, ...] = self.robot.arm_joints
+        #: number of arm joints (6 or 7)
+        self.n_joints = len(self.joint_names)
+        self.realism = Realism(realism, realism_seed, self.n_joints)
+        # PD motor gains per arm joint (see ARM_POSITION_GAIN)
+        self._arm_position_gains = (ARM_POSITION_GAIN,) * self.n_joints
+        self._arm_velocity_gains = (1.0,) * self.n_joints
         self.finger_names: tuple[str, ...] = self.robot.gripper.joints
         self.home_pose = np.array(self.robot.home_pose, dtype=float)
         # gripper joint positions (n_fingers,) of closure 0 and 1
@@ -406,8 +409,11 @@ class Simulation:
                                  jointDamping=0.05)
         if not ghost and not self.robot.gripper.self_collision:
             self._disable_gripper_self_collision(p, body)
+        if not ghost:
+            self._disable_welded_self_collision(p, body)
         # velocity motors off: joints are driven by the PD reference in step()
-        return _Robot(body=body, q_ref=self.home_pose.copy())
+        return _Robot(body=body, q_ref=self.home_pose.copy(), v_cmd=np.zeros(self.n_joints),
+                      v_applied=np.zeros(self.n_joints))
 
     def _disable_gripper_self_collision(self, p: BulletClient, body: int) -> None:
         """No contacts among the gripper's links and the links they hang from (the
@@ -422,6 +428,28 @@ class Simulation:
                 if a < b:
                     p.setCollisionFilterPair(body, body, a, b, 0)
 
+    def _disable_welded_self_collision(self, p: BulletClient, body: int) -> None:
+        """No contacts between links welded by fixed joints, nor between such a group and the
+        link its moving joint turns on. PyBullet's EXCLUDE_PARENT spares a link and its direct
+        parent only; the Panda's hand hangs from link 7 through a virtual link 8, and their
+        meshes overlap by design (the hand's collision with link 7 braked joint 7)."""
+        n = p.getNumJoints(body)
+        info = [p.getJointInfo(body, j) for j in range(n)]
+        # the rigid group of each link: the link its chain of fixed joints hangs from (-1: base)
+        root = {-1: -1}
+        for j in range(n):      # PyBullet numbers a parent link before its children
+            root[j] = root[info[j][16]] if info[j][2] == pb.JOINT_FIXED else j
+        for a in range(n):
+            if root[a] == a:
+                continue
+            # welded to its group's root, and to the link that root turns on
+            hinge = info[root[a]][16] if root[a] >= 0 else None
+            for b in {root[a], hinge} - {None, info[a][16]}:
+                p.setCollisionFilterPair(body, body, a, b, 0)
+            for c in range(a):
+                if root[c] == root[a] and c != info[a][16]:
+                    p.setCollisionFilterPair(body, body, a, c, 0)
+
     def _couple_mimic_joints(self, p: BulletClient, body: int, names: dict[str, int]) -> None:
         """Tie each URDF mimic joint of the gripper to its leader with a gear constraint
         (position = multiplier * leader + offset), its own motor off. PyBullet ignores
@@ -430,13 +458,12 @@ class Simulation:
         for joint, leader, multiplier, offset in self.robot.gripper.mimic:
             j, lead = names[joint], names[leader]
             p.setJointMotorControl2(body, j, pb.VELOCITY_CONTROL, force=0.0)
-            axis = p.getJointInfo(body, j)[13]
-            c = p.createConstraint(body, lead, body, j, pb.JOINT_GEAR, list(axis), [0, 0, 0],
-                                   [0, 0, 0])
+            info = p.getJointInfo(body, j)
+            c = p.createConstraint(body, lead, body, j, pb.JOINT_GEAR, list(info[13]),
+                                   [0, 0, 0], [0, 0, 0])
             # the gear holds q_j = multiplier * q_leader (+ offset, as a position target)
             p.changeConstraint(c, gearRatio=-multiplier, gearAuxLink=-1, erp=0.8,
-                               relativePositionTarget=offset,
-                               maxForce=p.getJointInfo(body, j)[10])
+                               relativePositionTarget=offset, maxForce=info[10])
 
     def _spawn(self, spec: ObjectSpec) -> int:
         p = self._p
@@ -507,13 +534,12 @@ class Simulation:
         self._objects = [(spec, self._spawn(spec)) for spec in specs]
         for robot in self._robots.values():
             for i, j in enumerate(self._arm_idx):
-                p.resetJointState(robot.body, j, self.home_pose[i], 0.0)
-            robot.states_step = -1
+                self._reset_arm_joint(robot, j, self.home_pose[i], 0.0)
             for j, q in zip(self._finger_idx, self._finger_open, strict=True):
                 p.resetJointState(robot.body, j, q, 0.0)
             robot.q_ref = self.home_pose.copy()
-            robot.command(np.zeros(6))
-            robot.apply(np.zeros(6))
+            robot.command(np.zeros(self.n_joints))
+            robot.apply(np.zeros(self.n_joints))
             robot.closure = 0.0
             robot.gripper_dirty = True
             robot.holding = False
@@ -550,18 +576,18 @@ class Simulation:
             raise SimError(msg) from None
 
     def set_joint_velocities(self, velocities: np.ndarray, robot: str = 'user') -> None:
-        """Command joint velocities (6,) rad/s, clipped to the joint velocity limits.
+        """Command joint velocities (n_joints,) rad/s, clipped to the joint velocity limits.
 
         Raises SimError for a wrong length or NaN/inf (the previous command stays in force).
         """
-        v = validate_velocities(velocities, 6)
+        v = validate_velocities(velocities, self.n_joints)
         r = self._robot(robot)
         r.command(np.clip(v, -self.max_velocity, self.max_velocity))
         r.holding = False
 
     def stop(self, robot: str = 'user') -> None:
         """Zero velocity command (the arm holds its current reference)."""
-        self._robot(robot).command(np.zeros(6))
+        self._robot(robot).command(np.zeros(self.n_joints))
 
     def set_gripper(self, closure: float, robot: str = 'user') -> None:
         """Gripper target: 0 open .. 1 closed; fingers close with limited torque (they stop on
@@ -575,15 +601,16 @@ class Simulation:
         r.gripper_dirty = True
 
     def set_joint_positions(self, positions: np.ndarray, robot: str = 'user') -> None:
-        """Teleport the arm to joint positions (6,) rad (tests, scripted set-ups; not physical)."""
-        q = np.clip(np.asarray(positions, dtype=float).reshape(6), self.lower, self.upper)
+        """Teleport the arm to joint positions (n_joints,) rad (tests, scripted set-ups; not
+        physical)."""
+        q = np.clip(np.asarray(positions, dtype=float).reshape(self.n_joints), self.lower,
+                    self.upper)
         r = self._robot(robot)
         for i, j in enumerate(self._arm_idx):
-            self._p.resetJointState(r.body, j, q[i], 0.0)
-        r.states_step = -1
+            self._reset_arm_joint(r, j, q[i], 0.0)
         r.q_ref = q.copy()
-        r.command(np.zeros(6))
-        r.apply(np.zeros(6))
+        r.command(np.zeros(self.n_joints))
+        r.apply(np.zeros(self.n_joints))
         r.holding = False
 
     def step(self, n: int = 1) -> None:
@@ -598,7 +625,7 @@ class Simulation:
                     # a real velocity controller follows the command with a lag
                     v = self.realism.lagged_velocity(r.v_applied, r.v_cmd, dt)
                     if not r.cmd_moving and np.max(np.abs(v)) < 1e-4:
-                        v = np.zeros(6)
+                        v = np.zeros(self.n_joints)
                     r.apply(v)
                     r.holding = False
                 elif not lagging and r.v_applied is not r.v_cmd:
@@ -614,8 +641,9 @@ class Simulation:
                     r.q_ref = np.minimum(np.maximum(r.q_ref, q - reach), q + reach)
                     p.setJointMotorControlArray(
                         r.body, self._arm_idx, pb.POSITION_CONTROL, targetPositions=r.q_ref,
-                        targetVelocities=[0.0] * 6, forces=self.max_effort,
-                        positionGains=_ARM_POSITION_GAINS, velocityGains=_ARM_VELOCITY_GAINS)
+                        targetVelocities=[0.0] * self.n_joints,
+                        forces=self.max_effort, positionGains=self._arm_position_gains,
+                        velocityGains=self._arm_velocity_gains)
                     r.holding = True
                 if r.gripper_dirty:
                     target = self._finger_open + (self._finger_closed - self._finger_open) \
@@ -654,7 +682,13 @@ class Simulation:
         p.setJointMotorControlArray(
             r.body, self._arm_idx, pb.POSITION_CONTROL, targetPositions=q + lag,
             targetVelocities=v_ff, forces=self.max_effort,
-            positionGains=_ARM_POSITION_GAINS, velocityGains=_ARM_VELOCITY_GAINS)
+            positionGains=self._arm_position_gains, velocityGains=self._arm_velocity_gains)
+
+    def _reset_arm_joint(self, r: _Robot, joint: int, q: float, v: float) -> None:
+        """Set arm joint ``joint`` (PyBullet index) of ``r`` to ``q`` rad, ``v`` rad/s; the
+        cached joint states of this step are stale after it."""
+        self._p.resetJointState(r.body, joint, q, v)
+        r.states_step = -1
 
     def _arm_states(self, r: _Robot) -> tuple:
         """``getJointStates`` of the arm's joints after the latest physics step (read once per
@@ -677,22 +711,21 @@ class Simulation:
             for i in np.flatnonzero(over):
                 j = self._arm_idx[i]
                 q = p.getJointState(r.body, j)[0]
-                p.resetJointState(r.body, j, q, float(np.sign(v[i]) * self.max_velocity[i]))
-            r.states_step = -1
+                self._reset_arm_joint(r, j, q, float(np.sign(v[i]) * self.max_velocity[i]))
 
     # ------------------------------------------------------------------ state
     def joint_positions(self, robot: str = 'user') -> np.ndarray:
-        """Arm joint positions (6,) rad."""
+        """Arm joint positions (n_joints,) rad."""
         r = self._robot(robot)
         return np.array([s[0] for s in self._arm_states(r)])
 
     def joint_velocities(self, robot: str = 'user') -> np.ndarray:
-        """Arm joint velocities (6,) rad/s."""
+        """Arm joint velocities (n_joints,) rad/s."""
         r = self._robot(robot)
         return np.array([s[1] for s in self._arm_states(r)])
 
     def joint_readings(self, robot: str = 'user') -> tuple[np.ndarray, np.ndarray]:
-        """What the arm's encoders report: joint positions (6,) rad and velocities (6,) rad/s,
+        """What the arm's encoders report: joint positions (n,) rad and velocities (n,) rad/s,
         with the realism profile's encoder noise and offsets (exact without realism)."""
         q, v = self.joint_positions(robot), self.joint_velocities(robot)
         if robot != 'user':
@@ -700,7 +733,7 @@ class Simulation:
         return self.realism.joint_readings(q, v)
 
     def joint_efforts(self, robot: str = 'user') -> np.ndarray:
-        """Arm joint motor torques (6,) N m applied in the last step."""
+        """Arm joint motor torques (n_joints,) N m applied in the last step."""
         r = self._robot(robot)
         return np.array([s[3] for s in self._arm_states(r)])
 
@@ -710,7 +743,7 @@ class Simulation:
         return np.array([s[0] for s in self._p.getJointStates(r.body, self._finger_idx)])
 
     def commanded_velocities(self, robot: str = 'user') -> np.ndarray:
-        """The velocity command in force (6,) rad/s, after clipping."""
+        """The velocity command in force (n_joints,) rad/s, after clipping."""
         return self._robot(robot).v_cmd.copy()
 
     def _link_pose(self, body: int, link: int) -> tuple[np.ndarray, np.ndarray]:
@@ -977,7 +1010,7 @@ class Simulation:
     def forward_kinematics(self, q: np.ndarray, link: str = 'tcp'
                            ) -> tuple[np.ndarray, np.ndarray]:
         """Pose (position (3,) m, quaternion xyzw (4,)) of ``link`` ('tcp' or 'camera') for
-        joint positions q (6,) rad, computed on a kinematic twin (the simulation is untouched)."""
+        joint positions q (n,) rad, computed on a kinematic twin (the simulation is untouched)."""
         self._kin_set(np.asarray(q, dtype=float))
         idx = {'tcp': self._tcp_idx, 'camera': self._cam_idx}.get(link)
         if idx is None:
@@ -988,7 +1021,7 @@ class Simulation:
         return _in_link(pos, orn, self.robot.camera if link == 'camera' else self.robot.tcp)
 
     def tool_jacobian(self, q: np.ndarray) -> np.ndarray:
-        """Geometric Jacobian (6, 6) of the TCP at joints ``q`` (6,) rad, on the kinematic twin:
+        """Geometric Jacobian (6, n) of the TCP at joints ``q`` (n,) rad, on the kinematic twin:
         rows linear (m/s) and angular (rad/s) velocity in the base frame per rad/s of each arm
         joint (pybullet.calculateJacobian, fingers open)."""
         q = np.asarray(q, dtype=float)
@@ -1006,7 +1039,7 @@ class Simulation:
     def inverse_kinematics(self, target_pos: np.ndarray, target_quat: np.ndarray | None = None,
                            robot: str = 'user', seed_q: np.ndarray | None = None,
                            iterations: int = 30, tolerance: float = 1e-3) -> np.ndarray:
-        """Joint positions (6,) rad that put the TCP at ``target_pos`` (3,) m (and orientation
+        """Joint positions (n,) rad that put the TCP at ``target_pos`` (3,) m (and orientation
         ``target_quat`` xyzw, if given), within the joint limits.
 
         Uses pybullet.calculateInverseKinematics (damped least squares, null space towards the
@@ -1020,7 +1053,7 @@ class Simulation:
             msg = f'IK target position must be finite (m), got {target_pos.tolist()}.'
             raise SimError(msg)
         q0 = (self.joint_positions(robot) if seed_q is None
-              else np.asarray(seed_q, dtype=float).reshape(6)).copy()
+              else np.asarray(seed_q, dtype=float).reshape(self.n_joints)).copy()
         best, best_err = self._ik_from(q0, target_pos, target_quat, iterations, tolerance)
         if best_err > tolerance:
             # damped least squares rarely swings the base far: retry with joint 1 facing the target
@@ -1051,7 +1084,7 @@ class Simulation:
             else:
                 sol = self._kin.calculateInverseKinematics(
                     self._kin_body, self._tcp_idx, target_pos.tolist(), **kwargs)
-            q = np.clip(np.array(sol[:6]), self.lower, self.upper)
+            q = np.clip(np.array(sol[:self.n_joints]), self.lower, self.upper)
             pos, orn = self.forward_kinematics(q)
             err = float(np.linalg.norm(pos - target_pos))
             if target_quat is not None:
