@@ -32,7 +32,7 @@ from typing import Any
 import yaml
 
 REPO = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO / 'tests' / 'bringup'))
+sys.path.insert(0, str(REPO / 'tests'))
 
 from conftest_bag import cut_in_half, damage_chunks  # noqa: E402
 from mindgrasp_bag import BagReader  # noqa: E402

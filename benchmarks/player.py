@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 
 REPO = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO / 'tests' / 'bringup'))
+sys.path.insert(0, str(REPO / 'tests'))
 
 from conftest_bag import EEG, PROBE, STRING, eeg_chunk, string  # noqa: E402
 from mindgrasp_bag import BagReader, BagWriter  # noqa: E402

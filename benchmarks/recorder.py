@@ -28,7 +28,7 @@ import uuid
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO / 'tests' / 'bringup'))
+sys.path.insert(0, str(REPO / 'tests'))
 
 from conftest_bag import eeg_chunk, image  # noqa: E402
 from mindgrasp_bag import BagReader, BagWriter, Recorder  # noqa: E402
@@ -155,7 +155,7 @@ def dds(scenario: str, out: Path, duration: float, rate: float = 0.0) -> tuple[i
         env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     try:
         time.sleep(2.0)
-        pub = subprocess.run([sys.executable, '-c', PUBLISHER, str(REPO / 'tests' / 'bringup'),
+        pub = subprocess.run([sys.executable, '-c', PUBLISHER, str(REPO / 'tests'),
                               prefix, scenario, str(duration), str(rate)],
                              env=env, capture_output=True, text=True, timeout=duration + 120)
     finally:
