@@ -6,7 +6,8 @@ Subscribes ``/bci/prediction`` (mindgrasp_msgs/MIPrediction), ``/vision/detectio
 (DetectionArray), ``/joint_states``, ``/gripper/joint_states`` + ``/gripper/contacts`` (finger
 angles, efforts and contact flags), ``/camera/color/camera_info``. Publishes the arm
 command in the form of ``command_interface`` (:mod:`mindgrasp_fsm.arm_output`):
-``/arm_controller/commands`` (std_msgs/Float64MultiArray, one velocity per arm joint in rad/s; default),
+``/arm_controller/commands`` (std_msgs/Float64MultiArray, one velocity per arm joint
+in rad/s; default),
 ``/arm_controller/joint_trajectory`` (trajectory_msgs/JointTrajectory) or
 ``/servo_node/delta_twist_cmds`` (geometry_msgs/TwistStamped, after
 ``/servo_node/switch_command_type``);
