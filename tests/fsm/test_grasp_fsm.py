@@ -657,6 +657,28 @@ def test_grasp_check_counts_fingers_loaded_by_effort(params: FsmParams) -> None:
     assert {'lift', 'check_lift'} <= {o.phase for o in outs}
 
 
+#: open fingertips pressed on the table (a live arm a few mm low): the motors loaded, the
+#: fingers not closed (seen live with real rclpy on a loaded machine)
+OPEN_ON_TABLE = GripperState(opening=0.95, force=1.2, stamp=0.0, contact=False,
+                             fingers_in_contact=0, efforts=(1.02, -1.2, -1.09))
+
+
+def test_a_load_before_the_fingers_close_is_not_contact(params: FsmParams) -> None:
+    """The closing holds at the contact point only once the fingers travelled
+    ``contact_min_travel`` since it began: loaded open fingertips (the table) are not the
+    object, and holding there (closure 0.15) lifted nothing. Once they close on the object
+    the hold is set from there."""
+    fsm = _grasp_fsm(params)
+    q = _grasp_pose()
+    outs, q, t = _drive(fsm, q, OPEN_ON_TABLE, 0.2)
+    assert {o.phase for o in outs} == {'close'}
+    assert all(o.gripper.position == params.gripper_closed_position for o in outs)
+    outs, _, _ = _drive(fsm, q, SQUEEZING, 1.0, t0=t)
+    held = [o.gripper.position for o in outs if o.gripper.position < params.gripper_closed_position]
+    assert held and held[0] == pytest.approx(1.0 - SQUEEZING.opening + params.grip_squeeze)
+    assert 'lift' in {o.phase for o in outs}
+
+
 def test_object_lost_in_the_lift_unloads_the_fingers(params: FsmParams) -> None:
     fsm = _grasp_fsm(params)
     q = _grasp_pose()

@@ -112,6 +112,7 @@ class GraspPolicy:
         self._stall_since: float | None = None
         self._contact_since: float | None = None   # all fingers touching since (s)
         self._hold_since: float | None = None      # compliant hold commanded since (s)
+        self._opening_at_close: float | None = None  # the first opening read while closing
         self._after_retreat = ''
         self._retreat_reason = ''
         self._lost_since: float | None = None
@@ -352,6 +353,7 @@ class GraspPolicy:
         self._last_opening = None
         self._contact_since = None
         self._hold_since = None
+        self._opening_at_close = None
         self._gripper = GripperCommand(self.params.gripper_closed_position,
                                        self.params.shape_value(self.shape, 'close_force'))
 
@@ -437,6 +439,13 @@ class GraspPolicy:
                     n = gripper.fingers_in_contact
                 if p.grasp_check == 'width':
                     n = None     # jaws: closing ends when they stall (on the object or shut)
+                if self._opening_at_close is None:
+                    self._opening_at_close = gripper.opening
+                if self._opening_at_close - gripper.opening < p.contact_min_travel:
+                    # a load before the fingers closed is not the object's: open fingertips
+                    # pressed on the table (a live arm that went a few mm low on a busy machine
+                    # held open at the contact point and lifted nothing)
+                    n = None
                 if self._hold_since is None and n is not None and n >= p.min_fingers_in_contact:
                     # every finger touches: stop closing and hold a little past this point
                     self._contact_since = self._contact_since if self._contact_since is not None \

@@ -301,6 +301,10 @@ class FsmParams:
                                 'close', min=0.0, max=1.0, live=True)
     contact_settle_time: float = param(0.05, 'all fingers touch this long before the closing '
                                        'stops', unit='s', min=0.0, max=10.0, live=True)
+    contact_min_travel: float = param(0.05, 'closure (0..1) the fingers travel after the '
+                                      'closing began before a load counts as contact (a load '
+                                      'before is not the object: e.g. open fingertips on the '
+                                      'table)', min=0.0, max=1.0, live=True)
     contact_min_force: float = param(1.0, 'finger force that counts as contact', unit='N',
                                      min=0.0, max=500.0, live=True)
     min_fingers_in_contact: int = param(3, 'fingers that must touch for a firm grasp (contact '
