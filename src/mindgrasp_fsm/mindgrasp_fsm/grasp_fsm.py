@@ -287,7 +287,7 @@ class GraspFsm:
                 GripperCommand(self.params.gripper_open_position, 0.0)
 
     # ---------------------------------------------------------------------------- outputs
-    def _output(self, v: np.ndarray, *, stopped: StopKind = StopKind.NONE,
+    def _output(self, v: np.ndarray, *, stop_kind: StopKind = StopKind.NONE,
                 reason: str | None = None, phase: str = '') -> FsmOutput:
         events, self._events = self._events, []
         if reason is None and self._pending is not None:
@@ -300,7 +300,7 @@ class GraspFsm:
         return FsmOutput(
             joint_velocities=v, gripper=self._gripper, state=self.state,
             previous_state=self.previous_state, locked=self._lock_until is not None,
-            stopped=stopped != StopKind.NONE, stop_kind=stopped,
+            stopped=stop_kind != StopKind.NONE, stop_kind=stop_kind,
             reason=self.reason if reason is None else reason,
             object_of_interest=self._ooi_label, phase=phase, grasp_attempts=self._attempt,
             grasp_outcome=self._outcome, events=events,
@@ -319,7 +319,7 @@ class GraspFsm:
             State.CENTER_OBJECT, State.INITIAL_APPROACH, State.FINAL_APPROACH)
 
     def _stop(self, kind: StopKind, why: str) -> FsmOutput:
-        return self._output(np.zeros(self.n_joints), stopped=kind, reason=why)
+        return self._output(np.zeros(self.n_joints), stop_kind=kind, reason=why)
 
     # ---------------------------------------------------------------------------- main tick
     def tick(self, inputs: FsmInputs) -> FsmOutput:
