@@ -75,7 +75,7 @@ from mindgrasp_ros.interfaces.visualization_msgs.msg import MarkerArray
 from scipy.spatial.transform import Rotation
 
 from mindgrasp_ros import rclpy
-from mindgrasp_ros.node_main import run_node
+from mindgrasp_ros.node_main import end_after, run_node
 from mindgrasp_ros.node_traits import NodeTraits
 from mindgrasp_ros.params import declare_params, param
 from mindgrasp_ros.topics import (
@@ -147,7 +147,9 @@ class SimParams:
     trainer_robot: bool = param(False, 'also simulate the green training robot under '
                                 '/trainer_robot/')
     gui: bool = param(False, 'PyBullet window (needs a display)')
-    duration: float = param(0.0, 'end after this many wall seconds; 0 = run until stopped',
+    duration: float = param(0.0, 'end after this long of the node\'s ROS time, as every node\'s '
+                            'duration (the simulator is the clock, so wall time unless a '
+                            'lock-step host sets its time); 0 = run until stopped',
                             unit='s', min=0.0)
     sim_duration: float = param(0.0, 'end after this many simulated seconds; 0 = no limit',
                                 unit='s', min=0.0)
@@ -309,7 +311,7 @@ class SimNode(rclpy.node.Node):
             # always ready; each call steps for ~2 ms of wall time, then lets the executor take
             # commands and requests (works under main() and in a composed process alike)
             self.create_timer(0.0, self.fast_callback)
-        self.create_timer(0.5, self.duration_callback)
+        end_after(self, p.duration)
         self._publish_robot_description()
         self.publish_all()
         robots = ' and the training robot' if 'trainer' in self.robots else ''
@@ -410,11 +412,6 @@ class SimNode(rclpy.node.Node):
         end = time.monotonic() + 0.002
         while not self.done.done() and time.monotonic() < end:
             self.fast_iteration()
-
-    def duration_callback(self) -> None:
-        limit = float(self.params.duration)
-        if limit > 0 and time.monotonic() - self._wall_start >= limit:
-            self._finish()
 
     # ------------------------------------------------------------------ commands
     def arm_command_callback(self, msg: Float64MultiArray, io: _RobotIO) -> None:
@@ -669,7 +666,8 @@ class SimNode(rclpy.node.Node):
 
 
 def main(args: list[str] | None = None) -> int:
-    """Run the simulator until Ctrl-C, ``duration`` (wall s) or ``sim_duration`` (simulated s)."""
+    """Run the simulator until Ctrl-C, ``duration`` (s of its ROS time) or ``sim_duration``
+    (simulated s)."""
     return run_node(SimNode, args, errors=(SimError,))
 
 
