@@ -79,10 +79,10 @@ def test_vision_live_change_rebuilds_the_pipeline_or_is_refused(rclpy_ctx):
     try:
         ok = node.set_parameters([param('hysteresis', value=0.3)])[0]
         assert ok.successful and node.pipeline.ranker.hysteresis == pytest.approx(0.3)
-        assert node.cfg.hysteresis == pytest.approx(0.3)
+        assert node.params.hysteresis == pytest.approx(0.3)
         bad = node.set_parameters([param('colour_ranges.red', value=[170, 8, 120])])[0]
         assert not bad.successful and 'needs 4 numbers' in bad.reason, bad.reason
-        assert node.cfg.colour_ranges['red'] == [170, 8, 120, 40]
+        assert node.params.colour_ranges['red'] == [170, 8, 120, 40]
         fixed = node.set_parameters([param('shape_model', value='none')])[0]
         assert not fixed.successful and 'read-only' in fixed.reason
         out = node.set_parameters([param('min_pixels', value=0)])[0]
@@ -112,3 +112,19 @@ def test_describe_works_with_an_enum_parameter_type_as_real_rclpy_has(monkeypatc
             assert desc.type == expected[type(default)], name
     ranged = [d for _, d in specs.values() if d.type == 3 and len(d.floating_point_range)]
     assert ranged, 'a DOUBLE with a range keeps its FloatingPointRange under an Enum Type'
+
+
+def test_every_node_reads_its_parameters_one_way():
+    """Issue 29: each node keeps what ``declare_params`` returns as ``self.params`` (typed
+    attributes), never as a dict or under another name (``self.p``, ``self.cfg``, ``vars(...)``)."""
+    import re
+    from pathlib import Path
+
+    src = Path(__file__).resolve().parents[2] / 'src'
+    calls = [(path, line.strip()) for path in sorted(src.rglob('*.py'))
+             for line in path.read_text(encoding='utf-8').splitlines()
+             if re.search(r'declare_params\(self\b', line)]
+    assert len(calls) >= 15, 'the rule found too few nodes to mean anything'
+    other = [f'{path.relative_to(src)}: {line}' for path, line in calls
+             if not re.match(r'self\.params(\s*=\s*p)?\s*=\s*declare_params\(self\b', line)]
+    assert not other, '\n'.join(other)

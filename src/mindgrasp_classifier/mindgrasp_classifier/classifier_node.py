@@ -87,19 +87,19 @@ class ClassifierNode(rclpy.node.Node):
 
     def __init__(self, **kwargs) -> None:
         super().__init__('classifier', **kwargs)
-        self.p = declare_params(self, ClassifierParams)
-        if self.p.blas_threads > 0:
+        self.params = declare_params(self, ClassifierParams)
+        if self.params.blas_threads > 0:
             # small matrices: multi-threaded BLAS only adds latency, worst on a busy machine
-            threadpool_limits(limits=int(self.p.blas_threads))
-        self.model = MiModel.load(self.p.model)
-        if self.p.classes:
-            check_classes(self.model, self.p.classes)
+            threadpool_limits(limits=int(self.params.blas_threads))
+        self.model = MiModel.load(self.params.model)
+        if self.params.classes:
+            check_classes(self.model, self.params.classes)
         self.adaptation = AdaptationConfig(
-            mode=self.p.adaptation, rate=self.p.adaptation_rate,
-            min_certainty=self.p.min_certainty, recenter=self.p.recenter,
-            recenter_rate=self.p.recenter_rate, recenter_prior=self.p.recenter_prior)
+            mode=self.params.adaptation, rate=self.params.adaptation_rate,
+            min_certainty=self.params.min_certainty, recenter=self.params.recenter,
+            recenter_rate=self.params.recenter_rate, recenter_prior=self.params.recenter_prior)
         self.adaptation.check()
-        self.cues = CueLabels(self.p.label_tmin, self.p.label_tmax)
+        self.cues = CueLabels(self.params.label_tmin, self.params.label_tmax)
         self._last_trial = -1
         self.decoder: MiDecoder | None = None
         self.n_predictions = 0
@@ -112,11 +112,11 @@ class ClassifierNode(rclpy.node.Node):
         self.create_subscription(EEGChunk, EEG_RAW.name, self.eeg_callback, EEG_RAW.qos)
         self.create_subscription(Prompt, TRAINER_PROMPT.name, self.prompt_callback,
                                  TRAINER_PROMPT.qos)
-        self.create_timer(self.p.status_period, self.status_callback)
+        self.create_timer(self.params.status_period, self.status_callback)
         self.done = rclpy.task.Future()
         declare_duration(self)
         self.get_logger().info(
-            f'Loaded {self.p.model}: {self.model.pipeline}, classes {self.model.class_names}, '
+            f'Loaded {self.params.model}: {self.model.pipeline}, classes {self.model.class_names}, '
             f'{len(self.model.channels)} channels at {self.model.rate:g} Hz, window '
             f'{self.model.window:g} s every {self.model.step * 1e3:.1f} ms; adaptation '
             f'{self.adaptation.mode}, re-centering {self.adaptation.recenter}.')
@@ -130,7 +130,7 @@ class ClassifierNode(rclpy.node.Node):
         if self.decoder is None:
             try:
                 self.decoder = MiDecoder(self.model, layout[0], layout[1],
-                                         self.adaptation, self.p.flat_threshold)
+                                         self.adaptation, self.params.flat_threshold)
             except ClassifierError as exc:
                 self.fail(str(exc))
                 return
@@ -184,7 +184,7 @@ class ClassifierNode(rclpy.node.Node):
                            window_length=float(self.model.window),
                            probabilities=np.asarray(pred.probabilities, dtype=np.float32))
         msg.header.stamp = rclpy.time.Time(nanoseconds=round(end_s * 1e9)).to_msg()
-        msg.header.frame_id = self.p.frame_id
+        msg.header.frame_id = self.params.frame_id
         self.pub_pred.publish(msg)
         self.n_predictions += 1
 
@@ -217,7 +217,7 @@ class ClassifierNode(rclpy.node.Node):
         """Publish /bci/status."""
         level, message = self._state
         dec = self.decoder
-        values = {'model': str(self.p.model), 'pipeline': self.model.pipeline,
+        values = {'model': str(self.params.model), 'pipeline': self.model.pipeline,
                   'predictions': str(self.n_predictions),
                   'adaptation': self.adaptation.mode, 'recenter': self.adaptation.recenter}
         if dec is not None:

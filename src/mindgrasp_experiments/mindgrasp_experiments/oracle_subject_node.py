@@ -66,12 +66,11 @@ class OracleSubjectNode(rclpy.node.Node):
     def __init__(self, **kwargs) -> None:
         super().__init__('oracle_subject', **kwargs)
         self.done = rclpy.task.Future()
-        p = vars(declare_params(self, OracleParams))
-        self.p = p
+        self.params = p = declare_params(self, OracleParams)
         self.subject = VirtualSubject('pursue', accuracy=1.0,
-                                      reaction_delay=p['reaction_delay'], seed=p['seed'],
-                                      decision_period=p['decision_period'],
-                                      heading_tolerance=p['heading_tolerance'])
+                                      reaction_delay=p.reaction_delay, seed=p.seed,
+                                      decision_period=p.decision_period,
+                                      heading_tolerance=p.heading_tolerance)
         latched = LATCHED_QUEUE.profile()
         self.create_subscription(TaskTarget, TASK_TARGET.name, self.target_callback, latched)
         self.create_subscription(MarkerArray, SIM_OBJECTS.name, self.objects_callback, latched)
@@ -81,8 +80,8 @@ class OracleSubjectNode(rclpy.node.Node):
         self.pub = self.create_publisher(MIPrediction, BCI_PREDICTION.name, BCI_PREDICTION.qos)
         self.pub_intent = self.create_publisher(String, VIRTUAL_SUBJECT_INTENT.name, latched)
         self._last_intent: object = 'unset'
-        self.create_timer(p['period'], self.predict_callback)
-        end_after(self, p['duration'])
+        self.create_timer(p.period, self.predict_callback)
+        end_after(self, p.duration)
 
     def now_s(self) -> float:
         return self.get_clock().now().nanoseconds * 1e-9
@@ -108,13 +107,13 @@ class OracleSubjectNode(rclpy.node.Node):
             return                                    # no /clock yet
         intent = self.subject.intent(now)
         cls = REST if intent is None else int(intent)
-        certainty = 0.0 if intent is None else self.p['certainty']
+        certainty = 0.0 if intent is None else self.params.certainty
         distances = np.full(len(DECODER_CLASS_NAMES), 1.0 + certainty, dtype=np.float32)
         distances[cls] = 1.0
         # the intended class (rest included) with p = oracle_probability, the rest shared
-        others = (1.0 - self.p['probability']) / (len(DECODER_CLASS_NAMES) - 1)
+        others = (1.0 - self.params.probability) / (len(DECODER_CLASS_NAMES) - 1)
         probabilities = np.full(len(DECODER_CLASS_NAMES), others, dtype=np.float32)
-        probabilities[cls] = self.p['probability']
+        probabilities[cls] = self.params.probability
         msg = MIPrediction(class_index=cls, class_names=list(DECODER_CLASS_NAMES),
                            certainty=float(certainty), distances=distances, window_length=0.0,
                            probabilities=probabilities)

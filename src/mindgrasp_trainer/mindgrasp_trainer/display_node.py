@@ -115,7 +115,7 @@ class DisplayNode(rclpy.node.Node):
 
     def __init__(self, **kwargs) -> None:
         super().__init__('participant_display', **kwargs)
-        p = self.p = declare_params(self, DisplayParams)
+        self.params = p = declare_params(self, DisplayParams)
         # a TrainerError here (no display, unwritable png_dir) ends the node with exit code 2
         # and its one-line message (run_node)
         self.screen = ParticipantScreen(int(p.width), int(p.height), p.layout, p.feedback,
@@ -221,7 +221,7 @@ class DisplayNode(rclpy.node.Node):
     def draw(self) -> None:
         """Render, flip, then stamp the pending prompts with the flip time."""
         age_ns = self.get_clock().now().nanoseconds - self.prediction_ns
-        timeout_ns = int(float(self.p.prediction_timeout) * 1e9)
+        timeout_ns = int(float(self.params.prediction_timeout) * 1e9)
         self.state.prediction = self.prediction if age_ns <= timeout_ns else None
         frame = self.screen.render(self.state)
         flip_mono = self.window.show(frame)
@@ -233,17 +233,17 @@ class DisplayNode(rclpy.node.Node):
             late = (flip.nanoseconds - _stamp_ns(prompt.header.stamp)) * 1e-9
             prompt.header.stamp = flip.to_msg()
             self.flip_pub.publish(prompt)
-            if late > float(self.p.late_threshold):
+            if late > float(self.params.late_threshold):
                 self.late_count += 1
                 self.get_logger().warning(
                     f'Trial {prompt.trial}: {prompt.phase} {prompt.class_name or ""} drawn '
                     f'{1e3 * late:.1f} ms after its prompt (limit '
-                    f'{1e3 * float(self.p.late_threshold):.0f} ms); /display/flip has the drawn '
-                    'time.')
+                    f'{1e3 * float(self.params.late_threshold):.0f} ms); /display/flip has the '
+                    'drawn time.')
         # the PNG and image rates count on the node clock (simulated time in lock-step)
         now = flip.nanoseconds * 1e-9
-        image_rate = float(self.p.image_rate)
-        if self.p.headless and image_rate > 0 and now - self.last_image >= 1 / image_rate:
+        image_rate = float(self.params.image_rate)
+        if self.params.headless and image_rate > 0 and now - self.last_image >= 1 / image_rate:
             self.last_image = now
             msg = Image(height=frame.shape[0], width=frame.shape[1], encoding='rgb8',
                         is_bigendian=0, step=frame.shape[1] * 3, data=frame.reshape(-1))
@@ -251,7 +251,8 @@ class DisplayNode(rclpy.node.Node):
             msg.header.frame_id = 'participant_display'
             self.image_pub.publish(msg)
         if self.png_dir is not None and (
-                prompts or (self.p.png_rate > 0 and now - self.last_png >= 1 / self.p.png_rate)):
+                prompts or (self.params.png_rate > 0
+                            and now - self.last_png >= 1 / self.params.png_rate)):
             self.last_png = now
             self.write_png(frame, prompts[-1] if prompts else None)
 

@@ -85,7 +85,7 @@ class GrazNode(rclpy.node.Node):
 
     def __init__(self, **kwargs) -> None:
         super().__init__('graz_prompter', **kwargs)
-        p = self.p = declare_params(self, GrazParams)
+        self.params = p = declare_params(self, GrazParams)
         # a TrainerError here (no class order keeps runs to max_repeat) ends the node with exit
         # code 2 and its one-line message (run_node)
         self.protocol = GrazProtocol(**{name: getattr(p, name) for name in _PROTOCOL})
@@ -132,7 +132,7 @@ class GrazNode(rclpy.node.Node):
             self.t0_ns = now.nanoseconds
         elapsed = (now.nanoseconds - self.t0_ns) * 1e-9
         events = self.sequencer.due(elapsed)
-        if self.p.duration > 0 and elapsed >= self.p.duration and not self.sequencer.done:
+        if self.params.duration > 0 and elapsed >= self.params.duration and not self.sequencer.done:
             events.append(self.sequencer.stop(elapsed))
         for event in events:
             self.prompt_pub.publish(to_msg(event, now.to_msg()))
@@ -148,7 +148,7 @@ class GrazNode(rclpy.node.Node):
 
     def display_callback(self) -> None:
         # a classifier that went quiet shows no bar rather than a stale one
-        p = self.p  # feedback and max_certainty are live: declare_params updates them in place
+        p = self.params  # feedback and max_certainty are live: declare_params updates them in place
         age_ns = self.get_clock().now().nanoseconds - self.prediction_ns
         prediction = self.prediction if age_ns <= p.prediction_timeout * 1e9 else None
         frame = render_display(self.sequencer.current, prediction, p.display_width,

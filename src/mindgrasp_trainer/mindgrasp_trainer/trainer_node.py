@@ -123,7 +123,7 @@ class TrainerNode(rclpy.node.Node):
 
     def __init__(self, **kwargs) -> None:
         super().__init__('trainer', **kwargs)
-        p = self.p = declare_params(self, TrainerParams)
+        self.params = p = declare_params(self, TrainerParams)
         self.protocol = TrainerProtocol(**{name: getattr(p, name) for name in _PROTOCOL})
         self.trainer_pos: np.ndarray | None = None
         self.user_pos: np.ndarray | None = None
@@ -206,13 +206,13 @@ class TrainerNode(rclpy.node.Node):
                 self.get_logger().error(
                     f'/trainer_robot/joint_states has {self.joint_count} joints but the '
                     f'trainer commands the {self.protocol.n_joints} arm joints of the robot '
-                    f"{self.p.robot!r}; start the simulator and the trainer with the same "
+                    f"{self.params.robot!r}; start the simulator and the trainer with the same "
                     'robot:= (mindgrasp launch trainer robot:=NAME) or check the remapping.'
                 )
                 self._finish(1)
                 return False
             return True
-        if self.p.robot_timeout > 0 and t - self.created > self.p.robot_timeout:
+        if self.params.robot_timeout > 0 and t - self.created > self.params.robot_timeout:
             missing = [
                 topic for topic, value in (
                     ('/trainer_robot/joint_states', self.joint_count),
@@ -220,9 +220,9 @@ class TrainerNode(rclpy.node.Node):
                 ) if value is None
             ]  # fmt: skip
             self.get_logger().error(
-                f'No message on {" and ".join(missing)} within {self.p.robot_timeout:.1f} s: start '
-                'the simulator with the training robot (mindgrasp launch trainer) or remap the '
-                "topics; 'robot_timeout' sets the wait."
+                f'No message on {" and ".join(missing)} within {self.params.robot_timeout:.1f} s: '
+                'start the simulator with the training robot (mindgrasp launch trainer) or remap '
+                "the topics; 'robot_timeout' sets the wait."
             )
             self._finish(1)
         return False
@@ -289,9 +289,9 @@ class TrainerNode(rclpy.node.Node):
             self.protocol.reset_finished(t, success=False)
             return
         request = ResetSim.Request(
-            new_random_draw=self.p.reset_new_random_draw, seed=-1
+            new_random_draw=self.params.reset_new_random_draw, seed=-1
         )
-        self.reset_deadline = t + self.p.reset_timeout
+        self.reset_deadline = t + self.params.reset_timeout
         self.reset_future = self.reset_client.call_async(request)
         self.reset_future.add_done_callback(self.reset_done_callback)
 
@@ -311,8 +311,8 @@ class TrainerNode(rclpy.node.Node):
     def _check_reset_timeout(self, t: float) -> None:
         if self.reset_deadline is not None and t > self.reset_deadline:
             self.get_logger().error(
-                f'/sim/reset did not answer within {self.p.reset_timeout:.1f} s; the session goes '
-                "on. Check the simulator's log, or raise 'reset_timeout'."
+                f'/sim/reset did not answer within {self.params.reset_timeout:.1f} s; the session '
+                "goes on. Check the simulator's log, or raise 'reset_timeout'."
             )
             self.reset_future = None
             self.reset_deadline = None
@@ -327,8 +327,8 @@ class TrainerNode(rclpy.node.Node):
             return
         summary = json.dumps(_rounded(self.protocol.summary()))
         self.get_logger().info(f'Trainer session summary (distances in m): {summary}')
-        if self.p.log_file:
-            self._write_log(self.p.log_file)
+        if self.params.log_file:
+            self._write_log(self.params.log_file)
 
     def _write_log(self, path: str) -> None:
         """Per-trial CSV: trial, class, onset (s), mean and final end-effector distance (m)."""

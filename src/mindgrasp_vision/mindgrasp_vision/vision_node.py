@@ -60,13 +60,13 @@ class VisionNode(rclpy.node.Node):
         super().__init__('vision', **kwargs)
         # callbacks may run on several threads (composition uses a MultiThreadedExecutor)
         self._lock = threading.RLock()
-        self.cfg = declare_params(self, VisionConfig, on_change=self.apply_parameters)
+        self.params = declare_params(self, VisionConfig, on_change=self.apply_parameters)
         classifier = None
         try:
-            classifier = self.cfg.load_classifier()
+            classifier = self.params.load_classifier()
         except VisionError as exc:
             self.get_logger().error(f'{exc} Running without shape classification.')
-        self.pipeline = self.cfg.build_pipeline(classifier)
+        self.pipeline = self.params.build_pipeline(classifier)
         self.detections_pub = self.create_publisher(DetectionArray, VISION_DETECTIONS.name,
                                                     VISION_DETECTIONS.qos)
         self.overlay_pub = self.create_publisher(Image, VISION_OVERLAY.name, VISION_OVERLAY.qos)
@@ -89,8 +89,8 @@ class VisionNode(rclpy.node.Node):
         self.create_timer(0.5, self.watch_callback)
         declare_duration(self)
         self.get_logger().info(
-            f'Vision ready: colours {self.cfg.colour_names}, shape model '
-            f'{"none" if classifier is None else self.cfg.shape_model}.')
+            f'Vision ready: colours {self.params.colour_names}, shape model '
+            f'{"none" if classifier is None else self.params.shape_model}.')
 
     # ------------------------------------------------------------------ callbacks
     def color_callback(self, msg: Image) -> None:
@@ -167,7 +167,7 @@ class VisionNode(rclpy.node.Node):
         if self._last_image is None or now < self._last_image:  # start, or sim time reset
             self._last_image = now
         silent = now - self._last_image
-        if 0 < self.cfg.image_timeout < silent:
+        if 0 < self.params.image_timeout < silent:
             self.get_logger().error(f'No camera image on {COLOR_IMAGE.name} for {silent:.1f} s; '
                                     'check that the camera driver or the simulator is running '
                                     'and publishing rgb8 images.', throttle_duration_sec=5.0)
@@ -178,7 +178,7 @@ class VisionNode(rclpy.node.Node):
         return self.get_clock().now().nanoseconds * 1e-9
 
     def _check_size(self, width: int, height: int, topic: str) -> None:
-        ew, eh = int(self.cfg.expected_width), int(self.cfg.expected_height)
+        ew, eh = int(self.params.expected_width), int(self.params.expected_height)
         if (ew and width != ew) or (eh and height != eh):
             msg = (f'The image on {topic} is {width}x{height} px, expected {ew or width}x'
                    f'{eh or height} px (parameters expected_width/expected_height); fix the '
@@ -189,7 +189,7 @@ class VisionNode(rclpy.node.Node):
         if self._pending is None:
             return
         stamp, rgb, header = self._pending
-        tol = int(self.cfg.sync_tolerance * 1e9)
+        tol = int(self.params.sync_tolerance * 1e9)
         if self._depth is not None and abs(self._depth[0] - stamp) <= tol:
             depth = self._depth[1]
         elif self._seen_depth and (self._depth is None or self._depth[0] < stamp - tol):
@@ -207,9 +207,9 @@ class VisionNode(rclpy.node.Node):
                                     throttle_duration_sec=5.0)
             depth = None
         mi = None
-        if self._mi is not None and self._now() - self._mi[1] <= self.cfg.prediction_timeout:
+        if self._mi is not None and self._now() - self._mi[1] <= self.params.prediction_timeout:
             mi = self._mi[0]
-        classify = classify or self._fsm_state in list(self.cfg.classify_states)
+        classify = classify or self._fsm_state in list(self.params.classify_states)
         try:
             result = self.pipeline.process(rgb, depth, mi, classify=classify)
         except VisionError as exc:
@@ -224,7 +224,7 @@ class VisionNode(rclpy.node.Node):
             detections=[detection_to_msg(Detection, RegionOfInterest, d)
                         for d in result.detections])
         self.detections_pub.publish(out)
-        if self.cfg.publish_overlay:
+        if self.params.publish_overlay:
             self.overlay_pub.publish(image_from_rgb(Image, self.pipeline.overlay(rgb, result),
                                                     header))
         return result
