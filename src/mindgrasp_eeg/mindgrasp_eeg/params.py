@@ -49,8 +49,9 @@ class AcquisitionParams:
                                   'mismatch')
     stream_unit: str = param('auto', 'unit of the stream values: auto (channel metadata, else '
                              'microvolts), microvolts, V, ...')
-    chunk_period: float = param(1.0 / 32.0, 'publish period of /eeg/raw', unit='s', min=1e-3,
-                                max=10.0)
+    chunk_period: float = param(1.0 / 32.0, 'period of the connection, status-level and marker '
+                                'checks (/eeg/raw goes out as each block arrives)', unit='s',
+                                min=1e-3, max=10.0)
     max_buflen: float = param(1.0, 'LSL inlet buffer bound: no stale backlog after a stall',
                               unit='s', min=1e-3)
     resolve_timeout: float = param(30.0, 'wait this long for the stream, then exit with the '
