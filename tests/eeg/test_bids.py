@@ -5,7 +5,6 @@ read back with ``mne_bids.read_raw_bids``, events included."""
 from __future__ import annotations
 
 import csv
-import gzip
 import json
 import os
 import shutil
@@ -71,17 +70,29 @@ VALIDATOR = [sys.executable, '-c', 'import sys; from bids_validator_deno import 
                                    'sys.exit(cli())']
 
 
-def test_the_official_validator_accepts_the_dataset(dataset: Path) -> None:
-    res = subprocess.run([*VALIDATOR, str(dataset), '--format', 'json'],
-                         capture_output=True, text=True, timeout=300)
+def _errors(*args: str) -> tuple[int, list[dict], dict]:
+    """Exit code, error issues and the summary of the validator run on ``args``."""
+    res = subprocess.run([*VALIDATOR, *args, '--format', 'json'], capture_output=True, text=True,
+                         timeout=300)
     report = json.loads(res.stdout)
     errors = [i for i in report['issues']['issues'] if i['severity'] == 'error']
-    assert res.returncode == 0 and not errors, errors
-    assert sorted(report['summary']['tasks']) == ['graz', 'setlocations']
-    # the robot's motion, a derivatives dataset of its own, is valid too
-    deriv = subprocess.run([*VALIDATOR, str(dataset / 'derivatives' / 'mindgrasp'),
-                            '--format', 'json'], capture_output=True, text=True, timeout=300)
-    assert deriv.returncode == 0, deriv.stdout[-3000:]
+    for deriv in report.get('derivativesSummary', {}).values():     # -r: each derivative
+        errors += [i for i in deriv['issues']['issues'] if i['severity'] == 'error']
+    return res.returncode, errors, report['summary']
+
+
+def test_the_official_validator_accepts_the_dataset(dataset: Path) -> None:
+    """From the root, as a user and OpenNeuro run it, and with -r, which also checks the robot
+    motion's derivatives dataset (its files once had no BIDS name and were flagged)."""
+    for args in ([str(dataset)], [str(dataset), '-r']):
+        code, errors, summary = _errors(*args)
+        assert code == 0 and not errors, (args, errors)
+        assert sorted(summary['tasks']) == ['graz', 'setlocations']
+    # the robot's motion, a derivatives dataset of its own, is valid on its own too
+    code, errors, summary = _errors(str(dataset / 'derivatives' / 'mindgrasp'))
+    assert code == 0 and not errors, errors
+    assert summary['dataTypes'] == ['motion'] or 'motion' in summary.get('modalities', []), \
+        summary
 
 
 def _path(root: Path, task: str, run: int) -> mne_bids.BIDSPath:
@@ -120,12 +131,16 @@ def test_the_experiment_run_has_targets_outcomes_states_and_robot_motion(dataset
     # the bag kept as recorded, and the robot's joints and end-effector pose as a time series
     source = dataset / 'sourcedata' / 'sub-B01' / 'ses-1' / 'setlocations_run-1' / 'bag'
     assert (source / 'metadata.yaml').is_file()
-    motion = next((dataset / 'derivatives' / 'mindgrasp').rglob('*setlocations*_timeseries.tsv.gz'))
-    sidecar = json.loads(motion.with_name(motion.name.replace('.tsv.gz', '.json')).read_text())
-    assert sidecar['Columns'][0] == 'onset' and 'ee_z' in sidecar['Columns']
-    with gzip.open(motion, 'rt') as f:
-        rows = [line.split('\t') for line in f]
-    assert len(rows) > 100 and all(len(r) == len(sidecar['Columns']) for r in rows)
+    motion = next((dataset / 'derivatives' / 'mindgrasp').rglob(
+        '*task-setlocations_tracksys-robot_run-1_motion.tsv'))
+    with open(str(motion).replace('_motion.tsv', '_channels.tsv'), encoding='utf-8') as f:
+        channels = list(csv.DictReader(f, delimiter='\t'))
+    assert channels[0]['type'] == 'LATENCY' and channels[0]['units'] == 's'
+    assert {'JNTANG', 'POS', 'ORNT'} <= {c['type'] for c in channels}
+    sidecar = json.loads(motion.with_suffix('.json').read_text())
+    assert sidecar['MotionChannelCount'] == len(channels) and sidecar['TaskName'] == 'setlocations'
+    rows = [line.rstrip('\n').split('\t') for line in motion.read_text().splitlines()]
+    assert len(rows) > 100 and all(len(r) == len(channels) for r in rows)
 
 
 def test_bad_input_gets_one_line_and_writes_nothing(recorded: dict[str, Path],

@@ -13,8 +13,11 @@ recording::
         ..._electrodes.tsv, ..._coordsystem.json   the standard_1020 montage
     <root>/sourcedata/sub-<ID>[/ses-<S>]/<task>_run-<n>/bag/   the run's rosbag2, as recorded
     <root>/derivatives/mindgrasp/sub-<ID>[/ses-<S>]/motion/
-        ..._desc-robot_timeseries.tsv.gz, .json   joint states and end-effector pose
-                            (:mod:`.robot_motion`; mne-bids does not write BIDS motion data)
+        ..._tracksys-robot_run-<n>_motion.tsv, _motion.json, _channels.tsv   the robot's joint
+                            states and end-effector pose as BIDS motion data
+                            (:mod:`.robot_motion`; written here, as mne-bids does not write
+                            motion data), in a derivatives dataset with its own
+                            dataset_description.json (GeneratedBy)
 
 The task is the protocol: a session phase's kind (``graz``, ``grazfeedback``, ``trainer``), else
 the run's trial manager protocol (``setlocations``, ``randomlocations``), else the prompter that
@@ -173,8 +176,32 @@ def export_bids(paths: list[str | Path], root: str | Path, subject: str,
     return written
 
 
+def _motion_channels(columns: list[str]) -> list[dict[str, str]]:
+    """Rows of the motion ``channels.tsv`` (name, component, type, tracked_point, units) for the
+    columns of :func:`~mindgrasp_eeg.robot_motion.read_robot_motion`: the onset is the LATENCY
+    channel, joint positions JNTANG (rad), joint velocities MISC (rad/s; BIDS motion has no joint
+    velocity type), the end effector POS (m) and ORNT (unit quaternion)."""
+    rows = []
+    for c in columns:
+        if c == 'onset':
+            row = ('n/a', 'LATENCY', 'n/a', 's')
+        elif c.startswith('ee_q'):
+            row = (f'quat_{c[-1]}', 'ORNT', 'end_effector', 'n/a')
+        elif c.startswith('ee_'):
+            row = (c[-1], 'POS', 'end_effector', 'm')
+        elif c.endswith('_position'):
+            row = ('n/a', 'JNTANG', c.removesuffix('_position'), 'rad')
+        else:
+            row = ('n/a', 'MISC', c.removesuffix('_velocity'), 'rad/s')
+        rows.append(dict(zip(('name', 'component', 'type', 'tracked_point', 'units'),
+                             (c, *row), strict=True)))
+    return rows
+
+
 def _write_motion(run_dir: Path, start_ns: int, root: Path, bids_path: object) -> None:
-    """The robot's motion of one run as a derivatives time series (nothing without joints)."""
+    """The robot's motion of one run as BIDS motion data (``tracksys-robot``) in the
+    derivatives dataset ``derivatives/mindgrasp`` (nothing without joints). BIDS motion file
+    names, so the validator accepts it, also when it checks the derivatives (``-r``)."""
     import mne_bids
 
     motion = read_robot_motion(find_bag(run_dir), start_ns)
@@ -185,20 +212,44 @@ def _write_motion(run_dir: Path, start_ns: int, root: Path, bids_path: object) -
     if not (deriv / 'dataset_description.json').is_file():
         mne_bids.make_dataset_description(
             path=deriv, name='MIndGrasp robot motion', dataset_type='derivative',
-            generated_by=[{'Name': 'mindgrasp export bids'}], overwrite=True, verbose='error')
-        # the robot's time series has no BIDS name yet (motion data would, but mne-bids does
-        # not write them): tell the validator (-r) to skip it
-        (deriv / '.bidsignore').write_text('*_desc-robot_timeseries.*\n', encoding='utf-8')
-    out = bids_path.copy().update(root=deriv, datatype='motion', suffix='timeseries',
-                                  description='robot', extension='.tsv.gz', check=False)
+            generated_by=[{'Name': 'mindgrasp export bids',
+                           'Description': 'the robot arm\'s joint states and end-effector pose '
+                                          'from each run\'s bag'}],
+            source_datasets=[{'URL': '../..'}], overwrite=True, verbose='error')
+        (deriv / 'README').write_text(
+            'MIndGrasp robot motion: for each EEG run of the raw dataset (two folders up), the '
+            "robot arm's joint states and end-effector pose as BIDS motion data "
+            '(tracksys-robot), written by `mindgrasp export bids`.\n', encoding='utf-8')
+    out = bids_path.copy().update(root=deriv, datatype='motion', suffix=None, extension=None,
+                                  check=False)
     out.mkdir(exist_ok=True)
-    # a headerless TSV with its columns in the JSON sidecar, as BIDS physio / timeseries files
-    np.savetxt(str(out.fpath), table, delimiter='\t', fmt='%.6g')
-    units = {c: ('s' if c == 'onset' else 'm' if c in ('ee_x', 'ee_y', 'ee_z')
-                 else 'rad/s' if c.endswith('_velocity') else 'rad' if c.endswith('_position')
-                 else 'n/a') for c in columns}
-    sidecar = Path(str(out.fpath)).with_name(out.fpath.name.replace('.tsv.gz', '.json'))
-    sidecar.write_text(json.dumps({
-        'Description': 'Robot joint states (/joint_states) and end-effector pose (/ee_pose) '
-                       'from the run\'s bag; onset in s from the first EEG sample.',
-        'Columns': columns, 'Units': units}, indent=1) + '\n', encoding='utf-8')
+    # BIDS orders tracksys before run; mne-bids 0.20 writes it after, which the validator refuses
+    stem = '_'.join(f'{key}-{value}' for key, value in (
+        ('sub', out.subject), ('ses', out.session), ('task', out.task),
+        ('tracksys', 'robot'), ('run', out.run)) if value is not None)
+    fpath = Path(str(out.directory)) / f'{stem}_motion.tsv'
+    # motion.tsv has no header: its columns are the rows of channels.tsv, in order; a value
+    # missing (no pose yet) is BIDS's n/a
+    fpath.write_text(''.join('\t'.join('n/a' if np.isnan(v) else f'{v:.6g}' for v in row) + '\n'
+                             for row in table), encoding='utf-8')
+    channels = _motion_channels(columns)
+    with fpath.with_name(fpath.name.replace('_motion.tsv', '_channels.tsv')).open(
+            'w', encoding='utf-8') as f:
+        f.write('\t'.join(channels[0]) + '\n')
+        f.writelines('\t'.join(row.values()) + '\n' for row in channels)
+    duration = float(table[-1, 0] - table[0, 0]) if len(table) > 1 else 0.0
+    counts: dict[str, int] = {}
+    for row in channels:
+        counts[row['type']] = counts.get(row['type'], 0) + 1
+    sidecar = {
+        'TaskName': bids_path.task, 'TrackingSystemName': 'robot',
+        'Description': 'The robot arm\'s joint states (/joint_states) and end-effector pose '
+                       '(/ee_pose) from the run\'s bag; the LATENCY channel is the time (s) '
+                       'from the first EEG sample.',
+        # the joint state rate, as measured: the bag's stamps, not a parameter
+        'SamplingFrequency': round((len(table) - 1) / duration) if duration else 'n/a',
+        'SamplingFrequencyEffective': round((len(table) - 1) / duration, 3) if duration else 'n/a',
+        'RecordingDuration': round(duration, 3), 'MotionChannelCount': len(channels),
+        **{f'{kind}ChannelCount': n for kind, n in counts.items() if kind != 'MISC'}}
+    fpath.with_suffix('.json').write_text(json.dumps(sidecar, indent=1) + '\n',
+                                          encoding='utf-8')
