@@ -112,6 +112,8 @@ def test_every_session_phase_reads_back_with_its_prompts(dataset: Path) -> None:
         suffix='eeg', extension='.json').fpath.read_text())
     assert sidecar['SamplingFrequency'] == 250.0 and sidecar['EEGReference'] == 'Cz'
     assert sidecar['PowerLineFrequency'] == 60.0
+    # lock-step runs have no LSL stream, so no amplifier metadata: options, else n/a, as before
+    assert sidecar['Manufacturer'] == 'n/a' and 'ManufacturersModelName' not in sidecar
     with open(_path(dataset, 'graz', 1).copy().update(suffix='channels', extension='.tsv')
               .fpath, encoding='utf-8') as f:
         channels = list(csv.DictReader(f, delimiter='\t'))
@@ -187,3 +189,42 @@ def test_a_session_exports_its_phases_in_order_one_task_per_protocol(
     runs = runs_to_export([recorded['session'], recorded['experiment']])
     assert [(r.run_dir.name, r.task) for r in runs] == [
         ('01_graz', 'graz'), ('02_heldout', 'graz'), ('experiment', 'setlocations')]
+
+
+def test_the_amplifier_metadata_comes_from_the_stream_and_options_override(
+        recorded: dict[str, Path], tmp_path: Path, spawn_node) -> None:
+    """A real amplifier stream (the virtual amplifier over LSL, declaring its manufacturer,
+    model, reference and channel units) read by the real acquisition node, which keeps the
+    metadata in its run directory; the export takes eeg.json's fields from it, options win."""
+    run = tmp_path / 'run'
+    shutil.copytree(recorded['experiment'], run)
+    name = f'mg-bids-amp-{uuid.uuid4().hex[:8]}'
+    spawn_node('mindgrasp_eeg.virtual_amp_node', stream_name=name, reference='Cz')
+    acq = spawn_node('mindgrasp_eeg.acquisition_node', stream_name=name,
+                     env={'MINDGRASP_RUN_DIR': str(run)})
+    assert acq.wait_for_output('Stream metadata kept in', 60), acq.output()
+    kept = json.loads((run / 'eeg_stream.json').read_text())
+    assert (kept['manufacturer'], kept['model'], kept['reference']) == (
+        'MIndGrasp', 'virtual amplifier', 'Cz')
+    assert len(kept['channels']) == 32 and kept['channels'][0] == {
+        'label': 'Fp1', 'unit': 'microvolts', 'type': 'EEG'}
+
+    def eeg_json(root: Path, *options: str) -> dict:
+        res = subprocess.run([*MG, 'export', 'bids', str(run), '--root', str(root),
+                              '--subject', 'B01', *options], env=_env(), capture_output=True,
+                             text=True, timeout=300)
+        assert res.returncode == 0 and res.stderr == '', res.stderr[-3000:]
+        bids_path = mne_bids.BIDSPath(subject='B01', task='setlocations', run=1,
+                                      datatype='eeg', root=root, suffix='eeg',
+                                      extension='.json')
+        return json.loads(bids_path.fpath.read_text())
+
+    sidecar = eeg_json(tmp_path / 'from_stream')
+    assert (sidecar['Manufacturer'], sidecar['ManufacturersModelName'],
+            sidecar['EEGReference']) == ('MIndGrasp', 'virtual amplifier', 'Cz')
+    sidecar = eeg_json(tmp_path / 'options', '--reference', 'linked mastoids',
+                       '--manufacturer', 'g.tec', '--model', 'g.Nautilus')
+    assert (sidecar['Manufacturer'], sidecar['ManufacturersModelName'],
+            sidecar['EEGReference']) == ('g.tec', 'g.Nautilus', 'linked mastoids')
+    code, errors, _ = _errors(str(tmp_path / 'from_stream'), '-r')
+    assert code == 0 and not errors, errors

@@ -25,6 +25,10 @@ on the same LSL-to-ROS mapping as the EEG samples, so the recorder keeps them an
 them as events (:mod:`mindgrasp_eeg.marker_inlet`). Off by default; a marker stream not found or
 lost is one log line, never an exit.
 
+The amplifier's metadata (``<acquisition>`` manufacturer, model, reference; each channel's
+label, unit and type) goes to ``$MINDGRASP_RUN_DIR/eeg_stream.json`` once connected
+(:mod:`mindgrasp_eeg.stream_metadata`), for ``mindgrasp export bids``.
+
 Which sender is trusted: by default any stream with the right name (a warning says so). Pin the
 amplifier with ``source_id`` and ``hostname`` (``hostname:=local`` means this host), so no other
 sender on the network can stand in for it.
@@ -32,6 +36,7 @@ sender on the network can stand in for it.
 
 from __future__ import annotations
 
+import os
 import socket
 import threading
 from collections import deque
@@ -53,6 +58,7 @@ from mindgrasp_eeg.acquisition import (
 from mindgrasp_eeg.marker_inlet import MarkerInlet, marker_stream_name
 from mindgrasp_eeg.params import AcquisitionParams
 from mindgrasp_eeg.ros_conversions import ns_to_time_fields
+from mindgrasp_eeg.stream_metadata import write_stream_metadata
 from mindgrasp_ros import rclpy
 from mindgrasp_ros.logs import log_at
 from mindgrasp_ros.node_main import end_after, fail, run_node
@@ -139,8 +145,24 @@ class AcquisitionNode(rclpy.node.Node):
                                f'(x{self.acq.scale:g} to volts); publishing /eeg/raw as each '
                                'block arrives.')
         self.status_callback()
+        self.record_metadata()
         self._streaming.set()
         return True
+
+    def record_metadata(self) -> None:
+        """Keep the amplifier's metadata (manufacturer, model, reference, channel units and
+        types) in the run directory, ``$MINDGRASP_RUN_DIR/eeg_stream.json``, for the exports;
+        nothing outside a launch. A failed write is a warning: the EEG still flows."""
+        run_dir = os.environ.get('MINDGRASP_RUN_DIR', '')
+        if not run_dir or self.acq.desc is None:
+            return
+        try:
+            path = write_stream_metadata(self.acq.desc, run_dir)
+        except OSError as exc:
+            self.get_logger().warning(f'Could not keep the stream metadata in {run_dir} ({exc}); '
+                                      'exports will use their options.')
+            return
+        self.get_logger().info(f'Stream metadata kept in {path}.')
 
     def read_loop(self) -> None:
         """Reader thread: wake the executor when the search ends (it checks the stream and

@@ -5,8 +5,12 @@ recording::
 
     <root>/dataset_description.json, participants.tsv, README
     <root>/sub-<ID>[/ses-<S>]/eeg/sub-<ID>[_ses-<S>]_task-<task>_run-<n>_eeg.edf   EEG, volts
-        ..._eeg.json        SamplingFrequency (the amplifier's), EEGReference, PowerLineFrequency
-        ..._channels.tsv    name, type, units (uV in the EDF header's physical unit)
+        ..._eeg.json        SamplingFrequency (the amplifier's), PowerLineFrequency, and
+                            Manufacturer, ManufacturersModelName, EEGReference from the
+                            amplifier's LSL metadata the acquisition node kept
+                            (:mod:`.stream_metadata`; options override, 'n/a' without either)
+        ..._channels.tsv    name, type (the stream's channel types where it declares them),
+                            units (uV in the EDF header's physical unit)
         ..._events.tsv      onset, duration, trial_type, value, sample: the annotations of
                             :func:`mindgrasp_eeg.export.read_session` (prompts, targets, grasp
                             results, controller states, intents)
@@ -41,6 +45,7 @@ import yaml
 from . import EEGError
 from .export import find_bag, read_session, to_raw
 from .robot_motion import read_robot_motion
+from .stream_metadata import read_stream_metadata
 
 __all__ = ['BidsRun', 'bids_label', 'export_bids', 'runs_to_export']
 
@@ -119,7 +124,8 @@ def _protocol(run_dir: Path) -> str:
 
 def export_bids(paths: list[str | Path], root: str | Path, subject: str,
                 session: str | None = None, *, line_freq: float = 50.0,
-                reference: str = 'n/a', overwrite: bool = False) -> list[Path]:
+                reference: str | None = None, manufacturer: str | None = None,
+                model: str | None = None, overwrite: bool = False) -> list[Path]:
     """Write the runs of ``paths`` into the BIDS dataset at ``root``; returns the EEG files.
 
     Args:
@@ -128,7 +134,10 @@ def export_bids(paths: list[str | Path], root: str | Path, subject: str,
         subject: participant label (letters and digits).
         session: session label, or None for none.
         line_freq: power line frequency (Hz) for eeg.json (50 in Europe, 60 in the Americas).
-        reference: the EEG reference for eeg.json (e.g. ``'Cz'``, ``'linked mastoids'``).
+        reference: the EEG reference for eeg.json (e.g. ``'Cz'``, ``'linked mastoids'``);
+            None: the stream's (its LSL metadata, as the acquisition node kept it), else 'n/a'.
+        manufacturer, model: the amplifier's, for eeg.json; None: the stream's, else 'n/a'
+            (the model is left out without one).
         overwrite: replace runs that exist already.
 
     Raises:
@@ -152,6 +161,8 @@ def export_bids(paths: list[str | Path], root: str | Path, subject: str,
             warnings.simplefilter('ignore', FutureWarning)
             raw = to_raw(recording)
         raw.info['line_freq'] = float(line_freq)
+        amp = read_stream_metadata(run.run_dir)
+        _set_channel_types(raw, amp)
         bids_path = mne_bids.BIDSPath(subject=subject, session=session, task=run.task,
                                       run=counts[run.task], datatype='eeg', root=root)
         try:
@@ -162,10 +173,14 @@ def export_bids(paths: list[str | Path], root: str | Path, subject: str,
                    'or another --session.')
             raise EEGError(msg) from exc
         sidecar = bids_path.copy().update(suffix='eeg', extension='.json')
-        mne_bids.update_sidecar_json(sidecar, {
-            'EEGReference': reference, 'TaskName': run.task,
+        fields = {
+            'EEGReference': reference or amp.get('reference') or 'n/a', 'TaskName': run.task,
             'SoftwareFilters': 'n/a', 'RecordingType': 'continuous',
-            'InstitutionName': 'n/a', 'Manufacturer': 'n/a'}, verbose='error')
+            'InstitutionName': 'n/a',
+            'Manufacturer': manufacturer or amp.get('manufacturer') or 'n/a'}
+        if model or amp.get('model'):
+            fields['ManufacturersModelName'] = model or amp['model']
+        mne_bids.update_sidecar_json(sidecar, fields, verbose='error')
         source = root / 'sourcedata' / f'sub-{subject}' / (f'ses-{session}' if session else '') \
             / f'{run.task}_run-{counts[run.task]}'
         if source.exists():
@@ -174,6 +189,22 @@ def export_bids(paths: list[str | Path], root: str | Path, subject: str,
         _write_motion(run.run_dir, recording.start_ns, root, bids_path)
         written.append(Path(str(bids_path.fpath)))
     return written
+
+
+#: LSL channel <type> (XDF meta-data convention, any case) -> MNE channel type
+_MNE_TYPES = {'eeg': 'eeg', 'eog': 'eog', 'emg': 'emg', 'ecg': 'ecg', 'misc': 'misc',
+              'stim': 'stim', 'trigger': 'stim', 'resp': 'resp', 'gsr': 'gsr'}
+
+
+def _set_channel_types(raw: object, amp: dict) -> None:
+    """Give ``raw``'s channels the types the stream declared (``channels.tsv`` then says EOG,
+    EMG ... where the amplifier said so); channels without a known type stay EEG."""
+    kinds = {c.get('label'): _MNE_TYPES.get(str(c.get('type', '')).lower())
+             for c in amp.get('channels', []) if isinstance(c, dict)}
+    mapping = {name: kinds[name] for name in raw.ch_names
+               if kinds.get(name) and kinds[name] != 'eeg'}
+    if mapping:
+        raw.set_channel_types(mapping, on_unit_change='ignore', verbose='error')
 
 
 def _motion_channels(columns: list[str]) -> list[dict[str, str]]:

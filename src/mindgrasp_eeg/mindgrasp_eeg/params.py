@@ -89,6 +89,8 @@ class VirtualAmpParams:
     sample_rate: float = param(250.0, 'sample rate (the synthetic EEG needs >= 60 Hz)',
                                unit='Hz', min=60.0, max=100000.0)
     unit: str = param('microvolts', 'unit of the LSL values (declared in the stream metadata)')
+    reference: str = param('', "EEG reference declared in the stream metadata (<acquisition>"
+                           "<reference>), e.g. Cz ('' = none declared)")
     subject_mode: str = param('noise', 'noise | follow (/trainer/prompt) | pursue (task, scene, '
                               'arm, fsm)', choices=MODES)
     accuracy: float = param(0.9, 'probability of imagining the right class', min=0.0, max=1.0)
