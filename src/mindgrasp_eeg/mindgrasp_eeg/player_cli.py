@@ -31,13 +31,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--loop', action='store_true', help='start again at the end')
     parser.add_argument('--duration', type=non_negative_float, default=0.0,
                         help='stop after this many seconds of wall time (0: at the end)')
-    parser.add_argument('--manufacturer', default='MIndGrasp',
-                        help="the recording amplifier's manufacturer, declared in the stream "
-                             'metadata (<acquisition>)')
-    parser.add_argument('--model', default='',
-                        help="its model (default: 'dataset player: <file>')")
-    parser.add_argument('--reference', default='',
-                        help='its EEG reference, e.g. Cz (default: none declared)')
+    amplifier = parser.add_argument_group(
+        'amplifier', "the amplifier that recorded the files, declared in the stream's "
+                     '<acquisition> metadata as its LSL app would')
+    for flag, default, text in (
+            ('--manufacturer', 'MIndGrasp', 'its manufacturer'),
+            ('--model', '', "its model (default: 'dataset player: <file>')"),
+            ('--reference', '', 'its EEG reference, e.g. Cz (default: none declared)')):
+        amplifier.add_argument(flag, default=default, help=text)
 
 
 def main(args: argparse.Namespace) -> int:
