@@ -279,3 +279,16 @@ def test_each_block_is_published_as_it_arrives(spawn_node, listener, stream_name
     age = np.array([(t - (m.header.stamp.sec * 10**9 + m.header.stamp.nanosec)) * 1e-9
                     for t, m in listener.chunks])
     assert np.all(age < 2.5), np.round(age, 3)
+
+
+def test_a_run_directory_that_refuses_the_metadata_is_one_line(spawn_node, listener,
+                                                                stream_name, tmp_path) -> None:
+    """The stream metadata cannot be kept (the run directory's path runs through a file): one
+    warning naming it, and the EEG flows on."""
+    (tmp_path / 'a_file').write_text('not a folder\n')
+    spawn_node('mindgrasp_eeg.virtual_amp_node', stream_name=stream_name)
+    acq = spawn_node('mindgrasp_eeg.acquisition_node', stream_name=stream_name,
+                     env={'MINDGRASP_RUN_DIR': str(tmp_path / 'a_file' / 'run')})
+    assert acq.wait_for_output('Cannot keep the stream metadata in', 60), acq.output()
+    assert listener.spin(60, lambda: len(listener.chunks) > 10), acq.output()
+    assert 'Traceback' not in acq.output()

@@ -40,11 +40,13 @@ import os
 import socket
 import threading
 from collections import deque
+from pathlib import Path
 
 import numpy as np
 from mindgrasp_ros.interfaces.diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import EEGChunk, EEGMarker
 
+from mindgrasp_common.safe_files import DeferredWriter
 from mindgrasp_eeg import EEGError
 from mindgrasp_eeg.acquisition import (
     ERROR,
@@ -124,6 +126,8 @@ class AcquisitionNode(rclpy.node.Node):
         self._ready = self.create_guard_condition(self.publish_callback)
         self._stop_reading = threading.Event()
         self._streaming = threading.Event()            # the search ended well: pull
+        run_dir = os.environ.get('MINDGRASP_RUN_DIR', '')
+        self._files = DeferredWriter(Path(run_dir)) if run_dir else None
         self.acq.start_search()
         self._reader = threading.Thread(target=self.read_loop, name='eeg-reader', daemon=True)
         self._reader.start()
@@ -152,17 +156,22 @@ class AcquisitionNode(rclpy.node.Node):
     def record_metadata(self) -> None:
         """Keep the amplifier's metadata (manufacturer, model, reference, channel units and
         types) in the run directory, ``$MINDGRASP_RUN_DIR/eeg_stream.json``, for the exports;
-        nothing outside a launch. A failed write is a warning: the EEG still flows."""
-        run_dir = os.environ.get('MINDGRASP_RUN_DIR', '')
-        if not run_dir or self.acq.desc is None:
+        nothing outside a launch. A full disk is one warning: the file is kept, retried at the
+        node's end and else copied to the fallback folder the line names; the EEG still flows."""
+        desc = self.acq.desc
+        if self._files is None or desc is None:
             return
+        run_dir = self._files.run_dir
         try:
-            path = write_stream_metadata(self.acq.desc, run_dir)
-        except OSError as exc:
-            self.get_logger().warning(f'Could not keep the stream metadata in {run_dir} ({exc}); '
-                                      'exports will use their options.')
-            return
-        self.get_logger().info(f'Stream metadata kept in {path}.')
+            lines = self._files.write(run_dir, 'stream metadata',
+                                      lambda directory: write_stream_metadata(desc, directory))
+        except OSError as exc:   # not a disk fault (DeferredWriter keeps those): say it, go on
+            lines = [f'Cannot keep the stream metadata in {run_dir} ({exc}); exports will use '
+                     'their options.']
+        for line in lines:
+            self.get_logger().warning(line)
+        if not self._files.pending:
+            self.get_logger().info(f'Stream metadata kept in {run_dir / "eeg_stream.json"}.')
 
     def read_loop(self) -> None:
         """Reader thread: wake the executor when the search ends (it checks the stream and
@@ -289,6 +298,8 @@ class AcquisitionNode(rclpy.node.Node):
         if self._reader is not None:
             self._reader.join(timeout=5.0)
         self.acq.close()
+        for line in self._files.close() if self._files is not None else ():
+            self.get_logger().warning(line)
         if self.markers is not None:
             self.markers.close()
         super().destroy_node()

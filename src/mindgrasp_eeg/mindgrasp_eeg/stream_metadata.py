@@ -19,6 +19,8 @@ import json
 from pathlib import Path
 from typing import Any
 
+from mindgrasp_common.safe_files import write_atomic
+
 from .lsl import StreamDescription
 
 __all__ = ['FILE_NAME', 'read_stream_metadata', 'stream_metadata', 'write_stream_metadata']
@@ -41,10 +43,15 @@ def stream_metadata(desc: StreamDescription) -> dict[str, Any]:
 
 
 def write_stream_metadata(desc: StreamDescription, run_dir: str | Path) -> Path:
-    """Write ``<run_dir>/eeg_stream.json``; returns its path."""
-    path = Path(run_dir) / FILE_NAME
-    path.write_text(json.dumps(stream_metadata(desc), indent=1) + '\n', encoding='utf-8')
-    return path
+    """Write ``<run_dir>/eeg_stream.json`` (atomically: whole or absent); returns its path.
+
+    Raises:
+        OSError: the disk refused it (the caller keeps it, see
+            :class:`mindgrasp_common.safe_files.DeferredWriter`).
+    """
+    text = json.dumps(stream_metadata(desc), indent=1) + '\n'
+    return write_atomic(Path(run_dir) / FILE_NAME,
+                        lambda tmp: tmp.write_text(text, encoding='utf-8'))
 
 
 def read_stream_metadata(run_dir: str | Path) -> dict[str, Any]:
