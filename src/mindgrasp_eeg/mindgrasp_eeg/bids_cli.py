@@ -7,7 +7,7 @@ Examples::
 
 Writes EDF with channels.tsv, eeg.json, events.tsv (prompts, targets, grasp results, controller
 states) and the 10-20 electrodes through mne-bids; the bags go to ``sourcedata/``. Check the result
-with ``bids-validator-deno ROOT``.
+with ``bids-validator-deno ROOT -r`` (-r: the robot motion's derivatives dataset too).
 """
 
 from __future__ import annotations
@@ -56,5 +56,5 @@ def main(args: argparse.Namespace) -> int:
     for f in files:
         print(f'Wrote {f}')
     print(f'BIDS dataset {args.root}: {len(files)} run(s) of sub-{args.subject}; check it with '
-          f'`bids-validator-deno {args.root}`.')
+          f'`bids-validator-deno {args.root} -r` (-r: its derivatives too).')
     return 0
