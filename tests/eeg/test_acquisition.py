@@ -231,3 +231,32 @@ def test_an_edf_played_by_mne_lsl_playerlsl_is_read_in_volts(stream_name) -> Non
     k = starts[0]
     m = min(len(data), len(raw) - k)
     np.testing.assert_allclose(data[:m], raw[k:k + m], rtol=1e-5, atol=1e-9)
+
+
+def test_amplifier_metadata_after_the_xdf_conventions() -> None:
+    """<acquisition> manufacturer/model/reference, the EEG convention's <reference><label>, each
+    channel's unit and type; a stream that declares none gives empty strings."""
+    import pylsl
+
+    from mindgrasp_eeg.lsl import StreamDescription
+
+    info = pylsl.StreamInfo('amp', 'EEG', 2, 500.0, pylsl.cf_float32, 'amp-1')
+    chans = info.desc().append_child('channels')
+    for label, unit, kind in (('C3', 'microvolts', 'EEG'), ('HEOG', 'microvolts', 'EOG')):
+        ch = chans.append_child('channel')
+        ch.append_child_value('label', label)
+        ch.append_child_value('unit', unit)
+        ch.append_child_value('type', kind)
+    acq = info.desc().append_child('acquisition')
+    acq.append_child_value('manufacturer', 'Brain Products')
+    acq.append_child_value('model', 'BrainAmp DC')
+    ref = info.desc().append_child('reference')
+    ref.append_child_value('label', 'TP9')
+    ref.append_child_value('label', 'TP10')
+    desc = StreamDescription.from_info(info)
+    assert (desc.manufacturer, desc.model, desc.reference) == ('Brain Products', 'BrainAmp DC',
+                                                               'TP9, TP10')
+    assert desc.channel_units == ('microvolts', 'microvolts')
+    assert desc.channel_types == ('EEG', 'EOG') and desc.unit == 'microvolts'
+    bare = StreamDescription.from_info(pylsl.StreamInfo('bare', 'EEG', 2, 250.0))
+    assert (bare.manufacturer, bare.model, bare.reference, bare.channel_units) == ('', '', '', ())

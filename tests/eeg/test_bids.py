@@ -5,7 +5,6 @@ read back with ``mne_bids.read_raw_bids``, events included."""
 from __future__ import annotations
 
 import csv
-import gzip
 import json
 import os
 import shutil
@@ -71,17 +70,29 @@ VALIDATOR = [sys.executable, '-c', 'import sys; from bids_validator_deno import 
                                    'sys.exit(cli())']
 
 
-def test_the_official_validator_accepts_the_dataset(dataset: Path) -> None:
-    res = subprocess.run([*VALIDATOR, str(dataset), '--format', 'json'],
-                         capture_output=True, text=True, timeout=300)
+def _errors(*args: str) -> tuple[int, list[dict], dict]:
+    """Exit code, error issues and the summary of the validator run on ``args``."""
+    res = subprocess.run([*VALIDATOR, *args, '--format', 'json'], capture_output=True, text=True,
+                         timeout=300)
     report = json.loads(res.stdout)
     errors = [i for i in report['issues']['issues'] if i['severity'] == 'error']
-    assert res.returncode == 0 and not errors, errors
-    assert sorted(report['summary']['tasks']) == ['graz', 'setlocations']
-    # the robot's motion, a derivatives dataset of its own, is valid too
-    deriv = subprocess.run([*VALIDATOR, str(dataset / 'derivatives' / 'mindgrasp'),
-                            '--format', 'json'], capture_output=True, text=True, timeout=300)
-    assert deriv.returncode == 0, deriv.stdout[-3000:]
+    for deriv in report.get('derivativesSummary', {}).values():     # -r: each derivative
+        errors += [i for i in deriv['issues']['issues'] if i['severity'] == 'error']
+    return res.returncode, errors, report['summary']
+
+
+def test_the_official_validator_accepts_the_dataset(dataset: Path) -> None:
+    """From the root, as a user and OpenNeuro run it, and with -r, which also checks the robot
+    motion's derivatives dataset (its files once had no BIDS name and were flagged)."""
+    for args in ([str(dataset)], [str(dataset), '-r']):
+        code, errors, summary = _errors(*args)
+        assert code == 0 and not errors, (args, errors)
+        assert sorted(summary['tasks']) == ['graz', 'setlocations']
+    # the robot's motion, a derivatives dataset of its own, is valid on its own too
+    code, errors, summary = _errors(str(dataset / 'derivatives' / 'mindgrasp'))
+    assert code == 0 and not errors, errors
+    assert summary['dataTypes'] == ['motion'] or 'motion' in summary.get('modalities', []), \
+        summary
 
 
 def _path(root: Path, task: str, run: int) -> mne_bids.BIDSPath:
@@ -101,6 +112,8 @@ def test_every_session_phase_reads_back_with_its_prompts(dataset: Path) -> None:
         suffix='eeg', extension='.json').fpath.read_text())
     assert sidecar['SamplingFrequency'] == 250.0 and sidecar['EEGReference'] == 'Cz'
     assert sidecar['PowerLineFrequency'] == 60.0
+    # lock-step runs have no LSL stream, so no amplifier metadata: options, else n/a, as before
+    assert sidecar['Manufacturer'] == 'n/a' and 'ManufacturersModelName' not in sidecar
     with open(_path(dataset, 'graz', 1).copy().update(suffix='channels', extension='.tsv')
               .fpath, encoding='utf-8') as f:
         channels = list(csv.DictReader(f, delimiter='\t'))
@@ -120,12 +133,16 @@ def test_the_experiment_run_has_targets_outcomes_states_and_robot_motion(dataset
     # the bag kept as recorded, and the robot's joints and end-effector pose as a time series
     source = dataset / 'sourcedata' / 'sub-B01' / 'ses-1' / 'setlocations_run-1' / 'bag'
     assert (source / 'metadata.yaml').is_file()
-    motion = next((dataset / 'derivatives' / 'mindgrasp').rglob('*setlocations*_timeseries.tsv.gz'))
-    sidecar = json.loads(motion.with_name(motion.name.replace('.tsv.gz', '.json')).read_text())
-    assert sidecar['Columns'][0] == 'onset' and 'ee_z' in sidecar['Columns']
-    with gzip.open(motion, 'rt') as f:
-        rows = [line.split('\t') for line in f]
-    assert len(rows) > 100 and all(len(r) == len(sidecar['Columns']) for r in rows)
+    motion = next((dataset / 'derivatives' / 'mindgrasp').rglob(
+        '*task-setlocations_tracksys-robot_run-1_motion.tsv'))
+    with open(str(motion).replace('_motion.tsv', '_channels.tsv'), encoding='utf-8') as f:
+        channels = list(csv.DictReader(f, delimiter='\t'))
+    assert channels[0]['type'] == 'LATENCY' and channels[0]['units'] == 's'
+    assert {'JNTANG', 'POS', 'ORNT'} <= {c['type'] for c in channels}
+    sidecar = json.loads(motion.with_suffix('.json').read_text())
+    assert sidecar['MotionChannelCount'] == len(channels) and sidecar['TaskName'] == 'setlocations'
+    rows = [line.rstrip('\n').split('\t') for line in motion.read_text().splitlines()]
+    assert len(rows) > 100 and all(len(r) == len(channels) for r in rows)
 
 
 def test_bad_input_gets_one_line_and_writes_nothing(recorded: dict[str, Path],
@@ -172,3 +189,42 @@ def test_a_session_exports_its_phases_in_order_one_task_per_protocol(
     runs = runs_to_export([recorded['session'], recorded['experiment']])
     assert [(r.run_dir.name, r.task) for r in runs] == [
         ('01_graz', 'graz'), ('02_heldout', 'graz'), ('experiment', 'setlocations')]
+
+
+def test_the_amplifier_metadata_comes_from_the_stream_and_options_override(
+        recorded: dict[str, Path], tmp_path: Path, spawn_node) -> None:
+    """A real amplifier stream (the virtual amplifier over LSL, declaring its manufacturer,
+    model, reference and channel units) read by the real acquisition node, which keeps the
+    metadata in its run directory; the export takes eeg.json's fields from it, options win."""
+    run = tmp_path / 'run'
+    shutil.copytree(recorded['experiment'], run)
+    name = f'mg-bids-amp-{uuid.uuid4().hex[:8]}'
+    spawn_node('mindgrasp_eeg.virtual_amp_node', stream_name=name, reference='Cz')
+    acq = spawn_node('mindgrasp_eeg.acquisition_node', stream_name=name,
+                     env={'MINDGRASP_RUN_DIR': str(run)})
+    assert acq.wait_for_output('Stream metadata kept in', 60), acq.output()
+    kept = json.loads((run / 'eeg_stream.json').read_text())
+    assert (kept['manufacturer'], kept['model'], kept['reference']) == (
+        'MIndGrasp', 'virtual amplifier', 'Cz')
+    assert len(kept['channels']) == 32 and kept['channels'][0] == {
+        'label': 'Fp1', 'unit': 'microvolts', 'type': 'EEG'}
+
+    def eeg_json(root: Path, *options: str) -> dict:
+        res = subprocess.run([*MG, 'export', 'bids', str(run), '--root', str(root),
+                              '--subject', 'B01', *options], env=_env(), capture_output=True,
+                             text=True, timeout=300)
+        assert res.returncode == 0 and res.stderr == '', res.stderr[-3000:]
+        bids_path = mne_bids.BIDSPath(subject='B01', task='setlocations', run=1,
+                                      datatype='eeg', root=root, suffix='eeg',
+                                      extension='.json')
+        return json.loads(bids_path.fpath.read_text())
+
+    sidecar = eeg_json(tmp_path / 'from_stream')
+    assert (sidecar['Manufacturer'], sidecar['ManufacturersModelName'],
+            sidecar['EEGReference']) == ('MIndGrasp', 'virtual amplifier', 'Cz')
+    sidecar = eeg_json(tmp_path / 'options', '--reference', 'linked mastoids',
+                       '--manufacturer', 'g.tec', '--model', 'g.Nautilus')
+    assert (sidecar['Manufacturer'], sidecar['ManufacturersModelName'],
+            sidecar['EEGReference']) == ('g.tec', 'g.Nautilus', 'linked mastoids')
+    code, errors, _ = _errors(str(tmp_path / 'from_stream'), '-r')
+    assert code == 0 and not errors, errors

@@ -258,3 +258,37 @@ def test_acquisition_searches_without_blocking_and_reports_it(spawn_node, listen
     spawn_node('mindgrasp_eeg.virtual_amp_node', stream_name=stream_name)
     assert listener.spin(60, lambda: len(listener.chunks) > 10), acq.output()
     assert listener.spin(60, lambda: level_of(listener.status[-1]) == 0)
+
+
+def test_each_block_is_published_as_it_arrives(spawn_node, listener, stream_name,
+                                                lsl_source) -> None:
+    """A block reaches /eeg/raw when it arrives, not at the node's next pull: with a 10 s
+    ``chunk_period`` (and an inlet buffer that keeps everything) a node that pulled on its timer
+    would publish each half-second block seconds late; the reader thread publishes it at once."""
+    lsl_source(stream_name, '--chunk', '125', '--duration', '120')   # a block every 0.5 s
+    acq = spawn_node('mindgrasp_eeg.acquisition_node', stream_name=stream_name,
+                     chunk_period=10.0, max_buflen=30.0)
+    assert listener.spin(60, lambda: sum(m.n_samples for _, m in listener.chunks) >= 500), \
+        acq.output()
+    chunks = [m for _, m in listener.chunks]
+    idx = np.array([m.first_sample_index for m in chunks])
+    n = np.array([m.n_samples for m in chunks])
+    assert np.all(idx[1:] == idx[:-1] + n[:-1]), 'samples missing or out of order'
+    # age of each chunk's first sample when it arrived: the block's span (0.5 s) plus LSL and
+    # DDS delivery; 2.5 s is generous for a loaded machine and far below the 10 s timer
+    age = np.array([(t - (m.header.stamp.sec * 10**9 + m.header.stamp.nanosec)) * 1e-9
+                    for t, m in listener.chunks])
+    assert np.all(age < 2.5), np.round(age, 3)
+
+
+def test_a_run_directory_that_refuses_the_metadata_is_one_line(spawn_node, listener,
+                                                                stream_name, tmp_path) -> None:
+    """The stream metadata cannot be kept (the run directory's path runs through a file): one
+    warning naming it, and the EEG flows on."""
+    (tmp_path / 'a_file').write_text('not a folder\n')
+    spawn_node('mindgrasp_eeg.virtual_amp_node', stream_name=stream_name)
+    acq = spawn_node('mindgrasp_eeg.acquisition_node', stream_name=stream_name,
+                     env={'MINDGRASP_RUN_DIR': str(tmp_path / 'a_file' / 'run')})
+    assert acq.wait_for_output('Cannot keep the stream metadata in', 60), acq.output()
+    assert listener.spin(60, lambda: len(listener.chunks) > 10), acq.output()
+    assert 'Traceback' not in acq.output()

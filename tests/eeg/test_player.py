@@ -152,3 +152,29 @@ def test_cli_reports_bad_file(tmp_path) -> None:
                           capture_output=True, text=True, timeout=60)
     assert proc.returncode == 1
     assert 'Cannot read the EEG file' in proc.stderr
+
+
+@pytest.mark.slow
+def test_the_player_declares_the_amplifier(tmp_path, stream_name) -> None:
+    """--manufacturer, --model and --reference go into the stream's <acquisition> metadata,
+    with each channel's label, unit and type, as the acquisition node reads them."""
+    import mne
+
+    from mindgrasp_eeg.lsl import StreamDescription
+
+    raw = mne.io.RawArray(np.zeros((2, 200)), mne.create_info(['C3', 'C4'], 100.0, 'eeg'),
+                          verbose='error')
+    path = tmp_path / 'two_raw.fif'
+    raw.save(path, verbose='error')
+    player = start_player(stream_name, str(path), '--loop', '--duration', '60',
+                          '--manufacturer', 'g.tec', '--model', 'g.Nautilus', '--reference',
+                          'right earlobe')
+    try:
+        desc = StreamDescription.from_info(open_inlet(stream_name).info(timeout=30))
+    finally:
+        player.kill()
+        player.wait()
+    assert (desc.manufacturer, desc.model, desc.reference) == ('g.tec', 'g.Nautilus',
+                                                               'right earlobe')
+    assert desc.channel_names == ('C3', 'C4') and desc.channel_types == ('EEG', 'EEG')
+    assert desc.channel_units == ('microvolts', 'microvolts')

@@ -65,6 +65,11 @@ NAN_POLICIES = ('replace', 'drop', 'keep')
 OK, WARN, ERROR = 0, 1, 2
 #: seconds a newly opened stream has to deliver its first sample before it counts as lost
 FIRST_SAMPLE_GRACE = 5.0
+#: seconds a waiting poll gives the rest of a block once its first sample is in: liblsl queues a
+#: pushed block sample by sample, so the first one wakes the reader before the others are there;
+#: without this one block in seven went out as two chunks (benchmarks/eeg.py, load 9:
+#: 720 chunks for 625 blocks, p95 push-to-publish 29 ms; with it 624 chunks, p95 8.9 ms)
+BLOCK_SETTLE = 0.002
 
 
 def ros_stamp_ns(t_lsl: float, lsl_now: float, ros_now_ns: int) -> int:
@@ -171,7 +176,8 @@ class EEGAcquisition:
         self.quality: QualityMonitor | None = None
         self.warnings: list[str] = []            # layout adoption and unit warnings, newest last
         self._inlet: pylsl.StreamInlet | None = None
-        self._lock = threading.Lock()
+        self._lock = threading.Lock()            # reconnection state (reconnect thread)
+        self._data_lock = threading.Lock()       # counters and quality (poll vs status)
         self._pending: tuple[pylsl.StreamInlet, StreamDescription] | None = None
         self._reconnect_error = ''
         self._reconnect_thread: threading.Thread | None = None
@@ -260,6 +266,15 @@ class EEGAcquisition:
         thread = threading.Thread(target=run, name='eeg-search', daemon=True)
         self._search = (thread, outcome)
         thread.start()
+
+    def wait_search(self, timeout: float) -> bool:
+        """Wait up to ``timeout`` s for the search of :meth:`start_search` to end; True when
+        :meth:`finish_search` has its outcome (or no search is under way)."""
+        search = self._search
+        if search is None:
+            return True
+        search[0].join(timeout)
+        return not search[0].is_alive()
 
     def finish_search(self) -> StreamDescription | None:
         """The stream's description once the search of :meth:`start_search` found it (and its
@@ -403,8 +418,14 @@ class EEGAcquisition:
         self._got_data = False
 
     # -- data ----------------------------------------------------------------------------------
-    def poll(self) -> list[Chunk]:
-        """Pull whatever arrived (never blocks); return gap-free chunks (possibly none).
+    def poll(self, timeout: float = 0.0) -> list[Chunk]:
+        """Pull whatever arrived; return gap-free chunks (possibly none).
+
+        ``timeout`` (s): 0 never blocks; > 0 waits up to that long for the first sample and
+        returns as soon as it arrives, with the rest of its block (:data:`BLOCK_SETTLE`, 2 ms;
+        LSL's ``pull_chunk`` with a timeout would wait for ``max_samples`` instead). Waiting is
+        how a reader thread publishes each block at once instead of at its next timer pull.
+        One caller thread at a time: it owns the inlet (:meth:`close` waits for no pull).
 
         Also detects a lost stream (no samples for ``lost_timeout``) and swaps in a reconnected
         one.
@@ -413,13 +434,23 @@ class EEGAcquisition:
             if self.desc is not None:
                 self._take_pending()
             if self._inlet is None:
+                self._stop.wait(timeout)      # a waiting caller must not spin while lost
                 return []
         try:
-            raw, ts = self._inlet.pull_chunk(timeout=0.0, max_samples=4096, as_numpy=True)
+            first, t_first = (self._inlet.pull_sample(timeout=timeout) if timeout > 0
+                              else (None, None))
+            # with a first sample: up to BLOCK_SETTLE s for the rest of its block (LSL's
+            # pull_chunk waits until max_samples or the timeout, whichever comes first)
+            raw, ts = self._inlet.pull_chunk(timeout=BLOCK_SETTLE if first is not None else 0.0,
+                                             max_samples=4096, as_numpy=True)
         except LostError:
             self._lost_reason = 'the sender closed the connection'
             self._mark_lost(closed=True)
             return []
+        if first is not None:
+            raw = np.vstack([np.asarray(first, dtype=np.float64)[None, :],
+                             np.asarray(raw, dtype=np.float64).reshape(-1, len(first))])
+            ts = np.concatenate([[t_first], np.asarray(ts, dtype=np.float64)])
         now = pylsl.local_clock()
         if len(ts) == 0:
             # a freshly opened stream gets FIRST_SAMPLE_GRACE to send its first sample (an
@@ -432,8 +463,9 @@ class EEGAcquisition:
             return []
         self._last_data_at = now
         self._got_data = True
-        return self._process(np.asarray(raw, dtype=np.float64) * self.scale,
-                             np.asarray(ts, dtype=np.float64))
+        with self._data_lock:                 # status() reads the counters and the quality
+            return self._process(np.asarray(raw, dtype=np.float64) * self.scale,
+                                 np.asarray(ts, dtype=np.float64))
 
     def _process(self, data: np.ndarray, ts: np.ndarray) -> list[Chunk]:
         assert self.desc is not None and self.quality is not None
@@ -484,6 +516,10 @@ class EEGAcquisition:
     # -- status --------------------------------------------------------------------------------
     def status(self) -> Status:
         """Current health, for ``/eeg/status``."""
+        with self._data_lock:                 # a reader thread may be processing samples
+            return self._status()
+
+    def _status(self) -> Status:
         values = {k: str(v) for k, v in self.counters.items()}
         desc = self.desc
         if desc is not None:

@@ -5,16 +5,23 @@ recording::
 
     <root>/dataset_description.json, participants.tsv, README
     <root>/sub-<ID>[/ses-<S>]/eeg/sub-<ID>[_ses-<S>]_task-<task>_run-<n>_eeg.edf   EEG, volts
-        ..._eeg.json        SamplingFrequency (the amplifier's), EEGReference, PowerLineFrequency
-        ..._channels.tsv    name, type, units (uV in the EDF header's physical unit)
+        ..._eeg.json        SamplingFrequency (the amplifier's), PowerLineFrequency, and
+                            Manufacturer, ManufacturersModelName, EEGReference from the
+                            amplifier's LSL metadata the acquisition node kept
+                            (:mod:`.stream_metadata`; options override, 'n/a' without either)
+        ..._channels.tsv    name, type (the stream's channel types where it declares them),
+                            units (uV in the EDF header's physical unit)
         ..._events.tsv      onset, duration, trial_type, value, sample: the annotations of
                             :func:`mindgrasp_eeg.export.read_session` (prompts, targets, grasp
                             results, controller states, intents)
         ..._electrodes.tsv, ..._coordsystem.json   the standard_1020 montage
     <root>/sourcedata/sub-<ID>[/ses-<S>]/<task>_run-<n>/bag/   the run's rosbag2, as recorded
     <root>/derivatives/mindgrasp/sub-<ID>[/ses-<S>]/motion/
-        ..._desc-robot_timeseries.tsv.gz, .json   joint states and end-effector pose
-                            (:mod:`.robot_motion`; mne-bids does not write BIDS motion data)
+        ..._tracksys-robot_run-<n>_motion.tsv, _motion.json, _channels.tsv   the robot's joint
+                            states and end-effector pose as BIDS motion data
+                            (:mod:`.robot_motion`; written here, as mne-bids does not write
+                            motion data), in a derivatives dataset with its own
+                            dataset_description.json (GeneratedBy)
 
 The task is the protocol: a session phase's kind (``graz``, ``grazfeedback``, ``trainer``), else
 the run's trial manager protocol (``setlocations``, ``randomlocations``), else the prompter that
@@ -38,6 +45,7 @@ import yaml
 from . import EEGError
 from .export import find_bag, read_session, to_raw
 from .robot_motion import read_robot_motion
+from .stream_metadata import read_stream_metadata
 
 __all__ = ['BidsRun', 'bids_label', 'export_bids', 'runs_to_export']
 
@@ -116,7 +124,8 @@ def _protocol(run_dir: Path) -> str:
 
 def export_bids(paths: list[str | Path], root: str | Path, subject: str,
                 session: str | None = None, *, line_freq: float = 50.0,
-                reference: str = 'n/a', overwrite: bool = False) -> list[Path]:
+                reference: str | None = None, manufacturer: str | None = None,
+                model: str | None = None, overwrite: bool = False) -> list[Path]:
     """Write the runs of ``paths`` into the BIDS dataset at ``root``; returns the EEG files.
 
     Args:
@@ -125,7 +134,10 @@ def export_bids(paths: list[str | Path], root: str | Path, subject: str,
         subject: participant label (letters and digits).
         session: session label, or None for none.
         line_freq: power line frequency (Hz) for eeg.json (50 in Europe, 60 in the Americas).
-        reference: the EEG reference for eeg.json (e.g. ``'Cz'``, ``'linked mastoids'``).
+        reference: the EEG reference for eeg.json (e.g. ``'Cz'``, ``'linked mastoids'``);
+            None: the stream's (its LSL metadata, as the acquisition node kept it), else 'n/a'.
+        manufacturer, model: the amplifier's, for eeg.json; None: the stream's, else 'n/a'
+            (the model is left out without one).
         overwrite: replace runs that exist already.
 
     Raises:
@@ -149,6 +161,8 @@ def export_bids(paths: list[str | Path], root: str | Path, subject: str,
             warnings.simplefilter('ignore', FutureWarning)
             raw = to_raw(recording)
         raw.info['line_freq'] = float(line_freq)
+        amp = read_stream_metadata(run.run_dir)
+        _set_channel_types(raw, amp)
         bids_path = mne_bids.BIDSPath(subject=subject, session=session, task=run.task,
                                       run=counts[run.task], datatype='eeg', root=root)
         try:
@@ -159,10 +173,14 @@ def export_bids(paths: list[str | Path], root: str | Path, subject: str,
                    'or another --session.')
             raise EEGError(msg) from exc
         sidecar = bids_path.copy().update(suffix='eeg', extension='.json')
-        mne_bids.update_sidecar_json(sidecar, {
-            'EEGReference': reference, 'TaskName': run.task,
+        fields = {
+            'EEGReference': reference or amp.get('reference') or 'n/a', 'TaskName': run.task,
             'SoftwareFilters': 'n/a', 'RecordingType': 'continuous',
-            'InstitutionName': 'n/a', 'Manufacturer': 'n/a'}, verbose='error')
+            'InstitutionName': 'n/a',
+            'Manufacturer': manufacturer or amp.get('manufacturer') or 'n/a'}
+        if model or amp.get('model'):
+            fields['ManufacturersModelName'] = model or amp['model']
+        mne_bids.update_sidecar_json(sidecar, fields, verbose='error')
         source = root / 'sourcedata' / f'sub-{subject}' / (f'ses-{session}' if session else '') \
             / f'{run.task}_run-{counts[run.task]}'
         if source.exists():
@@ -173,8 +191,48 @@ def export_bids(paths: list[str | Path], root: str | Path, subject: str,
     return written
 
 
+#: LSL channel <type> (XDF meta-data convention, any case) -> MNE channel type
+_MNE_TYPES = {'eeg': 'eeg', 'eog': 'eog', 'emg': 'emg', 'ecg': 'ecg', 'misc': 'misc',
+              'stim': 'stim', 'trigger': 'stim', 'resp': 'resp', 'gsr': 'gsr'}
+
+
+def _set_channel_types(raw: object, amp: dict) -> None:
+    """Give ``raw``'s channels the types the stream declared (``channels.tsv`` then says EOG,
+    EMG ... where the amplifier said so); channels without a known type stay EEG."""
+    kinds = {c.get('label'): _MNE_TYPES.get(str(c.get('type', '')).lower())
+             for c in amp.get('channels', []) if isinstance(c, dict)}
+    mapping = {name: kinds[name] for name in raw.ch_names
+               if kinds.get(name) and kinds[name] != 'eeg'}
+    if mapping:
+        raw.set_channel_types(mapping, on_unit_change='ignore', verbose='error')
+
+
+def _motion_channels(columns: list[str]) -> list[dict[str, str]]:
+    """Rows of the motion ``channels.tsv`` (name, component, type, tracked_point, units) for the
+    columns of :func:`~mindgrasp_eeg.robot_motion.read_robot_motion`: the onset is the LATENCY
+    channel, joint positions JNTANG (rad), joint velocities MISC (rad/s; BIDS motion has no joint
+    velocity type), the end effector POS (m) and ORNT (unit quaternion)."""
+    rows = []
+    for c in columns:
+        if c == 'onset':
+            row = ('n/a', 'LATENCY', 'n/a', 's')
+        elif c.startswith('ee_q'):
+            row = (f'quat_{c[-1]}', 'ORNT', 'end_effector', 'n/a')
+        elif c.startswith('ee_'):
+            row = (c[-1], 'POS', 'end_effector', 'm')
+        elif c.endswith('_position'):
+            row = ('n/a', 'JNTANG', c.removesuffix('_position'), 'rad')
+        else:
+            row = ('n/a', 'MISC', c.removesuffix('_velocity'), 'rad/s')
+        rows.append(dict(zip(('name', 'component', 'type', 'tracked_point', 'units'),
+                             (c, *row), strict=True)))
+    return rows
+
+
 def _write_motion(run_dir: Path, start_ns: int, root: Path, bids_path: object) -> None:
-    """The robot's motion of one run as a derivatives time series (nothing without joints)."""
+    """The robot's motion of one run as BIDS motion data (``tracksys-robot``) in the
+    derivatives dataset ``derivatives/mindgrasp`` (nothing without joints). BIDS motion file
+    names, so the validator accepts it, also when it checks the derivatives (``-r``)."""
     import mne_bids
 
     motion = read_robot_motion(find_bag(run_dir), start_ns)
@@ -185,20 +243,44 @@ def _write_motion(run_dir: Path, start_ns: int, root: Path, bids_path: object) -
     if not (deriv / 'dataset_description.json').is_file():
         mne_bids.make_dataset_description(
             path=deriv, name='MIndGrasp robot motion', dataset_type='derivative',
-            generated_by=[{'Name': 'mindgrasp export bids'}], overwrite=True, verbose='error')
-        # the robot's time series has no BIDS name yet (motion data would, but mne-bids does
-        # not write them): tell the validator (-r) to skip it
-        (deriv / '.bidsignore').write_text('*_desc-robot_timeseries.*\n', encoding='utf-8')
-    out = bids_path.copy().update(root=deriv, datatype='motion', suffix='timeseries',
-                                  description='robot', extension='.tsv.gz', check=False)
+            generated_by=[{'Name': 'mindgrasp export bids',
+                           'Description': 'the robot arm\'s joint states and end-effector pose '
+                                          'from each run\'s bag'}],
+            source_datasets=[{'URL': '../..'}], overwrite=True, verbose='error')
+        (deriv / 'README').write_text(
+            'MIndGrasp robot motion: for each EEG run of the raw dataset (two folders up), the '
+            "robot arm's joint states and end-effector pose as BIDS motion data "
+            '(tracksys-robot), written by `mindgrasp export bids`.\n', encoding='utf-8')
+    out = bids_path.copy().update(root=deriv, datatype='motion', suffix=None, extension=None,
+                                  check=False)
     out.mkdir(exist_ok=True)
-    # a headerless TSV with its columns in the JSON sidecar, as BIDS physio / timeseries files
-    np.savetxt(str(out.fpath), table, delimiter='\t', fmt='%.6g')
-    units = {c: ('s' if c == 'onset' else 'm' if c in ('ee_x', 'ee_y', 'ee_z')
-                 else 'rad/s' if c.endswith('_velocity') else 'rad' if c.endswith('_position')
-                 else 'n/a') for c in columns}
-    sidecar = Path(str(out.fpath)).with_name(out.fpath.name.replace('.tsv.gz', '.json'))
-    sidecar.write_text(json.dumps({
-        'Description': 'Robot joint states (/joint_states) and end-effector pose (/ee_pose) '
-                       'from the run\'s bag; onset in s from the first EEG sample.',
-        'Columns': columns, 'Units': units}, indent=1) + '\n', encoding='utf-8')
+    # BIDS orders tracksys before run; mne-bids 0.20 writes it after, which the validator refuses
+    stem = '_'.join(f'{key}-{value}' for key, value in (
+        ('sub', out.subject), ('ses', out.session), ('task', out.task),
+        ('tracksys', 'robot'), ('run', out.run)) if value is not None)
+    fpath = Path(str(out.directory)) / f'{stem}_motion.tsv'
+    # motion.tsv has no header: its columns are the rows of channels.tsv, in order; a value
+    # missing (no pose yet) is BIDS's n/a
+    fpath.write_text(''.join('\t'.join('n/a' if np.isnan(v) else f'{v:.6g}' for v in row) + '\n'
+                             for row in table), encoding='utf-8')
+    channels = _motion_channels(columns)
+    with fpath.with_name(fpath.name.replace('_motion.tsv', '_channels.tsv')).open(
+            'w', encoding='utf-8') as f:
+        f.write('\t'.join(channels[0]) + '\n')
+        f.writelines('\t'.join(row.values()) + '\n' for row in channels)
+    duration = float(table[-1, 0] - table[0, 0]) if len(table) > 1 else 0.0
+    counts: dict[str, int] = {}
+    for row in channels:
+        counts[row['type']] = counts.get(row['type'], 0) + 1
+    sidecar = {
+        'TaskName': bids_path.task, 'TrackingSystemName': 'robot',
+        'Description': 'The robot arm\'s joint states (/joint_states) and end-effector pose '
+                       '(/ee_pose) from the run\'s bag; the LATENCY channel is the time (s) '
+                       'from the first EEG sample.',
+        # the joint state rate, as measured: the bag's stamps, not a parameter
+        'SamplingFrequency': round((len(table) - 1) / duration) if duration else 'n/a',
+        'SamplingFrequencyEffective': round((len(table) - 1) / duration, 3) if duration else 'n/a',
+        'RecordingDuration': round(duration, 3), 'MotionChannelCount': len(channels),
+        **{f'{kind}ChannelCount': n for kind, n in counts.items() if kind != 'MISC'}}
+    fpath.with_suffix('.json').write_text(json.dumps(sidecar, indent=1) + '\n',
+                                          encoding='utf-8')

@@ -7,7 +7,7 @@ Examples::
 
 Writes EDF with channels.tsv, eeg.json, events.tsv (prompts, targets, grasp results, controller
 states) and the 10-20 electrodes through mne-bids; the bags go to ``sourcedata/``. Check the result
-with ``bids-validator-deno ROOT``.
+with ``bids-validator-deno ROOT -r`` (-r: the robot motion's derivatives dataset too).
 """
 
 from __future__ import annotations
@@ -29,8 +29,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--session', default=None, help='session label (letters, digits)')
     parser.add_argument('--line-freq', type=positive_float, default=50.0,
                         help='power line frequency for eeg.json (Hz; default 50)')
-    parser.add_argument('--reference', default='n/a',
-                        help="the amplifier's EEG reference for eeg.json (e.g. Cz)")
+    parser.add_argument('--reference', default=None,
+                        help="the amplifier's EEG reference for eeg.json (e.g. Cz; default: "
+                             "the stream's metadata, else n/a)")
+    parser.add_argument('--manufacturer', default=None,
+                        help="the amplifier's manufacturer for eeg.json (default: the stream's "
+                             'metadata, else n/a)')
+    parser.add_argument('--model', default=None,
+                        help="the amplifier's model for eeg.json (default: the stream's "
+                             'metadata, else none)')
     parser.add_argument('--overwrite', action='store_true', help='replace runs that exist')
 
 
@@ -41,6 +48,7 @@ def main(args: argparse.Namespace) -> int:
     try:
         files = export_bids(args.paths, args.root, args.subject, args.session,
                             line_freq=args.line_freq, reference=args.reference,
+                            manufacturer=args.manufacturer, model=args.model,
                             overwrite=args.overwrite)
     except EEGError as exc:
         print(f'mindgrasp export bids: {exc}', file=sys.stderr)
@@ -48,5 +56,5 @@ def main(args: argparse.Namespace) -> int:
     for f in files:
         print(f'Wrote {f}')
     print(f'BIDS dataset {args.root}: {len(files)} run(s) of sub-{args.subject}; check it with '
-          f'`bids-validator-deno {args.root}`.')
+          f'`bids-validator-deno {args.root} -r` (-r: its derivatives too).')
     return 0

@@ -67,6 +67,11 @@ class StreamDescription:
     """What an LSL stream says about itself.
 
     ``unit`` is the channels' common unit from the metadata, empty when the stream declares none.
+    The amplifier's own description, after the XDF/LSL meta-data conventions (empty when the
+    stream declares none): ``manufacturer``, ``model`` and ``reference`` from
+    ``<desc><acquisition>`` (the reference also from ``<desc><reference><label>``), and each
+    channel's ``<unit>`` and ``<type>`` (``channel_units``, ``channel_types``: one per channel,
+    or empty when the labels are missing).
     """
 
     name: str
@@ -80,24 +85,41 @@ class StreamDescription:
     hostname: str
     uid: str
     created_at: float
+    manufacturer: str = ''
+    model: str = ''
+    reference: str = ''
+    channel_units: tuple[str, ...] = ()
+    channel_types: tuple[str, ...] = ()
 
     @classmethod
     def from_info(cls, info: pylsl.StreamInfo) -> StreamDescription:
         """Read a (full, i.e. from ``inlet.info()``) StreamInfo; missing labels become ``ch<k>``."""
-        names, units = [], set()
+        names, units, types = [], [], []
         ch = info.desc().child('channels').child('channel')
         while not ch.empty() and len(names) < info.channel_count():
             names.append(ch.child_value('label'))
-            units.add(ch.child_value('unit'))
+            units.append(ch.child_value('unit'))
+            types.append(ch.child_value('type'))
             ch = ch.next_sibling('channel')
         if len(names) != info.channel_count():
             names = [f'ch{k + 1}' for k in range(info.channel_count())]
-            units = set()
-        units.discard('')
+            units, types = [], []
+        common = set(units) - {''}
+        acq = info.desc().child('acquisition')
+        reference = acq.child_value('reference')
+        if not reference:          # the XDF EEG convention: <reference><label>..</label>
+            ref = info.desc().child('reference').child('label')
+            labels = []
+            while not ref.empty():
+                labels.append(ref.child_value())
+                ref = ref.next_sibling('label')
+            reference = ', '.join(label for label in labels if label)
         return cls(info.name(), info.type(), info.source_id(), info.channel_count(),
                    float(info.nominal_srate()), tuple(names),
-                   units.pop() if len(units) == 1 else '', info.channel_format(),
-                   info.hostname(), info.uid(), info.created_at())
+                   common.pop() if len(common) == 1 else '', info.channel_format(),
+                   info.hostname(), info.uid(), info.created_at(),
+                   manufacturer=acq.child_value('manufacturer'), model=acq.child_value('model'),
+                   reference=reference, channel_units=tuple(units), channel_types=tuple(types))
 
     def summary(self) -> str:
         """One line: ``'name' (type, n ch @ rate Hz, source_id, host)``."""
@@ -271,12 +293,14 @@ class EEGOutlet:
     unit : str
         Unit of the pushed values declared in the metadata (``'microvolts'`` by default, as most
         amplifier apps); :meth:`push_volts` converts from volts.
+    manufacturer, model, reference : str
+        The amplifier's description (``<desc><acquisition>``); an empty reference is left out.
     """
 
     def __init__(self, name: str, channel_names: Sequence[str], sample_rate: float, *,
                  stream_type: str = 'EEG', source_id: str = '', unit: str = 'microvolts',
                  manufacturer: str = 'MIndGrasp', model: str = 'virtual amplifier',
-                 chunk_size: int = 0) -> None:
+                 reference: str = '', chunk_size: int = 0) -> None:
         self.scale = unit_scale(unit)
         self.n_channels = len(channel_names)
         info = pylsl.StreamInfo(name, stream_type, self.n_channels, float(sample_rate),
@@ -290,6 +314,8 @@ class EEGOutlet:
         acq = info.desc().append_child('acquisition')
         acq.append_child_value('manufacturer', manufacturer)
         acq.append_child_value('model', model)
+        if reference:
+            acq.append_child_value('reference', reference)
         self.info = info
         self._outlet = pylsl.StreamOutlet(info, chunk_size=chunk_size, max_buffered=30)
 

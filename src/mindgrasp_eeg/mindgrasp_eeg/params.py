@@ -49,8 +49,9 @@ class AcquisitionParams:
                                   'mismatch')
     stream_unit: str = param('auto', 'unit of the stream values: auto (channel metadata, else '
                              'microvolts), microvolts, V, ...')
-    chunk_period: float = param(1.0 / 32.0, 'publish period of /eeg/raw', unit='s', min=1e-3,
-                                max=10.0)
+    chunk_period: float = param(1.0 / 32.0, 'period of the connection, status-level and marker '
+                                'checks (/eeg/raw goes out as each block arrives)', unit='s',
+                                min=1e-3, max=10.0)
     max_buflen: float = param(1.0, 'LSL inlet buffer bound: no stale backlog after a stall',
                               unit='s', min=1e-3)
     resolve_timeout: float = param(30.0, 'wait this long for the stream, then exit with the '
@@ -88,6 +89,8 @@ class VirtualAmpParams:
     sample_rate: float = param(250.0, 'sample rate (the synthetic EEG needs >= 60 Hz)',
                                unit='Hz', min=60.0, max=100000.0)
     unit: str = param('microvolts', 'unit of the LSL values (declared in the stream metadata)')
+    reference: str = param('', "EEG reference declared in the stream metadata (<acquisition>"
+                           "<reference>), e.g. Cz ('' = none declared)")
     subject_mode: str = param('noise', 'noise | follow (/trainer/prompt) | pursue (task, scene, '
                               'arm, fsm)', choices=MODES)
     accuracy: float = param(0.9, 'probability of imagining the right class', min=0.0, max=1.0)

@@ -182,17 +182,22 @@ class DatasetPlayer:
         Start again at the end (timestamps keep increasing).
     block : int
         Samples per push.
+    manufacturer, model, reference : str
+        The amplifier that recorded the file, declared in the stream's ``<acquisition>``
+        metadata (default: ``MIndGrasp``, ``dataset player: <file>``, none).
     """
 
     def __init__(self, recording: Recording, name: str, *, rate: float = 1.0, loop: bool = False,
-                 source_id: str = '', block: int = 8, stream_type: str = 'EEG') -> None:
+                 source_id: str = '', block: int = 8, stream_type: str = 'EEG',
+                 manufacturer: str = 'MIndGrasp', model: str = '', reference: str = '') -> None:
         if rate <= 0:
             msg = f'The playback rate must be positive (1 = real time); {rate} is invalid.'
             raise EEGError(msg)
         self.rec, self.rate, self.loop, self.block = recording, rate, loop, max(1, block)
         self.outlet = EEGOutlet(name, recording.channels, recording.rate,
                                 stream_type=stream_type, source_id=source_id or name,
-                                model=f'dataset player: {Path(recording.source).name}')
+                                manufacturer=manufacturer, reference=reference,
+                                model=model or f'dataset player: {Path(recording.source).name}')
         self.markers = MarkerOutlet(f'{name}-markers', f'{source_id or name}-markers')
         self.n_pushed = 0                 # samples pushed, over all loops
         self.n_markers = 0

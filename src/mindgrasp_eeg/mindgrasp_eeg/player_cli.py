@@ -4,6 +4,7 @@ Examples::
 
     mindgrasp eeg play ../shared/data/MNE-eegbci-data/files/eegmmidb/1.0.0/S001/S001R04.edf
     mindgrasp eeg play eegbci:1:4,8 --name eegmmidb --rate 2 --loop
+    mindgrasp eeg play eegbci:1:4 --manufacturer BCI2000 --model 'BCI2000 64 ch' --reference n/a
 """
 
 from __future__ import annotations
@@ -30,6 +31,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--loop', action='store_true', help='start again at the end')
     parser.add_argument('--duration', type=non_negative_float, default=0.0,
                         help='stop after this many seconds of wall time (0: at the end)')
+    amplifier = parser.add_argument_group(
+        'amplifier', "the amplifier that recorded the files, declared in the stream's "
+                     '<acquisition> metadata as its LSL app would')
+    for flag, default, text in (
+            ('--manufacturer', 'MIndGrasp', 'its manufacturer'),
+            ('--model', '', "its model (default: 'dataset player: <file>')"),
+            ('--reference', '', 'its EEG reference, e.g. Cz (default: none declared)')):
+        amplifier.add_argument(flag, default=default, help=text)
 
 
 def main(args: argparse.Namespace) -> int:
@@ -39,7 +48,9 @@ def main(args: argparse.Namespace) -> int:
     try:
         recording = concatenate([load_recording(f) for f in expand_sources(args.files)])
         player = DatasetPlayer(recording, args.name, rate=args.rate, loop=args.loop,
-                               source_id=args.source_id, stream_type=args.type)
+                               source_id=args.source_id, stream_type=args.type,
+                               manufacturer=args.manufacturer, model=args.model,
+                               reference=args.reference)
     except EEGError as exc:
         print(f'mindgrasp eeg play: {exc}', file=sys.stderr)
         return 1

@@ -1,7 +1,7 @@
 """The robot's joint states and end-effector pose of a recorded run, as one table (ROS-free).
 
-BIDS has a motion datatype, but mne-bids does not write it, so :mod:`.bids` stores this table as a
-derivatives file (``derivatives/mindgrasp/...desc-robot_timeseries.tsv.gz`` with its JSON).
+:mod:`.bids` writes this table as BIDS motion data (``tracksys-robot``; mne-bids does not write
+motion data) in the derivatives dataset ``derivatives/mindgrasp``.
 Rows are the ``/joint_states`` messages; each row carries the latest ``/ee_pose`` at or before it.
 
 Columns: ``onset`` (s from the first EEG sample, from the header stamps), ``<joint>_position``

@@ -98,7 +98,8 @@ class VirtualAmpNode(rclpy.node.Node):
         else:
             # the outlets last, so streaming starts soon after the stream becomes visible
             outlet = EEGOutlet(p.stream_name, self.channel_names, self.sample_rate,
-                               stream_type=p.stream_type, source_id=p.source_id, unit=p.unit)
+                               stream_type=p.stream_type, source_id=p.source_id, unit=p.unit,
+                               reference=p.reference)
             self.markers = MarkerOutlet(f'{p.stream_name}-markers',
                                         f'{p.source_id or p.stream_name}-markers')
         sim_time = bool(self.get_parameter('use_sim_time').value)
