@@ -110,6 +110,12 @@ def _run_lockstep(args: argparse.Namespace, service: LaunchService,
                                      bag=run_dir / 'bag')
     print(f'lock-step: composing {len(components)} node(s) on simulated time: '
           + ', '.join(c.label for c in components) + f'; run directory {run_dir}', flush=True)
+    # the run's nodes as a live run lists them: the report tools ask their classes what they are
+    rundir.write_yaml(run_dir / 'launch.yaml', {
+        'profile': service.name, 'lockstep': True,
+        'launch_file': None if service.launch_file is None else str(service.launch_file),
+        'processes': [{'label': c.label, 'node': f'/{c.name or c.label}', 'module': c.module}
+                      for c in components]})
     import os
 
     os.environ['MINDGRASP_RUN_DIR'] = str(run_dir)
