@@ -68,6 +68,22 @@ def test_cli_bad_input_is_one_line_and_exit_code_2(tmp_path):
     assert not (tmp_path / 'subjects').exists()
 
 
+def test_a_phase_that_cannot_launch_fails_with_the_launchers_one_line(tmp_path):
+    """The session runs the launcher in its own process: a launch problem reaches it as an
+    error with the launcher's one-line reason (kept in session.yaml), not as an exit code."""
+    plan = tmp_path / 'bad.yaml'
+    plan.write_text('phases:\n  - {name: graz, kind: graz, trials: 2, args: {bogus: 1}}\n')
+    res = mindgrasp('session', 'run', '--subject', 'S1', '--session', 's1', '--plan', str(plan),
+                    cwd=tmp_path)
+    assert res.returncode == 1, res.stdout + res.stderr
+    assert 'Traceback' not in res.stderr and 'exit code' not in res.stdout, res.stdout
+    reason = "unknown launch argument 'bogus' for 'graz'"
+    assert len([line for line in res.stdout.splitlines() if reason in line]) == 1, res.stdout
+    entry = _log(tmp_path / 'subjects' / 'S1' / 's1')['phases'][0]
+    assert entry['status'] == 'failed' and reason in entry['error']
+    assert not (tmp_path / 'subjects' / 'S1' / 's1' / '01_graz').exists()   # nothing ran
+
+
 def _log(folder: Path) -> dict:
     return yaml.safe_load((folder / 'session.yaml').read_text())
 

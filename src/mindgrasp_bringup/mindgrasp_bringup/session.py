@@ -30,7 +30,9 @@ The subject folder::
         report.yaml, report.md  accuracy per phase, Trainer distances per trial, grasp figures
 
 An interrupted phase is moved aside (``01_graz.interrupted-1``) and run again on resume; finished
-phases are kept. No ROS imports: each phase runs ``mindgrasp launch`` as a child process.
+phases are kept. Each phase runs the launcher in this process (``LaunchService``, or
+``launch_lockstep``), so a launch that cannot start reaches the session as a
+:class:`SessionError` with its one-line reason.
 
 With the virtual subject and no display (``mindgrasp session calibrate``, or ``session run --amp
 virtual --display off``) nothing waits on the wall clock, so each phase runs ``mindgrasp launch
@@ -41,16 +43,15 @@ real time.
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import datetime as dt
 import math
 import os
 import re
-import subprocess
-import sys
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, field, fields
-from functools import lru_cache
+from functools import lru_cache, partial
 from pathlib import Path
 from typing import Any
 
@@ -181,7 +182,7 @@ def _resolved_nodes(profile: str, arguments: tuple[tuple[str, str], ...]
         return tuple((spec.node_name or spec.label, node_traits(spec))
                      for spec in plan.processes if spec.is_node)
     except LaunchError as exc:
-        msg = f'The phase cannot launch {profile!r}: {exc}'
+        msg = f'The launch {profile!r} cannot start: {exc}'
         raise SessionError(msg) from None
 
 
@@ -362,8 +363,14 @@ class Session:
             scale = next((float(e['certainty_q75']) for e in reversed(log['phases'][:i - 1])
                           if e.get('model') == model and 'certainty_q75' in e), 0.0)
             args = self._phase_arguments(phase, run_dir, model)
-            nodes = phase_nodes(phase.profile, args)
-            code = self._launch(phase, run_dir, args, nodes, i, scale)
+            try:
+                nodes = phase_nodes(phase.profile, args)
+                code = self._launch(phase, run_dir, args, nodes, i, scale)
+            except SessionError as err:   # the launch refused to start: nothing ran
+                entry.update(status='failed', error=str(err), ended=_now())
+                self.write_log(log)
+                out(str(err))
+                return 1
             entry.update(exit_code=code, ended=_now())
             code, note = _phase_outcome(
                 run_dir, code, _prompters(nodes, phase.kind))
@@ -438,9 +445,16 @@ class Session:
     def _launch(self, phase: Phase, run_dir: Path, args: dict[str, str],
                 nodes: Mapping[str, NodeTraits], index: int,
                 certainty_scale: float = 0.0) -> int:
-        """Run the phase's launch with ``args``; ``nodes``: its nodes (:func:`phase_nodes`)."""
+        """Run the phase's launch with ``args`` in this process, as ``mindgrasp launch`` runs it
+        (its nodes in processes of their own, or composed in lock-step on simulated time);
+        ``nodes``: its nodes (:func:`phase_nodes`). Returns the launch's exit code; a launch
+        that cannot start raises :class:`SessionError` with its one-line reason, and Ctrl-C (or
+        SIGTERM) that stopped it raises ``KeyboardInterrupt``."""
+        from mindgrasp_bringup.launch_system import LaunchError, LaunchService
+        from mindgrasp_bringup.launch_system.lockstep import launch_lockstep
+
         display = args.get('display', 'off')
-        env = dict(os.environ)
+        params_files = None
         params = {name: dict(values) for name, values in phase.params.items()}
         screens = _named(nodes, lambda t: t.participant_screen)
 
@@ -468,11 +482,21 @@ class Session:
             pfile = self.dir / f'params_{index:02d}_{phase.name}.yaml'
             pfile.write_text(yaml.safe_dump({n: {'ros__parameters': v} for n, v in
                                              params.items()}, sort_keys=False), encoding='utf-8')
-            env['MINDGRASP_PARAMS_FILES'] = str(pfile)
-        cmd = [sys.executable, '-m', 'mindgrasp_bringup', 'launch', phase.profile,
-               *(['--lockstep'] if self.lockstep else []),
-               '--run-dir', str(run_dir), *(f'{k}:={v}' for k, v in args.items())]
-        return subprocess.call(cmd, env=env)
+            params_files = str(pfile)
+        # the command that redoes the phase, kept in its launch.yaml
+        argv = ['mindgrasp', 'launch', phase.profile, *(['--lockstep'] if self.lockstep else []),
+                '--run-dir', str(run_dir), *(f'{k}:={v}' for k, v in args.items())]
+        with _environment('MINDGRASP_PARAMS_FILES', params_files):
+            try:
+                service = LaunchService(phase.profile, args, run_dir=run_dir, argv=argv)
+                code = (launch_lockstep(service, log=partial(print, flush=True))
+                        if self.lockstep else service.run())
+            except LaunchError as exc:
+                msg = f'Phase {phase.name} cannot launch {phase.profile}: {exc}'
+                raise SessionError(msg) from None
+        if (service.stop_reason or '').endswith(' received'):   # SIGINT, SIGTERM, SIGHUP
+            raise KeyboardInterrupt
+        return code
 
     # ------------------------------------------------------------------ figures
     def _retrain(self, plan: Plan, log: dict[str, Any], upto: int) -> dict[str, Any]:
@@ -611,6 +635,22 @@ class Session:
             {'subject': log['subject'], 'session': log['session'], 'phases': log['phases']},
             sort_keys=False), encoding='utf-8')
         return text
+
+
+@contextlib.contextmanager
+def _environment(name: str, value: str | None) -> Iterator[None]:
+    """``$name`` set to ``value`` while the block runs (None: left as it is), then restored: the
+    launcher reads a phase's parameter files from ``$MINDGRASP_PARAMS_FILES``."""
+    previous = os.environ.get(name)
+    if value is not None:
+        os.environ[name] = value
+    try:
+        yield
+    finally:
+        if previous is None:
+            os.environ.pop(name, None)
+        else:
+            os.environ[name] = previous
 
 
 def _phase_outcome(run_dir: Path, code: int, prompters: list[str]) -> tuple[int, str]:

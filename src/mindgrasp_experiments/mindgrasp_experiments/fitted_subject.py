@@ -195,8 +195,8 @@ def fitted_model(subject: FittedSubject, cache: Path | None = None,
     ``cache`` (default :func:`cache_root`) holds it already.
 
     The calibration is ``mindgrasp session calibrate``'s: :class:`~mindgrasp_bringup.session.
-    Session` runs the plan's lock-step Graz phase and a held-out run as ``mindgrasp launch graz
-    --lockstep`` child processes with the head's ``virtual_amp`` parameters, trains on the first
+    Session` runs the plan's lock-step Graz phase and a held-out run (``mindgrasp launch graz
+    --lockstep``, in this process) with the head's parameters, trains on the first
     and scores on the second. The model's provenance gets the head, the settings, the digest
     and the held-out accuracy; it is written to ``cache`` under the digest.
     """

@@ -69,6 +69,7 @@ class GraphRunner:
         self.scheduler = scheduler
         self.log = log
         self.nodes: list[Any] = []
+        self.interrupted = False   #: Ctrl-C ended :meth:`run` (its caller may stop too)
         self._closed = False
 
     def add(self, spec: NodeSpec) -> Any:
@@ -106,7 +107,7 @@ class GraphRunner:
             self.log(f'[{exc.node}] ERROR: {type(exc.error).__name__}: {exc.error}')
             raised = True
         except KeyboardInterrupt:
-            pass
+            self.interrupted = True
         finally:
             self.close()
         code = graph_exit_code(self.nodes, self.log)
