@@ -141,6 +141,34 @@ def test_virtual_session_runs_every_phase_retrains_and_resumes(tmp_path):
     assert (folder / 'report.yaml').is_file()
 
 
+@pytest.mark.timeout(300)
+def test_ctrl_c_in_a_lockstep_phase_stops_the_session_with_the_resume_hint(tmp_path):
+    """A lock-step phase runs in the session's own process: Ctrl-C ends its graph (the
+    recorder closes its bag) and the session stops with exit code 130, the phase left
+    'running' for resume, not as a failed phase followed by the next."""
+    folder = tmp_path / 'subjects' / 'V1' / 's1'
+    log = (tmp_path / 'run.log').open('w')
+    proc = subprocess.Popen(
+        [sys.executable, '-m', 'mindgrasp_bringup', 'session', 'calibrate', '--subject', 'V1',
+         '--session', 's1', '--virtual-accuracy', '0.9', '--trials-per-class', '3'],
+        cwd=tmp_path, env=os.environ | {'PYTHONUNBUFFERED': '1'}, stdout=log,
+        stderr=subprocess.STDOUT, start_new_session=True)
+    deadline = time.monotonic() + 120
+    bag = folder / '01_graz' / 'bag'
+    while time.monotonic() < deadline and proc.poll() is None:   # the graph runs: it records
+        if bag.exists():
+            break
+        time.sleep(0.1)
+    out = (tmp_path / 'run.log').read_text
+    assert bag.exists(), out()
+    os.killpg(proc.pid, signal.SIGINT)
+    assert proc.wait(120) == 130, out()
+    assert [e['status'] for e in _log(folder)['phases']] == ['running', 'pending'], out()
+    assert (bag / 'metadata.yaml').is_file(), out()          # the recorder closed its bag
+    assert 'Continue with: mindgrasp session resume --subject V1 --session s1' in out()
+    assert 'Traceback' not in out()
+
+
 @pytest.mark.timeout(900)   # two lock-step launches of ~45 simulated s each, and training
 def test_calibrate_runs_in_lockstep_end_to_end(tmp_path):
     """``session calibrate``: each phase is a lock-step launch (simulated time) that records a
