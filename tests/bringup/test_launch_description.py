@@ -361,3 +361,23 @@ def test_cli_show_args_list_and_errors(capsys: pytest.CaptureFixture[str]) -> No
     out = capsys.readouterr().out
     assert '[first] ' in out and '__ns:=/grp' in out and '<run dir>/params/first.yaml' in out
     assert launch_cmd.profile_summaries()[0][1]  # every profile has a docstring
+
+
+def test_a_profile_takes_the_params_files_of_each_launch_in_one_process(tmp_path,
+                                                                       monkeypatch) -> None:
+    """A session runs its phases' launches in its own process, each with its own
+    ``$MINDGRASP_PARAMS_FILES``: a description generated for one phase is not reused for the
+    next (a cached description once kept the first phase's files)."""
+    def fixation() -> list:
+        plan = LaunchService('graz', {}).plan(strict=False)
+        return [p.parameters.get('fixation') for p in plan.processes
+                if p.label == 'graz_prompter']
+
+    phase = tmp_path / 'phase.yaml'
+    phase.write_text('graz_prompter:\n  ros__parameters:\n    fixation: 0.25\n')
+    monkeypatch.delenv('MINDGRASP_PARAMS_FILES', raising=False)
+    default = fixation()
+    monkeypatch.setenv('MINDGRASP_PARAMS_FILES', str(phase))
+    assert fixation() == [0.25] != default
+    monkeypatch.delenv('MINDGRASP_PARAMS_FILES')
+    assert fixation() == default

@@ -68,6 +68,22 @@ def test_cli_bad_input_is_one_line_and_exit_code_2(tmp_path):
     assert not (tmp_path / 'subjects').exists()
 
 
+def test_a_phase_that_cannot_launch_fails_with_the_launchers_one_line(tmp_path):
+    """The session runs the launcher in its own process: a launch problem reaches it as an
+    error with the launcher's one-line reason (kept in session.yaml), not as an exit code."""
+    plan = tmp_path / 'bad.yaml'
+    plan.write_text('phases:\n  - {name: graz, kind: graz, trials: 2, args: {bogus: 1}}\n')
+    res = mindgrasp('session', 'run', '--subject', 'S1', '--session', 's1', '--plan', str(plan),
+                    cwd=tmp_path)
+    assert res.returncode == 1, res.stdout + res.stderr
+    assert 'Traceback' not in res.stderr and 'exit code' not in res.stdout, res.stdout
+    reason = "unknown launch argument 'bogus' for 'graz'"
+    assert len([line for line in res.stdout.splitlines() if reason in line]) == 1, res.stdout
+    entry = _log(tmp_path / 'subjects' / 'S1' / 's1')['phases'][0]
+    assert entry['status'] == 'failed' and reason in entry['error']
+    assert not (tmp_path / 'subjects' / 'S1' / 's1' / '01_graz').exists()   # nothing ran
+
+
 def _log(folder: Path) -> dict:
     return yaml.safe_load((folder / 'session.yaml').read_text())
 
@@ -123,6 +139,34 @@ def test_virtual_session_runs_every_phase_retrains_and_resumes(tmp_path):
     report = (folder / 'report.md').read_text()
     assert 'cross-validated accuracy' in report and 'Trainer end-effector distance' in report
     assert (folder / 'report.yaml').is_file()
+
+
+@pytest.mark.timeout(300)
+def test_ctrl_c_in_a_lockstep_phase_stops_the_session_with_the_resume_hint(tmp_path):
+    """A lock-step phase runs in the session's own process: Ctrl-C ends its graph (the
+    recorder closes its bag) and the session stops with exit code 130, the phase left
+    'running' for resume, not as a failed phase followed by the next."""
+    folder = tmp_path / 'subjects' / 'V1' / 's1'
+    log = (tmp_path / 'run.log').open('w')
+    proc = subprocess.Popen(
+        [sys.executable, '-m', 'mindgrasp_bringup', 'session', 'calibrate', '--subject', 'V1',
+         '--session', 's1', '--virtual-accuracy', '0.9', '--trials-per-class', '3'],
+        cwd=tmp_path, env=os.environ | {'PYTHONUNBUFFERED': '1'}, stdout=log,
+        stderr=subprocess.STDOUT, start_new_session=True)
+    deadline = time.monotonic() + 120
+    bag = folder / '01_graz' / 'bag'
+    while time.monotonic() < deadline and proc.poll() is None:   # the graph runs: it records
+        if bag.exists():
+            break
+        time.sleep(0.1)
+    out = (tmp_path / 'run.log').read_text
+    assert bag.exists(), out()
+    os.killpg(proc.pid, signal.SIGINT)
+    assert proc.wait(120) == 130, out()
+    assert [e['status'] for e in _log(folder)['phases']] == ['running', 'pending'], out()
+    assert (bag / 'metadata.yaml').is_file(), out()          # the recorder closed its bag
+    assert 'Continue with: mindgrasp session resume --subject V1 --session s1' in out()
+    assert 'Traceback' not in out()
 
 
 @pytest.mark.timeout(900)   # two lock-step launches of ~45 simulated s each, and training

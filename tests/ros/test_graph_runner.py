@@ -61,3 +61,52 @@ def test_a_graph_stops_after_its_duration_on_the_schedulers_clock(on_path):
     scheduler = Lockstep(0.05)
     assert GraphRunner(scheduler, log=lambda _l: None).run([forever], duration_s=2.0) == 0
     assert scheduler.time_s == pytest.approx(2.0)
+
+
+class _Command:
+    """A process built by its caller, as the launcher builds its own (a ``ProcessHandle``)."""
+
+    def __init__(self, label: str, code: str, stopped: list[str]) -> None:
+        import concurrent.futures
+
+        self.label, self.code, self.stopped = label, code, stopped
+        self.done: concurrent.futures.Future[int] = concurrent.futures.Future()
+        self.process = None
+
+    def get_name(self) -> str:
+        return self.label
+
+    def start(self) -> None:
+        import subprocess
+        import sys
+
+        self.process = subprocess.Popen([sys.executable, '-c', self.code])
+
+    def poll(self) -> None:
+        if self.process.poll() is not None and not self.done.done():
+            self.done.set_result(self.process.returncode)
+
+    def destroy_node(self) -> None:
+        self.stopped.append(self.label)
+        if self.process.poll() is None:
+            self.process.terminate()
+        self.process.wait(60)
+        self.poll()
+
+
+def test_processes_host_a_callers_own_processes_in_the_same_order(tmp_path):
+    """The launcher's processes are hosted by the same scheduler: started when added, polled
+    until one has ended (``is_done``), then stopped newest first (``end_graph``)."""
+    from mindgrasp_ros.node_main import is_done
+
+    stopped: list[str] = []
+    runner = GraphRunner(Processes(tmp_path))
+    first = runner.add(_Command('first', 'import time; time.sleep(120)', stopped))
+    middle = runner.add(_Command('middle', 'import time; time.sleep(120)', stopped))
+    last = runner.add(_Command('last', 'raise SystemExit(3)', stopped))
+    runner.spin_until(runner.ended, 60.0)
+    assert is_done(last) and last.done.result() == 3
+    assert not is_done(first) and not is_done(middle)
+    runner.close()
+    assert stopped == ['last', 'middle', 'first']
+    assert all(is_done(c) for c in (first, middle, last))

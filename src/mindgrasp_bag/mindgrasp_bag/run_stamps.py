@@ -1,5 +1,9 @@
 """Read the stamps :mod:`.latency` needs from a run's MCAP bag (and its params.yaml).
 
+A periodic topic's nominal rate is the parameter its publisher's class names for it
+(:attr:`~mindgrasp_ros.node_traits.NodeTraits.periodic`), read from the run's params.yaml for
+the nodes its launch.yaml lists.
+
 Each message's publication time is the MCAP ``publish_time`` (the DDS source timestamp our
 recorder and rosbag2 Jazzy store); bags without it (0) fall back to the receive time
 (``log_time``). Unfinished files (a killed recorder) are read up to their last complete record.
@@ -27,14 +31,9 @@ __all__ = ['PERIODIC', 'read_run_stamps']
 EEG, PRED, CMD = '/eeg/raw', '/bci/prediction', '/arm_controller/commands'
 PROMPT, FLIP = '/trainer/prompt', '/display/flip'
 
-#: periodic topic -> (node, parameter, 'period' | 'rate'): where its nominal rate is set
-PERIODIC: dict[str, tuple[str, str, str]] = {
-    EEG: ('eeg_acquisition', 'chunk_period', 'period'),
-    PRED: ('classifier', '', ''),                      # set by the model's window step
-    CMD: ('fsm', 'control_period', 'period'),
-    '/joint_states': ('sim', 'joint_state_rate', 'rate'),
-    '/camera/color/image_raw': ('sim', 'camera_rate', 'rate'),
-}
+#: periodic topics whose intervals the report measures (/bci/prediction: at the model's window
+#: step, no parameter of its own)
+PERIODIC: tuple[str, ...] = (EEG, PRED, CMD, '/joint_states', '/camera/color/image_raw')
 
 
 def _stamp_ns(header: Any) -> int:
@@ -58,17 +57,22 @@ def _messages(bag: Path, topics: set[str]) -> Iterator[tuple[str, int, bytes]]:
 
 
 def _nominal_periods(bag: Path) -> dict[str, float]:
-    """Nominal period (s) of each :data:`PERIODIC` topic set in the run's params.yaml."""
+    """Nominal period (s) of each :data:`PERIODIC` topic set in the run's params.yaml, by the
+    parameter the publishing node's class names for it."""
+    from mindgrasp_ros.run_nodes import run_nodes
+
     run_dir = run_dir_of(bag)
     if run_dir is None:
         return {}
     params = yaml.safe_load((run_dir / 'params.yaml').read_text(encoding='utf-8')) or {}
     out: dict[str, float] = {}
-    for topic, (node, name, kind) in PERIODIC.items():
-        value = (params.get(f'/{node}') or params.get(node) or {}).get(
-            'ros__parameters', {}).get(name) if name else None
-        if isinstance(value, (int, float)) and value > 0:
-            out[topic] = float(value) if kind == 'period' else 1.0 / float(value)
+    for node in run_nodes(run_dir):
+        section = (params.get(node.name) or params.get(node.name.lstrip('/')) or {}).get(
+            'ros__parameters', {})
+        for topic, (name, kind) in node.traits.periodic.items():
+            value = section.get(name)
+            if topic in PERIODIC and isinstance(value, (int, float)) and value > 0:
+                out[topic] = float(value) if kind == 'period' else 1.0 / float(value)
     return out
 
 

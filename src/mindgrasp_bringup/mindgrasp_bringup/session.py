@@ -17,6 +17,10 @@ Phase keys: ``name``, ``kind`` (graz | trainer | test), ``trials``, ``feedback``
 (more launch arguments), ``params`` (ROS parameters per node name, e.g.
 ``{graz_prompter: {fixation: 0.5}}``).
 
+Which node of a phase's launch prompts its trials, is the participant's screen or the virtual
+participant, the session asks the node classes (:class:`~mindgrasp_ros.node_traits.NodeTraits`
+of the nodes the launch resolves to, :func:`phase_nodes`), so it names no node itself.
+
 The subject folder::
 
     subjects/<ID>/<session>/
@@ -26,7 +30,9 @@ The subject folder::
         report.yaml, report.md  accuracy per phase, Trainer distances per trial, grasp figures
 
 An interrupted phase is moved aside (``01_graz.interrupted-1``) and run again on resume; finished
-phases are kept. No ROS imports: each phase runs ``mindgrasp launch`` as a child process.
+phases are kept. Each phase runs the launcher in this process (``LaunchService``, or
+``launch_lockstep``), so a launch that cannot start reaches the session as a
+:class:`SessionError` with its one-line reason.
 
 With the virtual subject and no display (``mindgrasp session calibrate``, or ``session run --amp
 virtual --display off``) nothing waits on the wall clock, so each phase runs ``mindgrasp launch
@@ -37,14 +43,15 @@ real time.
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import datetime as dt
 import math
 import os
 import re
-import subprocess
-import sys
-from dataclasses import dataclass, field
+from collections.abc import Callable, Iterator, Mapping
+from dataclasses import dataclass, field, fields
+from functools import lru_cache, partial
 from pathlib import Path
 from typing import Any
 
@@ -52,16 +59,15 @@ import yaml
 
 from mindgrasp_common.cli_checks import yaml_error_text
 from mindgrasp_common.resources import resource_path
+from mindgrasp_ros.node_traits import NodeTraits
 from mindgrasp_ros.topics import DISPLAY_FLIP, TASK_RESULT, TASK_TARGET, TRAINER_PROMPT
 from mindgrasp_trainer.protocol import TrainerError
 
 __all__ = ['PLAN_DIR', 'Phase', 'Plan', 'Session', 'SessionError', 'calibration_plan',
-           'check_subject', 'load_plan']
+           'check_subject', 'load_plan', 'phase_nodes']
 
 PLAN_DIR = resource_path('mindgrasp_bringup', 'plans')
 KINDS = {'graz': 'graz', 'trainer': 'trainer', 'test': 'demo'}   # phase kind -> launch profile
-#: the node whose end ends a phase's launch (on_exit=Shutdown), per phase kind
-PROMPTERS = {'graz': 'graz_prompter', 'trainer': 'trainer', 'test': 'trial_manager'}
 PHASE_KEYS = {'name', 'kind', 'trials', 'feedback', 'train', 'duration', 'args', 'params'}
 PLAN_KEYS = {'name', 'description', 'training', 'phases'}
 TRAINING_KEYS = {'min_trials', 'cv', 'pipeline', 'tmin', 'tmax', 'seed', 'labels'}
@@ -165,11 +171,50 @@ def load_plan(plan: str) -> Plan:
     return Plan(str(data.get('name') or path.stem), phases, training, data)
 
 
+@lru_cache(maxsize=16)
+def _resolved_nodes(profile: str, arguments: tuple[tuple[str, str], ...]
+                    ) -> tuple[tuple[str, NodeTraits], ...]:
+    from mindgrasp_bringup.launch_system import LaunchError, LaunchService
+    from mindgrasp_bringup.launch_system.lockstep import node_traits
+
+    try:
+        plan = LaunchService(profile, dict(arguments)).plan(strict=False)
+        return tuple((spec.node_name or spec.label, node_traits(spec))
+                     for spec in plan.processes if spec.is_node)
+    except LaunchError as exc:
+        msg = f'The launch {profile!r} cannot start: {exc}'
+        raise SessionError(msg) from None
+
+
+def phase_nodes(profile: str, arguments: Mapping[str, str] | None = None
+                ) -> dict[str, NodeTraits]:
+    """Node name -> :class:`NodeTraits` of every node ``mindgrasp launch <profile>`` starts with
+    ``arguments`` (resolved as the launcher resolves them; nothing starts). Cached: a session
+    asks once per phase."""
+    return dict(_resolved_nodes(profile, tuple(sorted((arguments or {}).items()))))
+
+
+def _named(nodes: Mapping[str, NodeTraits], test: Callable[[NodeTraits], bool],
+           parameter: str = '') -> list[str]:
+    """Names of the nodes whose traits pass ``test`` and, with ``parameter``, whose parameter
+    dataclass declares it (a parameter file's value for an undeclared name is an error)."""
+    return [name for name, traits in nodes.items() if test(traits) and (
+        not parameter or (traits.parameters is not None
+                          and parameter in {f.name for f in fields(traits.parameters)}))]
+
+
+def _prompters(nodes: Mapping[str, NodeTraits], kind: str, parameter: str = '') -> list[str]:
+    """The nodes that prompt a phase of ``kind`` (whose end ends its launch)."""
+    return _named(nodes, lambda traits: kind in traits.prompts, parameter)
+
+
 def _phase_classes(phase: Phase) -> int:
     """Number of classes a phase prompts (its prompter's ``classes`` parameter, else 4)."""
-    node = {'graz': 'graz_prompter', 'trainer': 'trainer'}.get(phase.kind, '')
-    classes = phase.params.get(node, {}).get('classes')
-    return len(classes) if isinstance(classes, list) and classes else 4
+    for node in _prompters(phase_nodes(phase.profile), phase.kind):
+        classes = phase.params.get(node, {}).get('classes')
+        if isinstance(classes, list) and classes:
+            return len(classes)
+    return 4
 
 
 def calibration_plan(plan: Plan, trials_per_class: int, virtual_accuracy: float,
@@ -191,7 +236,8 @@ def calibration_plan(plan: Plan, trials_per_class: int, virtual_accuracy: float,
         if phase.kind == 'test':
             continue
         params = {name: dict(values) for name, values in phase.params.items()}
-        params.setdefault('virtual_amp', {})['accuracy'] = float(virtual_accuracy)
+        for name in _named(phase_nodes(phase.profile), lambda t: t.virtual_subject):
+            params.setdefault(name, {})['accuracy'] = float(virtual_accuracy)
         phases.append(Phase(phase.name, phase.kind, trials_per_class * _phase_classes(phase),
                             phase.feedback, phase.train, phase.duration, dict(phase.args),
                             params))
@@ -199,9 +245,12 @@ def calibration_plan(plan: Plan, trials_per_class: int, virtual_accuracy: float,
         msg = f'The plan {plan.name} has no Graz or Trainer phase to calibrate on.'
         raise SessionError(msg)
     graz = next((p for p in phases if p.kind == 'graz'), None)
-    params = {name: dict(v) for name, v in (graz.params if graz else {}).items()
-              if name in ('graz_prompter', 'virtual_amp')}
-    params.setdefault('virtual_amp', {})['accuracy'] = float(virtual_accuracy)
+    nodes = phase_nodes(KINDS['graz'])
+    subjects = _named(nodes, lambda t: t.virtual_subject)
+    kept = {*subjects, *_prompters(nodes, 'graz')}
+    params = {name: dict(v) for name, v in (graz.params if graz else {}).items() if name in kept}
+    for name in subjects:
+        params.setdefault(name, {})['accuracy'] = float(virtual_accuracy)
     n_classes = _phase_classes(graz) if graz else 4
     heldout = Phase('heldout', 'graz', trials_per_class * n_classes, train=False,
                     args={'seed': str(seed + 1000)}, params=params)
@@ -313,9 +362,18 @@ class Session:
                 f"{', model ' + model if model else ''} -> {run_dir}")
             scale = next((float(e['certainty_q75']) for e in reversed(log['phases'][:i - 1])
                           if e.get('model') == model and 'certainty_q75' in e), 0.0)
-            code = self._launch(phase, run_dir, model, i, scale)
+            args = self._phase_arguments(phase, run_dir, model)
+            try:
+                nodes = phase_nodes(phase.profile, args)
+                code = self._launch(phase, run_dir, args, nodes, i, scale)
+            except SessionError as err:   # the launch refused to start: nothing ran
+                entry.update(status='failed', error=str(err), ended=_now())
+                self.write_log(log)
+                out(str(err))
+                return 1
             entry.update(exit_code=code, ended=_now())
-            code, note = _phase_outcome(phase, run_dir, code)
+            code, note = _phase_outcome(
+                run_dir, code, _prompters(nodes, phase.kind))
             if note:
                 entry['note'] = note
                 out(f'Phase {phase.name}: {note}')
@@ -355,12 +413,11 @@ class Session:
         return (self.launch_args.get('amp', 'virtual') == 'virtual'
                 and self.launch_args.get('display', 'off') == 'off')
 
-    def _launch(self, phase: Phase, run_dir: Path, model: str, index: int,
-                certainty_scale: float = 0.0) -> int:
+    def _phase_arguments(self, phase: Phase, run_dir: Path, model: str) -> dict[str, str]:
+        """The launch arguments of ``phase`` (``name:=value`` of ``mindgrasp launch``)."""
         args = {**self.launch_args}
         args.update(trials=str(phase.trials))
         display = args.get('display', 'off')
-        lockstep = self.lockstep
         if display != 'off':
             args.update(display_png_dir=str(run_dir / 'display'),
                         display_label=f'{phase.name} ({phase.kind})')
@@ -383,36 +440,63 @@ class Session:
         if phase.duration > 0:
             args['duration'] = str(phase.duration)
         args.update(phase.args)
-        env = dict(os.environ)
+        return args
+
+    def _launch(self, phase: Phase, run_dir: Path, args: dict[str, str],
+                nodes: Mapping[str, NodeTraits], index: int,
+                certainty_scale: float = 0.0) -> int:
+        """Run the phase's launch with ``args`` in this process, as ``mindgrasp launch`` runs it
+        (its nodes in processes of their own, or composed in lock-step on simulated time);
+        ``nodes``: its nodes (:func:`phase_nodes`). Returns the launch's exit code; a launch
+        that cannot start raises :class:`SessionError` with its one-line reason, and Ctrl-C (or
+        SIGTERM) that stopped it raises ``KeyboardInterrupt``."""
+        from mindgrasp_bringup.launch_system import LaunchError, LaunchService
+        from mindgrasp_bringup.launch_system.lockstep import launch_lockstep
+
+        display = args.get('display', 'off')
+        params_files = None
         params = {name: dict(values) for name, values in phase.params.items()}
+        screens = _named(nodes, lambda t: t.participant_screen)
+
+        def default(names: list[str], parameter: str, value: Any) -> None:
+            for name in names:
+                params.setdefault(name, {}).setdefault(parameter, value)
+
         if display != 'off':
             # the participant display's PNG per prompt phase is the record of the screen; frames
             # on topics would fill the bag (1.8 MB each), and the prompter's own screen is unused
-            params.setdefault('participant_display', {}).setdefault('image_rate', 0.0)
-            params.setdefault('graz_prompter', {}).setdefault('display_rate', 0.0)
+            default(screens, 'image_rate', 0.0)
+            default(_prompters(nodes, phase.kind, 'display_rate'), 'display_rate', 0.0)
         if certainty_scale > 0:
-            params.setdefault('participant_display', {}).setdefault('max_certainty',
-                                                                    round(certainty_scale, 4))
-        if lockstep:
+            default(screens, 'max_certainty', round(certainty_scale, 4))
+        if self.lockstep:
             # nobody can look at the prompter's own screen: no frames to render and record
-            params.setdefault('graz_prompter', {}).setdefault('display_rate', 0.0)
+            default(_prompters(nodes, phase.kind, 'display_rate'), 'display_rate', 0.0)
         if display == 'headless':  # frames for the record, not for a person: 10 Hz is plenty
-            params.setdefault('participant_display', {}).setdefault('rate', 10.0)
+            default(screens, 'rate', 10.0)
         # the first trial starts once EEG flows (the amplifier may start late on a busy machine)
-        prompter = {'graz': 'graz_prompter', 'trainer': 'trainer'}.get(phase.kind)
-        if prompter:
-            params.setdefault(prompter, {}).setdefault('wait_for_eeg', True)
-        if phase.kind == 'trainer':
-            params.setdefault('trainer', {})['log_file'] = str(run_dir / 'trainer_trials.csv')
+        default(_prompters(nodes, phase.kind, 'wait_for_eeg'), 'wait_for_eeg', True)
+        for name in _prompters(nodes, phase.kind, 'log_file'):
+            params.setdefault(name, {})['log_file'] = str(run_dir / 'trainer_trials.csv')
         if params:
             pfile = self.dir / f'params_{index:02d}_{phase.name}.yaml'
             pfile.write_text(yaml.safe_dump({n: {'ros__parameters': v} for n, v in
                                              params.items()}, sort_keys=False), encoding='utf-8')
-            env['MINDGRASP_PARAMS_FILES'] = str(pfile)
-        cmd = [sys.executable, '-m', 'mindgrasp_bringup', 'launch', phase.profile,
-               *(['--lockstep'] if lockstep else []),
-               '--run-dir', str(run_dir), *(f'{k}:={v}' for k, v in args.items())]
-        return subprocess.call(cmd, env=env)
+            params_files = str(pfile)
+        # the command that redoes the phase, kept in its launch.yaml
+        argv = ['mindgrasp', 'launch', phase.profile, *(['--lockstep'] if self.lockstep else []),
+                '--run-dir', str(run_dir), *(f'{k}:={v}' for k, v in args.items())]
+        with _environment('MINDGRASP_PARAMS_FILES', params_files):
+            try:
+                service = LaunchService(phase.profile, args, run_dir=run_dir, argv=argv)
+                code = (launch_lockstep(service, log=partial(print, flush=True))
+                        if self.lockstep else service.run())
+            except LaunchError as exc:
+                msg = f'Phase {phase.name} cannot launch {phase.profile}: {exc}'
+                raise SessionError(msg) from None
+        if (service.stop_reason or '').endswith(' received'):   # SIGINT, SIGTERM, SIGHUP
+            raise KeyboardInterrupt
+        return code
 
     # ------------------------------------------------------------------ figures
     def _retrain(self, plan: Plan, log: dict[str, Any], upto: int) -> dict[str, Any]:
@@ -553,16 +637,33 @@ class Session:
         return text
 
 
-def _phase_outcome(phase: Phase, run_dir: Path, code: int) -> tuple[int, str]:
-    """Whether a phase's launch counts as done: its prompter finished (exit code 0), no node died,
-    and the run was recorded. A node that needed SIGTERM to stop after the prompter had finished
-    (a slow shutdown on a loaded machine) loses nothing and is only noted."""
+@contextlib.contextmanager
+def _environment(name: str, value: str | None) -> Iterator[None]:
+    """``$name`` set to ``value`` while the block runs (None: left as it is), then restored: the
+    launcher reads a phase's parameter files from ``$MINDGRASP_PARAMS_FILES``."""
+    previous = os.environ.get(name)
+    if value is not None:
+        os.environ[name] = value
+    try:
+        yield
+    finally:
+        if previous is None:
+            os.environ.pop(name, None)
+        else:
+            os.environ[name] = previous
+
+
+def _phase_outcome(run_dir: Path, code: int, prompters: list[str]) -> tuple[int, str]:
+    """Whether a phase's launch counts as done: its prompter (one of ``prompters``, the nodes
+    whose end ends the phase) finished (exit code 0), no node died, and the run was recorded. A
+    node that needed SIGTERM to stop after the prompter had finished (a slow shutdown on a
+    loaded machine) loses nothing and is only noted."""
     summary_path = run_dir / 'summary.yaml'
     if code == 0 or not summary_path.is_file():
         return code, ''
     summary = yaml.safe_load(summary_path.read_text(encoding='utf-8')) or {}
     procs = {p.get('label'): p for p in summary.get('processes', [])}
-    prompter = procs.get(PROMPTERS[phase.kind], {})
+    prompter = next((procs[name] for name in prompters if name in procs), {})
     died = [label for label, p in procs.items() if p.get('how') == 'died']
     if (prompter.get('how') == 'finished' and prompter.get('returncode') == 0 and not died
             and (run_dir / 'bag' / 'metadata.yaml').is_file()):

@@ -35,6 +35,7 @@ from mindgrasp_classifier.errors import ClassifierError
 from mindgrasp_classifier.model import CLASS_NAMES, DEFAULT_MODEL, MiModel
 from mindgrasp_ros import rclpy
 from mindgrasp_ros.node_main import declare_duration, fail, run_node
+from mindgrasp_ros.node_traits import NodeTraits
 from mindgrasp_ros.params import declare_params, param
 from mindgrasp_ros.topics import BCI_PREDICTION, BCI_STATUS, EEG_RAW, TRAINER_PROMPT
 
@@ -85,8 +86,10 @@ class ClassifierParams:
 class ClassifierNode(rclpy.node.Node):
     """Wires :class:`MiDecoder` to ``/eeg/raw``, ``/trainer/prompt``, ``/bci/prediction``."""
 
+    node_traits = NodeTraits(name='classifier')
+
     def __init__(self, **kwargs) -> None:
-        super().__init__('classifier', **kwargs)
+        super().__init__(self.node_traits.name, **kwargs)
         self.params = declare_params(self, ClassifierParams)
         if self.params.blas_threads > 0:
             # small matrices: multi-threaded BLAS only adds latency, worst on a busy machine
@@ -226,7 +229,7 @@ class ClassifierNode(rclpy.node.Node):
             if dec.segment_start is not None:
                 # where the causal filter started: a replay starts there to decide identically
                 values['segment_start_sample'] = str(dec.segment_start)
-        item = DiagnosticStatus(level=level, name='classifier', message=message,
+        item = DiagnosticStatus(level=level, name=self.node_traits.name, message=message,
                                 hardware_id='', values=[KeyValue(key=k, value=v)
                                                         for k, v in sorted(values.items())])
         msg = DiagnosticArray(status=[item])

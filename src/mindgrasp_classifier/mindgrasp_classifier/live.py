@@ -48,6 +48,7 @@ def stream_live(model_path: str, rec: Recording, workdir: Path,
     from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import EEGChunk, MIPrediction
 
     from mindgrasp_eeg.acquisition import read_clocks
+    from mindgrasp_eeg.acquisition_node import AcquisitionNode
     from mindgrasp_eeg.player import DatasetPlayer
     from mindgrasp_ros import rclpy
 
@@ -82,8 +83,8 @@ def stream_live(model_path: str, rec: Recording, workdir: Path,
             msg = f'The classifier node did not start:\n{clf.output()[-2000:]}'
             raise ClassifierError(msg)
         acq = NodeProcess(
-            'mindgrasp_eeg.acquisition_node',
-            ['--ros-args', '-r', f'__node:=eeg_acquisition_{name[-8:]}',
+            AcquisitionNode.__module__,
+            ['--ros-args', '-r', f'__node:={AcquisitionNode.node_traits.name}_{name[-8:]}',
              '-p', f'stream_name:={name}', '-p', f'n_channels:={len(rec.channels)}',
              '-p', f'sample_rate:={rec.rate}', '-p', 'check_channel_names:=false',
              '-p', 'adapt_to_stream:=true', '-p', 'resolve_timeout:=30.0'],

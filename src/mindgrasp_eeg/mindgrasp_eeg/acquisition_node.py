@@ -77,7 +77,8 @@ class AcquisitionNode(rclpy.node.Node):
     """Wires :class:`EEGAcquisition` to ``/eeg/raw`` and ``/eeg/status``."""
 
     node_traits = NodeTraits(
-        provides=('eeg',),
+        name='eeg_acquisition', provides=('eeg',),
+        periodic={EEG_RAW.name: ('chunk_period', 'period')},
         lockstep_left_out='LSL runs on wall time; the virtual amplifier publishes /eeg/raw '
                           'itself in lock-step',
         lockstep_missing='lock-step cannot take EEG from an LSL stream: LSL runs on wall time, '
@@ -87,7 +88,7 @@ class AcquisitionNode(rclpy.node.Node):
                          'without --lockstep.')
 
     def __init__(self, **kwargs) -> None:
-        super().__init__('eeg_acquisition', **kwargs)
+        super().__init__(self.node_traits.name, **kwargs)
         self.done = rclpy.task.Future()
         self.params = p = declare_params(self, AcquisitionParams)
         self.acq = EEGAcquisition(

@@ -109,16 +109,23 @@ def _yaml(path: Path) -> dict:
 
 
 def _protocol(run_dir: Path) -> str:
-    """The run's protocol: the trial manager's ``protocol`` (``set_locations``, ...), else the
-    prompter that ran (``graz``, ``trainer``), else the launch profile, else the folder name."""
-    params = run_dir / 'params'
-    for node_params in _yaml(params / 'trial_manager.yaml').values():
-        protocol = (node_params or {}).get('ros__parameters', {}).get('protocol')
-        if protocol:
-            return str(protocol)
-    for node, task in (('graz_prompter', 'graz'), ('trainer', 'trainer')):
-        if (params / f'{node}.yaml').is_file():
-            return task
+    """The run's protocol: the parameter a node's class names as its task (the trial manager's
+    ``protocol``: ``set_locations``, ...), else the phase kind of the prompter that ran
+    (``graz``, ``trainer``), else the launch profile, else the folder name. Which node is which
+    is asked of the node classes the run's launch.yaml lists (:func:`run_nodes`)."""
+    from mindgrasp_ros.run_nodes import run_nodes
+
+    nodes = run_nodes(run_dir)
+    for node in nodes:
+        if node.traits.task_parameter:
+            for node_params in _yaml(run_dir / 'params' / f'{node.label}.yaml').values():
+                task = (node_params or {}).get('ros__parameters', {}).get(
+                    node.traits.task_parameter)
+                if task:
+                    return str(task)
+    for node in nodes:
+        if node.traits.prompts and not node.traits.task_parameter:
+            return node.traits.prompts[0]
     return str(_yaml(run_dir / 'launch.yaml').get('profile') or run_dir.name)
 
 

@@ -54,11 +54,12 @@ class VirtualAmpNode(rclpy.node.Node):
     """Feeds the virtual subject from ROS topics and paces the virtual amplifier."""
 
     # in lock-step there is no LSL (wall time): it publishes /eeg/raw itself
-    node_traits = NodeTraits(seed_parameters=('seed',), lockstep_parameters={'output': 'ros'},
-                             provides=('eeg',))
+    node_traits = NodeTraits(name='virtual_amp', seed_parameters=('seed',),
+                             lockstep_parameters={'output': 'ros'}, provides=('eeg',),
+                             virtual_subject=True)
 
     def __init__(self, **kwargs) -> None:
-        super().__init__('virtual_amp', **kwargs)
+        super().__init__(self.node_traits.name, **kwargs)
         self.done = rclpy.task.Future()
         self.params = p = declare_params(self, VirtualAmpParams)
         if p.eeg_source != 'synthetic':

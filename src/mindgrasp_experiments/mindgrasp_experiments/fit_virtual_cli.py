@@ -94,14 +94,16 @@ def format_table(result: FitResult, subject: str) -> str:
 
 def parameter_file(params: dict[str, float], subject: str, command: str, error: float,
                    head_seed: int = 0) -> str:
-    """The fitted values as a ROS 2 parameter file for the ``virtual_amp`` node (with the head
-    they were fitted for)."""
+    """The fitted values as a ROS 2 parameter file for the virtual participant's node (with the
+    head they were fitted for)."""
+    from mindgrasp_experiments.fitted_subject import virtual_subject_node
+
     body = '\n'.join(f'    {k}: {v:g}' for k, v in {'head_seed': head_seed, **params}.items())
     return (f'# Virtual subject fitted to {subject}: `{command}`\n'
             '# (decodability figures of mindgrasp_experiments.decodability within '
             f'{error:.3f} RMS of '
             'the real ones).\n'
-            f'virtual_amp:\n  ros__parameters:\n{body}\n')
+            f'{virtual_subject_node()}:\n  ros__parameters:\n{body}\n')
 
 
 def main(args: argparse.Namespace) -> int:

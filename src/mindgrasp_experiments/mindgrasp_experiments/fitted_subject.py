@@ -34,7 +34,7 @@ from typing import Any
 from mindgrasp_experiments import ExperimentError
 
 __all__ = ['CALIBRATION', 'FITTED_PREFIX', 'FITTED_TAG', 'FittedSubject', 'fitted_model',
-           'head_params', 'is_fitted', 'load_fitted']
+           'head_params', 'is_fitted', 'load_fitted', 'virtual_subject_node']
 
 FITTED_PREFIX = 'virtual:'
 #: the settings ``mindgrasp eeg fit-virtual`` writes (the head model and its decodability)
@@ -124,10 +124,11 @@ def load_fitted(subject: str) -> FittedSubject:
         raise _fail(path, f'is not valid YAML ({yaml_error_text(exc)})') from None
     except (OSError, UnicodeDecodeError) as exc:
         raise _fail(path, f'cannot be read ({exc})') from None
-    params = (doc.get('virtual_amp') or {}).get('ros__parameters') \
-        if isinstance(doc, dict) and isinstance(doc.get('virtual_amp'), dict) else None
+    node = virtual_subject_node()
+    params = (doc.get(node) or {}).get('ros__parameters') \
+        if isinstance(doc, dict) and isinstance(doc.get(node), dict) else None
     if not isinstance(params, dict):
-        raise _fail(path, 'has no virtual_amp: ros__parameters: mapping (a fit written by '
+        raise _fail(path, f'has no {node}: ros__parameters: mapping (a fit written by '
                           'fit-virtual --output)')
     missing = [key for key in HEAD_KEYS if key not in params]
     if missing:
@@ -145,10 +146,10 @@ def load_fitted(subject: str) -> FittedSubject:
         except ParameterError as exc:
             raise _fail(path, f'is out of range: {str(exc).rstrip(".")}') from None
         head[key] = kind(value)
-    extra = set(doc) - {'virtual_amp', 'calibration'}
+    extra = set(doc) - {node, 'calibration'}
     if extra:
         raise _fail(path, f"has unknown top-level key(s) {', '.join(sorted(map(str, extra)))} "
-                          '(allowed: virtual_amp, calibration)')
+                          f'(allowed: {node}, calibration)')
     return FittedSubject(path, head, _calibration(path, doc.get('calibration') or {}))
 
 
@@ -171,6 +172,15 @@ def _calibration(path: Path, given: Any) -> dict[str, Any]:
     return out
 
 
+def virtual_subject_node() -> str:
+    """The virtual participant's node name, the section of its parameter file (asked of the
+    node class, :class:`~mindgrasp_ros.node_traits.NodeTraits`)."""
+    from mindgrasp_eeg.virtual_amp_node import VirtualAmpNode
+    from mindgrasp_ros.node_traits import traits_of
+
+    return traits_of(VirtualAmpNode).name
+
+
 def cache_root() -> Path:
     """Where calibrated fitted subjects are kept (see the module docstring)."""
     if os.environ.get('MINDGRASP_CACHE'):
@@ -185,8 +195,8 @@ def fitted_model(subject: FittedSubject, cache: Path | None = None,
     ``cache`` (default :func:`cache_root`) holds it already.
 
     The calibration is ``mindgrasp session calibrate``'s: :class:`~mindgrasp_bringup.session.
-    Session` runs the plan's lock-step Graz phase and a held-out run as ``mindgrasp launch graz
-    --lockstep`` child processes with the head's ``virtual_amp`` parameters, trains on the first
+    Session` runs the plan's lock-step Graz phase and a held-out run (``mindgrasp launch graz
+    --lockstep``, in this process) with the head's parameters, trains on the first
     and scores on the second. The model's provenance gets the head, the settings, the digest
     and the held-out accuracy; it is written to ``cache`` under the digest.
     """
@@ -210,7 +220,7 @@ def fitted_model(subject: FittedSubject, cache: Path | None = None,
                             cal['seed'])
     plan.training['pipeline'] = cal['pipeline']
     for phase in plan.phases:            # every phase, the held-out run too, on the fitted head
-        phase.params.setdefault('virtual_amp', {}).update(subject.head)
+        phase.params.setdefault(virtual_subject_node(), {}).update(subject.head)
     session = Session(cache / 'sessions', 'fitted', f'{subject.name}-{digest[:12]}',
                       {'display': 'off', 'seed': str(cal['seed']),
                        'eeg_stream': f'MIndGrasp-fitted-{os.getpid()}'})

@@ -103,10 +103,11 @@ class TrialManagerParams:
 class TrialManagerNode(rclpy.node.Node):
     """Trial loop of the grasp protocols (see the module docstring)."""
 
-    node_traits = NodeTraits(trial_manager=True)
+    node_traits = NodeTraits(name='trial_manager', trial_manager=True, prompts=('test',),
+                             task_parameter='protocol')
 
     def __init__(self, **kwargs) -> None:
-        super().__init__('trial_manager', **kwargs)
+        super().__init__(self.node_traits.name, **kwargs)
         self.done = rclpy.task.Future()
         self.params = p = declare_params(self, TrialManagerParams)
         self.targets = [t.strip() for t in str(p.targets).split(',') if t.strip()]

@@ -51,6 +51,7 @@ from mindgrasp_ros.node_main import declare_duration, run_node
 from mindgrasp_ros.node_traits import NodeTraits
 from mindgrasp_ros.params import declare_params
 from mindgrasp_ros.topics import (
+    ARM_COMMANDS,
     BCI_PREDICTION,
     COLOR_INFO,
     FSM_STATE,
@@ -67,10 +68,12 @@ _NUMBER = re.compile(r'\d+(\.\d+)?')
 class FsmNode(rclpy.node.Node):
     """Thin ROS wrapper round :class:`GraspFsm` (parameters: config/param/fsm.yaml)."""
 
-    node_traits = NodeTraits(parameters=FsmParams)   # --param values checked before a trial
+    node_traits = NodeTraits(   # --param values checked before a trial
+        name='fsm', parameters=FsmParams,
+        periodic={ARM_COMMANDS.name: ('control_period', 'period')})
 
     def __init__(self, **kwargs: object) -> None:
-        super().__init__('fsm', **kwargs)
+        super().__init__(self.node_traits.name, **kwargs)
         # one FsmParams object, shared with the controller: live changes apply at the next tick
         self.params = declare_params(self, FsmParams)
         self.fsm = GraspFsm.from_params(self.params)

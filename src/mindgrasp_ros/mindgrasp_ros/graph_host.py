@@ -33,7 +33,7 @@ from typing import Any, Protocol
 from mindgrasp_ros.errors import NodeCallbackError
 from mindgrasp_ros.node_spec import NodeSpec
 
-__all__ = ['GraphRunner', 'InProcess', 'Lockstep', 'Processes', 'Scheduler']
+__all__ = ['GraphRunner', 'InProcess', 'Lockstep', 'ProcessHandle', 'Processes', 'Scheduler']
 
 
 class Scheduler(Protocol):
@@ -69,6 +69,7 @@ class GraphRunner:
         self.scheduler = scheduler
         self.log = log
         self.nodes: list[Any] = []
+        self.interrupted = False   #: Ctrl-C ended :meth:`run` (its caller may stop too)
         self._closed = False
 
     def add(self, spec: NodeSpec) -> Any:
@@ -106,7 +107,7 @@ class GraphRunner:
             self.log(f'[{exc.node}] ERROR: {type(exc.error).__name__}: {exc.error}')
             raised = True
         except KeyboardInterrupt:
-            pass
+            self.interrupted = True
         finally:
             self.close()
         code = graph_exit_code(self.nodes, self.log)
@@ -218,11 +219,31 @@ class _ProcessNode:
             self.done.set_result(code)
 
 
+class ProcessHandle(Protocol):
+    """A process a caller builds itself (a launch's process: its own command line, output and
+    respawn policy), hosted by :class:`Processes` as it hosts a node's process."""
+
+    done: concurrent.futures.Future[int]   #: completes with the exit code once it ended for good
+
+    def get_name(self) -> str:
+        """The label of the process."""
+
+    def start(self) -> None:
+        """Start the process."""
+
+    def poll(self) -> None:
+        """Look whether the process ended (and set :attr:`done`, or restart it)."""
+
+    def destroy_node(self) -> None:
+        """Stop the process (SIGINT, then SIGTERM, then SIGKILL) unless it ended already."""
+
+
 class Processes:
     """Each node in a process of its own (``python -m <module> --ros-args ...``), over DDS, its
     output in ``run_dir/<label>.log`` and its parameters in ``run_dir/params/<label>.yaml``;
     ``env``: the processes' environment (None: this one's). A node given as ``pkg.mod:Class``
-    runs under :func:`main` of this module."""
+    runs under :func:`main` of this module. :meth:`add` also takes a :class:`ProcessHandle`
+    (the launcher's processes), polled and stopped in the same order."""
 
     POLL_S = 0.05   #: how often (s) the host looks for a process that ended
 
@@ -230,12 +251,16 @@ class Processes:
         self.run_dir = Path(run_dir)
         self.run_dir.mkdir(parents=True, exist_ok=True)
         self.env = env
-        self._handles: list[_ProcessNode] = []
+        self._handles: list[Any] = []
         self._t0 = time.monotonic()
 
-    def add(self, spec: NodeSpec) -> Any:
+    def add(self, spec: NodeSpec | ProcessHandle) -> Any:
         from mindgrasp_ros.node_process import NodeProcess
 
+        if not isinstance(spec, NodeSpec):   # a process the caller built: it starts itself
+            self._handles.append(spec)
+            spec.start()
+            return spec
         args = spec.process_arguments(self.run_dir / 'params')
         module, args = ((__name__, [spec.module, *args]) if ':' in spec.module
                         else (spec.module, args))

@@ -7,6 +7,10 @@ module names, so renaming a node or adding a seeded parameter is an edit in one 
     class SimNode(rclpy.node.Node):
         node_traits = NodeTraits(seed_parameters=('seed', 'realism_seed'))
 
+Sessions, replay and the report tools ask the same traits which node prompts a phase, which node
+is the virtual participant or which parameter names a run's task, so no module outside a node's
+package names the node (``tests/docs/test_code_rules.py`` checks it).
+
 A class without the attribute has the defaults: no seed, composed as it is, not a trial manager.
 """
 
@@ -46,6 +50,20 @@ class NodeTraits:
         parameters: The dataclass the node declares its parameters from
             (:func:`mindgrasp_ros.params.declare_params`), so that a host checks a value's range
             and choices before it starts the node (None: checked when the node starts).
+        name: The node's own name (its constructor passes it to ``Node``), for a host that
+            needs it before the node exists: the section of a parameter file, a diagnostic
+            status ('' = not declared).
+        prompts: Session phase kinds (``'graz'``, ``'trainer'``, ``'test'``) whose trials the
+            node prompts; its end ends the phase's launch, and its run's task is that kind.
+        task_parameter: The node's parameter naming the task of its run (a trial manager's
+            ``protocol``), read from the run's parameter files ('' = none).
+        participant_screen: The screen the participant looks at (a session sets its frame
+            rates and the certainty that fills its feedback bar).
+        virtual_subject: The virtual participant (a session's ``--virtual-accuracy`` sets its
+            ``accuracy``; a fitted head's parameters are its parameters).
+        periodic: Topics the node publishes at a rate set by one of its parameters: topic ->
+            (parameter, ``'period'`` in s or ``'rate'`` in Hz), the nominal rate of the
+            latency report.
     """
 
     seed_parameters: tuple[str, ...] = ()
@@ -57,6 +75,13 @@ class NodeTraits:
     lockstep_exclude_parameter: str = ''
     lockstep_output_parameter: str = ''
     parameters: type | None = None
+    name: str = ''
+    prompts: tuple[str, ...] = ()
+    task_parameter: str = ''
+    participant_screen: bool = False
+    virtual_subject: bool = False
+    periodic: Mapping[str, tuple[str, str]] = field(
+        default_factory=lambda: MappingProxyType({}))
 
 
 _DEFAULT = NodeTraits()

@@ -212,10 +212,12 @@ def _check_params(p: dict) -> None:
 class SimNode(rclpy.node.Node):
     """Thin ROS layer over :class:`Simulation` (see the module docstring for the contract)."""
 
-    node_traits = NodeTraits(seed_parameters=('seed', 'realism_seed'))
+    node_traits = NodeTraits(name='sim', seed_parameters=('seed', 'realism_seed'),
+                             periodic={JOINT_STATES.name: ('joint_state_rate', 'rate'),
+                                       COLOR_IMAGE.name: ('camera_rate', 'rate')})
 
     def __init__(self, **kwargs) -> None:
-        super().__init__('sim', **kwargs)
+        super().__init__(self.node_traits.name, **kwargs)
         self.params = declare_params(self, SimParams)
         p = self.params
         try:

@@ -55,6 +55,7 @@ from mindgrasp_ros.interfaces.std_msgs.msg import Float64
 from mindgrasp_ros import rclpy
 from mindgrasp_ros import topics as tp
 from mindgrasp_ros.node_main import end_after, run_node
+from mindgrasp_ros.node_traits import NodeTraits
 from mindgrasp_ros.params import declare_params, param
 from mindgrasp_trainer.display import FEEDBACK_MODES
 from mindgrasp_trainer.protocol import PromptEvent, TrainerError
@@ -113,8 +114,11 @@ def _stamp_ns(stamp) -> int:
 class DisplayNode(rclpy.node.Node):
     """Shows :class:`ParticipantScreen` frames and publishes when each prompt was drawn."""
 
+    node_traits = NodeTraits(name='participant_display', participant_screen=True,
+                             parameters=DisplayParams)
+
     def __init__(self, **kwargs) -> None:
-        super().__init__('participant_display', **kwargs)
+        super().__init__(self.node_traits.name, **kwargs)
         self.params = p = declare_params(self, DisplayParams)
         # a TrainerError here (no display, unwritable png_dir) ends the node with exit code 2
         # and its one-line message (run_node)

@@ -21,6 +21,7 @@ from mindgrasp_ros.interfaces.sensor_msgs.msg import Image
 
 from mindgrasp_ros import rclpy
 from mindgrasp_ros.node_main import run_node
+from mindgrasp_ros.node_traits import NodeTraits
 from mindgrasp_ros.params import declare_params, param
 from mindgrasp_ros.topics import BCI_PREDICTION, TRAINER_DISPLAY, TRAINER_PROMPT
 from mindgrasp_trainer.display import FEEDBACK_MODES, render_display
@@ -83,8 +84,10 @@ class GrazParams:
 class GrazNode(rclpy.node.Node):
     """Publishes the Graz-BCI schedule of :class:`GrazProtocol` as it unfolds in ROS time."""
 
+    node_traits = NodeTraits(name='graz_prompter', prompts=('graz',), parameters=GrazParams)
+
     def __init__(self, **kwargs) -> None:
-        super().__init__('graz_prompter', **kwargs)
+        super().__init__(self.node_traits.name, **kwargs)
         self.params = p = declare_params(self, GrazParams)
         # a TrainerError here (no class order keeps runs to max_repeat) ends the node with exit
         # code 2 and its one-line message (run_node)

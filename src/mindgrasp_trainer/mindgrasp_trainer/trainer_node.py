@@ -31,6 +31,7 @@ from mindgrasp_ros.interfaces.std_msgs.msg import Float64, Float64MultiArray
 from mindgrasp_common.robot_description import RobotDescriptionError, load_robot
 from mindgrasp_ros import rclpy
 from mindgrasp_ros.node_main import run_node
+from mindgrasp_ros.node_traits import NodeTraits
 from mindgrasp_ros.params import declare_params, param
 from mindgrasp_ros.topics import (
     ARM_COMMANDS,
@@ -121,8 +122,10 @@ def _position(msg: PoseStamped) -> np.ndarray:
 class TrainerNode(rclpy.node.Node):
     """Runs :class:`TrainerProtocol` against the simulated training robot."""
 
+    node_traits = NodeTraits(name='trainer', prompts=('trainer',), parameters=TrainerParams)
+
     def __init__(self, **kwargs) -> None:
-        super().__init__('trainer', **kwargs)
+        super().__init__(self.node_traits.name, **kwargs)
         self.params = p = declare_params(self, TrainerParams)
         self.protocol = TrainerProtocol(**{name: getattr(p, name) for name in _PROTOCOL})
         self.trainer_pos: np.ndarray | None = None

@@ -90,37 +90,6 @@ def profile_summaries() -> list[tuple[str, str]]:
     return out
 
 
-def _run_lockstep(args: argparse.Namespace, service: LaunchService,
-                  launch_arguments: list[str]) -> int:
-    """``--lockstep``: every node composed on simulated time (mindgrasp_experiments.engine);
-    ``duration:=S`` counts simulated seconds. Returns 1 when a node failed."""
-    from mindgrasp_bringup.launch_system import rundir
-    from mindgrasp_bringup.launch_system.lockstep import (
-        check_left_out_nodes,
-        lockstep_components,
-        run_lockstep,
-    )
-
-    # argument problems are reported before anything is created
-    check_left_out_nodes(service.plan().processes)
-    run_dir = rundir.create_run_dir(service.name, args.run_dir, service.runs_root)
-    given = dict(a.split(':=', 1) for a in launch_arguments)
-    duration = float(given.pop('duration', 0) or 0)
-    components = lockstep_components(service.launch_file, given, run_dir / 'params', log=print,
-                                     bag=run_dir / 'bag')
-    print(f'lock-step: composing {len(components)} node(s) on simulated time: '
-          + ', '.join(c.label for c in components) + f'; run directory {run_dir}', flush=True)
-    import os
-
-    os.environ['MINDGRASP_RUN_DIR'] = str(run_dir)
-    code = run_lockstep(components, duration_s=duration)
-    # every run directory has a report; simulated time has no latencies, and it says so
-    from mindgrasp_bringup.launch_system.run_report import write_run_report
-
-    write_run_report(run_dir, service.name)
-    return code
-
-
 def main(args: argparse.Namespace) -> int:
     """Run ``mindgrasp launch``; 0 when every node ended cleanly, 1 on a failure, 2 on bad
     input."""
@@ -153,7 +122,11 @@ def main(args: argparse.Namespace) -> int:
                     print(f'      cannot start: {spec.problem}')
             return 2 if any(spec.problem for spec in plan.processes) else 0
         if args.lockstep:
-            return _run_lockstep(args, service, launch_arguments)
+            import functools
+
+            from mindgrasp_bringup.launch_system.lockstep import launch_lockstep
+
+            return launch_lockstep(service, log=functools.partial(print, flush=True))
         return service.run()
     except LaunchError as exc:
         print(f'mindgrasp launch: error: {exc}', file=sys.stderr)

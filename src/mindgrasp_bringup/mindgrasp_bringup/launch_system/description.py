@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import importlib.util
+import os
 import sys
 from collections.abc import Iterable, Mapping
 from pathlib import Path
@@ -92,13 +93,15 @@ def find_launch_file(profile_or_path: str | Path) -> Path:
     raise LaunchError(msg)
 
 
-_CACHE: dict[tuple[Path, float], LaunchDescription] = {}
+_CACHE: dict[tuple[Path, float, str], LaunchDescription] = {}
 
 
 def load_launch_file(path: str | Path) -> LaunchDescription:
     """Import a launch file and call its ``generate_launch_description()``."""
     path = find_launch_file(path)
-    key = (path, path.stat().st_mtime)
+    # a description lists the parameter files of $MINDGRASP_PARAMS_FILES when it is generated
+    # (launch_system.params.config_files): a session's phases in one process each name theirs
+    key = (path, path.stat().st_mtime, os.environ.get('MINDGRASP_PARAMS_FILES', ''))
     if key in _CACHE:
         return _CACHE[key]
     module_name = 'mindgrasp_launch_file_' + ''.join(c if c.isalnum() else '_'

@@ -17,6 +17,7 @@ done. The experiments (:mod:`mindgrasp_experiments.engine`) build on these.
 
 from __future__ import annotations
 
+import os
 import time
 from collections.abc import Mapping, Sequence
 from pathlib import Path
@@ -27,8 +28,8 @@ from mindgrasp_bringup.launch_system import rundir
 from mindgrasp_ros.node_spec import NodeSpec
 from mindgrasp_ros.node_traits import NodeTraits, traits_of
 
-__all__ = ['check_left_out_nodes', 'lockstep_components', 'node_traits', 'run_lockstep',
-           'set_log_level']
+__all__ = ['check_left_out_nodes', 'launch_lockstep', 'lockstep_components', 'node_traits',
+           'run_lockstep', 'set_log_level']
 
 #: the runner's own /clock is not a topic of the launch (a live run has none): a recorder
 #: leaves it out beside the launch's record_exclude_regex (NodeTraits.lockstep_exclude_parameter)
@@ -153,17 +154,21 @@ def set_log_level(level: str) -> None:
 
 
 def run_lockstep(components: Sequence[NodeSpec], *, step_s: float = 0.02,
-                 duration_s: float = 0.0, log: Any = print) -> int:
+                 duration_s: float = 0.0, log: Any = print, runner: Any = None) -> int:
     """``mindgrasp launch <profile> --lockstep``: the graph host under the lock-step scheduler,
     until a node is done (``done``), ``duration_s`` simulated seconds (> 0) or Ctrl-C; then one
     line with the real-time factor. Returns the graph's exit code
-    (:meth:`~mindgrasp_ros.graph_host.GraphRunner.run`)."""
+    (:meth:`~mindgrasp_ros.graph_host.GraphRunner.run`). ``runner``: a
+    :class:`~mindgrasp_ros.graph_host.GraphRunner` under a ``Lockstep`` scheduler that the
+    caller keeps, to see afterwards whether Ctrl-C ended the graph (``interrupted``)."""
     from mindgrasp_ros.graph_host import GraphRunner, Lockstep
 
-    scheduler = Lockstep(step_s)                # nodes start with the clock at 0: no jump
+    # nodes start with the clock at 0: no jump
+    runner = runner if runner is not None else GraphRunner(Lockstep(step_s), log=log)
+    scheduler = runner.scheduler
     wall0, cpu0 = time.perf_counter(), time.process_time()
     try:
-        return GraphRunner(scheduler, log=log).run(components, duration_s=duration_s)
+        return runner.run(components, duration_s=duration_s)
     finally:
         wall, sim = time.perf_counter() - wall0, scheduler.time_s
         cpu = time.process_time() - cpu0
@@ -173,3 +178,48 @@ def run_lockstep(components: Sequence[NodeSpec], *, step_s: float = 0.02,
         else:   # stopped (Ctrl-C) while composing: no rate to report (it read 8e8 CPU s per s)
             log(f'lock-step: stopped after {wall:.1f} s wall time, before the first simulated '
                 'step.')
+
+
+def launch_lockstep(service: Any, *, log: Any = print) -> int:
+    """Run the launch of ``service`` (a :class:`LaunchService`, with its arguments and run
+    directory option) with ``--lockstep``: every node composed on simulated time in this
+    process, its recorder writing ``<run dir>/bag``; ``duration:=S`` counts simulated seconds.
+
+    Returns the graph's exit code (1 when a node failed). Problems with the launch raise
+    :class:`LaunchError` before anything is created; Ctrl-C ends the graph and sets
+    ``service.stop_reason`` as a live launch does.
+    """
+    from mindgrasp_bringup.launch_system.run_report import write_run_report
+    from mindgrasp_ros.graph_host import GraphRunner, Lockstep
+
+    # argument problems are reported before anything is created
+    check_left_out_nodes(service.plan().processes)
+    run_dir = rundir.create_run_dir(service.name, service.run_dir_option, service.runs_root)
+    service.run_dir = run_dir
+    given = dict(service.given)
+    duration = float(given.pop('duration', 0) or 0)
+    components = lockstep_components(service.launch_file, given, run_dir / 'params', log=log,
+                                     bag=run_dir / 'bag')
+    log(f'lock-step: composing {len(components)} node(s) on simulated time: '
+        + ', '.join(c.label for c in components) + f'; run directory {run_dir}')
+    # the run's nodes as a live run lists them: the report tools ask their classes what they are
+    rundir.write_yaml(run_dir / 'launch.yaml', {
+        'profile': service.name, 'lockstep': True,
+        'launch_file': None if service.launch_file is None else str(service.launch_file),
+        'processes': [{'label': c.label, 'node': f'/{c.name or c.label}', 'module': c.module}
+                      for c in components]})
+    runner = GraphRunner(Lockstep(), log=log)
+    previous = os.environ.get('MINDGRASP_RUN_DIR')
+    os.environ['MINDGRASP_RUN_DIR'] = str(run_dir)   # the nodes' run directory (trial records)
+    try:
+        code = run_lockstep(components, duration_s=duration, log=log, runner=runner)
+    finally:
+        if previous is None:
+            os.environ.pop('MINDGRASP_RUN_DIR', None)
+        else:
+            os.environ['MINDGRASP_RUN_DIR'] = previous
+    if runner.interrupted:
+        service.stop_reason = 'SIGINT received'
+    # every run directory has a report; simulated time has no latencies, and it says so
+    write_run_report(run_dir, service.name)
+    return code

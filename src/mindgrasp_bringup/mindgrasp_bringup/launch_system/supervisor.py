@@ -9,11 +9,20 @@ A process ended *cleanly* when it exited with code 0 by itself, or when it stopp
 SIGINT timeout once the launch asked it to (exit code 0, or killed by that SIGINT). A process
 that needed SIGTERM or SIGKILL, or died with another code, did not; the launch's exit code is 0
 only when every process ended cleanly.
+
+The supervisor is a caller of the graph host (:mod:`mindgrasp_ros.graph_host`): each process is
+a :class:`~mindgrasp_ros.graph_host.ProcessHandle` of the ``Processes`` scheduler, which polls
+them; a process has ended when its ``done`` future has (:func:`~mindgrasp_ros.node_main.is_done`,
+as for every node of every graph host), and the launch stops them in the graph host's shutdown
+order (:func:`~mindgrasp_ros.node_main.end_graph`: newest first). What is the launch's own: the
+command lines, the prefixed output, respawn, ``required``, ``on_exit=Shutdown()`` and the
+SIGINT/SIGTERM/SIGKILL stages with their timeouts.
 """
 
 from __future__ import annotations
 
 import collections
+import concurrent.futures
 import contextlib
 import ctypes
 import logging
@@ -31,11 +40,12 @@ from typing import IO
 
 from mindgrasp_bringup.launch_system.actions.execute_process import ProcessSpec
 from mindgrasp_bringup.launch_system.output import Printer
+from mindgrasp_ros.graph_host import GraphRunner, Processes
+from mindgrasp_ros.node_main import is_done
 
 logger = logging.getLogger('launch')
 
 TAIL_LINES = 20
-_POLL_S = 0.05
 _CLEAN_ON_SIGINT = (0, -signal.SIGINT, 128 + signal.SIGINT)
 #: a ROS log line: [LEVEL] [stamp] [logger.name]: message (rcutils' default format)
 _LOG_LINE = re.compile(r'^\[[A-Z]+\] \[[0-9.]+\] \[([^\]]+)\]: ')
@@ -100,6 +110,8 @@ class ManagedProcess:
     clean: bool = True
     lock: threading.Lock = field(default_factory=threading.Lock)
     component_logs: dict[str, IO[str]] = field(default_factory=dict)
+    #: completes with the exit code once the process ended for good (no respawn pending)
+    done: concurrent.futures.Future = field(default_factory=concurrent.futures.Future)
 
     @property
     def running(self) -> bool:
@@ -108,6 +120,36 @@ class ManagedProcess:
     @property
     def label(self) -> str:
         return self.spec.label
+
+    def settle(self) -> None:
+        """Complete :attr:`done` once the process neither runs nor waits for a respawn."""
+        if not self.running and self.restart_at is None and not self.done.done():
+            self.done.set_result(self.returncode)
+
+
+class _Hosted:
+    """A launch's process as the graph host sees it (a ``ProcessHandle``): the supervisor
+    starts it, looks for its end and stops it."""
+
+    def __init__(self, supervisor: Supervisor, proc: ManagedProcess) -> None:
+        self.supervisor = supervisor
+        self.proc = proc
+
+    @property
+    def done(self) -> concurrent.futures.Future:
+        return self.proc.done
+
+    def get_name(self) -> str:
+        return self.proc.label
+
+    def start(self) -> None:
+        self.supervisor.start(self.proc)
+
+    def poll(self) -> None:
+        self.supervisor.poll(self.proc)
+
+    def destroy_node(self) -> None:
+        self.supervisor.end(self.proc)
 
 
 class Supervisor:
@@ -298,14 +340,15 @@ class Supervisor:
                 handlers[signum] = signal.signal(signum, self._on_signal)
         try:
             self._started_at = time.monotonic()
+            runner = GraphRunner(Processes(self.log_dir), log=logger.error)
             if not self.procs:
                 self.request_shutdown('the launch description starts no process')
             for proc in self.procs:
                 if self._stop_reason is not None:
                     break
-                self._start(proc)
-            self._loop()
-            self._shutdown()
+                runner.add(_Hosted(self, proc))
+            runner.spin_until(self._should_stop)
+            self._shutdown(runner)
         finally:
             for signum, previous in handlers.items():
                 signal.signal(signum, previous)
@@ -319,26 +362,33 @@ class Supervisor:
                         handle.close()
         return self.results()
 
-    def _loop(self) -> None:
-        while self._stop_reason is None:
-            now = time.monotonic()
-            if self.duration is not None and now - self._started_at >= self.duration:
-                self.request_shutdown(f'duration of {self.duration:g} s reached')
-                break
-            for proc in self.procs:
-                if proc.running and proc.popen.poll() is not None:  # type: ignore[union-attr]
-                    self._handle_exit(proc, now)
-                if proc.restart_at is not None and now >= proc.restart_at \
-                        and self._stop_reason is None:
-                    proc.restart_at = None
-                    proc.restarts += 1
-                    self._start(proc)
-            active = [p for p in self.procs if not p.spec.daemon
-                      and (p.running or p.restart_at is not None)]
-            if not active and any(not p.spec.daemon for p in self.procs):
-                self.request_shutdown('every node has ended')
-                break
-            time.sleep(_POLL_S)
+    def start(self, proc: ManagedProcess) -> None:
+        """Start ``proc`` (the graph host adds it)."""
+        self._start(proc)
+        proc.settle()                  # a process that could not start has ended
+
+    def poll(self, proc: ManagedProcess) -> None:
+        """The graph host's poll of ``proc``: its end, or its respawn when the delay is over."""
+        now = time.monotonic()
+        if proc.running and proc.popen.poll() is not None:  # type: ignore[union-attr]
+            self._handle_exit(proc, now)
+        if proc.restart_at is not None and now >= proc.restart_at \
+                and self._stop_reason is None:
+            proc.restart_at = None
+            proc.restarts += 1
+            self._start(proc)
+        proc.settle()
+
+    def _should_stop(self) -> bool:
+        """The launch ends: a reason was given, its duration is over, or every process that is
+        not a daemon (the recorder) has ended (:func:`is_done`)."""
+        if self._stop_reason is None and self.duration is not None \
+                and time.monotonic() - self._started_at >= self.duration:
+            self.request_shutdown(f'duration of {self.duration:g} s reached')
+        if self._stop_reason is None and any(not p.spec.daemon for p in self.procs) and all(
+                is_done(p) for p in self.procs if not p.spec.daemon):
+            self.request_shutdown('every node has ended')
+        return self._stop_reason is not None
 
     def _wait(self, proc: ManagedProcess, timeout: float) -> bool:
         deadline = time.monotonic() + timeout
@@ -385,19 +435,21 @@ class Supervisor:
             logger.error("process '%s' (pid %d) had to be stopped with %s (%s).", spec.label,
                          proc.popen.pid, proc.stop_stage, describe_exit(rc))
 
-    def _shutdown(self) -> None:
+    def end(self, proc: ManagedProcess) -> None:
+        """Stop ``proc`` unless it ended already (the graph host's ``destroy_node``)."""
+        if proc.popen is not None:
+            if proc.returncode is None and proc.popen.poll() is not None:
+                self._handle_exit(proc, time.monotonic())
+            elif proc.returncode is None:
+                self._stop(proc)
+        proc.settle()
+
+    def _shutdown(self, runner: GraphRunner) -> None:
         reason = self._stop_reason or 'launch ended'
         logger.info('stopping the launch: %s.', reason)
         for proc in self.procs:
             proc.restart_at = None
-        for proc in reversed(self.procs):
-            if proc.popen is None:
-                continue
-            if proc.returncode is None and proc.popen.poll() is not None:
-                self._handle_exit(proc, time.monotonic())
-                continue
-            if proc.returncode is None:
-                self._stop(proc)
+        runner.close()   # the graph host's shutdown order: each started process, newest first
 
     @property
     def stop_reason(self) -> str | None:

@@ -43,9 +43,8 @@ from mindgrasp_ros.topics import BCI_PREDICTION, BCI_STATUS, CLOCK, EEG_RAW, FSM
 
 __all__ = ['COMPARED_TOPICS', 'NODES', 'ReplayConfig', 'ReplayResult', 'replay']
 
-#: nodes a replay can re-run: key -> (node module, node name in params.yaml)
-NODES = {'classifier': ('mindgrasp_classifier.classifier_node', 'classifier'),
-         'controller': ('mindgrasp_fsm.fsm_node', 'fsm')}
+#: nodes a replay can re-run, by the key of ``-p KEY.NAME:=VALUE`` (:func:`_node_classes`)
+NODES = ('classifier', 'controller')
 #: outputs compared recorded vs replayed: topic -> type
 COMPARED_TOPICS = {BCI_PREDICTION.name: BCI_PREDICTION.type, FSM_STATE.name: FSM_STATE.type}
 EEG_TOPIC = EEG_RAW.name
@@ -104,6 +103,15 @@ class ReplayResult:
     parameter_changes: list[dict[str, Any]] = field(default_factory=list)  # recorded, re-applied
 
 
+def _node_classes() -> dict[str, type]:
+    """Key of :data:`NODES` -> the node class; its name (the section of params.yaml, its
+    diagnostic status) is the class's own (:class:`~mindgrasp_ros.node_traits.NodeTraits`)."""
+    from mindgrasp_classifier.classifier_node import ClassifierNode
+    from mindgrasp_fsm.fsm_node import FsmNode
+
+    return {'classifier': ClassifierNode, 'controller': FsmNode}
+
+
 def _node_params(run_dir: Path | None, name: str) -> dict[str, Any]:
     if run_dir is None:
         return {}
@@ -118,13 +126,14 @@ def _node_params(run_dir: Path | None, name: str) -> dict[str, Any]:
     return {}
 
 
-def _segment_starts(statuses: list[bytes], store: Any) -> list[int]:
-    """Samples where the live classifier (re)started its filter, in order (from /bci/status)."""
+def _segment_starts(statuses: list[bytes], store: Any, classifier: str) -> list[int]:
+    """Samples where the live classifier (status name ``classifier``) (re)started its filter,
+    in order (from /bci/status)."""
     starts: list[int] = []
     for data in statuses:
         msg = store.deserialize_cdr(data, 'diagnostic_msgs/msg/DiagnosticArray')
         for status in msg.status:
-            if status.name != 'classifier':
+            if status.name != classifier:
                 continue
             for kv in status.values:
                 if kv.key == 'segment_start_sample':
@@ -147,12 +156,15 @@ def replay(cfg: ReplayConfig) -> ReplayResult:
     from mindgrasp_ros import rclpy
     from mindgrasp_ros.graph_host import GraphRunner, Lockstep
     from mindgrasp_ros.node_spec import NodeSpec
+    from mindgrasp_ros.node_traits import traits_of
     from mindgrasp_ros.runtime.arguments import load_params_file
 
     bag = resolve_bag(cfg.run)
     run_dir = run_dir_of(bag)
     store = default_typestore()
-    keys = ['classifier', 'controller'] if cfg.controller else ['classifier']
+    keys = list(NODES) if cfg.controller else ['classifier']
+    classes = _node_classes()
+    names = {key: traits_of(classes[key]).name for key in keys}
     stamp = dt.datetime.now(dt.timezone.utc).strftime('%Y%m%dT%H%M%SZ')
     base = run_dir if run_dir is not None else bag.resolve().parent
     output = Path(cfg.output) if cfg.output else base / 'replays' / stamp
@@ -172,7 +184,7 @@ def replay(cfg: ReplayConfig) -> ReplayResult:
         try:
             nodes = []
             for key in keys:
-                module, name = NODES[key]
+                module, name = classes[key].__module__, names[key]
                 params = _node_params(run_dir, name)
                 params.update(cfg.params.get(key, {}))
                 if key == 'classifier' and cfg.model:
@@ -230,15 +242,15 @@ def replay(cfg: ReplayConfig) -> ReplayResult:
                     events.append((t_ns, data))
                 if topic in pubs:
                     inputs.append((topic, t_ns, data))
-            starts = _segment_starts(statuses, store)
+            starts = _segment_starts(statuses, store, names['classifier'])
             result = ReplayResult(bag, run_dir, output, keys, recorded, replayed,
                                   dict.fromkeys(feed, 0), 0, None, None, reader.start_ns,
                                   reader.end_ns, damage=damage.as_dict())
             result.notes += [f'Damaged bag: {line}' for line in damage.lines()]
             max_step = cfg.max_step_s or (0.01 if cfg.controller else 0.1)
-            by_name = {f'/{NODES[k][1]}': n for k, n in zip(keys, nodes, strict=True)}
+            by_name = {f'/{names[k]}': n for k, n in zip(keys, nodes, strict=True)}
             changes = recorded_changes(events, store, set(by_name), {
-                (f'/{NODES[k][1]}', name) for k in keys for name in cfg.params.get(k, {})})
+                (f'/{names[k]}', name) for k in keys for name in cfg.params.get(k, {})})
             _feed(runner, inputs, pubs, store, starts, result, max_step, cfg.progress,
                   changes, by_name)
         finally:
