@@ -32,7 +32,7 @@ from pathlib import Path
 import psutil
 
 from mindgrasp_bag import BagReader, BagWriter
-from mindgrasp_bringup.launch_system.run_extras import DEFAULT_RECORD_EXCLUDE
+from mindgrasp_launch.run_extras import DEFAULT_RECORD_EXCLUDE
 
 COMPRESSIONS = ('none', 'lz4', 'zstd')
 

@@ -58,7 +58,6 @@ setup(
         ],
         # the mindgrasp command's own commands and verbs (cli.py discovers them, as ros2cli does)
         'mindgrasp.command': [
-            'launch = mindgrasp_bringup.commands.launch',
             'run = mindgrasp_bringup.commands.run',
             'replay = mindgrasp_bringup.commands.replay',
         ],

@@ -13,7 +13,7 @@ import yaml
 from mcap.reader import make_reader
 
 from mindgrasp_bag import BagReader
-from mindgrasp_bringup.launch_system.run_extras import DEFAULT_RECORD_EXCLUDE
+from mindgrasp_launch.run_extras import DEFAULT_RECORD_EXCLUDE
 from mindgrasp_trainer.graz import GrazProtocol
 
 # short Graz timing: 2 trials take ~5 simulated seconds; a few /trainer/display frames, which
@@ -63,7 +63,7 @@ def test_lockstep_components_compose_the_launchs_recorder(tmp_path: Path) -> Non
     """The recorder of a live launch (same topics argument), writing the given bag; none without
     a bag (the experiments) or with record:=false."""
     from mindgrasp_bag.recorder_node import RecorderNode
-    from mindgrasp_bringup.launch_system.lockstep import lockstep_components
+    from mindgrasp_launch.lockstep import lockstep_components
 
     def recorders(args: dict, bag: Path | None) -> list:
         comps = lockstep_components('graz', args, tmp_path / 'params', bag=bag)

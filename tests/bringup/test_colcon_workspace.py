@@ -18,7 +18,7 @@ from pathlib import Path
 import pytest
 from catkin_pkg.package import parse_package
 
-from mindgrasp_bringup.launch_system.actions.node import node_module
+from mindgrasp_launch.actions.node import node_module
 from mindgrasp_testing import console_scripts, spin_until
 
 REPO = Path(__file__).resolve().parents[2]
@@ -121,7 +121,7 @@ def test_launch_files_name_installed_executables() -> None:
     scripts = {p.name: console_scripts(p) for p in PYTHON_PACKAGES}
     bringup = SRC / 'mindgrasp_bringup' / 'mindgrasp_bringup'
     files = [*sorted((bringup / 'launch').glob('*.launch.py')),
-             bringup / 'launch_system' / 'common.py']
+             SRC / 'mindgrasp_launch' / 'mindgrasp_launch' / 'common.py']
     pairs = set()
     for path in files:
         text = path.read_text(encoding='utf-8')

@@ -21,7 +21,7 @@ from launch_fixtures.runner import fixture, launch_env, run_launch
 from conftest_bag import EEG, JOINTS, eeg_chunk, joints
 from mindgrasp_bag import BagWriter
 from mindgrasp_bag.latency import LatencyError, RunStamps, latency_report
-from mindgrasp_bringup.launch_system.run_report import write_run_report
+from mindgrasp_launch.run_report import write_run_report
 
 MS = 1_000_000
 T0 = 1_795_000_000_000_000_000   # a wall-clock time (ns)

@@ -8,7 +8,7 @@ import sys
 
 import pytest
 
-from mindgrasp_bringup.launch_system import LaunchError, LaunchService
+from mindgrasp_launch import LaunchError, LaunchService
 
 
 @pytest.mark.parametrize(('args', 'message'), [

@@ -3,7 +3,7 @@
 Each command lives in a module that defines ``add_arguments(parser)`` and ``main(args) -> int``.
 Packages register their commands themselves, as ros2cli's packages do (``ros2cli.command``,
 ``ros2topic.verb``): entry points in their setup.py, group ``mindgrasp.command``
-(``'launch = mindgrasp_bringup.commands.launch'``) for a command without verbs, group
+(``'launch = mindgrasp_launch.commands.launch'``) for a command without verbs, group
 ``mindgrasp.verb`` (``'bag record = mindgrasp_bag.commands.bag_record'``) for a command's verb;
 several packages may add verbs to one command (``train classifier``, ``train vision``).
 Commands and verbs are listed in name order, as ``ros2 --help``. Modules are imported only when
@@ -139,7 +139,7 @@ def build_parser(argv: Sequence[str]) -> argparse.ArgumentParser:
 def version_text() -> str:
     """``mindgrasp 0.1.0`` and, in a git checkout, ``(git <describe>)``: what every run's
     provenance records."""
-    from mindgrasp_bringup.launch_system.rundir import DIST_NAME, git_info, package_versions
+    from mindgrasp_launch.rundir import DIST_NAME, git_info, package_versions
 
     text = f'mindgrasp {package_versions()[DIST_NAME] or "(not installed)"}'
     describe = git_info().get('describe')

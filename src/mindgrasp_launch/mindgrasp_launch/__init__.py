@@ -2,7 +2,7 @@
 
 Launch files (``src/mindgrasp_bringup/launch/<profile>.launch.py``) import from here::
 
-    from mindgrasp_bringup.launch_system import (DeclareLaunchArgument, LaunchConfiguration,
+    from mindgrasp_launch import (DeclareLaunchArgument, LaunchConfiguration,
                                                  LaunchDescription, Node)
 
     def generate_launch_description():
@@ -17,7 +17,7 @@ per module), ``description`` (launch files, includes), ``service`` (resolve + ru
 ``supervisor`` (processes, output, signals), ``composed`` (one-process mode).
 """
 
-from mindgrasp_bringup.launch_system.actions import (
+from mindgrasp_launch.actions import (
     Action,
     DeclareLaunchArgument,
     ExecuteProcess,
@@ -31,14 +31,14 @@ from mindgrasp_bringup.launch_system.actions import (
     SetRemap,
     Shutdown,
 )
-from mindgrasp_bringup.launch_system.conditions import (
+from mindgrasp_launch.conditions import (
     IfCondition,
     LaunchConfigurationEquals,
     LaunchConfigurationNotEquals,
     UnlessCondition,
 )
-from mindgrasp_bringup.launch_system.context import LaunchContext
-from mindgrasp_bringup.launch_system.description import (
+from mindgrasp_launch.context import LaunchContext
+from mindgrasp_launch.description import (
     IncludeLaunchDescription,
     LaunchDescription,
     PythonLaunchDescriptionSource,
@@ -46,10 +46,10 @@ from mindgrasp_bringup.launch_system.description import (
     load_launch_file,
     profiles,
 )
-from mindgrasp_bringup.launch_system.errors import LaunchError
-from mindgrasp_bringup.launch_system.params import config_files
-from mindgrasp_bringup.launch_system.service import LaunchService
-from mindgrasp_bringup.launch_system.substitutions import (
+from mindgrasp_launch.errors import LaunchError
+from mindgrasp_launch.params import config_files
+from mindgrasp_launch.service import LaunchService
+from mindgrasp_launch.substitutions import (
     CameraSpec,
     EnvironmentVariable,
     EqualsSubstitution,

@@ -1,4 +1,4 @@
-"""Pieces several launch profiles share, built through :mod:`mindgrasp_bringup.launch_api`: real
+"""Pieces several launch profiles share, built through :mod:`mindgrasp_launch.launch_api`: real
 launch_ros actions under ``ros2 launch``, ours under ``mindgrasp launch``."""
 
 from __future__ import annotations
@@ -6,7 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from mindgrasp_bringup import launch_api as la
+from mindgrasp_launch import launch_api as la
 
 
 def _if_equal(argument: str, value: str) -> Any:
@@ -195,7 +195,7 @@ def run_directory_actions() -> list[Any]:
     """The run directory, the recorder and the ``duration:=`` limit as ordinary launch actions,
     for ``ros2 launch``: the launch arguments ``record``, ``record_topics``, ``record_regex``,
     ``duration`` and ``run_dir``, then a
-    :class:`~mindgrasp_bringup.launch_ros_extras.RunDirectory`. Put them after the profile's
+    :class:`~mindgrasp_launch.launch_ros_extras.RunDirectory`. Put them after the profile's
     own arguments and before its first node.
 
     Under ``mindgrasp launch`` the list is empty: that launcher adds the same to every launch
@@ -203,8 +203,8 @@ def run_directory_actions() -> list[Any]:
     """
     if not la.using_real_launch():
         return []
-    from mindgrasp_bringup.launch_ros_extras import RunDirectory
-    from mindgrasp_bringup.launch_system.run_extras import COMMON_ARGUMENTS
+    from mindgrasp_launch.launch_ros_extras import RunDirectory
+    from mindgrasp_launch.run_extras import COMMON_ARGUMENTS
 
     return [
         *(la.DeclareLaunchArgument(a.name, default_value=a.default_text(),
@@ -230,10 +230,10 @@ def driver_nodes(role: str, condition: Any = None) -> list[Any]:
     if la.using_real_launch():
         from launch.actions import OpaqueFunction
 
-        from mindgrasp_bringup.launch_ros_extras import driver_node
+        from mindgrasp_launch.launch_ros_extras import driver_node
 
         return [OpaqueFunction(function=driver_node, args=[role], condition=condition)]
-    from mindgrasp_bringup.launch_system.substitutions import SplitArguments
+    from mindgrasp_launch.substitutions import SplitArguments
 
     return [la.Node(executable=la.LaunchConfiguration(f'{role}_driver'), name=f'{role}_driver',
                     arguments=[SplitArguments(la.LaunchConfiguration(f'{role}_driver_args'))],

@@ -14,14 +14,14 @@ import logging
 import sys
 from pathlib import Path
 
-from mindgrasp_bringup.launch_system import rundir
-from mindgrasp_bringup.launch_system.actions.execute_process import ProcessSpec
-from mindgrasp_bringup.launch_system.actions.node import find_module
-from mindgrasp_bringup.launch_system.errors import LaunchError
+from mindgrasp_launch import rundir
+from mindgrasp_launch.actions.execute_process import ProcessSpec
+from mindgrasp_launch.actions.node import find_module
+from mindgrasp_launch.errors import LaunchError
 
 logger = logging.getLogger('launch')
 
-CONTAINER_MODULE = 'mindgrasp_bringup.launch_system.container'
+CONTAINER_MODULE = 'mindgrasp_launch.container'
 CONTAINER_LABEL = 'composed'
 
 

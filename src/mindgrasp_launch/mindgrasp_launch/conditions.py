@@ -4,11 +4,11 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from mindgrasp_bringup.launch_system.errors import LaunchError
-from mindgrasp_bringup.launch_system.substitutions import SomeSubstitutions, perform_substitutions
+from mindgrasp_launch.errors import LaunchError
+from mindgrasp_launch.substitutions import SomeSubstitutions, perform_substitutions
 
 if TYPE_CHECKING:
-    from mindgrasp_bringup.launch_system.context import LaunchContext
+    from mindgrasp_launch.context import LaunchContext
 
 _TRUE = ('true', '1', 'yes', 'on')
 _FALSE = ('false', '0', 'no', 'off')
@@ -62,7 +62,7 @@ class LaunchConfigurationEquals(Condition):
         self.expected_value = expected_value
 
     def evaluate(self, context: LaunchContext) -> bool:
-        from mindgrasp_bringup.launch_system.substitutions import LaunchConfiguration
+        from mindgrasp_launch.substitutions import LaunchConfiguration
 
         return (LaunchConfiguration(self.name).perform(context)
                 == perform_substitutions(context, self.expected_value))

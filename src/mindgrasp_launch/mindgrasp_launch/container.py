@@ -1,7 +1,7 @@
 """The process of ``mindgrasp launch --composed``: loads node modules as components and spins
 them under one executor until SIGINT.
 
-    python -m mindgrasp_bringup.launch_system.container <run dir>/composed.yaml
+    python -m mindgrasp_launch.container <run dir>/composed.yaml
 """
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Run the components listed in the file given as the only argument."""
     argv = list(sys.argv[1:] if argv is None else argv)
     if len(argv) != 1:
-        print('usage: python -m mindgrasp_bringup.launch_system.container <composed.yaml>',
+        print('usage: python -m mindgrasp_launch.container <composed.yaml>',
               file=sys.stderr)
         return 2
     with open(argv[0], encoding='utf-8') as f:

@@ -8,10 +8,10 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
-    from mindgrasp_bringup.launch_system.actions.declare_launch_argument import (
+    from mindgrasp_launch.actions.declare_launch_argument import (
         DeclareLaunchArgument,
     )
-    from mindgrasp_bringup.launch_system.actions.execute_process import ProcessSpec
+    from mindgrasp_launch.actions.execute_process import ProcessSpec
 
 
 @dataclass

@@ -8,19 +8,19 @@ from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from mindgrasp_bringup.launch_api import own_launcher
-from mindgrasp_bringup.launch_system.actions.action import Action
-from mindgrasp_bringup.launch_system.actions.declare_launch_argument import DeclareLaunchArgument
-from mindgrasp_bringup.launch_system.errors import LaunchError
-from mindgrasp_bringup.launch_system.substitutions import (
+from mindgrasp_common.resources import resource_path
+from mindgrasp_launch.actions.action import Action
+from mindgrasp_launch.actions.declare_launch_argument import DeclareLaunchArgument
+from mindgrasp_launch.errors import LaunchError
+from mindgrasp_launch.launch_api import own_launcher
+from mindgrasp_launch.substitutions import (
     SomeSubstitutions,
     Substitution,
     perform_substitutions,
 )
-from mindgrasp_common.resources import resource_path
 
 if TYPE_CHECKING:
-    from mindgrasp_bringup.launch_system.context import LaunchContext
+    from mindgrasp_launch.context import LaunchContext
 
 #: the profiles: mindgrasp_bringup/launch/<profile>.launch.py (share/mindgrasp_bringup/launch
 #: in a colcon install)

@@ -1,10 +1,10 @@
 """The one import point of launch files: the real ``launch``/``launch_ros`` when ROS 2 is sourced,
-our launcher (:mod:`mindgrasp_bringup.launch_system`) otherwise.
+our launcher (:mod:`mindgrasp_launch`) otherwise.
 
 Launch files import every action from here, so the same file runs under ``ros2 launch`` and under
 ``mindgrasp launch``, as node code imports ``from mindgrasp_ros import rclpy``::
 
-    from mindgrasp_bringup.launch_api import (DeclareLaunchArgument, LaunchConfiguration,
+    from mindgrasp_launch.launch_api import (DeclareLaunchArgument, LaunchConfiguration,
                                               LaunchDescription, Node, config_files)
 
 Which one a name resolves to is decided when the launch file imports it:
@@ -26,7 +26,7 @@ import os
 import threading
 from collections.abc import Iterator
 
-_OWN = 'mindgrasp_bringup.launch_system'
+_OWN = 'mindgrasp_launch'
 
 #: name -> (module of the real launch / launch_ros, module of ours)
 _SOURCES: dict[str, tuple[str, str]] = {
@@ -56,29 +56,29 @@ _SOURCES: dict[str, tuple[str, str]] = {
     'SetParameter': ('launch_ros.actions', _OWN),
     'SetRemap': ('launch_ros.actions', _OWN),
     # ours, with a real-launch twin
-    'SplitArguments': ('mindgrasp_bringup.launch_ros_extras', _OWN),
-    'CameraSpec': ('mindgrasp_bringup.launch_ros_extras', _OWN),
+    'SplitArguments': ('mindgrasp_launch.launch_ros_extras', _OWN),
+    'CameraSpec': ('mindgrasp_launch.launch_ros_extras', _OWN),
 }
 
 #: our helpers, the same under both launchers (they build actions through this module)
 _HELPERS = {
-    'config_files': 'mindgrasp_bringup.launch_system.params',
-    'number_argument': 'mindgrasp_bringup.launch_system.number_argument',
-    'file_argument': 'mindgrasp_bringup.launch_system.number_argument',
-    'checked_argument': 'mindgrasp_bringup.launch_system.number_argument',
-    'classifier_nodes': 'mindgrasp_bringup.launch_system.common',
-    'eeg_source_arguments': 'mindgrasp_bringup.launch_system.common',
-    'eeg_source_nodes': 'mindgrasp_bringup.launch_system.common',
-    'display_arguments': 'mindgrasp_bringup.launch_system.common',
-    'display_nodes': 'mindgrasp_bringup.launch_system.common',
-    'sim_scene_camera': 'mindgrasp_bringup.launch_system.common',
-    'live_view_arguments': 'mindgrasp_bringup.launch_system.common',
-    'live_view_nodes': 'mindgrasp_bringup.launch_system.common',
-    'run_directory_actions': 'mindgrasp_bringup.launch_system.common',
-    'driver_nodes': 'mindgrasp_bringup.launch_system.common',
-    'fsm_node': 'mindgrasp_bringup.launch_system.common',
-    'command_interface_argument': 'mindgrasp_bringup.launch_system.common',
-    'robot_argument': 'mindgrasp_bringup.launch_system.common',
+    'config_files': 'mindgrasp_launch.params',
+    'number_argument': 'mindgrasp_launch.number_argument',
+    'file_argument': 'mindgrasp_launch.number_argument',
+    'checked_argument': 'mindgrasp_launch.number_argument',
+    'classifier_nodes': 'mindgrasp_launch.common',
+    'eeg_source_arguments': 'mindgrasp_launch.common',
+    'eeg_source_nodes': 'mindgrasp_launch.common',
+    'display_arguments': 'mindgrasp_launch.common',
+    'display_nodes': 'mindgrasp_launch.common',
+    'sim_scene_camera': 'mindgrasp_launch.common',
+    'live_view_arguments': 'mindgrasp_launch.common',
+    'live_view_nodes': 'mindgrasp_launch.common',
+    'run_directory_actions': 'mindgrasp_launch.common',
+    'driver_nodes': 'mindgrasp_launch.common',
+    'fsm_node': 'mindgrasp_launch.common',
+    'command_interface_argument': 'mindgrasp_launch.common',
+    'robot_argument': 'mindgrasp_launch.common',
 }
 
 __all__ = ['own_launcher', 'using_real_launch', *_SOURCES, *_HELPERS]

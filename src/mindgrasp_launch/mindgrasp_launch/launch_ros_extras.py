@@ -1,6 +1,6 @@
 """Our launch extensions as real ``launch`` entities, for launch files run by ``ros2 launch``.
 
-Imported only through :mod:`mindgrasp_bringup.launch_api` when the real ``launch`` is in use.
+Imported only through :mod:`mindgrasp_launch.launch_api` when the real ``launch`` is in use.
 """
 
 from __future__ import annotations
@@ -22,10 +22,10 @@ from launch.substitutions.substitution_failure import SubstitutionFailure
 from launch.utilities import normalize_to_list_of_substitutions, perform_substitutions
 from launch_ros.actions import Node
 
-from mindgrasp_bringup.launch_system import rundir
-from mindgrasp_bringup.launch_system.actions.node import find_module
-from mindgrasp_bringup.launch_system.errors import LaunchError
-from mindgrasp_bringup.launch_system.run_extras import (
+from mindgrasp_launch import rundir
+from mindgrasp_launch.actions.node import find_module
+from mindgrasp_launch.errors import LaunchError
+from mindgrasp_launch.run_extras import (
     RECORDER_EXECUTABLE,
     RECORDER_NAME,
     RECORDER_PACKAGE,
@@ -38,7 +38,7 @@ from mindgrasp_bringup.launch_system.run_extras import (
 
 class CameraSpec(Substitution):
     """One field (``'width'``, ``'height'`` or ``'rate'``) of a ``WIDTHxHEIGHT@HZ`` text: parsed
-    by :func:`mindgrasp_bringup.launch_args.parse_camera`, never evaluated."""
+    by :func:`mindgrasp_launch.launch_args.parse_camera`, never evaluated."""
 
     def __init__(self, value: SomeSubstitutionsType, field: str) -> None:
         super().__init__()
@@ -49,7 +49,7 @@ class CameraSpec(Substitution):
         return f'CameraSpec({" + ".join(s.describe() for s in self.value)}, {self.field!r})'
 
     def perform(self, context: LaunchContext) -> str:
-        from mindgrasp_bringup.launch_args import CAMERA_FIELDS, parse_camera
+        from mindgrasp_launch.launch_args import CAMERA_FIELDS, parse_camera
 
         try:
             values = parse_camera(perform_substitutions(context, self.value))

@@ -22,8 +22,8 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from mindgrasp_bringup.launch_system import params as ros_params
-from mindgrasp_bringup.launch_system import rundir
+from mindgrasp_launch import params as ros_params
+from mindgrasp_launch import rundir
 from mindgrasp_ros.node_spec import NodeSpec
 from mindgrasp_ros.node_traits import NodeTraits, traits_of
 
@@ -47,7 +47,7 @@ def lockstep_components(launch: str | Path, arguments: Sequence[str] | Mapping[s
     ``params_dir`` (the run's record of them); each spec holds them typed, as the node reads that
     file. Raises :class:`LaunchError` naming the problem and the fix.
     """
-    from mindgrasp_bringup.launch_system import LaunchError, LaunchService
+    from mindgrasp_launch import LaunchError, LaunchService
     from mindgrasp_ros.runtime.arguments import load_params_file
 
     args = dict(arguments) if isinstance(arguments, Mapping) else \
@@ -109,7 +109,7 @@ def lockstep_components(launch: str | Path, arguments: Sequence[str] | Mapping[s
 def node_traits(spec: Any) -> NodeTraits:
     """The traits the node class of a launch process declares (defaults for other programs);
     :class:`LaunchError` when its module cannot be loaded."""
-    from mindgrasp_bringup.launch_system import LaunchError
+    from mindgrasp_launch import LaunchError
     from mindgrasp_ros.composition import CompositionError, load_node_class
 
     if spec.module is None:
@@ -126,7 +126,7 @@ def check_left_out_nodes(processes: Sequence[Any],
     """Raise :class:`LaunchError` when a node that lock-step leaves out (the LSL acquisition
     node) provides something that no composed node provides (EEG: the virtual amplifier).
     ``traits``: those of ``processes``, in order, when the caller has them already."""
-    from mindgrasp_bringup.launch_system import LaunchError
+    from mindgrasp_launch import LaunchError
 
     if traits is None:
         traits = [node_traits(spec) for spec in processes]

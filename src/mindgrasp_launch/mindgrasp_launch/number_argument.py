@@ -21,11 +21,11 @@ import math
 from collections.abc import Callable
 from typing import Any
 
-from mindgrasp_bringup.launch_system.actions.declare_launch_argument import (
+from mindgrasp_common.resources import ResourceNotFoundError, resolve_path
+from mindgrasp_launch.actions.declare_launch_argument import (
     DeclareLaunchArgument,
 )
-from mindgrasp_bringup.launch_system.errors import LaunchError
-from mindgrasp_common.resources import ResourceNotFoundError, resolve_path
+from mindgrasp_launch.errors import LaunchError
 
 __all__ = ['CheckedLaunchArgument', 'FileLaunchArgument', 'NumberLaunchArgument',
            'check_number', 'checked_argument', 'file_argument', 'number_argument']
@@ -75,7 +75,7 @@ class NumberLaunchArgument(DeclareLaunchArgument):
 def number_argument(name: str, *, default_value: str, description: str, kind: type = int,
                     minimum: float | None = None, maximum: float | None = None) -> Any:
     """Declare ``name`` as a number argument (see the module docstring)."""
-    from mindgrasp_bringup import launch_api
+    from mindgrasp_launch import launch_api
 
     if launch_api.using_real_launch():
         return launch_api.DeclareLaunchArgument(name, default_value=default_value,
@@ -108,7 +108,7 @@ class FileLaunchArgument(DeclareLaunchArgument):
 
 def file_argument(name: str, *, default_value: str, description: str) -> Any:
     """Declare ``name`` as a file argument (see the module docstring)."""
-    from mindgrasp_bringup import launch_api
+    from mindgrasp_launch import launch_api
 
     if launch_api.using_real_launch():
         return launch_api.DeclareLaunchArgument(name, default_value=default_value,
@@ -138,7 +138,7 @@ def checked_argument(name: str, *, check: Callable[[str], object], default_value
                      description: str) -> Any:
     """Declare ``name`` with a value check (see the module docstring): ``check(text)`` raises
     with a message naming the valid values when ``text`` is not one."""
-    from mindgrasp_bringup import launch_api
+    from mindgrasp_launch import launch_api
 
     if launch_api.using_real_launch():
         return launch_api.DeclareLaunchArgument(name, default_value=default_value,

@@ -20,9 +20,9 @@ from typing import Any
 
 import yaml
 
-from mindgrasp_bringup.launch_system.errors import LaunchError
 from mindgrasp_common.cli_checks import yaml_error_text
 from mindgrasp_common.resources import ResourceNotFoundError, resource_path
+from mindgrasp_launch.errors import LaunchError
 
 PARAMS_KEY = 'ros__parameters'
 _SCALARS = (bool, int, float, str, bytes)

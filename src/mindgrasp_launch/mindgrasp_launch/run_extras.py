@@ -1,9 +1,9 @@
 """What every launch gets around its nodes: the run directory, the recorder and a duration limit.
 
-``mindgrasp launch`` adds them to any launch file (:mod:`~mindgrasp_bringup.launch_system.service`);
+``mindgrasp launch`` adds them to any launch file (:mod:`~mindgrasp_launch.service`);
 under ``ros2 launch`` the profiles carry them as ordinary actions
-(:func:`~mindgrasp_bringup.launch_system.common.run_directory_actions`,
-:class:`mindgrasp_bringup.launch_ros_extras.RunDirectory`). Both read the same launch arguments
+(:func:`~mindgrasp_launch.common.run_directory_actions`,
+:class:`mindgrasp_launch.launch_ros_extras.RunDirectory`). Both read the same launch arguments
 through the functions here, so ``record_topics:=...`` or ``duration:=30`` mean the same under both.
 """
 
@@ -16,11 +16,11 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from mindgrasp_bringup.launch_system import rundir
-from mindgrasp_bringup.launch_system.actions.declare_launch_argument import DeclareLaunchArgument
-from mindgrasp_bringup.launch_system.conditions import evaluate_bool
-from mindgrasp_bringup.launch_system.errors import LaunchError
 from mindgrasp_common.safe_files import DeferredWriter
+from mindgrasp_launch import rundir
+from mindgrasp_launch.actions.declare_launch_argument import DeclareLaunchArgument
+from mindgrasp_launch.conditions import evaluate_bool
+from mindgrasp_launch.errors import LaunchError
 
 RECORDER_PACKAGE = 'mindgrasp_bag'
 RECORDER_EXECUTABLE = 'recorder_node'

@@ -30,9 +30,9 @@ from typing import Any
 
 import yaml
 
-from mindgrasp_bringup.launch_system.errors import LaunchError
 from mindgrasp_common.resources import resource_path
 from mindgrasp_common.safe_files import write_atomic
+from mindgrasp_launch.errors import LaunchError
 
 DIST_NAME = 'mindgrasp-ros'
 _ENV_KEYS = ('ROS_DOMAIN_ID', 'ROS_AUTOMATIC_DISCOVERY_RANGE', 'ROS_STATIC_PEERS',

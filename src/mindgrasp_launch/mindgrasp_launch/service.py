@@ -18,25 +18,26 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from mindgrasp_bringup.launch_system import params as ros_params
-from mindgrasp_bringup.launch_system import rundir
-from mindgrasp_bringup.launch_system.actions.declare_launch_argument import DeclareLaunchArgument
-from mindgrasp_bringup.launch_system.actions.execute_process import ProcessSpec
-from mindgrasp_bringup.launch_system.actions.node import Node
-from mindgrasp_bringup.launch_system.context import LaunchContext
-from mindgrasp_bringup.launch_system.description import (
+from mindgrasp_common.safe_files import DeferredWriter
+from mindgrasp_launch import params as ros_params
+from mindgrasp_launch import rundir
+from mindgrasp_launch.actions.declare_launch_argument import DeclareLaunchArgument
+from mindgrasp_launch.actions.execute_process import ProcessSpec
+from mindgrasp_launch.actions.node import Node
+from mindgrasp_launch.context import LaunchContext
+from mindgrasp_launch.description import (
     LaunchDescription,
     collect_arguments,
     find_launch_file,
     load_launch_file,
 )
-from mindgrasp_bringup.launch_system.errors import LaunchError
-from mindgrasp_bringup.launch_system.output import (
+from mindgrasp_launch.errors import LaunchError
+from mindgrasp_launch.output import (
     Printer,
     configure_launch_logger,
     remove_handlers,
 )
-from mindgrasp_bringup.launch_system.run_extras import (
+from mindgrasp_launch.run_extras import (
     COMMON_ARGUMENTS,
     RECORDER_EXECUTABLE,
     RECORDER_NAME,
@@ -46,9 +47,8 @@ from mindgrasp_bringup.launch_system.run_extras import (
     recorder_outputs,
     recorder_parameters,
 )
-from mindgrasp_bringup.launch_system.run_report import write_run_report
-from mindgrasp_bringup.launch_system.supervisor import ProcessResult, Supervisor
-from mindgrasp_common.safe_files import DeferredWriter
+from mindgrasp_launch.run_report import write_run_report
+from mindgrasp_launch.supervisor import ProcessResult, Supervisor
 
 logger = logging.getLogger('launch')
 
@@ -290,7 +290,7 @@ class LaunchService:
                 raise LaunchError(msg) from None
             logger.info("run directory: %s", run_dir)
             if self.composed:
-                from mindgrasp_bringup.launch_system.composed import compose
+                from mindgrasp_launch.composed import compose
 
                 processes, commands = compose(processes, commands, run_dir)
             env = dict(os.environ)

@@ -13,10 +13,10 @@ from collections.abc import Iterable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from mindgrasp_bringup.launch_system.errors import LaunchError
+from mindgrasp_launch.errors import LaunchError
 
 if TYPE_CHECKING:
-    from mindgrasp_bringup.launch_system.context import LaunchContext
+    from mindgrasp_launch.context import LaunchContext
 
 
 class Substitution:
@@ -172,7 +172,7 @@ class CameraSpec(Substitution):
     ``CameraSpec(LaunchConfiguration('camera'), 'width')``: parsed, never evaluated."""
 
     def __init__(self, value: SomeSubstitutions, field: str) -> None:
-        from mindgrasp_bringup.launch_args import CAMERA_FIELDS
+        from mindgrasp_launch.launch_args import CAMERA_FIELDS
 
         if field not in CAMERA_FIELDS:
             msg = f'CameraSpec field {field!r} is unknown; use one of {CAMERA_FIELDS}.'
@@ -180,7 +180,7 @@ class CameraSpec(Substitution):
         self.value, self.field = value, field
 
     def perform(self, context: LaunchContext) -> str:
-        from mindgrasp_bringup.launch_args import CAMERA_FIELDS, parse_camera
+        from mindgrasp_launch.launch_args import CAMERA_FIELDS, parse_camera
 
         try:
             values = parse_camera(perform_substitutions(context, self.value))

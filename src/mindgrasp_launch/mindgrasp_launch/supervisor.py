@@ -29,8 +29,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO
 
-from mindgrasp_bringup.launch_system.actions.execute_process import ProcessSpec
-from mindgrasp_bringup.launch_system.output import Printer
+from mindgrasp_launch.actions.execute_process import ProcessSpec
+from mindgrasp_launch.output import Printer
 
 logger = logging.getLogger('launch')
 

@@ -11,7 +11,7 @@ for the EEG sample -> command timing.
 
 import sys
 
-import mindgrasp_bringup.launch_api as la
+import mindgrasp_launch.launch_api as la
 
 
 def generate_launch_description() -> la.LaunchDescription:

@@ -15,7 +15,7 @@ import os
 import sys
 from pathlib import Path
 
-from mindgrasp_bringup.launch_system.actions.node import find_module, resolve_program
+from mindgrasp_launch.actions.node import find_module, resolve_program
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

@@ -5,8 +5,8 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from mindgrasp_bringup.launch_system.conditions import Condition
-    from mindgrasp_bringup.launch_system.context import LaunchContext
+    from mindgrasp_launch.conditions import Condition
+    from mindgrasp_launch.context import LaunchContext
 
 
 class Action:

@@ -5,9 +5,9 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
-from mindgrasp_bringup.launch_system.actions.action import Action
-from mindgrasp_bringup.launch_system.errors import LaunchError
-from mindgrasp_bringup.launch_system.substitutions import (
+from mindgrasp_launch.actions.action import Action
+from mindgrasp_launch.errors import LaunchError
+from mindgrasp_launch.substitutions import (
     SomeSubstitutions,
     TextSubstitution,
     normalize,
@@ -15,7 +15,7 @@ from mindgrasp_bringup.launch_system.substitutions import (
 )
 
 if TYPE_CHECKING:
-    from mindgrasp_bringup.launch_system.context import LaunchContext
+    from mindgrasp_launch.context import LaunchContext
 
 
 class DeclareLaunchArgument(Action):

@@ -7,18 +7,18 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from mindgrasp_bringup.launch_system.actions.action import Action
-from mindgrasp_bringup.launch_system.actions.set_launch_configuration import Shutdown
-from mindgrasp_bringup.launch_system.conditions import evaluate_bool
-from mindgrasp_bringup.launch_system.errors import LaunchError
-from mindgrasp_bringup.launch_system.substitutions import (
+from mindgrasp_launch.actions.action import Action
+from mindgrasp_launch.actions.set_launch_configuration import Shutdown
+from mindgrasp_launch.conditions import evaluate_bool
+from mindgrasp_launch.errors import LaunchError
+from mindgrasp_launch.substitutions import (
     SomeSubstitutions,
     SplitArguments,
     perform_substitutions,
 )
 
 if TYPE_CHECKING:
-    from mindgrasp_bringup.launch_system.context import LaunchContext
+    from mindgrasp_launch.context import LaunchContext
 
 OUTPUTS = ('screen', 'log', 'both')
 

@@ -5,12 +5,12 @@ from __future__ import annotations
 from collections.abc import Iterable
 from typing import TYPE_CHECKING
 
-from mindgrasp_bringup.launch_system.actions.action import Action
-from mindgrasp_bringup.launch_system.errors import LaunchError
-from mindgrasp_bringup.launch_system.substitutions import SomeSubstitutions, perform_substitutions
+from mindgrasp_launch.actions.action import Action
+from mindgrasp_launch.errors import LaunchError
+from mindgrasp_launch.substitutions import SomeSubstitutions, perform_substitutions
 
 if TYPE_CHECKING:
-    from mindgrasp_bringup.launch_system.context import LaunchContext
+    from mindgrasp_launch.context import LaunchContext
 
 
 def join_namespace(base: str, namespace: str) -> str:
@@ -39,7 +39,7 @@ class GroupAction(Action):
         return [a for a in self.actions if isinstance(a, Action)]
 
     def execute(self, context: LaunchContext) -> None:
-        from mindgrasp_bringup.launch_system.description import visit_entities
+        from mindgrasp_launch.description import visit_entities
 
         inner = context.scoped() if self.scoped else context
         for name, value in self.launch_configurations.items():

@@ -12,15 +12,15 @@ from typing import TYPE_CHECKING, Any
 
 import yaml
 
-from mindgrasp_bringup.launch_system import params as ros_params
-from mindgrasp_bringup.launch_system.actions.execute_process import (
+from mindgrasp_launch import params as ros_params
+from mindgrasp_launch.actions.execute_process import (
     ExecuteProcess,
     ProcessSpec,
     resolve_list,
 )
-from mindgrasp_bringup.launch_system.actions.group_action import join_namespace
-from mindgrasp_bringup.launch_system.errors import LaunchError
-from mindgrasp_bringup.launch_system.substitutions import (
+from mindgrasp_launch.actions.group_action import join_namespace
+from mindgrasp_launch.errors import LaunchError
+from mindgrasp_launch.substitutions import (
     SomeSubstitutions,
     Substitution,
     is_substitution,
@@ -28,7 +28,7 @@ from mindgrasp_bringup.launch_system.substitutions import (
 )
 
 if TYPE_CHECKING:
-    from mindgrasp_bringup.launch_system.context import LaunchContext
+    from mindgrasp_launch.context import LaunchContext
 
 ParameterItem = str | Path | Substitution | Mapping[str, Any]
 

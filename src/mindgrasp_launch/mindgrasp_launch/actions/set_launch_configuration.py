@@ -5,11 +5,11 @@ from __future__ import annotations
 import logging
 from typing import TYPE_CHECKING
 
-from mindgrasp_bringup.launch_system.actions.action import Action
-from mindgrasp_bringup.launch_system.substitutions import SomeSubstitutions, perform_substitutions
+from mindgrasp_launch.actions.action import Action
+from mindgrasp_launch.substitutions import SomeSubstitutions, perform_substitutions
 
 if TYPE_CHECKING:
-    from mindgrasp_bringup.launch_system.context import LaunchContext
+    from mindgrasp_launch.context import LaunchContext
 
 logger = logging.getLogger('launch')
 
@@ -47,7 +47,7 @@ class SetParameter(Action):
         self.value = value
 
     def execute(self, context: LaunchContext) -> None:
-        from mindgrasp_bringup.launch_system.actions.node import resolve_parameter_value
+        from mindgrasp_launch.actions.node import resolve_parameter_value
 
         context.global_parameters[self.name] = resolve_parameter_value(context, self.value)
 
@@ -75,6 +75,6 @@ class Shutdown(Action):
 
     def execute(self, context: LaunchContext) -> None:
         msg = 'Shutdown() is only supported as on_exit=Shutdown() of a Node or ExecuteProcess.'
-        from mindgrasp_bringup.launch_system.errors import LaunchError
+        from mindgrasp_launch.errors import LaunchError
 
         raise LaunchError(msg)

@@ -7,10 +7,10 @@ import ast
 import shlex
 import sys
 
-from mindgrasp_bringup.launch_system import LaunchError, LaunchService, profiles
-from mindgrasp_bringup.launch_system.description import LAUNCH_SUFFIX, PROFILE_DIR
-from mindgrasp_bringup.launch_system.service import format_arguments
 from mindgrasp_common.cli_checks import OneLineParser, non_negative_float, positive_float
+from mindgrasp_launch import LaunchError, LaunchService, profiles
+from mindgrasp_launch.description import LAUNCH_SUFFIX, PROFILE_DIR
+from mindgrasp_launch.service import format_arguments
 
 EPILOG = """examples:
   mindgrasp launch demo                      headless demo, recorded to runs/<UTC time>_demo/
@@ -94,8 +94,8 @@ def _run_lockstep(args: argparse.Namespace, service: LaunchService,
                   launch_arguments: list[str]) -> int:
     """``--lockstep``: every node composed on simulated time (mindgrasp_experiments.engine);
     ``duration:=S`` counts simulated seconds. Returns 1 when a node failed."""
-    from mindgrasp_bringup.launch_system import rundir
-    from mindgrasp_bringup.launch_system.lockstep import (
+    from mindgrasp_launch import rundir
+    from mindgrasp_launch.lockstep import (
         check_left_out_nodes,
         lockstep_components,
         run_lockstep,
@@ -115,7 +115,7 @@ def _run_lockstep(args: argparse.Namespace, service: LaunchService,
     os.environ['MINDGRASP_RUN_DIR'] = str(run_dir)
     code = run_lockstep(components, duration_s=duration)
     # every run directory has a report; simulated time has no latencies, and it says so
-    from mindgrasp_bringup.launch_system.run_report import write_run_report
+    from mindgrasp_launch.run_report import write_run_report
 
     write_run_report(run_dir, service.name)
     return code
