@@ -9,7 +9,6 @@ from pathlib import Path
 import pytest
 import yaml
 
-from mindgrasp_bringup.commands import launch as launch_cmd
 from mindgrasp_launch import (
     DeclareLaunchArgument,
     EnvironmentVariable,
@@ -32,6 +31,7 @@ from mindgrasp_launch import (
     profiles,
 )
 from mindgrasp_launch import params as ros_params
+from mindgrasp_launch.commands import launch as launch_cmd
 from mindgrasp_launch.service import format_arguments, parse_launch_arguments
 
 HERE = Path(__file__).resolve().parent
