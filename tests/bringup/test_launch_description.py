@@ -345,7 +345,7 @@ def test_bad_launch_files(tmp_path: Path) -> None:
 
 
 def test_cli_show_args_list_and_errors(capsys: pytest.CaptureFixture[str]) -> None:
-    from mindgrasp_bringup.cli import main
+    from mindgrasp_cli.cli import main
 
     assert main(['launch', '--list']) == 0
     assert 'demo' in capsys.readouterr().out

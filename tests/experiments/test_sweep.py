@@ -33,7 +33,7 @@ JSON_KEYS = ('accuracy', 'trials', 'interrupted_trials', 'success_rate',
 
 
 def mindgrasp(*args: str, timeout: float = 1500.0) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', *args],
+    return subprocess.run([sys.executable, '-m', 'mindgrasp_cli', *args],
                           capture_output=True, text=True, timeout=timeout,
                           env=dict(os.environ), check=False)
 

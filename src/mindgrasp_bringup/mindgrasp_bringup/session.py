@@ -409,7 +409,7 @@ class Session:
             pfile.write_text(yaml.safe_dump({n: {'ros__parameters': v} for n, v in
                                              params.items()}, sort_keys=False), encoding='utf-8')
             env['MINDGRASP_PARAMS_FILES'] = str(pfile)
-        cmd = [sys.executable, '-m', 'mindgrasp_bringup', 'launch', phase.profile,
+        cmd = [sys.executable, '-m', 'mindgrasp_cli', 'launch', phase.profile,
                *(['--lockstep'] if lockstep else []),
                '--run-dir', str(run_dir), *(f'{k}:={v}' for k, v in args.items())]
         return subprocess.call(cmd, env=env)

@@ -1,7 +1,7 @@
-"""``python -m mindgrasp_bringup`` is the ``mindgrasp`` command."""
+"""``python -m mindgrasp_cli`` is the ``mindgrasp`` command."""
 
 import sys
 
-from mindgrasp_bringup.cli import main
+from mindgrasp_cli.cli import main
 
 sys.exit(main())

@@ -26,7 +26,7 @@ def generate_launch_description() -> la.LaunchDescription:
         *la.classifier_nodes(la.config_files('classifier', 'demo')),
         la.Node(package='mindgrasp_fsm', executable='fsm_node', name='fsm',
                 parameters=la.config_files('fsm', 'demo')),
-        la.ExecuteProcess(cmd=[sys.executable, '-m', 'mindgrasp_bringup', 'topic', 'echo',
+        la.ExecuteProcess(cmd=[sys.executable, '-m', 'mindgrasp_cli', 'topic', 'echo',
                                '/bci/prediction', 'mindgrasp_msgs/msg/MIPrediction', '--times',
                                predictions, '--field', 'class_index'],
                           name='enough_predictions',

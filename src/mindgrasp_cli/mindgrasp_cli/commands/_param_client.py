@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from mindgrasp_bringup.ros_cli import CliError
+from mindgrasp_cli.ros_cli import CliError
 
 
 def call(node: Any, target: str, service: str, request: Any, timeout_s: float = 10.0,

@@ -6,7 +6,7 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
-from mindgrasp_bringup.ros_cli import is_hidden_name, wait_for_graph
+from mindgrasp_cli.ros_cli import is_hidden_name, wait_for_graph
 from mindgrasp_common.cli_checks import non_negative_float
 
 

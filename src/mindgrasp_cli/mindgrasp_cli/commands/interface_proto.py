@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import argparse
 
-from mindgrasp_bringup.ros_cli import UsageError, message_to_yaml, print_error
+from mindgrasp_cli.ros_cli import UsageError, message_to_yaml, print_error
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

@@ -12,7 +12,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from mindgrasp_bringup.ros_cli import UsageError, print_error
+from mindgrasp_cli.ros_cli import UsageError, print_error
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

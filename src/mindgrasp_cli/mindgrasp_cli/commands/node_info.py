@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from mindgrasp_bringup.ros_cli import cli_node, node_name, print_error, wait_for_graph
+from mindgrasp_cli.ros_cli import cli_node, node_name, print_error, wait_for_graph
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

@@ -8,8 +8,8 @@ from __future__ import annotations
 
 import argparse
 
-from mindgrasp_bringup.commands._param_client import call
-from mindgrasp_bringup.ros_cli import CliError, cli_node, node_name, print_error
+from mindgrasp_cli.commands._param_client import call
+from mindgrasp_cli.ros_cli import CliError, cli_node, node_name, print_error
 
 TYPE_NAMES = {0: 'not set', 1: 'boolean', 2: 'integer', 3: 'double', 4: 'string',
               5: 'byte array', 6: 'boolean array', 7: 'integer array', 8: 'double array',

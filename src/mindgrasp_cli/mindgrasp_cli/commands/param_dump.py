@@ -14,8 +14,8 @@ from typing import Any
 
 import yaml
 
-from mindgrasp_bringup.commands._param_client import call
-from mindgrasp_bringup.ros_cli import CliError, cli_node, print_error
+from mindgrasp_cli.commands._param_client import call
+from mindgrasp_cli.ros_cli import CliError, cli_node, print_error
 from mindgrasp_common.cli_checks import existing_directory
 
 

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import argparse
 
-from mindgrasp_bringup.commands._param_client import call
-from mindgrasp_bringup.ros_cli import CliError, cli_node, node_name, print_error
+from mindgrasp_cli.commands._param_client import call
+from mindgrasp_cli.ros_cli import CliError, cli_node, node_name, print_error
 
 TYPE_LABELS = {1: 'Boolean', 2: 'Integer', 3: 'Double', 4: 'String', 5: 'Byte array',
                6: 'Boolean array', 7: 'Integer array', 8: 'Double array', 9: 'String array'}

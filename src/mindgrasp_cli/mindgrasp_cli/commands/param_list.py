@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import argparse
 
-from mindgrasp_bringup.commands._param_client import call
-from mindgrasp_bringup.ros_cli import CliError, cli_node, node_name, print_error
+from mindgrasp_cli.commands._param_client import call
+from mindgrasp_cli.ros_cli import CliError, cli_node, node_name, print_error
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

@@ -14,8 +14,8 @@ import argparse
 import sys
 from pathlib import Path
 
-from mindgrasp_bringup.commands._param_client import call
-from mindgrasp_bringup.ros_cli import CliError, UsageError, cli_node, print_error
+from mindgrasp_cli.commands._param_client import call
+from mindgrasp_cli.ros_cli import CliError, UsageError, cli_node, print_error
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

@@ -6,8 +6,8 @@ import argparse
 
 import yaml
 
-from mindgrasp_bringup.commands._param_client import call
-from mindgrasp_bringup.ros_cli import CliError, UsageError, cli_node, node_name, print_error
+from mindgrasp_cli.commands._param_client import call
+from mindgrasp_cli.ros_cli import CliError, UsageError, cli_node, node_name, print_error
 from mindgrasp_common.cli_checks import yaml_error_text
 
 

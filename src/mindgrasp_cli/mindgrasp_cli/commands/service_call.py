@@ -16,7 +16,7 @@ from typing import Any
 
 import yaml
 
-from mindgrasp_bringup.ros_cli import CliError, UsageError, cli_node, print_error, set_fields
+from mindgrasp_cli.ros_cli import CliError, UsageError, cli_node, print_error, set_fields
 from mindgrasp_common.cli_checks import positive_float
 
 

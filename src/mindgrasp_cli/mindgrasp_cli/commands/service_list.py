@@ -7,8 +7,8 @@ from __future__ import annotations
 
 import argparse
 
-from mindgrasp_bringup.commands._services import add_graph_arguments, service_names_and_types
-from mindgrasp_bringup.ros_cli import cli_node, print_names_and_types
+from mindgrasp_cli.commands._services import add_graph_arguments, service_names_and_types
+from mindgrasp_cli.ros_cli import cli_node, print_names_and_types
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

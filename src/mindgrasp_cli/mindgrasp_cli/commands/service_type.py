@@ -8,8 +8,8 @@ from __future__ import annotations
 
 import argparse
 
-from mindgrasp_bringup.commands._services import add_graph_arguments, service_names_and_types
-from mindgrasp_bringup.ros_cli import CliError, cli_node, print_error
+from mindgrasp_cli.commands._services import add_graph_arguments, service_names_and_types
+from mindgrasp_cli.ros_cli import CliError, cli_node, print_error
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import time
 
-from mindgrasp_bringup.ros_cli import (
+from mindgrasp_cli.ros_cli import (
     CliError,
     cli_node,
     find_topic_type,

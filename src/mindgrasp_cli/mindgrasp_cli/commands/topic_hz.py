@@ -8,7 +8,7 @@ from collections import deque
 
 import numpy as np
 
-from mindgrasp_bringup.ros_cli import (
+from mindgrasp_cli.ros_cli import (
     CliError,
     cli_node,
     find_topic_type,

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from mindgrasp_bringup.ros_cli import cli_node, print_names_and_types, wait_for_graph
+from mindgrasp_cli.ros_cli import cli_node, print_names_and_types, wait_for_graph
 from mindgrasp_common.cli_checks import non_negative_float
 
 

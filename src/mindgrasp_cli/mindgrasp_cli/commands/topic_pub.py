@@ -7,7 +7,7 @@ import time
 
 import yaml
 
-from mindgrasp_bringup.ros_cli import (
+from mindgrasp_cli.ros_cli import (
     CliError,
     UsageError,
     cli_node,
