@@ -210,11 +210,15 @@ def test_colcon_installs_executables_and_share_files(workspace: Path) -> None:
         sourced(workspace, sys.executable, '-c',
                 'from mindgrasp_common.resources import resource_path as r; '
                 'print(r("mindgrasp_fsm", "param/fsm.yaml")); print(r("mindgrasp_sim", "scenes")); '
-                'print(r("mindgrasp_bringup", "param/demo.yaml"))'),
+                'print(r("mindgrasp_bringup", "param/demo.yaml")); '
+                'print(r("mindgrasp_sim", "robots/xarm6.yaml")); '
+                'print(r("mindgrasp_sim", "urdf/mindgrasp_arm.urdf"))'),
         env=workspace_env(), capture_output=True, text=True, timeout=120, check=False)
     assert found.returncode == 0, found.stderr
     assert found.stdout.split() == [str(config / 'param' / 'fsm.yaml'), str(config / 'scenes'),
-                                    str(config / 'profiles' / 'demo.yaml')]
+                                    str(config / 'profiles' / 'demo.yaml'),
+                                    str(config / 'robots' / 'xarm6.yaml'),
+                                    str(config / 'robots' / 'urdf' / 'mindgrasp_arm.urdf')]
     cli = install / 'mindgrasp_cli' / 'lib' / 'mindgrasp_cli' / 'mindgrasp'
     help_run = subprocess.run(sourced(workspace, str(cli), '--help'), env=workspace_env(),
                               capture_output=True, text=True, timeout=120, check=False)
