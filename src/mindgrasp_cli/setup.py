@@ -1,24 +1,15 @@
 """ament_python package for colcon build; the root pyproject.toml also installs it.
 
-Metadata is in setup.cfg. The package has no data files: it installs its modules, package.xml,
-the ament index marker and the ``mindgrasp`` console script (the root setup.py installs the same
-script and every package's ``mindgrasp.*`` entry points for the root install).
+Metadata and the data files (package.xml, the ament index marker) are in setup.cfg, the
+description copied from package.xml; here only what the root setup.py reads too, the entry
+points: the ``mindgrasp`` console script (installed to lib/mindgrasp_cli/ by colcon, to the
+virtualenv's bin/ by the root install) and the command line's own commands and verbs.
 """
-
-import re
-from pathlib import Path
 
 from setuptools import find_packages, setup
 
-package_name = 'mindgrasp_cli'
-package_xml = (Path(__file__).resolve().parent / 'package.xml').read_text(encoding='utf-8')
-
 setup(
     packages=find_packages(exclude=['test']),
-    data_files=[('share/ament_index/resource_index/packages', ['resource/' + package_name]),
-                ('share/' + package_name, ['package.xml'])],
-    # one description: package.xml's
-    description=re.search(r'<description>(.*?)</description>', package_xml, re.S).group(1),
     entry_points={
         'console_scripts': [
             'mindgrasp = mindgrasp_cli.cli:main',

@@ -44,7 +44,7 @@ def test_sim_launch_runs_and_records(tmp_path):
     run_dir = tmp_path / 'run'
     topics = ('/joint_states', '/camera/color/image_raw', '/camera/depth/image_raw',
               '/camera/color/camera_info', '/ee_pose', '/sim/objects', '/clock')
-    launch = NodeProcess('mindgrasp_bringup', ['launch', 'sim', 'time_mode:=fast', '--run-dir',
+    launch = NodeProcess('mindgrasp_cli', ['launch', 'sim', 'time_mode:=fast', '--run-dir',
                                                str(run_dir)],
                          dict(os.environ), tmp_path / 'launch.log')
     try:

@@ -87,7 +87,7 @@ def create_run_dir(profile: str, run_dir: str | Path | None = None,
 
 def _source_dir() -> Path:
     """Where the running code lives (git finds the checkout enclosing it, if any)."""
-    return resource_path('mindgrasp_bringup')
+    return resource_path('mindgrasp_launch')
 
 
 def _git(*args: str) -> str | None:
