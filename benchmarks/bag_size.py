@@ -32,7 +32,7 @@ from pathlib import Path
 import psutil
 
 from mindgrasp_bag import BagReader, BagWriter
-from mindgrasp_bringup.launch_system.run_extras import DEFAULT_RECORD_EXCLUDE
+from mindgrasp_launch.run_extras import DEFAULT_RECORD_EXCLUDE
 
 COMPRESSIONS = ('none', 'lz4', 'zstd')
 
@@ -45,7 +45,7 @@ def record(profile: str, duration: float, run_dir: Path, arguments: list[str]
            ) -> tuple[Path, float]:
     """Launch ``profile`` for ``duration`` s; its bag and the recorder process's CPU seconds
     (sampled every 0.2 s until it ends, so the last ~0.2 s of closing may be missed)."""
-    cmd = [sys.executable, '-m', 'mindgrasp_bringup', 'launch', profile, f'duration:={duration}',
+    cmd = [sys.executable, '-m', 'mindgrasp_cli', 'launch', profile, f'duration:={duration}',
            *arguments, '--run-dir', str(run_dir)]
     print(f'recording: {" ".join(cmd[2:])}', flush=True)
     launch = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)

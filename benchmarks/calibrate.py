@@ -24,7 +24,7 @@ from pathlib import Path
 def calibrate(root: Path, trials_per_class: int, accuracy: float, *,
               realtime: bool) -> dict:
     """One ``mindgrasp session calibrate --json`` run in ``root``; its JSON result."""
-    cmd = [sys.executable, '-m', 'mindgrasp_bringup', 'session', 'calibrate', '--subject', 'B01',
+    cmd = [sys.executable, '-m', 'mindgrasp_cli', 'session', 'calibrate', '--subject', 'B01',
            '--root', str(root), '--virtual-accuracy', str(accuracy),
            '--trials-per-class', str(trials_per_class), '--json']
     if realtime:

@@ -46,7 +46,7 @@ class Demo:
     """A live ``mindgrasp launch demo`` in its own process group, its output collected."""
 
     def __init__(self, run_dir: Path) -> None:
-        cmd = [sys.executable, '-m', 'mindgrasp_bringup', 'launch', 'demo', 'trials:=1',
+        cmd = [sys.executable, '-m', 'mindgrasp_cli', 'launch', 'demo', 'trials:=1',
                'duration:=600', 'live_view:=false', 'record:=false',
                f'eeg_stream:=mg-faults-{uuid.uuid4().hex[:8]}', '--run-dir', str(run_dir)]
         self.proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,

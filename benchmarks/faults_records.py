@@ -44,7 +44,7 @@ DAMAGES = {'cut in half': cut_in_half, 'three damaged chunks': damage_chunks}
 
 def _mindgrasp(*args: str, env: dict[str, str] | None = None,
                timeout: float = 1200) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', *args], capture_output=True,
+    return subprocess.run([sys.executable, '-m', 'mindgrasp_cli', *args], capture_output=True,
                           text=True, env=env, timeout=timeout, check=False)
 
 

@@ -40,7 +40,7 @@ def _burn() -> None:
 
 def run_demo(run_dir: Path, timeout: float) -> None:
     """``mindgrasp launch demo`` with one grasp trial, recorded to ``run_dir``."""
-    cmd = [sys.executable, '-m', 'mindgrasp_bringup', 'launch', 'demo', 'trials:=1',
+    cmd = [sys.executable, '-m', 'mindgrasp_cli', 'launch', 'demo', 'trials:=1',
            'duration:=300', 'live_view:=false', f'eeg_stream:=mg-latency-{uuid.uuid4().hex[:8]}',
            'targets:=red cube', '--run-dir', str(run_dir)]
     res = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, check=False)
@@ -52,9 +52,9 @@ def run_demo(run_dir: Path, timeout: float) -> None:
 
 def latency(run_dir: Path) -> dict:
     """The run's ``mindgrasp bag latency --json`` object (text report printed too)."""
-    text = subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', 'bag', 'latency',
+    text = subprocess.run([sys.executable, '-m', 'mindgrasp_cli', 'bag', 'latency',
                            str(run_dir)], capture_output=True, text=True, check=False)
-    res = subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', 'bag', 'latency',
+    res = subprocess.run([sys.executable, '-m', 'mindgrasp_cli', 'bag', 'latency',
                           str(run_dir), '--json'], capture_output=True, text=True, check=False)
     if res.returncode != 0:
         raise SystemExit(res.stderr.strip())

@@ -130,7 +130,7 @@ def main() -> int:
                           f'    poll_period: {args.poll_period}\n', encoding='utf-8')
         env['MINDGRASP_PARAMS_FILES'] = str(params)
     stream = f'mg-live-view-bench-{uuid.uuid4().hex[:8]}'  # LSL names are host-wide
-    cmd = [sys.executable, '-m', 'mindgrasp_bringup', 'launch', 'demo', 'trials:=0',
+    cmd = [sys.executable, '-m', 'mindgrasp_cli', 'launch', 'demo', 'trials:=0',
            'record:=false', f'live_view_port:={port}', f'eeg_stream:={stream}',
            f'duration:={args.warmup + 3 * args.seconds + 40}', '--run-dir', str(run_dir)]
     launcher = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,

@@ -183,7 +183,7 @@ def cli_env() -> dict[str, str]:
 
 def mindgrasp_cli(*args: str, timeout: float = 300) -> subprocess.CompletedProcess:
     """``mindgrasp ARGS`` in a child process, to its end (text stdout/stderr)."""
-    return subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', *args],
+    return subprocess.run([sys.executable, '-m', 'mindgrasp_cli', *args],
                           capture_output=True, text=True, env=cli_env(), timeout=timeout)
 
 

@@ -54,34 +54,13 @@ setup(
         'console_scripts': [
             'foxglove_bridge_node = mindgrasp_bringup.foxglove_bridge_node:main',
             'replay_node = mindgrasp_bringup.replay.replay_node:main',
-            'mindgrasp = mindgrasp_bringup.cli:main',
         ],
-        # the mindgrasp command's own commands and verbs (cli.py discovers them, as ros2cli does)
+        # this package's command and verbs of the mindgrasp command (mindgrasp_cli discovers
+        # them, as ros2cli does)
         'mindgrasp.command': [
-            'launch = mindgrasp_bringup.commands.launch',
-            'run = mindgrasp_bringup.commands.run',
             'replay = mindgrasp_bringup.commands.replay',
         ],
         'mindgrasp.verb': [
-            'topic list = mindgrasp_bringup.commands.topic_list',
-            'topic echo = mindgrasp_bringup.commands.topic_echo',
-            'topic hz = mindgrasp_bringup.commands.topic_hz',
-            'topic info = mindgrasp_bringup.commands.topic_info',
-            'topic pub = mindgrasp_bringup.commands.topic_pub',
-            'node list = mindgrasp_bringup.commands.node_list',
-            'node info = mindgrasp_bringup.commands.node_info',
-            'service list = mindgrasp_bringup.commands.service_list',
-            'service type = mindgrasp_bringup.commands.service_type',
-            'service call = mindgrasp_bringup.commands.service_call',
-            'interface list = mindgrasp_bringup.commands.interface_list',
-            'interface show = mindgrasp_bringup.commands.interface_show',
-            'interface proto = mindgrasp_bringup.commands.interface_proto',
-            'param list = mindgrasp_bringup.commands.param_list',
-            'param get = mindgrasp_bringup.commands.param_get',
-            'param set = mindgrasp_bringup.commands.param_set',
-            'param describe = mindgrasp_bringup.commands.param_describe',
-            'param dump = mindgrasp_bringup.commands.param_dump',
-            'param load = mindgrasp_bringup.commands.param_load',
             'session run = mindgrasp_bringup.session_cli',
             'session resume = mindgrasp_bringup.session_cli',
             'session calibrate = mindgrasp_bringup.session_cli',

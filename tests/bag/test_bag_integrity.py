@@ -120,7 +120,7 @@ def test_bag_info_and_play_accept_a_run_directory_and_play_shows_progress(tmp_pa
     assert by_run.returncode == 0 and by_run.stdout == by_bag.stdout
     assert 'Count:      20' in by_run.stdout
     lines: list[str] = []
-    proc = subprocess.Popen([sys.executable, '-m', 'mindgrasp_bringup', 'bag', 'play', str(run),
+    proc = subprocess.Popen([sys.executable, '-m', 'mindgrasp_cli', 'bag', 'play', str(run),
                              '--delay', '0.2'], stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                             text=True, env=cli_env())
     reader = threading.Thread(target=lambda: lines.extend(proc.stdout), daemon=True)

@@ -13,7 +13,7 @@ import yaml
 from mcap.reader import make_reader
 
 from mindgrasp_bag import BagReader
-from mindgrasp_bringup.launch_system.run_extras import DEFAULT_RECORD_EXCLUDE
+from mindgrasp_launch.run_extras import DEFAULT_RECORD_EXCLUDE
 from mindgrasp_trainer.graz import GrazProtocol
 
 # short Graz timing: 2 trials take ~5 simulated seconds; a few /trainer/display frames, which
@@ -63,7 +63,7 @@ def test_lockstep_components_compose_the_launchs_recorder(tmp_path: Path) -> Non
     """The recorder of a live launch (same topics argument), writing the given bag; none without
     a bag (the experiments) or with record:=false."""
     from mindgrasp_bag.recorder_node import RecorderNode
-    from mindgrasp_bringup.launch_system.lockstep import lockstep_components
+    from mindgrasp_launch.lockstep import lockstep_components
 
     def recorders(args: dict, bag: Path | None) -> list:
         comps = lockstep_components('graz', args, tmp_path / 'params', bag=bag)
@@ -85,7 +85,7 @@ def test_lockstep_components_compose_the_launchs_recorder(tmp_path: Path) -> Non
 
 def test_lockstep_refuses_an_lsl_amplifier_with_one_line(tmp_path: Path) -> None:
     result = subprocess.run(
-        [sys.executable, '-m', 'mindgrasp_bringup', 'launch', 'graz', 'amp:=lsl',
+        [sys.executable, '-m', 'mindgrasp_cli', 'launch', 'graz', 'amp:=lsl',
          'eeg_stream:=MyAmp', '--lockstep', '--run-dir', str(tmp_path / 'run')],
         capture_output=True, text=True, timeout=300, check=False)
     assert result.returncode == 2
@@ -100,7 +100,7 @@ def test_lockstep_refuses_an_lsl_amplifier_with_one_line(tmp_path: Path) -> None
 def launch_graz(run_dir: Path, params_file: Path) -> subprocess.CompletedProcess:
     env = dict(os.environ, MINDGRASP_PARAMS_FILES=str(params_file))
     return subprocess.run(
-        [sys.executable, '-m', 'mindgrasp_bringup', 'launch', 'graz', 'trials:=2', 'seed:=5',
+        [sys.executable, '-m', 'mindgrasp_cli', 'launch', 'graz', 'trials:=2', 'seed:=5',
          '--lockstep', '--run-dir', str(run_dir)],
         capture_output=True, text=True, timeout=600, env=env, check=False)
 
@@ -114,7 +114,7 @@ def test_lockstep_launch_records_a_bag_on_sim_time(tmp_path: Path) -> None:
         result = launch_graz(tmp_path / name, params)
         assert result.returncode == 0, result.stdout[-2000:] + result.stderr[-2000:]
         runs.append(tmp_path / name / 'bag')
-    info = subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', 'bag', 'info',
+    info = subprocess.run([sys.executable, '-m', 'mindgrasp_cli', 'bag', 'info',
                            str(runs[0])], capture_output=True, text=True, timeout=300,
                           check=False)
     assert info.returncode == 0, info.stderr
@@ -155,7 +155,7 @@ def test_trainer_profile_in_lockstep_records_its_session(tmp_path: Path) -> None
 
     run_dir = tmp_path / 'run'
     result = subprocess.run(
-        [sys.executable, '-m', 'mindgrasp_bringup', 'launch', 'trainer', 'trials:=2', 'seed:=1',
+        [sys.executable, '-m', 'mindgrasp_cli', 'launch', 'trainer', 'trials:=2', 'seed:=1',
          '--lockstep', '--run-dir', str(run_dir)],
         capture_output=True, text=True, timeout=800, check=False)
     assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]

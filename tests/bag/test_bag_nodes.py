@@ -130,7 +130,7 @@ def test_recorder_node_records_discovered_topics_byte_exact(recorded):
 
 def test_bag_info_cli_prints_counts_rates_and_types(recorded):
     prefix, bag, _ = recorded
-    out = subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', 'bag', 'info', str(bag)],
+    out = subprocess.run([sys.executable, '-m', 'mindgrasp_cli', 'bag', 'info', str(bag)],
                          capture_output=True, text=True, env=_env(), timeout=60)
     assert out.returncode == 0, out.stderr
     n_text = int(N_EEG * 100 / 130)
@@ -142,7 +142,7 @@ def test_bag_info_cli_prints_counts_rates_and_types(recorded):
     # the first and last stamps of a short recording drifts: a loose bound, the count is exact
     assert 5.0 < rate < 20.0
     info = yaml.safe_load(subprocess.run(
-        [sys.executable, '-m', 'mindgrasp_bringup', 'bag', 'info', str(bag), '--yaml'],
+        [sys.executable, '-m', 'mindgrasp_cli', 'bag', 'info', str(bag), '--yaml'],
         capture_output=True, text=True, env=_env(), timeout=60).stdout)
     assert {t['name'] for t in info['topics']} == {f'{prefix}/eeg', f'{prefix}/chatter'}
 
@@ -155,7 +155,7 @@ def test_bag_play_cli_republishes_identical_bytes_with_original_timing(recorded)
     try:
         assert probe_out.wait_for('ready', 20), probe_out.lines
         play = subprocess.run(
-            [sys.executable, '-m', 'mindgrasp_bringup', 'bag', 'play', str(bag),
+            [sys.executable, '-m', 'mindgrasp_cli', 'bag', 'play', str(bag),
              '--remap', f'{prefix}/eeg:={out_prefix}/eeg', '--priority', '20', '--delay', '1.0',
              '--clock', '20'],
             capture_output=True, text=True, env=_env(), timeout=120)
@@ -188,7 +188,7 @@ def test_bag_play_cli_republishes_identical_bytes_with_original_timing(recorded)
 
 
 def test_bag_play_missing_bag_is_a_clear_error(tmp_path):
-    out = subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', 'bag', 'play',
+    out = subprocess.run([sys.executable, '-m', 'mindgrasp_cli', 'bag', 'play',
                           str(tmp_path / 'nope')], capture_output=True, text=True, env=_env(),
                          timeout=60)
     assert out.returncode == 2    # a bad argument: the node refuses to start
@@ -207,7 +207,7 @@ def test_recorder_node_full_disk_stops_recording_and_keeps_running(tmp_path):
     try:
         # Through the CLI this time: `mindgrasp bag record`.
         recorder, rec_out = _start([
-            sys.executable, '-m', 'mindgrasp_bringup', 'bag', 'record', '-o', str(mount / 'bag'),
+            sys.executable, '-m', 'mindgrasp_cli', 'bag', 'record', '-o', str(mount / 'bag'),
             '-e', f'^{prefix}/', '--flush-interval', '0.2', '--duration', '60'])
         assert rec_out.wait_for('Recording to', 20), rec_out.lines
         publisher, pub_out = _start([sys.executable, '-c', PUBLISHER, str(HERE), prefix, '30'])
@@ -235,7 +235,7 @@ def test_bag_record_bad_options_are_clear_errors(tmp_path):
             (['-e', '('], 2, 'The topic regular expression is not valid'),
             (['--compression', 'zstd', '--max-queue-mb', '0'], 2,
              'argument --max-queue-mb: must be >= 1, got 0')):
-        out = subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', 'bag', 'record',
+        out = subprocess.run([sys.executable, '-m', 'mindgrasp_cli', 'bag', 'record',
                               '-o', str(tmp_path / uuid.uuid4().hex), *extra],
                              capture_output=True, text=True, env=_env(), timeout=60)
         assert out.returncode == code and message in out.stderr, out.stderr

@@ -19,7 +19,7 @@ from rosbags.rosbag2 import Reader as RosbagsReader
 
 from conftest_bag import EEG, IMAGE, STRING, eeg_chunk, image, string
 from mindgrasp_bag import BagReader, BagWriter, Recorder
-from mindgrasp_bringup.cli import main as cli_main
+from mindgrasp_cli.cli import main as cli_main
 from mindgrasp_testing import small_tmpfs
 
 

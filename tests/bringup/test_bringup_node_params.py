@@ -16,8 +16,8 @@ import pytest
 
 from mindgrasp_bag.player_node import PlayerParams
 from mindgrasp_bag.recorder_node import RecorderParams
-from mindgrasp_bringup.launch_system import LaunchService
 from mindgrasp_bringup.replay.replay_node import ReplayParams
+from mindgrasp_launch import LaunchService
 from mindgrasp_ros.params import ParameterError, describe, from_mapping
 
 PARAMS = {'mindgrasp_bag.recorder_node': RecorderParams,

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from mindgrasp_bringup import cli
+from mindgrasp_cli import cli
 from mindgrasp_testing import root_setup
 
 SRC = Path(__file__).resolve().parents[2] / 'src'
@@ -60,7 +60,7 @@ def test_installed_commands_are_the_declared_ones_in_name_order() -> None:
 
 
 def test_cli_names_no_command_module() -> None:
-    text = (SRC / 'mindgrasp_bringup' / 'mindgrasp_bringup' / 'cli.py').read_text(encoding='utf-8')
+    text = (SRC / 'mindgrasp_cli' / 'mindgrasp_cli' / 'cli.py').read_text(encoding='utf-8')
     code = re.sub(r'""".*?"""', '', text, flags=re.S)   # docstrings may give examples
     named = set(re.findall(r"'(mindgrasp_\w+(?:\.\w+)+)'", code))
     assert not named, f'cli.py names command modules: {sorted(named)}'
@@ -73,7 +73,7 @@ def test_cli_names_no_command_module() -> None:
 ])
 def test_help_lists_commands_and_verbs_in_order(argv: list[str], listed: list[str]) -> None:
     """The installed command, run as a user runs it."""
-    run = subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', *argv], capture_output=True,
+    run = subprocess.run([sys.executable, '-m', 'mindgrasp_cli', *argv], capture_output=True,
                          text=True, timeout=120, check=False)
     assert run.returncode == 0, run.stderr
     shown = re.findall(r'^    (\S+)', run.stdout.split('<command>' if argv == ['--help']
@@ -91,7 +91,7 @@ def test_an_install_without_entry_points_says_how_to_fix_it(tmp_path: Path) -> N
         if (site / name).exists():
             (libs / name).symlink_to(site / name)
     code = ('import sys; sys.path[:0] = sys.argv[1:]; '
-            'from mindgrasp_bringup.cli import main; sys.exit(main(["launch", "demo"]))')
+            'from mindgrasp_cli.cli import main; sys.exit(main(["launch", "demo"]))')
     run = subprocess.run([sys.executable, '-S', '-c', code,
                           *(str(p) for p in sorted(SRC.glob('mindgrasp_*'))), str(libs)],
                          cwd=tmp_path, capture_output=True, text=True, timeout=120, check=False)
@@ -103,11 +103,11 @@ def test_an_install_without_entry_points_says_how_to_fix_it(tmp_path: Path) -> N
 def test_help_imports_no_command_package() -> None:
     """``mindgrasp --help`` reads the commands' docstrings from their files: no package that
     registers a verb is imported (the bag package's ``__init__`` alone costs 140 ms)."""
-    code = ('import sys; from mindgrasp_bringup import cli; cli.build_parser(["--help"]); '
+    code = ('import sys; from mindgrasp_cli import cli; cli.build_parser(["--help"]); '
             'print(" ".join(sorted(m for m in sys.modules if m.startswith("mindgrasp_"))))')
     run = subprocess.run([sys.executable, '-c', code], capture_output=True, text=True,
                          timeout=120, check=True)
     imported = set(run.stdout.split())
     registering = {module.split('.')[0] for target in cli.commands().values()
                    for module in ([target] if isinstance(target, str) else target.values())}
-    assert not imported & (registering - {'mindgrasp_bringup'}), sorted(imported)
+    assert not imported & (registering - {'mindgrasp_cli'}), sorted(imported)

@@ -1,7 +1,7 @@
 """Bad input to any command or node ends in ONE stderr line naming the problem, no traceback, and
 a non-zero exit code (2 for usage errors, as argparse and ros2cli give it).
 
-The cases are made from the CLI's own table (:func:`mindgrasp_bringup.cli.commands`, so verbs added
+The cases are made from the CLI's own table (:func:`mindgrasp_cli.cli.commands`, so verbs added
 later are covered) and from every package's console scripts (the node executables): unknown
 flags, missing values, values of the wrong type or out of their choices, missing arguments,
 malformed ``--ros-args`` and parameter files. They run in-process and fail before any DDS traffic
@@ -21,7 +21,7 @@ from pathlib import Path
 
 import pytest
 
-from mindgrasp_bringup import cli
+from mindgrasp_cli import cli
 from mindgrasp_common.cli_checks import (
     finite_float,
     non_negative_float,
@@ -294,7 +294,7 @@ def test_every_node_refuses_bad_ros_args_in_one_line(target, bad_files, capsys):
 # -- a handful as real processes: the console script, its exit code and its stderr ---------------
 
 def _mindgrasp(*argv: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', *argv], capture_output=True,
+    return subprocess.run([sys.executable, '-m', 'mindgrasp_cli', *argv], capture_output=True,
                           text=True, timeout=120, check=False)
 
 

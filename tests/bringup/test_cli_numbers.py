@@ -7,7 +7,7 @@ import argparse
 
 import pytest
 
-from mindgrasp_bringup.cli import main as cli_main
+from mindgrasp_cli.cli import main as cli_main
 from mindgrasp_common.cli_checks import (
     non_negative_float,
     non_negative_int,

@@ -18,7 +18,7 @@ from pathlib import Path
 import pytest
 from catkin_pkg.package import parse_package
 
-from mindgrasp_bringup.launch_system.actions.node import node_module
+from mindgrasp_launch.actions.node import node_module
 from mindgrasp_testing import console_scripts, spin_until
 
 REPO = Path(__file__).resolve().parents[2]
@@ -77,6 +77,27 @@ def test_no_package_uses_a_package_that_depends_on_it() -> None:
     assert not cycles, '\n'.join(cycles)
 
 
+#: the layering of the packages that start and inspect a graph, as ROS's launch, ros2cli and a
+#: bringup package: the launcher uses neither the command line nor the launch files' package; the
+#: command line uses the launcher (``run``, ``--version``) but no launch file; bringup (launch
+#: files, replay, sessions) sits on both
+LAYERS = {'mindgrasp_launch': {'mindgrasp_cli', 'mindgrasp_bringup', 'mindgrasp_experiments'},
+          'mindgrasp_cli': {'mindgrasp_bringup', 'mindgrasp_experiments'},
+          'mindgrasp_bag': {'mindgrasp_launch', 'mindgrasp_cli', 'mindgrasp_bringup'}}
+
+
+@pytest.mark.parametrize('package', sorted(LAYERS))
+def test_launch_and_cli_use_no_package_above_them(package: str) -> None:
+    package_dir = SRC / package
+    above = (_used(package_dir) | _declared(package_dir)) & LAYERS[package]
+    assert not above, f'{package} uses {sorted(above)}, which sit above it'
+
+
+def test_bringup_sits_on_the_launcher_and_the_command_line() -> None:
+    declared = _declared(SRC / 'mindgrasp_bringup')
+    assert {'mindgrasp_launch', 'mindgrasp_cli', 'mindgrasp_bag'} <= declared
+
+
 def test_readme_layout_shows_every_package() -> None:
     """The root README's layout block names each package folder (and config/), and each package
     has a README of its own."""
@@ -121,7 +142,7 @@ def test_launch_files_name_installed_executables() -> None:
     scripts = {p.name: console_scripts(p) for p in PYTHON_PACKAGES}
     bringup = SRC / 'mindgrasp_bringup' / 'mindgrasp_bringup'
     files = [*sorted((bringup / 'launch').glob('*.launch.py')),
-             bringup / 'launch_system' / 'common.py']
+             SRC / 'mindgrasp_launch' / 'mindgrasp_launch' / 'common.py']
     pairs = set()
     for path in files:
         text = path.read_text(encoding='utf-8')
@@ -189,12 +210,16 @@ def test_colcon_installs_executables_and_share_files(workspace: Path) -> None:
         sourced(workspace, sys.executable, '-c',
                 'from mindgrasp_common.resources import resource_path as r; '
                 'print(r("mindgrasp_fsm", "param/fsm.yaml")); print(r("mindgrasp_sim", "scenes")); '
-                'print(r("mindgrasp_bringup", "param/demo.yaml"))'),
+                'print(r("mindgrasp_bringup", "param/demo.yaml")); '
+                'print(r("mindgrasp_sim", "robots/xarm6.yaml")); '
+                'print(r("mindgrasp_sim", "urdf/mindgrasp_arm.urdf"))'),
         env=workspace_env(), capture_output=True, text=True, timeout=120, check=False)
     assert found.returncode == 0, found.stderr
     assert found.stdout.split() == [str(config / 'param' / 'fsm.yaml'), str(config / 'scenes'),
-                                    str(config / 'profiles' / 'demo.yaml')]
-    cli = install / 'mindgrasp_bringup' / 'lib' / 'mindgrasp_bringup' / 'mindgrasp'
+                                    str(config / 'profiles' / 'demo.yaml'),
+                                    str(config / 'robots' / 'xarm6.yaml'),
+                                    str(config / 'robots' / 'urdf' / 'mindgrasp_arm.urdf')]
+    cli = install / 'mindgrasp_cli' / 'lib' / 'mindgrasp_cli' / 'mindgrasp'
     help_run = subprocess.run(sourced(workspace, str(cli), '--help'), env=workspace_env(),
                               capture_output=True, text=True, timeout=120, check=False)
     assert help_run.returncode == 0, help_run.stderr
@@ -202,13 +227,16 @@ def test_colcon_installs_executables_and_share_files(workspace: Path) -> None:
     # each installed package brings its own commands and verbs (entry points in its setup.py)
     registered = subprocess.run(
         sourced(workspace, sys.executable, '-c',
-                'import importlib.metadata as m; print(sorted({(e.name, e.dist.name) for e in '
-                'm.entry_points(group="mindgrasp.verb")}))'),
+                'import importlib.metadata as m; print(sorted({(e.name, e.dist.name) for g in '
+                '("mindgrasp.verb", "mindgrasp.command") for e in m.entry_points(group=g)}))'),
         env=workspace_env(), capture_output=True, text=True, timeout=120, check=True).stdout
-    for verb, package in [('bag record', 'mindgrasp_bag'), ('topic echo', 'mindgrasp_bringup'),
+    for verb, package in [('bag record', 'mindgrasp_bag'), ('topic echo', 'mindgrasp_cli'),
+                          ('session run', 'mindgrasp_bringup'),
                           ('train classifier', 'mindgrasp_classifier'),
                           ('train vision', 'mindgrasp_vision'),
-                          ('eeg fit-virtual', 'mindgrasp_experiments')]:
+                          ('eeg fit-virtual', 'mindgrasp_experiments'),
+                          ('launch', 'mindgrasp_launch'), ('run', 'mindgrasp_cli'),
+                          ('replay', 'mindgrasp_bringup')]:
         assert repr((verb, package)) in registered, registered
     # an installed node executable (ros2 run mindgrasp_fsm fsm_node --help): its docstring and
     # the ROS arguments, without starting the node

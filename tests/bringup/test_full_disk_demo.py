@@ -106,7 +106,7 @@ def test_demo_on_a_full_disk_keeps_every_record_and_tells_the_truth(small_disk, 
         assert sum(1 for _ in reader.messages()) == int(kept.group(1)) > 0
     # bag info on the full disk: reads, reports the cut file, writes nothing
     before = sorted(p.name for p in (run_dir / 'bag').iterdir())
-    info = subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', 'bag', 'info', str(run_dir)],
+    info = subprocess.run([sys.executable, '-m', 'mindgrasp_cli', 'bag', 'info', str(run_dir)],
                           capture_output=True, text=True, env=launch_env(), timeout=300)
     assert info.returncode == 1 and 'cut off' in info.stdout, info.stdout + info.stderr
     assert f'Readable:          {kept.group(1)} message(s) readable' in info.stdout

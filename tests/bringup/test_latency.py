@@ -21,7 +21,7 @@ from launch_fixtures.runner import fixture, launch_env, run_launch
 from conftest_bag import EEG, JOINTS, eeg_chunk, joints
 from mindgrasp_bag import BagWriter
 from mindgrasp_bag.latency import LatencyError, RunStamps, latency_report
-from mindgrasp_bringup.launch_system.run_report import write_run_report
+from mindgrasp_launch.run_report import write_run_report
 
 MS = 1_000_000
 T0 = 1_795_000_000_000_000_000   # a wall-clock time (ns)
@@ -116,7 +116,7 @@ def test_a_run_that_cannot_give_latencies_says_why(change: dict, match: str) -> 
 
 
 def _latency_cli(run: Path, *args: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', 'bag', 'latency',
+    return subprocess.run([sys.executable, '-m', 'mindgrasp_cli', 'bag', 'latency',
                            str(run), *args], capture_output=True, text=True, timeout=120,
                           env=launch_env(), check=False)
 
@@ -211,7 +211,7 @@ def test_a_run_without_a_bag_says_so_in_its_report(tmp_path: Path) -> None:
 @pytest.mark.slow
 def test_a_lock_step_run_has_a_report_that_says_why_it_has_no_latencies(tmp_path: Path) -> None:
     run_dir = tmp_path / 'run'
-    res = subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', 'launch', 'graz',
+    res = subprocess.run([sys.executable, '-m', 'mindgrasp_cli', 'launch', 'graz',
                           'trials:=1', '--lockstep', '--run-dir', str(run_dir)],
                          capture_output=True, text=True, timeout=300, env=launch_env(),
                          check=False)

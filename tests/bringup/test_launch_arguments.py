@@ -8,7 +8,7 @@ import sys
 
 import pytest
 
-from mindgrasp_bringup.launch_system import LaunchError, LaunchService
+from mindgrasp_launch import LaunchError, LaunchService
 
 
 @pytest.mark.parametrize(('args', 'message'), [
@@ -88,7 +88,7 @@ def test_a_robot_is_a_name_a_path_or_a_package_uri(tmp_path, monkeypatch):
 ])
 def test_bad_argument_starts_nothing_and_exits_2(tmp_path, profile, argument, line):
     run_dir = tmp_path / 'run'
-    out = subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', 'launch', profile,
+    out = subprocess.run([sys.executable, '-m', 'mindgrasp_cli', 'launch', profile,
                           argument, '--run-dir', str(run_dir)],
                          capture_output=True, text=True, timeout=120)
     assert out.returncode == 2

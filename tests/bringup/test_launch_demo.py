@@ -10,7 +10,7 @@ import pytest
 import yaml
 from launch_fixtures.runner import run_launch
 
-from mindgrasp_bringup.launch_system import LaunchService
+from mindgrasp_launch import LaunchService
 
 pytestmark = pytest.mark.slow
 

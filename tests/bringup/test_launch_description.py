@@ -9,8 +9,7 @@ from pathlib import Path
 import pytest
 import yaml
 
-from mindgrasp_bringup.commands import launch as launch_cmd
-from mindgrasp_bringup.launch_system import (
+from mindgrasp_launch import (
     DeclareLaunchArgument,
     EnvironmentVariable,
     ExecuteProcess,
@@ -31,8 +30,9 @@ from mindgrasp_bringup.launch_system import (
     UnlessCondition,
     profiles,
 )
-from mindgrasp_bringup.launch_system import params as ros_params
-from mindgrasp_bringup.launch_system.service import format_arguments, parse_launch_arguments
+from mindgrasp_launch import params as ros_params
+from mindgrasp_launch.commands import launch as launch_cmd
+from mindgrasp_launch.service import format_arguments, parse_launch_arguments
 
 HERE = Path(__file__).resolve().parent
 FIXTURES = HERE / 'launch_fixtures'
@@ -125,7 +125,7 @@ def test_group_scopes_namespace_and_configurations() -> None:
 
 
 def test_set_parameter_and_set_remap_apply_to_the_nodes_that_follow() -> None:
-    from mindgrasp_bringup.launch_system import SetParameter, SetRemap
+    from mindgrasp_launch import SetParameter, SetRemap
 
     description = LaunchDescription([
         DeclareLaunchArgument('sim_time', default_value='true'),
@@ -166,13 +166,13 @@ def test_include_passes_arguments_and_keeps_scope() -> None:
 def test_include_by_path_relative_to_this_launch_file(tmp_path: Path) -> None:
     inner = tmp_path / 'inner.launch.py'
     inner.write_text(
-        'from mindgrasp_bringup.launch_system import *\n'
+        'from mindgrasp_launch import *\n'
         'def generate_launch_description():\n'
         '    return LaunchDescription([ExecuteProcess(cmd=["true", ThisLaunchFileDir()],'
         ' name="inner")])\n')
     outer = tmp_path / 'outer.launch.py'
     outer.write_text(
-        'from mindgrasp_bringup.launch_system import *\n'
+        'from mindgrasp_launch import *\n'
         'def generate_launch_description():\n'
         '    return LaunchDescription([IncludeLaunchDescription("inner.launch.py")])\n')
     (spec,) = LaunchService(outer, ['record:=false']).plan().processes
@@ -180,7 +180,7 @@ def test_include_by_path_relative_to_this_launch_file(tmp_path: Path) -> None:
     assert ThisLaunchFileDir  # imported for the launch files above
     cyclic = tmp_path / 'cycle.launch.py'
     cyclic.write_text(
-        'from mindgrasp_bringup.launch_system import *\n'
+        'from mindgrasp_launch import *\n'
         'def generate_launch_description():\n'
         '    return LaunchDescription([IncludeLaunchDescription(__file__)])\n')
     with pytest.raises(LaunchError, match='cycle'):
@@ -345,7 +345,7 @@ def test_bad_launch_files(tmp_path: Path) -> None:
 
 
 def test_cli_show_args_list_and_errors(capsys: pytest.CaptureFixture[str]) -> None:
-    from mindgrasp_bringup.cli import main
+    from mindgrasp_cli.cli import main
 
     assert main(['launch', '--list']) == 0
     assert 'demo' in capsys.readouterr().out

@@ -21,14 +21,14 @@ from launch_fixtures.runner import (
     wait_for_file_text,
 )
 
-from mindgrasp_bringup.launch_system import (
+from mindgrasp_launch import (
     LaunchDescription,
     LaunchService,
     Node,
     Shutdown,
 )
-from mindgrasp_bringup.launch_system.output import Printer
-from mindgrasp_bringup.launch_system.run_extras import DEFAULT_RECORD_EXCLUDE
+from mindgrasp_launch.output import Printer
+from mindgrasp_launch.run_extras import DEFAULT_RECORD_EXCLUDE
 
 pytestmark = pytest.mark.slow
 
@@ -268,7 +268,7 @@ def test_existing_run_directory_is_never_overwritten(tmp_path: Path) -> None:
 def test_missing_profile_module_fails_before_starting_anything(tmp_path: Path) -> None:
     launch_file = tmp_path / 'missing.launch.py'
     launch_file.write_text(
-        'from mindgrasp_bringup.launch_system import LaunchDescription, Node\n'
+        'from mindgrasp_launch import LaunchDescription, Node\n'
         'def generate_launch_description():\n'
         '    return LaunchDescription([Node(package="launch_fixtures", executable="ticker"),\n'
         '        Node(package="mindgrasp_sim", executable="not_written_yet", name="sim")])\n')
@@ -301,7 +301,7 @@ def test_nodes_get_sigint_even_when_the_launcher_started_with_it_ignored(tmp_pat
 
 
 def test_a_launch_with_nothing_to_start_ends_at_once(tmp_path: Path) -> None:
-    from mindgrasp_bringup.launch_system import IfCondition
+    from mindgrasp_launch import IfCondition
 
     description = LaunchDescription([Node(package='launch_fixtures', executable='ticker',
                                           condition=IfCondition('false'))])

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from mindgrasp_bringup.launch_system import LaunchError, LaunchService, profiles
+from mindgrasp_launch import LaunchError, LaunchService, profiles
 
 
 def processes(profile: str, *args: str) -> dict[str, object]:
@@ -150,7 +150,7 @@ def test_trainer_and_graz_end_with_their_prompter(tmp_path, monkeypatch) -> None
 
 
 def test_a_profile_can_be_included_by_name() -> None:
-    from mindgrasp_bringup.launch_system import (
+    from mindgrasp_launch import (
         IncludeLaunchDescription,
         LaunchDescription,
         PythonLaunchDescriptionSource,

@@ -24,7 +24,7 @@ pytestmark = pytest.mark.slow
 
 
 def mindgrasp(*args: str, timeout: float = 300) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', *args], env=launch_env(),
+    return subprocess.run([sys.executable, '-m', 'mindgrasp_cli', *args], env=launch_env(),
                           capture_output=True, text=True, timeout=timeout, check=False)
 
 

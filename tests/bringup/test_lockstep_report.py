@@ -4,7 +4,7 @@ CPU s per simulated s")."""
 
 from __future__ import annotations
 
-from mindgrasp_bringup.launch_system.lockstep import run_lockstep
+from mindgrasp_launch.lockstep import run_lockstep
 from mindgrasp_ros import rclpy
 from mindgrasp_ros.node_spec import NodeSpec
 

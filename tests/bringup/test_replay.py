@@ -63,7 +63,7 @@ def demo_run(tmp_path_factory) -> Path:
 
 
 def _mindgrasp(*args: str, timeout: float = 600) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', *args],
+    return subprocess.run([sys.executable, '-m', 'mindgrasp_cli', *args],
                           capture_output=True, text=True, env=launch_env(), timeout=timeout)
 
 

@@ -14,7 +14,7 @@ GRAZ_FAST = ['--ros-args', '-p', 'n_trials:=1', '-p', 'start_delay:=0.2', '-p', 
 
 
 def _run(*args: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', 'run', *args],
+    return subprocess.run([sys.executable, '-m', 'mindgrasp_cli', 'run', *args],
                           capture_output=True, text=True, timeout=120, check=False)
 
 

@@ -8,8 +8,8 @@ from concurrent.futures import ThreadPoolExecutor
 import pytest
 import yaml
 
-from mindgrasp_bringup.launch_system import LaunchError, rundir
-from mindgrasp_bringup.launch_system.run_extras import (
+from mindgrasp_launch import LaunchError, rundir
+from mindgrasp_launch.run_extras import (
     DEFAULT_RECORD_EXCLUDE,
     RunFiles,
     duration_limit,
@@ -38,7 +38,7 @@ def test_an_explicit_run_dir_with_files_is_refused(tmp_path) -> None:
 
 
 def test_run_files_of_another_launcher_are_complete_whenever_it_stops(tmp_path) -> None:
-    """What ros2 launch's RunDirectory action writes (mindgrasp_bringup.launch_ros_extras)."""
+    """What ros2 launch's RunDirectory action writes (mindgrasp_launch.launch_ros_extras)."""
     path = rundir.create_run_dir('demo', None, tmp_path)
     files = RunFiles(path)
     files.write_start(profile='demo', launch_file='/ws/share/demo.launch.py',

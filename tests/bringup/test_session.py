@@ -18,7 +18,7 @@ from mindgrasp_common.robot_description import robot_names
 
 
 def mindgrasp(*args: str, cwd: Path) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', *args], cwd=cwd,
+    return subprocess.run([sys.executable, '-m', 'mindgrasp_cli', *args], cwd=cwd,
                           capture_output=True, text=True, timeout=120)
 
 
@@ -97,7 +97,7 @@ def test_virtual_session_runs_every_phase_retrains_and_resumes(tmp_path):
     env = os.environ | {'PYTHONUNBUFFERED': '1'}
     log = (tmp_path / 'run.log').open('w')
     proc = subprocess.Popen(
-        [sys.executable, '-m', 'mindgrasp_bringup', 'session', 'run', '--subject', 'V1',
+        [sys.executable, '-m', 'mindgrasp_cli', 'session', 'run', '--subject', 'V1',
          '--session', 's1', '--plan', 'quick'], cwd=tmp_path, env=env, stdout=log,
         stderr=subprocess.STDOUT, start_new_session=True)
     deadline = time.monotonic() + 400
@@ -115,7 +115,7 @@ def test_virtual_session_runs_every_phase_retrains_and_resumes(tmp_path):
     assert proc.wait(120) == 130, out()
     assert _log(folder)['phases'][1]['status'] == 'running'
 
-    res = subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', 'session', 'resume',
+    res = subprocess.run([sys.executable, '-m', 'mindgrasp_cli', 'session', 'resume',
                           '--subject', 'V1'], cwd=tmp_path, env=env, capture_output=True,
                          text=True, timeout=600)
     assert res.returncode == 0, res.stdout[-3000:] + res.stderr[-3000:]
@@ -149,7 +149,7 @@ def test_ctrl_c_in_a_lockstep_phase_stops_the_session_with_the_resume_hint(tmp_p
     folder = tmp_path / 'subjects' / 'V1' / 's1'
     log = (tmp_path / 'run.log').open('w')
     proc = subprocess.Popen(
-        [sys.executable, '-m', 'mindgrasp_bringup', 'session', 'calibrate', '--subject', 'V1',
+        [sys.executable, '-m', 'mindgrasp_cli', 'session', 'calibrate', '--subject', 'V1',
          '--session', 's1', '--virtual-accuracy', '0.9', '--trials-per-class', '3'],
         cwd=tmp_path, env=os.environ | {'PYTHONUNBUFFERED': '1'}, stdout=log,
         stderr=subprocess.STDOUT, start_new_session=True)
@@ -178,7 +178,7 @@ def test_calibrate_runs_in_lockstep_end_to_end(tmp_path):
     from mindgrasp_bag import BagReader
 
     res = subprocess.run(
-        [sys.executable, '-m', 'mindgrasp_bringup', 'session', 'calibrate', '--subject', 'V1',
+        [sys.executable, '-m', 'mindgrasp_cli', 'session', 'calibrate', '--subject', 'V1',
          '--session', 's1', '--virtual-accuracy', '0.9', '--trials-per-class', '3', '--json'],
         cwd=tmp_path, capture_output=True, text=True, timeout=800)
     assert res.returncode == 0, res.stdout[-3000:] + res.stderr[-3000:]

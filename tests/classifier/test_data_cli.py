@@ -126,7 +126,7 @@ def test_event_map_parsing():
 
 
 def _mindgrasp(*args):
-    return subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', *args],
+    return subprocess.run([sys.executable, '-m', 'mindgrasp_cli', *args],
                           capture_output=True, text=True, timeout=300)
 
 

@@ -29,7 +29,7 @@ def test_live_agrees_with_offline(tmp_path):
     rec.data = rec.data + np.random.RandomState(5).randn(*rec.data.shape) * 10e-6
     bag = write_run_bag(tmp_path / 'run', rec, drop=())
     env = dict(os.environ)
-    out = subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', 'evaluate', 'classifier',
+    out = subprocess.run([sys.executable, '-m', 'mindgrasp_cli', 'evaluate', 'classifier',
                           '--model', str(path), '--bag', str(bag), '--live', '--json'],
                          capture_output=True, text=True, timeout=400, env=env)
     assert out.returncode == 0, out.stdout[-3000:] + out.stderr[-3000:]

@@ -39,7 +39,7 @@ def test_live_evaluation_takes_a_package_uri(tmp_path):
     rec = make_recording(classes=(0, 1), trials_per_class=1, seed=3, rate=model.rate,
                          channels=list(model.channels))           # 12 s, played in real time
     bag = write_run_bag(tmp_path / 'run', rec, drop=())
-    out = subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', 'evaluate', 'classifier',
+    out = subprocess.run([sys.executable, '-m', 'mindgrasp_cli', 'evaluate', 'classifier',
                           '--model', URI, '--bag', str(bag), '--live', '--json', '--no-progress'],
                          capture_output=True, text=True, timeout=400, env=dict(os.environ),
                          cwd=tmp_path)

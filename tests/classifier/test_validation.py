@@ -220,7 +220,7 @@ def test_reliability_diagram_is_written(tmp_path):
 
 
 def _mindgrasp(*args):
-    return subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', *args],
+    return subprocess.run([sys.executable, '-m', 'mindgrasp_cli', *args],
                           capture_output=True, text=True, timeout=300)
 
 

@@ -26,7 +26,7 @@ from mindgrasp_ros.node_process import NodeProcess
 
 pytestmark = pytest.mark.slow
 HERE = Path(__file__).resolve().parent
-MG = [sys.executable, '-m', 'mindgrasp_bringup']
+MG = [sys.executable, '-m', 'mindgrasp_cli']
 TRIALS = 8
 
 

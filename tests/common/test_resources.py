@@ -96,6 +96,9 @@ REPO = Path(__file__).resolve().parents[2]
     ('mindgrasp_sim', 'scenes/set_locations.yaml', 'scenes/set_locations.yaml'),
     ('mindgrasp_bringup', 'plans/graded.yaml', 'plans/graded.yaml'),
     ('mindgrasp_bringup', 'config/plans/graded.yaml', 'plans/graded.yaml'),
+    ('mindgrasp_sim', 'robots/xarm6.yaml', 'robots/xarm6.yaml'),
+    ('mindgrasp_sim', 'urdf/mindgrasp_arm.urdf', 'robots/urdf/mindgrasp_arm.urdf'),
+    ('mindgrasp_bringup', 'config/robots/panda.yaml', 'robots/panda.yaml'),
 ])
 def test_config_files_are_found_in_config_by_their_package(package, rel, in_config):
     expected = REPO / 'config' / in_config
@@ -104,8 +107,10 @@ def test_config_files_are_found_in_config_by_their_package(package, rel, in_conf
 
 
 def test_no_package_keeps_a_file_that_belongs_in_config():
-    left = sorted(str(p.relative_to(REPO)) for folder in ('param', 'scenes', 'plans')
-                  for p in REPO.glob(f'src/mindgrasp_*/mindgrasp_*/{folder}/*.yaml'))
+    left = sorted(str(p.relative_to(REPO))
+                  for folder, pattern in (('param', '*.yaml'), ('scenes', '*.yaml'),
+                                          ('plans', '*.yaml'), ('robots', '*'), ('urdf', '*'))
+                  for p in REPO.glob(f'src/mindgrasp_*/mindgrasp_*/{folder}/{pattern}'))
     assert not left, f'move to config/ (config/README.md): {left}'
 
 
@@ -123,6 +128,21 @@ def test_installed_config_wins_without_ros(tmp_path, monkeypatch):
     assert resource_path('mindgrasp_fsm', 'param', 'fsm.yaml') == installed
     # a file the install lacks: the checkout's
     assert resource_path('mindgrasp_sim', 'scenes') == REPO / 'config' / 'scenes'
+
+
+def test_robot_descriptions_are_config_files_with_their_urdfs():
+    """robot:=NAME finds the descriptions in config/robots/, and each one's URDF (the shipped
+    arm's beside it in config/robots/urdf/, the others' in pybullet_data) with its licence."""
+    from mindgrasp_common.robot_description import load_robot, robot_names
+
+    assert robot_names() == ['mindgrasp_arm', 'panda', 'xarm6']
+    for name in robot_names():
+        robot = load_robot(name)
+        assert robot.path == REPO / 'config' / 'robots' / f'{name}.yaml'
+        assert robot.urdf.is_file()
+        assert robot.licence
+    shipped_urdf = REPO / 'config' / 'robots' / 'urdf' / 'mindgrasp_arm.urdf'
+    assert load_robot('mindgrasp_arm').urdf == shipped_urdf
 
 
 def test_missing_config_file_names_where_it_looked():

@@ -46,7 +46,7 @@ def test_the_readmes_have_commands_to_check() -> None:
 
 @pytest.mark.parametrize(('where', 'line'), [c for c in COMMANDS if ' launch ' not in c[1]])
 def test_a_readme_command_parses(where: str, line: str) -> None:
-    from mindgrasp_bringup.cli import build_parser
+    from mindgrasp_cli.cli import build_parser
 
     argv = shlex.split(line)[1:]
     try:
@@ -58,7 +58,7 @@ def test_a_readme_command_parses(where: str, line: str) -> None:
 @pytest.mark.parametrize(('where', 'line'), [c for c in COMMANDS if ' launch ' in c[1]])
 def test_a_readme_launch_resolves(where: str, line: str, tmp_path) -> None:
     argv = shlex.split(line)[1:]
-    run = subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', *argv, '--dry-run'],
+    run = subprocess.run([sys.executable, '-m', 'mindgrasp_cli', *argv, '--dry-run'],
                          capture_output=True, text=True, timeout=120, cwd=tmp_path)
     assert run.returncode == 0, f'{where}: `{line}`\n{run.stdout[-2000:]}{run.stderr[-2000:]}'
 

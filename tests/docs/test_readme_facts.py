@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pylsl
 
-from mindgrasp_bringup.launch_system.run_extras import COMMON_ARGUMENTS
+from mindgrasp_launch.run_extras import COMMON_ARGUMENTS
 
 README = (Path(__file__).resolve().parents[2] / 'README.md').read_text(encoding='utf-8')
 

@@ -20,7 +20,7 @@ from mindgrasp_eeg import EEGError
 from mindgrasp_eeg.bids import bids_label, runs_to_export
 
 pytestmark = pytest.mark.slow
-MG = [sys.executable, '-m', 'mindgrasp_bringup']
+MG = [sys.executable, '-m', 'mindgrasp_cli']
 # what the export reads: EEG, annotations and the robot's motion (no camera images: a small bag)
 EXPORT_TOPICS = ('/eeg/raw /trainer/prompt /task/target /task/result /fsm/state '
                  '/virtual_subject/intent /joint_states /ee_pose')

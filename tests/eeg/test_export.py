@@ -140,7 +140,7 @@ def test_export_errors(tmp_path, run_dir) -> None:
 def test_cli(run_dir) -> None:
     path, _ = run_dir
     out = path / 'x.edf'
-    proc = subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', 'export', 'eeg', str(path),
+    proc = subprocess.run([sys.executable, '-m', 'mindgrasp_cli', 'export', 'eeg', str(path),
                            '--format', 'edf', '-o', str(out)], capture_output=True, text=True,
                           timeout=120)
     assert proc.returncode == 0, proc.stderr

@@ -19,12 +19,12 @@ from .test_player import eegbci_file
 @pytest.mark.slow
 def test_launch_eeg_records_a_played_dataset(tmp_path: Path, stream_name: str) -> None:
     path = eegbci_file(8)
-    player = subprocess.Popen([sys.executable, '-m', 'mindgrasp_bringup', 'eeg', 'play', path,
+    player = subprocess.Popen([sys.executable, '-m', 'mindgrasp_cli', 'eeg', 'play', path,
                                '--name', stream_name, '--duration', '60'],
                               stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
     try:
         assert player.stdout is not None and 'Playing' in player.stdout.readline()
-        run = subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', 'launch', 'eeg',
+        run = subprocess.run([sys.executable, '-m', 'mindgrasp_cli', 'launch', 'eeg',
                               f'eeg_stream:={stream_name}', 'marker_stream:=auto',
                               '--duration', '12', '--run-dir',
                               str(tmp_path / 'run')], capture_output=True, text=True, timeout=120)

@@ -10,8 +10,8 @@ import time
 import pylsl
 import pytest
 
-from mindgrasp_bringup.launch_system import LaunchService
 from mindgrasp_eeg.event_markers import lsl_time
+from mindgrasp_launch import LaunchService
 
 
 def test_lsl_time_moves_an_event_to_the_lsl_clock() -> None:

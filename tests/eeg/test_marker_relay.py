@@ -72,7 +72,7 @@ def test_amplifier_markers_relayed_recorded_and_exported(
 
     n_ch = 4
     bag = tmp_path / 'bag'
-    recorder = spawn_node('mindgrasp_bringup', 'bag', 'record', '-o', str(bag), '/eeg/raw',
+    recorder = spawn_node('mindgrasp_cli', 'bag', 'record', '-o', str(bag), '/eeg/raw',
                           '/eeg/markers')
     # once the node's inlet is connected, markers every 0.5 s of samples; the marker stream
     # closes after 2 s of them, the EEG goes on
@@ -124,7 +124,7 @@ def test_amplifier_markers_relayed_recorded_and_exported(
     # a replay of the bag publishes them again, stamps and all
     replayed = MarkerListener(rclpy_ctx)
     try:
-        spawn_node('mindgrasp_bringup', 'bag', 'play', str(bag), '--topics', '/eeg/markers',
+        spawn_node('mindgrasp_cli', 'bag', 'play', str(bag), '--topics', '/eeg/markers',
                    '--no-progress')
         recorded = {(m.data, _ns(m.header.stamp)) for m in listener.markers}
         assert replayed.spin_until(lambda: len(replayed.markers) >= len(anns)), anns

@@ -30,7 +30,7 @@ def eegbci_file(run: int) -> str:
 
 
 def start_player(name: str, *args: str) -> subprocess.Popen:
-    return subprocess.Popen([sys.executable, '-m', 'mindgrasp_bringup', 'eeg', 'play', *args,
+    return subprocess.Popen([sys.executable, '-m', 'mindgrasp_cli', 'eeg', 'play', *args,
                              '--name', name], stdout=subprocess.PIPE,
                             stderr=subprocess.DEVNULL, text=True)
 
@@ -148,7 +148,7 @@ def test_corrupt_and_unsupported_files(tmp_path) -> None:
 def test_cli_reports_bad_file(tmp_path) -> None:
     bad = tmp_path / 'broken.fif'
     bad.write_bytes(b'\x00' * 100)
-    proc = subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', 'eeg', 'play', str(bad)],
+    proc = subprocess.run([sys.executable, '-m', 'mindgrasp_cli', 'eeg', 'play', str(bad)],
                           capture_output=True, text=True, timeout=60)
     assert proc.returncode == 1
     assert 'Cannot read the EEG file' in proc.stderr

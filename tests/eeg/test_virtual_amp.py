@@ -49,7 +49,7 @@ def test_same_seed_same_stream_whatever_the_pacing() -> None:
 
 @pytest.mark.slow
 def test_cli_without_ros_streams_labelled_eeg(stream_name) -> None:
-    proc = subprocess.Popen([sys.executable, '-m', 'mindgrasp_bringup', 'eeg', 'virtual-amp',
+    proc = subprocess.Popen([sys.executable, '-m', 'mindgrasp_cli', 'eeg', 'virtual-amp',
                              '--no-ros', '--cues', '1', '--name', stream_name],
                             stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
     try:

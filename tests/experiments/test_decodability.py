@@ -171,7 +171,7 @@ def test_real_subject_figures_are_above_chance() -> None:
 
 
 def run_cli(*args: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', 'eeg', 'fit-virtual',
+    return subprocess.run([sys.executable, '-m', 'mindgrasp_cli', 'eeg', 'fit-virtual',
                            *args], capture_output=True, text=True, timeout=600)
 
 

@@ -24,7 +24,7 @@ def mindgrasp(*args: str, timeout: float = 1200.0) -> subprocess.CompletedProces
     env = dict(os.environ)
     # the user's own nodes (tests/experiments/user_nodes) for --launch
     env['PYTHONPATH'] = f"{HERE}{os.pathsep}{env.get('PYTHONPATH', '')}"
-    return subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', *args],
+    return subprocess.run([sys.executable, '-m', 'mindgrasp_cli', *args],
                           capture_output=True, text=True, timeout=timeout, env=env, check=False)
 
 
@@ -206,7 +206,7 @@ def test_ctrl_c_writes_the_finished_trials(tmp_path: Path) -> None:
     env = dict(os.environ)
     # started as a script's background job is: with SIGINT ignored (inherited), which the
     # command must not keep (it ran all 50 trials through the Ctrl-C)
-    proc = subprocess.Popen([sys.executable, '-m', 'mindgrasp_bringup', 'experiment',
+    proc = subprocess.Popen([sys.executable, '-m', 'mindgrasp_cli', 'experiment',
                              'random-locations', '--trials', '50', '--trial-timeout', '3',
                              '--out', str(out), '--no-progress'],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env,

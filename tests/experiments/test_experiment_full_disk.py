@@ -33,7 +33,7 @@ def nearly_full_disk(tmp_path):
 def test_experiment_on_a_filling_disk_loses_no_record(nearly_full_disk, tmp_path):
     out, state = nearly_full_disk / 'run', tmp_path / 'state'
     done = subprocess.run(
-        [sys.executable, '-m', 'mindgrasp_bringup', 'experiment', 'set-locations', '--trials',
+        [sys.executable, '-m', 'mindgrasp_cli', 'experiment', 'set-locations', '--trials',
          '2', '--subject', 'oracle', '--seed', '2', '--out', str(out), '--no-progress'],
         capture_output=True, text=True, timeout=800, check=False,
         env=dict(os.environ, XDG_STATE_HOME=str(state)))

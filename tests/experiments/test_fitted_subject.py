@@ -125,7 +125,7 @@ def test_the_digest_follows_the_head_and_the_calibration_settings(tmp_path: Path
 @pytest.mark.slow
 def test_the_command_line_refuses_a_missing_fit_in_one_line(tmp_path: Path) -> None:
     proc = subprocess.run(
-        [sys.executable, '-m', 'mindgrasp_bringup', 'experiment', 'set-locations', '--trials',
+        [sys.executable, '-m', 'mindgrasp_cli', 'experiment', 'set-locations', '--trials',
          '1', '--subject', f'virtual:{tmp_path}/none.yaml', '--out', str(tmp_path / 'run')],
         capture_output=True, text=True, timeout=120, cwd=REPO)
     assert proc.returncode == 2

@@ -8,12 +8,12 @@ import re
 import pytest
 
 from mindgrasp_bag.recorder_node import RecorderNode, RecorderParams
-from mindgrasp_bringup.launch_system import LaunchError, lockstep
-from mindgrasp_bringup.launch_system.lockstep import check_left_out_nodes, node_traits
 from mindgrasp_eeg.acquisition_node import AcquisitionNode
 from mindgrasp_eeg.virtual_amp_node import VirtualAmpNode, VirtualAmpParams
 from mindgrasp_experiments.oracle_subject_node import OracleParams, OracleSubjectNode
 from mindgrasp_experiments.trial_manager_node import TrialManagerNode
+from mindgrasp_launch import LaunchError, lockstep
+from mindgrasp_launch.lockstep import check_left_out_nodes, node_traits
 from mindgrasp_ros.node_traits import NodeTraits, traits_of
 from mindgrasp_sim.sim_node import SimNode, SimParams
 

@@ -17,7 +17,7 @@ def _records() -> list[TrialRecord]:
 
 
 def _report(run: Path) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', 'experiment', 'report',
+    return subprocess.run([sys.executable, '-m', 'mindgrasp_cli', 'experiment', 'report',
                            str(run)], capture_output=True, text=True, timeout=300, check=False)
 
 

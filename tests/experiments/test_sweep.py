@@ -33,7 +33,7 @@ JSON_KEYS = ('accuracy', 'trials', 'interrupted_trials', 'success_rate',
 
 
 def mindgrasp(*args: str, timeout: float = 1500.0) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', *args],
+    return subprocess.run([sys.executable, '-m', 'mindgrasp_cli', *args],
                           capture_output=True, text=True, timeout=timeout,
                           env=dict(os.environ), check=False)
 
@@ -198,9 +198,9 @@ def test_bad_subject_is_one_clear_line_and_exit_2(tmp_path: Path, command: str, 
 
 def test_applied_params_are_the_ones_in_the_run_directory(tmp_path: Path) -> None:
     """A point's params/<node>.yaml holds the values it ran with (issue 31, item 4)."""
-    from mindgrasp_bringup.launch_system import params as ros_params
     from mindgrasp_experiments.engine import lockstep_components
     from mindgrasp_experiments.sweep import apply_params
+    from mindgrasp_launch import params as ros_params
 
     comps = lockstep_components('experiment', {'subject': 'virtual', 'protocol': 'set_locations',
                                                'seed': '0', 'trials': '1'}, tmp_path,

@@ -1,7 +1,7 @@
 """Synthetic inputs for GraspFsm tests: frames, predictions, a kinematic arm and a pinhole camera.
 
 The kinematic arm integrates the commanded joint velocities (no physics); the camera projects a
-point object through the real robot model (mindgrasp_sim/urdf/mindgrasp_arm.urdf), so the grasp
+point object through the real robot model (config/robots/urdf/mindgrasp_arm.urdf), so the grasp
 policy's geometry is checked without PyBullet.
 """
 

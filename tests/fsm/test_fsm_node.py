@@ -131,7 +131,7 @@ def _mindgrasp(*args: str):
     import subprocess
     import sys
 
-    return subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', *args],
+    return subprocess.run([sys.executable, '-m', 'mindgrasp_cli', *args],
                           capture_output=True, text=True, timeout=120)
 
 

@@ -32,7 +32,7 @@ def test_a_composed_graph_fails_when_a_node_ends_with_a_code(spawn_node, tmp_pat
     plan.write_text(yaml.safe_dump({'components': [
         {'label': 'ticker', 'module': 'skeleton_node', 'ros_args': ENDS_WITH_3}]}))
     path = os.pathsep.join([str(HERE), os.environ.get('PYTHONPATH', '')])
-    proc = spawn_node('mindgrasp_bringup.launch_system.container', str(plan),
+    proc = spawn_node('mindgrasp_launch.container', str(plan),
                       env={'PYTHONPATH': path})
     assert proc.wait(60) == 1, proc.output()
     assert LINE in proc.output()
@@ -40,7 +40,7 @@ def test_a_composed_graph_fails_when_a_node_ends_with_a_code(spawn_node, tmp_pat
 
 
 def test_a_lockstep_graph_fails_when_a_node_ends_with_a_code(monkeypatch):
-    from mindgrasp_bringup.launch_system.lockstep import run_lockstep
+    from mindgrasp_launch.lockstep import run_lockstep
     from mindgrasp_ros.node_spec import NodeSpec
 
     monkeypatch.syspath_prepend(str(HERE))
@@ -83,7 +83,7 @@ _FOREIGN_PRIVATE = re.compile(r'\b(?!self\b|cls\b)[A-Za-z_]\w*\._[a-z]\w*')
 
 def test_the_graph_hosts_read_no_private_field_of_another_object():
     hosts = [SRC / 'mindgrasp_ros' / 'mindgrasp_ros' / 'composition.py',
-             SRC / 'mindgrasp_bringup' / 'mindgrasp_bringup' / 'launch_system' / 'lockstep.py']
+             SRC / 'mindgrasp_launch' / 'mindgrasp_launch' / 'lockstep.py']
     found = [f'{path.name}:{n}: {line.strip()}' for path in hosts
              for n, line in enumerate(path.read_text().splitlines(), 1)
              if _FOREIGN_PRIVATE.search(line.split('#')[0])]

@@ -11,7 +11,7 @@ from mindgrasp_common.resources import resource_path
 
 
 def mindgrasp(*args: str, stdin: str | None = None) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', *args], input=stdin,
+    return subprocess.run([sys.executable, '-m', 'mindgrasp_cli', *args], input=stdin,
                           capture_output=True, text=True, timeout=60, check=False)
 
 

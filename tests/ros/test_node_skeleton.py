@@ -62,7 +62,7 @@ def test_ctrl_c_is_a_clean_stop(spawn_node):
 
 
 def _cli(*args: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', *args],
+    return subprocess.run([sys.executable, '-m', 'mindgrasp_cli', *args],
                           capture_output=True, text=True, timeout=120)
 
 

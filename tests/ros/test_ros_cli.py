@@ -12,7 +12,7 @@ PEER = str(Path(__file__).with_name('ros_peer.py'))
 
 
 def mindgrasp(*args: str, timeout: float = 30) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', *args],
+    return subprocess.run([sys.executable, '-m', 'mindgrasp_cli', *args],
                           capture_output=True, text=True, timeout=timeout, check=False)
 
 

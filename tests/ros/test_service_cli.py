@@ -10,7 +10,7 @@ pytestmark = pytest.mark.slow
 
 
 def mindgrasp(*args: str, timeout: float = 60) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', *args],
+    return subprocess.run([sys.executable, '-m', 'mindgrasp_cli', *args],
                           capture_output=True, text=True, timeout=timeout, check=False)
 
 

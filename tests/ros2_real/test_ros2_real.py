@@ -18,7 +18,7 @@ PEER = str(Path(__file__).resolve().parents[1] / 'ros' / 'ros_peer.py')
 
 
 def mindgrasp(*args: str, env: dict[str, str] | None = None) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', *args], env=env,
+    return subprocess.run([sys.executable, '-m', 'mindgrasp_cli', *args], env=env,
                           capture_output=True, text=True, timeout=120, check=False)
 
 
@@ -123,7 +123,7 @@ def test_a_recorded_launch_on_real_rclpy(rclpy_env, tmp_path):
     """`MINDGRASP_RMW=rclpy mindgrasp launch sim`: the recorder and the simulator on the real
     rclpy (both died at start before: params.py), served and recorded as on our runtime."""
     run = tmp_path / 'run'
-    proc = subprocess.Popen([sys.executable, '-m', 'mindgrasp_bringup', 'launch', 'sim',
+    proc = subprocess.Popen([sys.executable, '-m', 'mindgrasp_cli', 'launch', 'sim',
                              'duration:=300', '--run-dir', str(run)], env=rclpy_env,
                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
                             start_new_session=True)

@@ -8,7 +8,7 @@ import time
 
 import pytest
 
-from mindgrasp_bringup.launch_system import LaunchService
+from mindgrasp_launch import LaunchService
 from mindgrasp_ros.node_process import NodeProcess
 
 
@@ -44,7 +44,7 @@ def test_sim_launch_runs_and_records(tmp_path):
     run_dir = tmp_path / 'run'
     topics = ('/joint_states', '/camera/color/image_raw', '/camera/depth/image_raw',
               '/camera/color/camera_info', '/ee_pose', '/sim/objects', '/clock')
-    launch = NodeProcess('mindgrasp_bringup', ['launch', 'sim', 'time_mode:=fast', '--run-dir',
+    launch = NodeProcess('mindgrasp_cli', ['launch', 'sim', 'time_mode:=fast', '--run-dir',
                                                str(run_dir)],
                          dict(os.environ), tmp_path / 'launch.log')
     try:
@@ -75,14 +75,14 @@ def test_sim_launch_runs_and_records(tmp_path):
 ])
 def test_camera_argument_is_parsed_never_evaluated(text):
     """Hostile or malformed camera:= text: one clear error naming the form, nothing run."""
-    from mindgrasp_bringup.launch_system import LaunchError
+    from mindgrasp_launch import LaunchError
 
     with pytest.raises(LaunchError, match=r'camera:=.* e\.g\. camera:=640x480@30'):
         sim_process('record:=false', f'camera:={text}')
 
 
 def test_parse_camera():
-    from mindgrasp_bringup.launch_args import parse_camera
+    from mindgrasp_launch.launch_args import parse_camera
 
     assert parse_camera('640x480@30') == (640, 480, 30.0)
     assert parse_camera(' 128x96@7.5 ') == (128, 96, 7.5)

@@ -54,7 +54,7 @@ def test_bad_values_name_the_parameter_and_the_fix(cls, values, match):
 
 
 def _mindgrasp(*args: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, '-m', 'mindgrasp_bringup', *args],
+    return subprocess.run([sys.executable, '-m', 'mindgrasp_cli', *args],
                           capture_output=True, text=True, timeout=120)
 
 

@@ -29,7 +29,7 @@ def test_a_trainer_session_runs_on_two_copies_of_the_robot(robot: str, tmp_path:
     run_dir = tmp_path / 'run'
     env = {**os.environ, 'ROS_DOMAIN_ID': os.environ.get('ROS_DOMAIN_ID', '43')}
     result = subprocess.run(
-        [sys.executable, '-m', 'mindgrasp_bringup', 'launch', 'trainer', f'robot:={robot}',
+        [sys.executable, '-m', 'mindgrasp_cli', 'launch', 'trainer', f'robot:={robot}',
          'trials:=2', 'seed:=2', '--run-dir', str(run_dir)],
         capture_output=True, text=True, timeout=540, check=False, env=env)
     output = result.stdout[-4000:] + result.stderr[-4000:]

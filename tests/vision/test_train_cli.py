@@ -7,7 +7,7 @@ import json
 import numpy as np
 import pytest
 
-from mindgrasp_bringup.cli import main as mindgrasp
+from mindgrasp_cli.cli import main as mindgrasp
 from mindgrasp_vision.shape_cnn import ShapeClassifier
 from mindgrasp_vision.train_cli import split_indices
 

@@ -1,2 +1,2 @@
-"""mindgrasp_bringup: the ``mindgrasp`` command, the launcher, launch descriptions, bag tools and
-experiments of MIndGrasp-ROS."""
+"""mindgrasp_bringup: the launch files and profiles of MIndGrasp-ROS, replay, calibration sessions
+and the Foxglove live view."""

@@ -174,8 +174,8 @@ def load_plan(plan: str) -> Plan:
 @lru_cache(maxsize=16)
 def _resolved_nodes(profile: str, arguments: tuple[tuple[str, str], ...]
                     ) -> tuple[tuple[str, NodeTraits], ...]:
-    from mindgrasp_bringup.launch_system import LaunchError, LaunchService
-    from mindgrasp_bringup.launch_system.lockstep import node_traits
+    from mindgrasp_launch import LaunchError, LaunchService
+    from mindgrasp_launch.lockstep import node_traits
 
     try:
         plan = LaunchService(profile, dict(arguments)).plan(strict=False)
@@ -450,8 +450,8 @@ class Session:
         ``nodes``: its nodes (:func:`phase_nodes`). Returns the launch's exit code; a launch
         that cannot start raises :class:`SessionError` with its one-line reason, and Ctrl-C (or
         SIGTERM) that stopped it raises ``KeyboardInterrupt``."""
-        from mindgrasp_bringup.launch_system import LaunchError, LaunchService
-        from mindgrasp_bringup.launch_system.lockstep import launch_lockstep
+        from mindgrasp_launch import LaunchError, LaunchService
+        from mindgrasp_launch.lockstep import launch_lockstep
 
         display = args.get('display', 'off')
         params_files = None

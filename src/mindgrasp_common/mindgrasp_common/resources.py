@@ -1,10 +1,11 @@
 """Data files shipped with the MIndGrasp packages: the one way to find them.
 
-Models, URDFs and robot descriptions are package data of the package that owns them
-(``mindgrasp_sim/robots/xarm6.yaml``, ``mindgrasp_classifier/models/...``). What a user edits is in
-the top-level ``config/`` of the checkout: the nodes' parameter files (``config/param/``), the
-launch profiles' overlays (``config/profiles/``), scenes (``config/scenes/``) and session plans
-(``config/plans/``); a colcon build installs it as ``share/mindgrasp_bringup/config/``. Code
+Models are package data of the package that owns them (``mindgrasp_classifier/models/...``).
+What a user edits is in the top-level ``config/`` of the checkout: the nodes' parameter files
+(``config/param/``), the launch profiles' overlays (``config/profiles/``), scenes
+(``config/scenes/``), session plans (``config/plans/``) and robot descriptions with their URDFs
+(``config/robots/``, ``config/robots/urdf/``); a colcon build installs it as
+``share/mindgrasp_bringup/config/``. Code
 asks for both kinds the same way, by the package the file belongs to, found by
 :func:`resource_path`::
 
@@ -51,6 +52,8 @@ CONFIG_FOLDERS: dict[tuple[str, str], str] = {
        for name in ('eeg', 'classifier', 'vision', 'fsm', 'sim', 'trainer')},
     (CONFIG_PACKAGE, 'param'): 'profiles',
     ('mindgrasp_sim', 'scenes'): 'scenes',
+    ('mindgrasp_sim', 'robots'): 'robots',
+    ('mindgrasp_sim', 'urdf'): 'robots/urdf',
     (CONFIG_PACKAGE, 'plans'): 'plans',
     (CONFIG_PACKAGE, 'config'): '',
 }

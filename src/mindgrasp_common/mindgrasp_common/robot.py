@@ -1,5 +1,5 @@
 """The shipped MIndGrasp arm as module constants, read from its robot description
-(``mindgrasp_sim/robots/mindgrasp_arm.yaml`` and the URDF beside it; see
+(``config/robots/mindgrasp_arm.yaml`` and the URDF beside it; see
 :mod:`mindgrasp_common.robot_description`), so there is one definition of each value.
 
 Code that works with any arm takes a :class:`~mindgrasp_common.robot_description.RobotDescription`

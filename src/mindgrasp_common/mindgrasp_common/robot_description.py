@@ -7,7 +7,7 @@ controller may use. Everything else (position, velocity and effort limits) is re
 so there is one definition of each value. Angles in rad, velocities in rad/s, efforts in N m,
 lengths in m.
 
-Shipped descriptions live in ``mindgrasp_sim/robots/<name>.yaml`` (package data, as the URDFs);
+Shipped descriptions live in ``config/robots/<name>.yaml`` (config files of ``mindgrasp_sim``);
 :func:`load_robot` takes such a name or the path of a lab's own file::
 
     from mindgrasp_common.robot_description import load_robot
@@ -225,7 +225,7 @@ def _numbers(value: Any, n: int, what: str, where: str) -> tuple[float, ...]:
 
 def _section(data: dict, key: str, where: str, kind: type = dict) -> Any:
     if key not in data:
-        msg = f'{where}: the key {key!r} is missing; add it (see mindgrasp_sim/robots/*.yaml).'
+        msg = f'{where}: the key {key!r} is missing; add it (see config/robots/*.yaml).'
         raise RobotDescriptionError(msg)
     if not isinstance(data[key], kind):
         msg = f'{where}: {key!r} must be a {kind.__name__}, got {data[key]!r}.'

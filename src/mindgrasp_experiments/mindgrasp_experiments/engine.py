@@ -24,13 +24,13 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from mindgrasp_bringup.launch_system import LaunchError
-from mindgrasp_bringup.launch_system.lockstep import (
-    lockstep_components as _lockstep_components,
-)
-from mindgrasp_bringup.launch_system.lockstep import run_lockstep, set_log_level
 from mindgrasp_experiments import ExperimentError
 from mindgrasp_experiments.records import TrialRecord
+from mindgrasp_launch import LaunchError
+from mindgrasp_launch.lockstep import (
+    lockstep_components as _lockstep_components,
+)
+from mindgrasp_launch.lockstep import run_lockstep, set_log_level
 from mindgrasp_ros.node_spec import NodeSpec
 from mindgrasp_ros.node_traits import NodeTraits
 
@@ -46,7 +46,7 @@ def is_trial_manager(component: NodeSpec) -> bool:
 def lockstep_components(launch: str | Path, arguments: Sequence[str] | Mapping[str, Any],
                         params_dir: Path, *, overlay: str | Path | None = None,
                         log: Any = None) -> list[NodeSpec]:
-    """:func:`mindgrasp_bringup.launch_system.lockstep.lockstep_components` without the
+    """:func:`mindgrasp_launch.lockstep.lockstep_components` without the
     recorder (an experiment writes records, not a bag per trial), raising
     :class:`ExperimentError` with the launcher's message."""
     try:

@@ -126,8 +126,6 @@ class Experiment:
         Ctrl-C ends the run early: the finished trials are written and ``interrupted`` is set.
         Raises :class:`ExperimentError` (one sentence with the fix) before any trial runs.
         """
-        from mindgrasp_bringup.launch_system import LaunchError
-        from mindgrasp_bringup.launch_system.rundir import create_run_dir
         from mindgrasp_common.safe_files import DeferredWriter
         from mindgrasp_eeg import EEGError
         from mindgrasp_experiments.cli import subject_launch_args
@@ -135,6 +133,8 @@ class Experiment:
         from mindgrasp_experiments.report import write_run
         from mindgrasp_experiments.summary import calibration_accuracy_of, summarise
         from mindgrasp_experiments.workers import run_trials
+        from mindgrasp_launch import LaunchError
+        from mindgrasp_launch.rundir import create_run_dir
 
         try:
             out = create_run_dir(self.protocol, run_dir)

@@ -213,8 +213,8 @@ def apply_params(components: Sequence[NodeSpec], combo: Mapping[str, Any],
     ``params_dir`` (where :func:`~mindgrasp_experiments.engine.lockstep_components` wrote the
     run's parameter files), each changed node's ``<node>.yaml`` there is written again with the
     values used."""
-    from mindgrasp_bringup.launch_system import params as ros_params
-    from mindgrasp_bringup.launch_system import rundir
+    from mindgrasp_launch import params as ros_params
+    from mindgrasp_launch import rundir
 
     out = []
     for comp in components:

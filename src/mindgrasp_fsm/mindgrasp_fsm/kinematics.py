@@ -63,7 +63,7 @@ class UrdfKinematics:
     Parameters
     ----------
     urdf_path : str or Path
-        Robot description (e.g. ``mindgrasp_sim/urdf/mindgrasp_arm.urdf``).
+        Robot description (e.g. ``config/robots/urdf/mindgrasp_arm.urdf``).
     joint_names : sequence of str
         The arm joints (6 or 7), base to wrist.
     tool_link, camera_link : str

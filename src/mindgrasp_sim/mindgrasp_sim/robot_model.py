@@ -2,9 +2,9 @@
 Jaco-like three-finger gripper and an eye-in-palm RGB-D camera.
 
 No public model of the paper's arm exists, so this module writes one from a few dimensions
-(:class:`ArmSpec`). The committed file ``mindgrasp_sim/urdf/mindgrasp_arm.urdf`` is this module's
+(:class:`ArmSpec`). The committed file ``config/robots/urdf/mindgrasp_arm.urdf`` is this module's
 output (``python -m mindgrasp_sim.robot_model >
-src/mindgrasp_sim/mindgrasp_sim/urdf/mindgrasp_arm.urdf``); a test checks that they agree.
+config/robots/urdf/mindgrasp_arm.urdf``); a test checks that they agree.
 Researchers can edit the spec, or load any URDF with the same link names.
 
 Kinematics (all angles zero = arm pointing straight up, the x axis is "forward"):
@@ -230,7 +230,7 @@ def build_urdf(spec: ArmSpec | None = None, name: str = 'mindgrasp_arm') -> str:
 
 
 def main() -> int:
-    """Print the default URDF (to regenerate ``mindgrasp_sim/urdf/mindgrasp_arm.urdf``)."""
+    """Print the default URDF (to regenerate ``config/robots/urdf/mindgrasp_arm.urdf``)."""
     sys.stdout.write(build_urdf())
     return 0
 

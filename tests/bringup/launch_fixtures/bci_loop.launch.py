@@ -11,7 +11,7 @@ for the EEG sample -> command timing.
 
 import sys
 
-import mindgrasp_bringup.launch_api as la
+import mindgrasp_launch.launch_api as la
 
 
 def generate_launch_description() -> la.LaunchDescription:
@@ -26,7 +26,7 @@ def generate_launch_description() -> la.LaunchDescription:
         *la.classifier_nodes(la.config_files('classifier', 'demo')),
         la.Node(package='mindgrasp_fsm', executable='fsm_node', name='fsm',
                 parameters=la.config_files('fsm', 'demo')),
-        la.ExecuteProcess(cmd=[sys.executable, '-m', 'mindgrasp_bringup', 'topic', 'echo',
+        la.ExecuteProcess(cmd=[sys.executable, '-m', 'mindgrasp_cli', 'topic', 'echo',
                                '/bci/prediction', 'mindgrasp_msgs/msg/MIPrediction', '--times',
                                predictions, '--field', 'class_index'],
                           name='enough_predictions',

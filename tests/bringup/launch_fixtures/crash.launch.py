@@ -1,7 +1,7 @@
 """One process runs until stopped, another dies with exit code 5 after a few lines: the launch
 must report the death with its last lines, stop the other and exit with 1."""
 
-from mindgrasp_bringup.launch_system import LaunchDescription, Node
+from mindgrasp_launch import LaunchDescription, Node
 
 
 def generate_launch_description() -> LaunchDescription:

@@ -1,7 +1,7 @@
 """Processes that run until the launch stops them; ``stubborn:=true`` adds one that ignores
 SIGINT (the launcher must escalate to SIGTERM)."""
 
-from mindgrasp_bringup.launch_system import (
+from mindgrasp_launch import (
     DeclareLaunchArgument,
     IfCondition,
     LaunchConfiguration,

@@ -1,6 +1,6 @@
 """A process that stops on KeyboardInterrupt, as rclpy nodes do (it installs no SIGINT handler)."""
 
-from mindgrasp_bringup.launch_system import LaunchDescription, Node
+from mindgrasp_launch import LaunchDescription, Node
 
 
 def generate_launch_description() -> LaunchDescription:

@@ -1,6 +1,6 @@
 """A process that crashes once (exit code 3) and is respawned, next to a normal one."""
 
-from mindgrasp_bringup.launch_system import (
+from mindgrasp_launch import (
     DeclareLaunchArgument,
     LaunchConfiguration,
     LaunchDescription,

@@ -27,8 +27,8 @@ def launch_env(**extra: str) -> dict[str, str]:
 
 
 def launch_cmd(*args: str) -> list[str]:
-    """``python -m mindgrasp_bringup launch <args>``."""
-    return [sys.executable, '-m', 'mindgrasp_bringup', 'launch', *args]
+    """``python -m mindgrasp_cli launch <args>``."""
+    return [sys.executable, '-m', 'mindgrasp_cli', 'launch', *args]
 
 
 def fixture(name: str) -> str:

@@ -3,7 +3,7 @@
 Parameters reach both through --params-file (prefix), the listener's topic through a remapping.
 """
 
-from mindgrasp_bringup.launch_system import (
+from mindgrasp_launch import (
     DeclareLaunchArgument,
     GroupAction,
     LaunchConfiguration,

@@ -1,6 +1,6 @@
 """Two plain processes that tick and end by themselves (launcher tests)."""
 
-from mindgrasp_bringup.launch_system import (
+from mindgrasp_launch import (
     DeclareLaunchArgument,
     LaunchConfiguration,
     LaunchDescription,

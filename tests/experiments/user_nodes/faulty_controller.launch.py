@@ -1,6 +1,6 @@
 """A controller that raises 2 s into each trial."""
 
-from mindgrasp_bringup.launch_api import LaunchDescription, Node
+from mindgrasp_launch.launch_api import LaunchDescription, Node
 
 
 def generate_launch_description() -> LaunchDescription:

@@ -1,6 +1,6 @@
 """My own controller in place of the MIndGrasp one (the node named fsm is replaced)."""
 
-from mindgrasp_bringup.launch_api import LaunchDescription, Node
+from mindgrasp_launch.launch_api import LaunchDescription, Node
 
 
 def generate_launch_description() -> LaunchDescription:

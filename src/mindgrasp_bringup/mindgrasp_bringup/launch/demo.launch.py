@@ -20,7 +20,7 @@ demo's own settings), then the launch arguments below (later entries win).
 """
 
 
-from mindgrasp_bringup.launch_api import (
+from mindgrasp_launch.launch_api import (
     DeclareLaunchArgument,
     LaunchConfiguration,
     LaunchDescription,

@@ -13,7 +13,7 @@ names). With marker_stream:=auto (``<eeg_stream>-markers``) or marker_stream:=NA
 relays that LSL marker stream (the amplifier's triggers) to /eeg/markers, which the run records.
 """
 
-from mindgrasp_bringup.launch_api import (
+from mindgrasp_launch.launch_api import (
     DeclareLaunchArgument,
     IfCondition,
     LaunchConfiguration,

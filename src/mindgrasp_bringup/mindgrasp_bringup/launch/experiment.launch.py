@@ -18,7 +18,8 @@ Parameters: config/param/<package>.yaml, then config/profiles/experiment.yaml, t
 arguments below.
 """
 
-from mindgrasp_bringup.launch_api import (
+from mindgrasp_eeg.subject_file import check_eeg_source
+from mindgrasp_launch.launch_api import (
     DeclareLaunchArgument,
     EqualsSubstitution,
     GroupAction,
@@ -37,7 +38,6 @@ from mindgrasp_bringup.launch_api import (
     robot_argument,
     run_directory_actions,
 )
-from mindgrasp_eeg.subject_file import check_eeg_source
 
 
 def _when(subject: str) -> IfCondition:

@@ -10,7 +10,7 @@ EEG are recorded so that the classifier can be trained on them.
 The launch ends when the prompter has run all its trials (or after duration:=S).
 """
 
-from mindgrasp_bringup.launch_api import (
+from mindgrasp_launch.launch_api import (
     DeclareLaunchArgument,
     GroupAction,
     IfCondition,

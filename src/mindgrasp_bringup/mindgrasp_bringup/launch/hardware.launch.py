@@ -29,7 +29,7 @@ camera_driver) publishes /camera/color/image_raw (rgb8), /camera/depth/image_raw
 /camera/color/camera_info. Drivers are started as ROS nodes (``--ros-args -r __node:=...``).
 """
 
-from mindgrasp_bringup.launch_api import (
+from mindgrasp_launch.launch_api import (
     DeclareLaunchArgument,
     IfCondition,
     LaunchConfiguration,

@@ -13,7 +13,7 @@ agree 100 %. Same as ``mindgrasp replay RUN``. For a plain real-time playback in
 use ``mindgrasp bag play``.
 """
 
-from mindgrasp_bringup.launch_api import (
+from mindgrasp_launch.launch_api import (
     DeclareLaunchArgument,
     LaunchConfiguration,
     LaunchDescription,

@@ -12,7 +12,7 @@ the arm contract of a ros2_control forward velocity controller (drive it from ou
 Parameters: config/param/sim.yaml, then the launch arguments below.
 """
 
-from mindgrasp_bringup.launch_api import (
+from mindgrasp_launch.launch_api import (
     CameraSpec,
     DeclareLaunchArgument,
     LaunchConfiguration,

@@ -9,7 +9,7 @@ follows it with their own arm by motor imagery; prompts and EEG are recorded for
 The launch ends when the trainer has run all its trials (or after duration:=S).
 """
 
-from mindgrasp_bringup.launch_api import (
+from mindgrasp_launch.launch_api import (
     DeclareLaunchArgument,
     LaunchConfiguration,
     LaunchDescription,

@@ -54,8 +54,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def main(args: argparse.Namespace) -> int:
     from tqdm import tqdm
 
-    from mindgrasp_bringup.launch_system import LaunchError
-    from mindgrasp_bringup.launch_system.rundir import create_run_dir
     from mindgrasp_eeg import EEGError
     from mindgrasp_experiments import ExperimentError
     from mindgrasp_experiments.cli import experiment_from, subject_launch_args
@@ -72,6 +70,8 @@ def main(args: argparse.Namespace) -> int:
         point_name,
         write_sweep,
     )
+    from mindgrasp_launch import LaunchError
+    from mindgrasp_launch.rundir import create_run_dir
 
     try:
         accuracies = parse_accuracies(args.accuracy)

@@ -1,0 +1,1 @@
+"""The launcher's own command: ``mindgrasp launch`` (registered in this package's setup.py)."""
