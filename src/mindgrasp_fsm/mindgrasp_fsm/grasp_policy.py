@@ -106,6 +106,7 @@ class GraspPolicy:
         self._q_target: np.ndarray | None = None
         self._line: tuple[np.ndarray, np.ndarray, float, float] | None = None  # p0, p1, t0, T
         self._yaw = 0.0
+        self._tilt = 0.0          # rad, the tool's lean towards the base (0: vertical)
         self._refinements = 0
         self._gripper = GripperCommand(params.gripper_open_position, 0.0)
         self._last_opening: tuple[float, float] | None = None  # (time, opening)
@@ -150,7 +151,7 @@ class GraspPolicy:
         p0, p1, t0, duration = self._line
         s = min(1.0, (t - t0) / duration)
         setpoint = p0 + (p1 - p0) * s
-        q_set = self.kinematics.grasp_ik(setpoint, self._yaw, q)
+        q_set = self.kinematics.grasp_ik(setpoint, self._yaw, q, self._tilt)
         if q_set is None:
             return self._zeros(), False, True
         v, reached = self._track(q, q_set)
@@ -239,11 +240,23 @@ class GraspPolicy:
         # thumb towards the base (pi): the natural hand orientation of this arm (joint 6 near 0)
         self._yaw = wrap_angle(math.atan2(y, x) + math.pi
                                + self.params.shape_value(self.shape, 'wrist_yaw'))
-        q_pre = self.kinematics.grasp_ik(self._pregrasp_point(), self._yaw, q)
-        if q_pre is None:
-            return f'no inverse-kinematics solution above the object at ({x:.2f}, {y:.2f}) m'
-        self._q_target = q_pre
-        return ''
+        for tilt, hand_yaw in self._leans(self._yaw):
+            # vertical: the hand at yaw or turned round (both are one grasp); leaning: at yaw
+            # over every lean first (turned round, the arm found a pose twisted round joint 1)
+            q_pre = self.kinematics.grasp_ik(self._pregrasp_point(), hand_yaw, q, tilt,
+                                             turn_round=tilt == 0.0)
+            if q_pre is not None:
+                self._q_target, self._tilt, self._yaw = q_pre, tilt, hand_yaw
+                return ''
+        return f'no inverse-kinematics solution above the object at ({x:.2f}, {y:.2f}) m'
+
+    def _leans(self, yaw: float) -> list[tuple[float, float]]:
+        """(tool lean rad, yaw rad) to try for the pre-grasp, in order: vertical, then leaning
+        in steps of about 0.15 rad up to ``max_approach_tilt`` at ``yaw``, then at ``yaw + pi``:
+        the least lean that has an IK solution."""
+        steps = math.ceil(self.params.max_approach_tilt / 0.15 - 1e-9)
+        tilts = [self.params.max_approach_tilt * i / steps for i in range(1, steps + 1)]
+        return [(0.0, yaw)] + [(t, y) for y in (yaw, wrap_angle(yaw + math.pi)) for t in tilts]
 
     # ------------------------------------------------------------------ state 4
     def begin_approach(self, t: float, shape: str, attempt: int) -> None:
@@ -253,6 +266,7 @@ class GraspPolicy:
         self.phase = 'open'
         self._t0 = t
         self._refinements = 0
+        self._tilt = 0.0
         self.object_height = None
         self._lost_since = None
         self._samples = []
