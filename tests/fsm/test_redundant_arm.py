@@ -162,3 +162,28 @@ def test_a_near_object_is_approached_with_the_tool_leaning_back(panda: GraspFsm)
     for z in np.linspace(pre[2], policy._grasp_z(), 12):
         q_now = kin.grasp_ik(np.array([obj[0], obj[1], z]), policy._yaw, q_now, policy._tilt)
         assert q_now is not None
+
+
+def test_the_hand_turns_round_only_after_every_lean(panda: GraspFsm) -> None:
+    """Seed 1 trial 55: vertical with the hand turned round, the Panda's IK found a pose
+    twisted 0.8 rad about joint 1 whose link 5 hit link 1 on the way; leaning at the grasp
+    yaw keeps the arm's posture, facing the object."""
+    q = np.array([-2.21, -0.60, 0.0, -2.50, 0.0, 1.53, 0.78])
+    panda.policy.begin_approach(0.0, 'cylinder', 0)
+    panda.policy.object_position = np.array([-0.1458, -0.1880, 0.025])
+    assert panda.policy._plan_pregrasp(q) == ''
+    assert abs(panda.policy._q_target[0] - q[0]) < 0.1
+
+
+def test_a_descent_without_a_pose_at_its_lean_leans_further(panda: GraspFsm) -> None:
+    """Seed 1 trial 60: half way down to a near cylinder, the lean chosen above it (0.15 rad)
+    had no pose (the elbow at its limit); the descent leans further instead of failing."""
+    policy = panda.policy
+    q = np.array([1.735, -0.559, -0.547, -3.132, -0.467, 2.437, 1.061])
+    setpoint = np.array([0.04259, 0.22219, 0.10170])    # where the descent was
+    policy.begin_approach(0.0, 'cylinder', 0)
+    policy._yaw, policy._tilt = -1.7483, 0.15
+    policy._line = (setpoint, setpoint, 0.0, 1.0)
+    assert panda.kinematics.grasp_ik(setpoint, policy._yaw, q, 0.15, turn_round=False) is None
+    _, _, failed = policy._follow_line(0.5, q)
+    assert not failed and policy._tilt > 0.15
