@@ -133,3 +133,57 @@ def test_a_grasp_behind_the_base_keeps_the_arm_facing_it(panda: GraspFsm, degree
         assert q is not None
         assert abs(q[0] - seed[0]) < 0.1 and abs(q[2]) < 0.1 and abs(q[4]) < 0.1, q
         seed = q
+
+
+def test_a_near_object_is_approached_with_the_tool_leaning_back(panda: GraspFsm) -> None:
+    """Random locations seed 0 trial 19: a cube 0.20 m from the Panda's base axis. With the elbow
+    at its limit no vertical pose exists 0.10 m above it (the trial ended 'no inverse-kinematics
+    solution above the object', then an arm twisted round joint 1 that hit its own base); the
+    pre-grasp leans the tool back towards the base, the descent keeps that lean."""
+    kin, policy = panda.kinematics, panda.policy
+    q = np.array([-2.306, -0.602, 0.001, -2.500, 0.001, 1.468, 0.786])   # entering state 4
+    obj = np.array([-0.1396, -0.1485, 0.025])
+    policy.begin_approach(0.0, 'cube', 0)
+    policy.object_position = obj
+    pre = policy._pregrasp_point()
+    yaw = np.arctan2(obj[1], obj[0]) + np.pi
+    assert kin.grasp_ik(pre, yaw, q) is None
+    assert policy._plan_pregrasp(q) == ''
+    q_pre = policy._q_target
+    assert 0.0 < policy._tilt <= policy.params.max_approach_tilt
+    np.testing.assert_allclose(kin.tool_position(q_pre), pre, atol=0.01)
+    tool_z = (kin.link_pose(q_pre, kin.tool_link) @ kin._tool_offset)[:3, 2]
+    radial = obj[:2] / np.linalg.norm(obj[:2])
+    assert tool_z[2] < -0.8 and float(tool_z[:2] @ radial) < -0.1     # down, tip to the base
+    # the same arm posture, turned to the object: joint 1 stays where it faces it
+    assert abs(q_pre[0] - q[0]) < 0.1
+    # every point of the straight descent to the grasp height has a pose at the same lean
+    q_now = q_pre
+    for z in np.linspace(pre[2], policy._grasp_z(), 12):
+        q_now = kin.grasp_ik(np.array([obj[0], obj[1], z]), policy._yaw, q_now, policy._tilt)
+        assert q_now is not None
+
+
+def test_the_hand_turns_round_only_after_every_lean(panda: GraspFsm) -> None:
+    """Seed 1 trial 55: vertical with the hand turned round, the Panda's IK found a pose
+    twisted 0.8 rad about joint 1 whose link 5 hit link 1 on the way; leaning at the grasp
+    yaw keeps the arm's posture, facing the object."""
+    q = np.array([-2.21, -0.60, 0.0, -2.50, 0.0, 1.53, 0.78])
+    panda.policy.begin_approach(0.0, 'cylinder', 0)
+    panda.policy.object_position = np.array([-0.1458, -0.1880, 0.025])
+    assert panda.policy._plan_pregrasp(q) == ''
+    assert abs(panda.policy._q_target[0] - q[0]) < 0.1
+
+
+def test_a_descent_without_a_pose_at_its_lean_leans_further(panda: GraspFsm) -> None:
+    """Seed 1 trial 60: half way down to a near cylinder, the lean chosen above it (0.15 rad)
+    had no pose (the elbow at its limit); the descent leans further instead of failing."""
+    policy = panda.policy
+    q = np.array([1.735, -0.559, -0.547, -3.132, -0.467, 2.437, 1.061])
+    setpoint = np.array([0.04259, 0.22219, 0.10170])    # where the descent was
+    policy.begin_approach(0.0, 'cylinder', 0)
+    policy._yaw, policy._tilt = -1.7483, 0.15
+    policy._line = (setpoint, setpoint, 0.0, 1.0)
+    assert panda.kinematics.grasp_ik(setpoint, policy._yaw, q, 0.15, turn_round=False) is None
+    _, _, failed = policy._follow_line(0.5, q)
+    assert not failed and policy._tilt > 0.15

@@ -106,6 +106,7 @@ class GraspPolicy:
         self._q_target: np.ndarray | None = None
         self._line: tuple[np.ndarray, np.ndarray, float, float] | None = None  # p0, p1, t0, T
         self._yaw = 0.0
+        self._tilt = 0.0          # rad, the tool's lean towards the base (0: vertical)
         self._refinements = 0
         self._gripper = GripperCommand(params.gripper_open_position, 0.0)
         self._last_opening: tuple[float, float] | None = None  # (time, opening)
@@ -150,7 +151,13 @@ class GraspPolicy:
         p0, p1, t0, duration = self._line
         s = min(1.0, (t - t0) / duration)
         setpoint = p0 + (p1 - p0) * s
-        q_set = self.kinematics.grasp_ik(setpoint, self._yaw, q)
+        q_set = self.kinematics.grasp_ik(setpoint, self._yaw, q, self._tilt,
+                                         turn_round=self._tilt == 0.0)
+        for tilt in (t for t in self._tilt_steps() if t > self._tilt and q_set is None):
+            # no pose on the way at this lean: lean further rather than give up (seed 1
+            # trial 60: the Panda's elbow at its limit half way down to a near cylinder)
+            q_set = self.kinematics.grasp_ik(setpoint, self._yaw, q, tilt, turn_round=False)
+            self._tilt = tilt if q_set is not None else self._tilt
         if q_set is None:
             return self._zeros(), False, True
         v, reached = self._track(q, q_set)
@@ -175,6 +182,14 @@ class GraspPolicy:
         offset = self.params.shape_value(self.shape, 'grasp_height_offset')
         return self.params.table_height + max(self._height() * frac + offset,
                                               self.params.min_tcp_height)
+
+    def _grasp_point(self) -> np.ndarray:
+        """Where the straight descent ends (m, base frame): above the object's centre at
+        :meth:`_grasp_z`."""
+        assert self.object_position is not None
+        target = self.object_position.copy()
+        target[2] = self._grasp_z()
+        return target
 
     def _pregrasp_point(self) -> np.ndarray:
         assert self.object_position is not None
@@ -239,11 +254,32 @@ class GraspPolicy:
         # thumb towards the base (pi): the natural hand orientation of this arm (joint 6 near 0)
         self._yaw = wrap_angle(math.atan2(y, x) + math.pi
                                + self.params.shape_value(self.shape, 'wrist_yaw'))
-        q_pre = self.kinematics.grasp_ik(self._pregrasp_point(), self._yaw, q)
-        if q_pre is None:
-            return f'no inverse-kinematics solution above the object at ({x:.2f}, {y:.2f}) m'
-        self._q_target = q_pre
-        return ''
+        for tilt, hand_yaw in self._leans(self._yaw):
+            # every lean at yaw before the hand turned round (the same grasp): turned round,
+            # the Panda found poses twisted about joint 1 that hit its own base (seed 1 trial
+            # 55, vertical); the six-joint arms need neither in the scenes' range
+            q_pre = self.kinematics.grasp_ik(self._pregrasp_point(), hand_yaw, q, tilt,
+                                             turn_round=False)
+            # and the descent's end at the same lean (seed 1 trials 55, 60, 80: a near
+            # cylinder had a pose above it but none at the grasp height, the descent failed)
+            if q_pre is not None and self.kinematics.grasp_ik(
+                    self._grasp_point(), hand_yaw, q_pre, tilt, turn_round=False) is not None:
+                self._q_target, self._tilt, self._yaw = q_pre, tilt, hand_yaw
+                return ''
+        return f'no inverse-kinematics solution above the object at ({x:.2f}, {y:.2f}) m'
+
+    def _leans(self, yaw: float) -> list[tuple[float, float]]:
+        """(tool lean rad, yaw rad) to try for the pre-grasp, in order: vertical, then leaning
+        in steps of about 0.15 rad up to ``max_approach_tilt``, at ``yaw``, then the same at
+        ``yaw + pi``: the least lean that has an IK solution."""
+        return [(t, y) for y in (yaw, wrap_angle(yaw + math.pi))
+                for t in [0.0, *self._tilt_steps()]]
+
+    def _tilt_steps(self) -> list[float]:
+        """The tool leans (rad) other than vertical, ascending: steps of about 0.15 rad up to
+        ``max_approach_tilt`` (none when it is 0)."""
+        steps = math.ceil(self.params.max_approach_tilt / 0.15 - 1e-9)
+        return [self.params.max_approach_tilt * i / steps for i in range(1, steps + 1)]
 
     # ------------------------------------------------------------------ state 4
     def begin_approach(self, t: float, shape: str, attempt: int) -> None:
@@ -253,6 +289,7 @@ class GraspPolicy:
         self.phase = 'open'
         self._t0 = t
         self._refinements = 0
+        self._tilt = 0.0
         self.object_height = None
         self._lost_since = None
         self._samples = []
@@ -327,11 +364,8 @@ class GraspPolicy:
                           f'unknown approach phase {self.phase!r}')
 
     def _begin_descend(self, t: float, q: np.ndarray) -> PolicyStep:
-        assert self.object_position is not None
-        target = self.object_position.copy()
-        target[2] = self._grasp_z()
         self.phase = 'descend'
-        self._start_line(t, q, target)
+        self._start_line(t, q, self._grasp_point())
         return PolicyStep(self._zeros(), self._gripper, self.phase)
 
     # ------------------------------------------------------------------ straight lift (state 6)

@@ -242,6 +242,11 @@ class FsmParams:
                              min=0.0, max=5.0, live=True)
     max_reach: float = param(0.85, 'objects farther from the base axis are not grasped',
                              unit='m', min=0.0, max=5.0, live=True)
+    # an arm folded near its base cannot hold the tool vertical over a near object (the
+    # Panda's elbow at its limit, 0.20 m from the base axis): the tool then leans back
+    max_approach_tilt: float = param(0.45, 'largest lean of the tool from vertical, its tip '
+                                     'towards the base, where no vertical grasp pose exists',
+                                     unit='rad', min=0.0, max=1.2, live=True)
     segment_timeout: float = param(8.0, 'for one motion segment', unit='s', min=0.1, max=120.0,
                                    live=True)
     # the fingertips reach 0.025 m below the grasp point and would stall on the table
