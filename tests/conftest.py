@@ -49,6 +49,19 @@ if SHARED_DATA.is_dir():
     os.environ.setdefault('MNE_DATASETS_EEGBCI_PATH', str(SHARED_DATA))
 
 
+@pytest.fixture(autouse=True)
+def _process_log_level() -> Iterator[None]:
+    """Each test starts at the process's default log level and leaves it there: a lock-step run
+    sets the level of every node logger in its process (``set_log_level``, as ``--log-level``),
+    and a later test in the same xdist worker that expects an info line would otherwise depend on
+    which tests ran before it."""
+    from mindgrasp_ros.runtime.logging import get_logger_effective_level, set_logger_level
+
+    level = get_logger_effective_level('')
+    yield
+    set_logger_level('', level)
+
+
 @pytest.fixture
 def rclpy_ctx() -> Iterator[object]:
     """``rclpy`` (ours or the real one), initialised for the test and shut down after it."""
