@@ -264,10 +264,13 @@ def test_each_block_is_published_as_it_arrives(spawn_node, listener, stream_name
                                                 lsl_source) -> None:
     """A block reaches /eeg/raw when it arrives, not at the node's next pull: with a 10 s
     ``chunk_period`` (and an inlet buffer that keeps everything) a node that pulled on its timer
-    would publish each half-second block seconds late; the reader thread publishes it at once."""
+    would publish each half-second block seconds late; the reader thread publishes it at once.
+    ``lost_timeout`` is well above the block period: at its default (0.5 s, one block period) a
+    block late on a loaded machine made the node take the stream for lost and reconnect, and the
+    samples between were gone (a fresh-clone run)."""
     lsl_source(stream_name, '--chunk', '125', '--duration', '120')   # a block every 0.5 s
     acq = spawn_node('mindgrasp_eeg.acquisition_node', stream_name=stream_name,
-                     chunk_period=10.0, max_buflen=30.0)
+                     chunk_period=10.0, max_buflen=30.0, lost_timeout=10.0)
     assert listener.spin(60, lambda: sum(m.n_samples for _, m in listener.chunks) >= 500), \
         acq.output()
     chunks = [m for _, m in listener.chunks]
@@ -275,10 +278,11 @@ def test_each_block_is_published_as_it_arrives(spawn_node, listener, stream_name
     n = np.array([m.n_samples for m in chunks])
     assert np.all(idx[1:] == idx[:-1] + n[:-1]), 'samples missing or out of order'
     # age of each chunk's first sample when it arrived: the block's span (0.5 s) plus LSL and
-    # DDS delivery; 2.5 s is generous for a loaded machine and far below the 10 s timer
+    # DDS delivery; 5 s is generous for a loaded machine, and a node pulling on its 10 s timer
+    # publishes the first 500 samples 8.5-10 s old
     age = np.array([(t - (m.header.stamp.sec * 10**9 + m.header.stamp.nanosec)) * 1e-9
                     for t, m in listener.chunks])
-    assert np.all(age < 2.5), np.round(age, 3)
+    assert np.all(age < 5.0), np.round(age, 3)
 
 
 def test_a_run_directory_that_refuses_the_metadata_is_one_line(spawn_node, listener,
