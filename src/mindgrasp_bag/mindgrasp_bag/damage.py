@@ -42,7 +42,9 @@ class BagDamage:
         expected_messages: What metadata.yaml (else the files' summaries) says the bag holds;
             None when neither exists (a killed recorder's bag).
         readable_messages: Messages a scan of every record can read.
-        skipped_records: Corrupt records skipped (chunks whose CRC fails, bad framing).
+        skipped_records: Damaged stretches skipped (a chunk whose CRC fails or no longer
+            decompresses, bytes that do not frame a record up to the next intact chunk).
+        skipped_bytes: Bytes those stretches span.
         cut_files: Files whose scan stopped early (cut off, garbage) or that have no footer.
         lost_spans: Bag time ranges ``(start, end)`` where messages are missing: between the
             last message before a skipped record and the first after it, and from the last
@@ -54,6 +56,7 @@ class BagDamage:
     expected_messages: int | None
     readable_messages: int
     skipped_records: int = 0
+    skipped_bytes: int = 0
     cut_files: int = 0
     lost_spans: list[tuple[int, int]] = field(default_factory=list)
     problems: list[str] = field(default_factory=list)
@@ -81,6 +84,7 @@ class BagDamage:
         return {'damaged': self.damaged, 'expected_messages': self.expected_messages,
                 'readable_messages': self.readable_messages,
                 'lost_messages': self.lost_messages, 'skipped_records': self.skipped_records,
+                'skipped_bytes': self.skipped_bytes,
                 'cut_files': self.cut_files, 'lost_span_s': round(self.lost_span_ns / 1e9, 6),
                 'problems': list(self.problems), 'summary': self.count_line()}
 
@@ -90,8 +94,9 @@ class BagDamage:
                     if self.expected_messages is None else
                     f'of {self.expected_messages} recorded ({self.lost_messages} lost)')
         return (f'{self.readable_messages} message(s) readable {expected}; '
-                f'{self.skipped_records} damaged record(s) skipped, {self.cut_files} file(s) '
-                f'cut off; {self.lost_span_ns / 1e9:.3f} s of bag time has missing messages.')
+                f'{self.skipped_records} damaged record(s) skipped ({self.skipped_bytes} bytes), '
+                f'{self.cut_files} file(s) cut off; {self.lost_span_ns / 1e9:.3f} s of bag time '
+                'has missing messages.')
 
     def lines(self) -> list[str]:
         """Each problem, then the counts (empty for a sound bag)."""
@@ -139,6 +144,7 @@ def assess_bag(bag: Path) -> BagDamage:
         contents = read_mcap_contents(path, scan=True)
         damage.readable_messages += contents.message_count
         damage.skipped_records += len(contents.damaged)
+        damage.skipped_bytes += contents.skipped_bytes
         damage.problems += damage_sentences(contents)
         cut = bool(contents.stopped_at) or not contents.footer
         damage.cut_files += cut

@@ -71,6 +71,8 @@ class RunStamps:
         flip_ns: (trial, phase) -> the display's flip stamp (/display/flip).
         periodic_ns: topic -> shape (n,) publication times, for the jitter table.
         nominal_period_s: topic -> nominal period (s) from the run's parameters.
+        notes: What the bag reader skipped or recovered (damaged chunks, unfinished files),
+            as sentences; they go into the report's notes.
     """
 
     chunk_first_ns: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
@@ -83,6 +85,7 @@ class RunStamps:
     flip_ns: dict[tuple[int, str], int] = field(default_factory=dict)
     periodic_ns: dict[str, np.ndarray] = field(default_factory=dict)
     nominal_period_s: dict[str, float] = field(default_factory=dict)
+    notes: list[str] = field(default_factory=list)
 
 
 def summarize_ms(values_ns: np.ndarray) -> dict[str, Any]:
@@ -141,7 +144,7 @@ def latency_report(stamps: RunStamps) -> dict[str, Any]:
                '/eeg/raw chunk and a later command (their stamps are on different clocks, or '
                'the recorder missed the EEG); record a live run with `mindgrasp launch demo`.')
         raise LatencyError(msg)
-    notes = []
+    notes = list(s.notes)
     if not ok.all():
         notes.append(f'{int((~ok).sum())} of {ok.size} predictions were left out: the /eeg/raw '
                      'chunk of their last sample or a later command is not in the bag (recorded '

@@ -24,10 +24,12 @@ from .errors import BagError
 from .mcap_scan import McapContents, read_mcap_contents
 from .qos import parse_offered_qos
 
-__all__ = ['FileStats', 'TopicStats', 'build_metadata', 'load_metadata', 'mcap_files',
-           'rebuild_metadata', 'write_metadata']
+__all__ = ['DAMAGED_SUFFIX', 'FileStats', 'TopicStats', 'build_metadata', 'load_metadata',
+           'mcap_files', 'rebuild_metadata', 'write_metadata']
 
 METADATA_FILE = 'metadata.yaml'
+#: what `bag reindex` appends to the name of a file it repaired, kept as it was
+DAMAGED_SUFFIX = '.damaged'
 ROS_DISTRO = 'jazzy'
 
 
@@ -119,14 +121,21 @@ def load_metadata(bag_dir: Path) -> dict[str, Any]:
     except FileNotFoundError:
         msg = f'{path} does not exist; run `mindgrasp bag reindex {bag_dir}` to rebuild it.'
         raise BagError(msg) from None
-    except yaml.YAMLError as exc:
-        msg = (f'{path} is not valid YAML ({exc}); delete it and run '
-               f'`mindgrasp bag reindex {bag_dir}` to rebuild it from the storage files.')
+    except (yaml.YAMLError, UnicodeDecodeError) as exc:
+        where = getattr(exc, 'problem_mark', None)
+        at = f' at line {where.line + 1}' if where is not None else ''
+        msg = (f'{path} is corrupt (not valid YAML{at}); run `mindgrasp bag reindex {bag_dir}` '
+               'to rebuild it from the .mcap files (the corrupt one is kept as '
+               f'{METADATA_FILE}{DAMAGED_SUFFIX}).')
+        raise BagError(msg) from None
+    except OSError as exc:
+        msg = f'Cannot read {path}: {exc.strerror}; check its permissions.'
         raise BagError(msg) from None
     info = data.get('rosbag2_bagfile_information') if isinstance(data, dict) else None
-    if not isinstance(info, dict):
-        msg = (f'{path} has no rosbag2_bagfile_information section; delete it and run '
-               f'`mindgrasp bag reindex {bag_dir}` to rebuild it from the storage files.')
+    if not isinstance(info, dict) or not isinstance(info.get('message_count', 0), int):
+        msg = (f'{path} is corrupt (no valid rosbag2_bagfile_information section); run '
+               f'`mindgrasp bag reindex {bag_dir}` to rebuild it from the .mcap files (the '
+               f'corrupt one is kept as {METADATA_FILE}{DAMAGED_SUFFIX}).')
         raise BagError(msg)
     return info
 
@@ -170,7 +179,14 @@ def rebuild_metadata(bag_dir: Path, *, write: bool = True) -> dict[str, Any]:
             topic.message_count += contents.channel_counts.get(channel.id, 0)
         compression = compression or contents.compression
     _ = compression  # chunk compression is internal to MCAP: rosbag2 leaves the fields empty
-    metadata = build_metadata(files, list(topics.values()))
+    custom_data = None
+    if (bag_dir / METADATA_FILE).exists():      # keep what the recording said about itself
+        try:
+            custom_data = load_metadata(bag_dir).get('custom_data') or None
+        except BagError:
+            custom_data = None
+    metadata = build_metadata(files, list(topics.values()),
+                              custom_data=custom_data if isinstance(custom_data, dict) else None)
     if write:
         write_metadata(bag_dir, metadata)
     return metadata

@@ -1,13 +1,16 @@
-"""Read any rosbag2 bag: ours, ``ros2 bag`` (sqlite3 or MCAP), rosbags; finished or not.
+"""Read any rosbag2 bag: ours, ``ros2 bag`` (sqlite3 or MCAP), rosbags; finished or not,
+sound or damaged.
 
-Complete bags are read with ``rosbags.rosbag2.Reader`` (both storage plugins, all compression
-modes). A bag whose recorder was killed (MCAP files without summary, maybe no metadata.yaml) is
-read by scanning its MCAP files (:mod:`.mcap_scan`), which recovers every complete record.
+MCAP bags are read by :mod:`.mcap_scan`: a file with an intact summary through its chunk index
+(in time order, a damaged chunk skipped and said in ``notes``), a file without one (a recorder
+killed, a disk full, a file cut short, a damaged summary) by a scan that skips damage and reads
+every intact chunk after it. A damaged chunk thus costs only its own messages, in every tool that
+reads bags through this class (info, play, replay, export, training, latency). sqlite3 bags and
+whole-file compressed ones are read with ``rosbags.rosbag2.Reader``.
 """
 
 from __future__ import annotations
 
-import itertools
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -20,11 +23,12 @@ from rosbags.rosbag2.errors import ReaderError
 from .errors import BagError
 from .mcap_scan import (
     CORRUPT_RECORD_ERRORS,
-    is_finished,
-    iter_mcap_messages,
+    McapContents,
+    iter_indexed_messages,
+    iter_scanned_messages,
     read_mcap_contents,
 )
-from .metadata import METADATA_FILE, load_metadata, mcap_files, rebuild_metadata
+from .metadata import DAMAGED_SUFFIX, METADATA_FILE, load_metadata, mcap_files, rebuild_metadata
 from .qos import parse_offered_qos
 
 __all__ = ['BagReader', 'TopicInfo']
@@ -63,7 +67,7 @@ class BagReader:
         self.notes: list[str] = []
         self.complete = True
         self._reader: Reader | None = None
-        self._scan_files: list[Path] = []
+        self._contents: list[McapContents] = []
 
     @property
     def duration_ns(self) -> int:
@@ -93,25 +97,15 @@ class BagReader:
                            'file); pass the directory that `mindgrasp bag record` or '
                            '`ros2 bag record` created.')
                 raise BagError(msg)
-            unfinished = [p for p in self.files if not is_finished(p)]
-            if has_metadata and not unfinished:
-                try:
-                    self._open_rosbags(self.path)
-                except BagError as exc:
-                    if not self.files:
-                        raise
-                    # read what can be read: a damaged summary or metadata.yaml does not
-                    # make the records unreadable
-                    self.notes.append(f'{exc} The files were read by a scan instead.')
-                    self._open_scan(self.files, [], has_metadata)
+            if self.files:
+                # MCAP: our own reader, which loses only damaged chunks (rosbags stops at the
+                # first one); rosbags reads sqlite3 bags and whole-file compressed ones
+                self._open_mcap(self.files, has_metadata)
             else:
-                self._open_scan(self.files, unfinished, has_metadata)
+                self._open_rosbags(self.path)
         elif self.path.suffix == '.mcap':
             self.files = [self.path]
-            if is_finished(self.path):
-                self._open_rosbags(self.path)
-            else:
-                self._open_scan(self.files, self.files, False)
+            self._open_mcap(self.files, False)
         elif self.path.suffix == '.db3':
             self.files = [self.path]
             self._open_rosbags(self.path)
@@ -151,29 +145,31 @@ class BagReader:
                 conn.msgdef.data if conn.msgdef else '',
                 getattr(conn.ext, 'serialization_format', 'cdr'))
 
-    def _open_scan(self, files: list[Path], unfinished: list[Path], has_metadata: bool) -> None:
+    def _open_mcap(self, files: list[Path], has_metadata: bool) -> None:
+        """Topics, counts and times from each file's summary (a scan where it has none)."""
         self.storage = 'mcap'
+        self._contents = [read_mcap_contents(path) for path in files]
+        unfinished = [c.path.name for c in self._contents if not c.footer]
         self.complete = not unfinished
-        self._scan_files = files
-        names = ', '.join(p.name for p in unfinished)
         if unfinished:
-            self.notes.append(f'The file(s) {names} were not closed (the recorder was killed or '
-                              'the disk was full); their complete records were recovered.')
-        metadata = None
+            self.notes.append(f'The file(s) {", ".join(unfinished)} were not closed (the recorder '
+                              'was killed or the disk was full); their complete records were '
+                              'recovered.')
         if has_metadata:
             try:
-                metadata = load_metadata(self.path)
-            except BagError:
-                metadata = None
+                load_metadata(self.path)
+            except BagError as exc:   # corrupt, not missing: the files are read all the same
+                self.notes.append(f'{exc} The .mcap files were read without it.')
+        elif self.path.is_dir():
+            self.notes.append(f'metadata.yaml is missing; run `mindgrasp bag reindex {self.path}` '
+                              'to write it.')
         start, end = 2**63 - 1, 0
-        for path in files:
-            contents = read_mcap_contents(path)
+        for contents in self._contents:
+            name = contents.path.name
             for damage in contents.damaged:
-                self.notes.append(f'{path.name}: a {damage}; it was skipped.')
+                self.notes.append(f'{name}: a {damage}; it was skipped.')
             if contents.stopped_at:
-                self.notes.append(
-                    f'{path.name}: reading stopped because the {contents.stopped_at}.')
-            schemas = {}
+                self.notes.append(f'{name}: reading stopped because the {contents.stopped_at}.')
             for channel in contents.channels.values():
                 topic = self.topics.get(channel.topic)
                 if topic is None:
@@ -184,16 +180,18 @@ class BagReader:
                         channel.schema_data.decode('utf-8', 'replace'),
                         channel.message_encoding)
                 topic.message_count += contents.channel_counts.get(channel.id, 0)
-                schemas[channel.id] = channel
             if contents.message_count:
                 start = min(start, contents.start_ns)
                 end = max(end, contents.end_ns)
             self.message_count += contents.message_count
         if self.message_count:
             self.start_ns, self.end_ns = start, end
-        if metadata is None and self.path.is_dir():
-            self.notes.append(f'metadata.yaml is missing; run `mindgrasp bag reindex {self.path}` '
-                              'to write it.')
+        if self.path.is_dir():
+            backups = sorted(p.name for p in self.path.glob(f'*{DAMAGED_SUFFIX}*'))
+            if backups:
+                self.notes.append(f'{", ".join(backups)}: the original(s) of the files `mindgrasp '
+                                  'bag reindex` repaired, kept as they were; delete them once the '
+                                  'repaired bag has what you need.')
 
     def rebuild_metadata(self) -> Path:
         """Write metadata.yaml from the MCAP files (for bags opened by a scan)."""
@@ -202,63 +200,65 @@ class BagReader:
 
     def messages(self, topics: Iterable[str] | None = None,
                  start_ns: int | None = None) -> Iterator[tuple[str, int, bytes]]:
-        """``(topic, timestamp_ns, cdr_bytes)`` in time order (file order for recovered files).
+        """``(topic, timestamp_ns, cdr_bytes)`` in time order (file order for unfinished files).
+
+        Damaged chunks are skipped (each one said in ``notes``); every other message is read.
 
         Args:
             topics: Only these topics (default: all).
             start_ns: Only messages at or after this bag time (ns).
+        """
+        for topic, timestamp, _, data in self.records(topics, start_ns):
+            yield topic, timestamp, data
+
+    def records(self, topics: Iterable[str] | None = None,
+                start_ns: int | None = None) -> Iterator[tuple[str, int, int, bytes]]:
+        """As :meth:`messages`, with the publication time: ``(topic, log_time_ns,
+        publish_time_ns, cdr_bytes)`` (``publish_time`` is the log time when the bag has none).
         """
         wanted = None if topics is None else set(topics)
         if self._reader is not None:
             conns = [c for c in self._reader.connections if wanted is None or c.topic in wanted]
             if not conns:
                 return
-            last: int | None = None
-            at_last: set[tuple[str, int, bytes]] = set()   # yielded at time ``last``
             try:
                 for conn, timestamp, data in self._reader.messages(conns, start=start_ns):
-                    if timestamp != last:
-                        last, at_last = timestamp, set()
-                    at_last.add(_key(conn.topic, data))
-                    yield conn.topic, timestamp, data
+                    yield conn.topic, timestamp, timestamp, data
             except (ReaderError, *CORRUPT_RECORD_ERRORS) as exc:
-                mcap = [f for f in self.files if f.suffix == '.mcap']
-                if not mcap:
-                    msg = (f'The bag {self.path} is corrupt: {exc} Messages up to this point '
-                           'were read; the rest cannot be.')
-                    raise BagError(msg) from exc
-                # read what can be read: the rest comes from a scan, which skips damaged records
-                self.notes.append(f'A damaged record stopped the indexed reader ({exc}); the '
-                                  'messages after it were read by a scan that skips it.')
-                for topic, timestamp, data in self._scan(mcap, wanted, start_ns):
-                    if last is not None and (timestamp < last or (timestamp == last
-                                             and _key(topic, data) in at_last)):
-                        continue
-                    yield topic, timestamp, data
+                msg = (f'The bag {self.path} is corrupt: {exc} Messages up to this point '
+                       'were read; the rest cannot be.')
+                raise BagError(msg) from exc
             return
-        if not self._scan_files:
+        if not self._contents:
             msg = f'The bag {self.path} is not open; call open() first.'
             raise BagError(msg)
-        yield from self._scan(self._scan_files, wanted, start_ns)
+        for contents in self._contents:
+            ids = None if wanted is None else {
+                cid for cid, ch in contents.channels.items() if ch.topic in wanted}
+            if ids is not None and not ids:
+                continue
+            if contents.indexed:
+                source = iter_indexed_messages(contents, channel_ids=ids, start_ns=start_ns,
+                                               on_skip=self._skipped)
+            else:
+                source = iter_scanned_messages(contents.path, channel_ids=ids)
+            for m in source:
+                if wanted is not None and m.channel.topic not in wanted:
+                    continue
+                if start_ns is not None and m.log_time < start_ns:
+                    continue
+                yield m.channel.topic, m.log_time, m.publish_time or m.log_time, m.data
 
-    @staticmethod
-    def _scan(files: list[Path], wanted: set[str] | None,
-              start_ns: int | None) -> Iterator[tuple[str, int, bytes]]:
-        """Every readable message of ``files`` in file order (damaged records skipped)."""
-        for channel, timestamp, data in itertools.chain.from_iterable(
-                iter_mcap_messages(p) for p in files):
-            if wanted is not None and channel.topic not in wanted:
-                continue
-            if start_ns is not None and timestamp < start_ns:
-                continue
-            yield channel.topic, timestamp, data
+    def _skipped(self, sentence: str) -> None:
+        if sentence not in self.notes:
+            self.notes.append(sentence)
 
     def close(self) -> None:
         """Release the files."""
         if self._reader is not None:
             self._reader.close()
             self._reader = None
-        self._scan_files = []
+        self._contents = []
 
     def __enter__(self) -> BagReader:
         return self.open()
@@ -266,11 +266,6 @@ class BagReader:
     def __exit__(self, exc_type: type[BaseException] | None, exc: BaseException | None,
                  tb: TracebackType | None) -> None:
         self.close()
-
-
-def _key(topic: str, data: bytes | memoryview) -> tuple[str, int, bytes]:
-    """Tells apart messages of one timestamp, cheaply (no hash of a whole image)."""
-    return topic, len(data), bytes(data[:64])
 
 
 def _rosbags_qos(qos: Any) -> dict[str, Any]:

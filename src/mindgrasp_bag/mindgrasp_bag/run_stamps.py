@@ -6,7 +6,10 @@ the nodes its launch.yaml lists.
 
 Each message's publication time is the MCAP ``publish_time`` (the DDS source timestamp our
 recorder and rosbag2 Jazzy store); bags without it (0) fall back to the receive time
-(``log_time``). Unfinished files (a killed recorder) are read up to their last complete record.
+(``log_time``). The bag is read with :class:`~.reader.BagReader`, as by every bag tool: an
+unfinished file (a killed recorder, a full disk, a file cut short) is read up to its last
+complete record, and a damaged chunk costs only its own messages; what was skipped goes into the
+report's notes.
 """
 
 from __future__ import annotations
@@ -17,13 +20,10 @@ from typing import Any
 
 import numpy as np
 import yaml
-from mcap.exceptions import McapError
-from mcap.reader import make_reader
 
-from .errors import BagError
 from .latency import RunStamps
-from .metadata import mcap_files
 from .paths import run_dir_of
+from .reader import BagReader
 from .typestore import typestore
 
 __all__ = ['PERIODIC', 'read_run_stamps']
@@ -40,20 +40,17 @@ def _stamp_ns(header: Any) -> int:
     return int(header.stamp.sec) * 10**9 + int(header.stamp.nanosec)
 
 
-def _messages(bag: Path, topics: set[str]) -> Iterator[tuple[str, int, bytes]]:
-    """``(topic, publication ns, cdr bytes)`` of ``topics`` from every MCAP file of ``bag``."""
-    files = mcap_files(bag) if bag.is_dir() else [bag]
-    if not files:
-        msg = (f'{bag} holds no .mcap file; the timing report reads MCAP bags (the format '
-               '`mindgrasp launch` records).')
-        raise BagError(msg)
-    for path in files:
-        with path.open('rb') as f:
-            try:
-                for _, channel, message in make_reader(f).iter_messages(topics=list(topics)):
-                    yield channel.topic, message.publish_time or message.log_time, message.data
-            except (McapError, EOFError, ValueError):
-                continue   # an unfinished file: its complete records were read
+def _messages(bag: Path, topics: set[str],
+              notes: list[str]) -> Iterator[tuple[str, int, bytes]]:
+    """``(topic, publication ns, cdr bytes)`` of ``topics``, read as every bag tool reads (a
+    damaged chunk or a cut-off tail costs only its own messages); what the reader skipped or
+    recovered is appended to ``notes``."""
+    with BagReader(bag) as reader:
+        present = topics & set(reader.topics)
+        if present:
+            for topic, _, pub, data in reader.records(present):
+                yield topic, pub, data
+        notes.extend(reader.notes)
 
 
 def _nominal_periods(bag: Path) -> dict[str, float]:
@@ -83,7 +80,7 @@ def read_run_stamps(bag: Path | str) -> RunStamps:
         bag: a bag directory (``runs/<run>/bag``) or one .mcap file.
 
     Raises:
-        BagError: no MCAP file in ``bag``.
+        BagError: ``bag`` is not a bag.
     """
     bag = Path(bag)
     store = typestore()
@@ -92,7 +89,7 @@ def read_run_stamps(bag: Path | str) -> RunStamps:
     commands: list[int] = []
     s = RunStamps()
     periodic: dict[str, list[int]] = {t: [] for t in PERIODIC}
-    for topic, pub, data in _messages(bag, {EEG, PRED, CMD, PROMPT, FLIP, *PERIODIC}):
+    for topic, pub, data in _messages(bag, {EEG, PRED, CMD, PROMPT, FLIP, *PERIODIC}, s.notes):
         if topic in periodic:
             periodic[topic].append(pub)
         if topic == EEG:

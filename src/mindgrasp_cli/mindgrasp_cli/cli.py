@@ -18,6 +18,7 @@ import functools
 import importlib
 import importlib.metadata
 import importlib.util
+import os
 import sys
 from collections.abc import Sequence
 from pathlib import Path
@@ -146,8 +147,30 @@ def version_text() -> str:
     return f'{text} (git {describe})' if describe else text
 
 
+#: exit code when the reader of stdout went away (``mindgrasp bag info RUN | head -1``): what a
+#: shell reports for a process ended by SIGPIPE (128 + 13), as 130 is for Ctrl-C
+EXIT_PIPE_CLOSED = 141
+
+
 def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of the ``mindgrasp`` console script."""
+    """Entry point of the ``mindgrasp`` console script.
+
+    Output piped into a reader that stops early (``| head -1``) ends every command quietly
+    with :data:`EXIT_PIPE_CLOSED`: Python's recipe (the ``signal`` module's note on SIGPIPE),
+    stdout pointed at /dev/null so that the interpreter's last flush cannot raise again.
+    """
+    try:
+        try:
+            return _main(argv)
+        finally:
+            sys.stdout.flush()   # a closed pipe shows here rather than at the interpreter's exit
+    except BrokenPipeError:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        return EXIT_PIPE_CLOSED
+
+
+def _main(argv: Sequence[str] | None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     if not commands() and argv[:1] != ['--version']:
         # an install older than the packages' setup.py files (pulled, not re-installed)
