@@ -82,7 +82,8 @@ def test_predictions_without_their_chunk_are_left_out_with_a_note() -> None:
     assert report['end_to_end']['count'] == 37
     assert report['notes'] == [
         '3 of 40 predictions were left out: the /eeg/raw chunk of their last sample or a later '
-        'command is not in the bag (recorded before the recorder started or after it stopped).']
+        'command is not in the bag (recorded before the recorder started or after it stopped, '
+        'or in a damaged chunk).']
 
 
 @pytest.mark.parametrize(('change', 'match'), [

@@ -148,7 +148,7 @@ def latency_report(stamps: RunStamps) -> dict[str, Any]:
     if not ok.all():
         notes.append(f'{int((~ok).sum())} of {ok.size} predictions were left out: the /eeg/raw '
                      'chunk of their last sample or a later command is not in the bag (recorded '
-                     'before the recorder started or after it stopped).')
+                     'before the recorder started or after it stopped, or in a damaged chunk).')
     sample, chunk_pub = s.pred_stamp_ns[ok], s.chunk_pub_ns[idx[ok]]
     pred_pub, command_pub = s.pred_pub_ns[ok], s.command_pub_ns[nxt[ok]]
     hops = {'acquisition': summarize_ms(chunk_pub - sample),

@@ -237,11 +237,12 @@ def _resync(buf: bytes | mmap.mmap, start: int, size: int) -> int | None:
         pos += 1
 
 
-def _message_index_count(buf: bytes | mmap.mmap, offset: int, size: int) -> int | None:
-    """Messages listed by the message index records at ``offset`` (those that follow a chunk);
-    None when there are none or they are damaged too."""
-    total, seen = 0, False
-    while offset + 9 + 6 <= size:
+def _message_index_count(buf: bytes | mmap.mmap, offset: int, size: int, *,
+                         records: int | None = None) -> int | None:
+    """Messages listed by the message index records at ``offset`` (those that follow a chunk;
+    at most ``records`` of them); None when there are none or they are damaged too."""
+    total, seen = 0, 0
+    while offset + 9 + 6 <= size and (records is None or seen < records):
         opcode, length = _RECORD_HEADER.unpack_from(buf, offset)
         if opcode != _OPCODE_MESSAGE_INDEX or offset + 9 + length > size or length < 6:
             break
@@ -249,7 +250,7 @@ def _message_index_count(buf: bytes | mmap.mmap, offset: int, size: int) -> int 
         if 6 + n_bytes != length or n_bytes % 16:
             return None
         total += n_bytes // 16
-        seen = True
+        seen += 1
         offset += 9 + length
     return total if seen else None
 
@@ -260,7 +261,7 @@ def _chunk_index_count(buf: bytes | mmap.mmap, index: ChunkIndex, size: int) -> 
         return 0
     total = 0
     for offset in index.message_index_offsets.values():
-        count = _message_index_count(buf, offset, min(size, offset + index.message_index_length))
+        count = _message_index_count(buf, offset, size, records=1)
         if count is None:
             return None
         total += count

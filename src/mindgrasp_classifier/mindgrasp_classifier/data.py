@@ -226,8 +226,7 @@ def load_bag(path: str | Path, eeg_topic: str = EEG_RAW.name,
         msg = ("--labels markers needs --event-map naming the markers' classes, e.g. "
                'T1=left_hand,T2=right_hand.')
         raise ClassifierError(msg)
-    from rosbags.rosbag2 import Reader
-
+    from mindgrasp_bag.reader import BagReader
     from mindgrasp_ros.typesupport import typestore
 
     path = Path(path)
@@ -240,8 +239,10 @@ def load_bag(path: str | Path, eeg_topic: str = EEG_RAW.name,
     label_topic = {'prompt': prompt_topic, 'intent': intent_topic,
                    'markers': EEG_MARKERS.name}[labels]
     try:
-        with Reader(bag_dir) as reader:
-            topics = {c.topic for c in reader.connections}
+        # every bag tool's reader: a damaged chunk costs only its own messages (their samples
+        # are NaN, and windows over them are skipped)
+        with BagReader(bag_dir) as reader:
+            topics = set(reader.topics)
             if eeg_topic not in topics:
                 msg = (f'The bag {bag_dir} has no {eeg_topic} topic (it has {sorted(topics)}); '
                        'record the EEG stream or name the EEG topic.')
@@ -256,10 +257,10 @@ def load_bag(path: str | Path, eeg_topic: str = EEG_RAW.name,
                        'nothing to label with; record with the acquisition node relaying the '
                        'marker stream (marker_stream:=auto or its name).')
                 raise ClassifierError(msg)
-            conns = [c for c in reader.connections if c.topic in (eeg_topic, label_topic)]
-            for conn, t_ns, raw in reader.messages(connections=conns):
-                msg_obj = store.deserialize_cdr(raw, conn.msgtype)
-                if conn.topic == eeg_topic:
+            wanted = {eeg_topic, label_topic} & topics
+            for topic, t_ns, raw in reader.messages(wanted):
+                msg_obj = store.deserialize_cdr(raw, reader.topics[topic].type)
+                if topic == eeg_topic:
                     chunks.append(msg_obj)
                 elif labels == 'prompt':
                     prompts.append(msg_obj)
@@ -270,7 +271,7 @@ def load_bag(path: str | Path, eeg_topic: str = EEG_RAW.name,
                     intents.append((t_ns * 1e-9, str(msg_obj.data)))
     except ClassifierError:
         raise
-    except Exception as exc:  # rosbags raises its own error types for damaged bags
+    except Exception as exc:  # rosbags raises its own error types for sqlite3 bags
         msg = f'Cannot read the bag {bag_dir} ({type(exc).__name__}: {exc}); is it a rosbag2?'
         raise ClassifierError(msg) from None
     if not chunks:
@@ -336,6 +337,9 @@ def _find_bag_dir(path: Path) -> Path:
         return path
     if (path / 'bag' / 'metadata.yaml').is_file():   # a run directory (it may hold replays too)
         return path / 'bag'
+    for cand in (path / 'bag', path):   # a recorder killed before metadata.yaml: its .mcap files
+        if cand.is_dir() and any(cand.glob('*.mcap')):
+            return cand
     found = sorted(p.parent for p in path.rglob('metadata.yaml'))
     if len(found) == 1:
         return found[0]

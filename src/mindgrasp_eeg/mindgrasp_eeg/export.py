@@ -59,11 +59,9 @@ def find_bag(path: str | Path) -> Path:
     for cand in (p / 'bag', p):
         if (cand / 'metadata.yaml').is_file():
             return cand
-    if p.is_dir() and any(p.glob('**/*.mcap')):
-        msg = (f'The bag under {str(p)!r} has no metadata.yaml (the recording did not end '
-               f'cleanly); rebuild it with `mindgrasp bag info --fix` or the bag tools, then '
-               f'export again.')
-        raise EEGError(msg)
+    for cand in (p / 'bag', p):      # a recorder killed before metadata.yaml: its .mcap files
+        if cand.is_dir() and any(cand.glob('*.mcap')):
+            return cand
     msg = f'{str(p)!r} is neither a run directory with a bag nor a rosbag2 folder; check the path.'
     raise EEGError(msg)
 
@@ -87,7 +85,7 @@ def read_session(path: str | Path, eeg_topic: str = EEG_RAW.name) -> Recording:
     EEGError
         No bag, no EEG on ``eeg_topic``, or an unreadable bag.
     """
-    from rosbags.rosbag2 import Reader
+    from mindgrasp_bag.reader import BagReader
 
     bag = find_bag(path)
     store = _typestore()
@@ -98,16 +96,17 @@ def read_session(path: str | Path, eeg_topic: str = EEG_RAW.name) -> Recording:
     targets: list[tuple[int, str]] = []                   # (stamp ns, description)
     skipped = 0
     try:
-        with Reader(bag) as reader:
+        # every bag tool's reader: a damaged chunk costs only its own messages (their samples
+        # become a BAD_gap), a recorder killed mid-run leaves its complete records readable
+        with BagReader(bag) as reader:
             wanted = {eeg_topic, TRAINER_PROMPT.name, TASK_TARGET.name,
                       VIRTUAL_SUBJECT_INTENT.name, TASK_RESULT.name, FSM_STATE.name,
-                      EEG_MARKERS.name}
-            conns = [c for c in reader.connections if c.topic in wanted]
-            if not any(c.topic == eeg_topic for c in conns):
-                conns = []    # no EEG: reported below (rosbags reads every topic for [])
-            for conn, t_log, raw in (reader.messages(connections=conns) if conns else ()):
-                msg = store.deserialize_cdr(raw, conn.msgtype)
-                if conn.topic == eeg_topic:
+                      EEG_MARKERS.name} & set(reader.topics)
+            if eeg_topic not in wanted:
+                wanted = set()    # no EEG: reported below
+            for topic, t_log, raw in (reader.messages(wanted) if wanted else ()):
+                msg = store.deserialize_cdr(raw, reader.topics[topic].type)
+                if topic == eeg_topic:
                     this = (float(msg.sample_rate), tuple(msg.channel_names))
                     layout = layout or this
                     if this != layout:
@@ -116,20 +115,20 @@ def read_session(path: str | Path, eeg_topic: str = EEG_RAW.name) -> Recording:
                     data = np.asarray(msg.data, dtype=np.float64).reshape(
                         int(msg.n_samples), len(this[1]))
                     chunks.append((int(msg.first_sample_index), _stamp_ns(msg.header), data))
-                elif conn.topic == TRAINER_PROMPT.name:
+                elif topic == TRAINER_PROMPT.name:
                     events.append((_stamp_ns(msg.header), float(msg.duration),
                                    prompt_marker(msg.phase, msg.class_index)))
-                elif conn.topic == TASK_TARGET.name:
+                elif topic == TASK_TARGET.name:
                     targets.append((_stamp_ns(msg.header) or t_log,
                                     target_marker(msg.colour, msg.shape)))
-                elif conn.topic == TASK_RESULT.name:
+                elif topic == TASK_RESULT.name:
                     end = _stamp_ns(msg.header) or t_log
                     events.append((end - round(float(msg.duration) * 1e9), float(msg.duration),
                                    result_marker(msg.success, msg.desired_object)))
-                elif conn.topic == FSM_STATE.name:
+                elif topic == FSM_STATE.name:
                     states.append((_stamp_ns(msg.header) or t_log,
                                    state_marker(msg.state, msg.state_name)))
-                elif conn.topic == EEG_MARKERS.name:
+                elif topic == EEG_MARKERS.name:
                     events.append((_stamp_ns(msg.header), 0.0, msg.data or 'marker'))
                 else:
                     events.append((t_log, 0.0, f'intent/{msg.data}'))

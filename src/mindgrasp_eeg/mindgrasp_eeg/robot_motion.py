@@ -37,21 +37,20 @@ def read_robot_motion(bag: Path, start_ns: int) -> tuple[list[str], np.ndarray] 
         column names and an array of shape (n_messages, n_columns); NaN where a value is
         missing (no pose yet, a joint missing from a message).
     """
-    from rosbags.rosbag2 import Reader
-
+    from mindgrasp_bag.reader import BagReader
     from mindgrasp_ros.typesupport import typestore
 
     store = typestore()
     joints: list[str] = []
     rows: list[tuple[int, dict[str, float], tuple[float, ...]]] = []
     pose: tuple[float, ...] = (np.nan,) * len(EE_COLUMNS)
-    with Reader(bag) as reader:
-        conns = [c for c in reader.connections if c.topic in (JOINT_STATES.name, EE_POSE.name)]
-        if not any(c.topic == JOINT_STATES.name for c in conns):
-            return None         # (no connections would make rosbags read every message)
-        for conn, _, raw in reader.messages(connections=conns):
-            msg = store.deserialize_cdr(raw, conn.msgtype)
-            if conn.topic == EE_POSE.name:
+    with BagReader(bag) as reader:     # a damaged chunk costs only its own messages
+        topics = {JOINT_STATES.name, EE_POSE.name} & set(reader.topics)
+        if JOINT_STATES.name not in topics:
+            return None
+        for topic, _, raw in reader.messages(topics):
+            msg = store.deserialize_cdr(raw, reader.topics[topic].type)
+            if topic == EE_POSE.name:
                 p, q = msg.pose.position, msg.pose.orientation
                 pose = (p.x, p.y, p.z, q.x, q.y, q.z, q.w)
                 continue
