@@ -107,10 +107,13 @@ def test_reindex_on_a_full_disk_leaves_the_bag_as_it_was(tmp_path):
 
 def test_the_reader_reads_on_past_damaged_chunks_in_order_without_repeats(tmp_path):
     run = run_with_bag(tmp_path)
-    damage_chunks(run / 'bag' / 'bag_0.mcap')
+    offsets = damage_chunks(run / 'bag' / 'bag_0.mcap')
     with BagReader(run / 'bag') as reader:
         got = list(reader.messages())
-        assert any('stopped the indexed reader' in n for n in reader.notes)
+        # read through the index, each damaged chunk skipped and said with its offset and count
+        skipped = [n for n in reader.notes if 'is corrupt' in n]
+        assert [int(re.search(r'chunk at byte (\d+)', n)[1]) for n in skipped] == offsets
+        assert all(re.search(r'\d+ message\(s\) lost', n) for n in skipped), skipped
     times = [t for _, t, _ in got]
     assert times == sorted(times) and len(set(times)) == len(times)
     assert len(got) == assess_bag(run / 'bag').readable_messages

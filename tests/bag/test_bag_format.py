@@ -217,8 +217,12 @@ def test_missing_and_corrupt_bags_give_clear_errors(tmp_path):
         BagReader(garbage).open()
     bag = _write(tmp_path / 'run', _messages(2))
     (bag / 'metadata.yaml').write_text('rosbag2_bagfile_information: {version: 9, storage_identi')
-    with BagReader(bag) as reader:       # read what can be read: the files, by a scan
-        assert any('cannot be read' in n and 'read by a scan instead' in n for n in reader.notes)
+    with BagReader(bag) as reader:       # read what can be read: the files, without it
+        # said as corrupt (not as missing), with the fix
+        corrupt = [n for n in reader.notes if 'metadata.yaml' in n]
+        assert len(corrupt) == 1 and 'is corrupt (not valid YAML at line 1)' in corrupt[0]
+        assert f'run `mindgrasp bag reindex {bag}`' in corrupt[0]
+        assert 'is missing' not in corrupt[0] and 'read without it' in corrupt[0]
         assert len(list(reader.messages())) == reader.message_count > 0
     bag2 = shutil.copytree(tmp_path / 'run', tmp_path / 'run2')
     (bag2 / 'run_0.mcap').unlink()
