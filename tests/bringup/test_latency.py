@@ -9,18 +9,24 @@ separate processes over DDS and LSL) and read its real MCAP bag.
 from __future__ import annotations
 
 import json
+import os
+import random
+import signal
 import subprocess
 import sys
+import time
 import uuid
 from pathlib import Path
 
 import numpy as np
+import psutil
 import pytest
-from launch_fixtures.runner import fixture, launch_env, run_launch
+from launch_fixtures.runner import fixture, kill_group, launch_env, run_launch, start_launch
 
 from conftest_bag import EEG, JOINTS, eeg_chunk, joints
-from mindgrasp_bag import BagWriter
+from mindgrasp_bag import BagError, BagReader, BagWriter
 from mindgrasp_bag.latency import LatencyError, RunStamps, latency_report
+from mindgrasp_bag.run_stamps import read_run_stamps
 from mindgrasp_launch.run_report import write_run_report
 
 MS = 1_000_000
@@ -219,3 +225,68 @@ def test_a_lock_step_run_has_a_report_that_says_why_it_has_no_latencies(tmp_path
     assert res.returncode == 0, res.stderr[-3000:]
     assert "No latency figures: The run's /eeg/raw stamps are not on the wall clock (a " \
         'lock-step run on simulated time)' in (run_dir / 'report.md').read_text(encoding='utf-8')
+
+
+def _predictions_in(bag: Path) -> int:
+    """/bci/prediction messages readable in a bag being recorded (0 before it has any)."""
+    try:
+        with BagReader(bag) as reader:
+            return sum(1 for _ in reader.messages(['/bci/prediction']))
+    except (BagError, OSError, ValueError):
+        return 0
+
+
+@pytest.mark.slow
+@pytest.mark.timeout(900)
+def test_a_run_whose_recorder_was_killed_still_gets_its_latencies(tmp_path: Path) -> None:
+    """Item 4 of issue 42: the recorder of a live run (real processes over DDS and LSL) is
+    killed with SIGKILL mid-run; its bag has no footer, no summary, no metadata.yaml. The run's
+    report.md and ``bag latency`` still give the figures of what reached the file, say that the
+    file was not closed, and ``bag latency`` exits 1 unless --allow-damaged."""
+    run_dir = tmp_path / 'run'
+    stream = f'mg-latency-{uuid.uuid4().hex[:8]}'
+    launch = start_launch(fixture('bci_loop.launch.py'), f'eeg_stream:={stream}',
+                          '--sigint-timeout', '20', '--run-dir', str(run_dir))
+    try:
+        deadline = time.monotonic() + 400
+        while _predictions_in(run_dir / 'bag') < 30 and time.monotonic() < deadline:
+            assert launch.poll() is None, launch.communicate()[1][-3000:]
+            time.sleep(2)
+        assert _predictions_in(run_dir / 'bag') >= 30, 'no predictions recorded in time'
+        recorders = [p for p in psutil.Process(launch.pid).children(recursive=True)
+                     if any('recorder_node' in part for part in p.cmdline())]
+        assert len(recorders) == 1, recorders
+        recorders[0].send_signal(signal.SIGKILL)
+        recorders[0].wait(30)
+        time.sleep(2)
+        os.kill(launch.pid, signal.SIGINT)             # the user's Ctrl-C ends the run
+        _, err = launch.communicate(timeout=180)
+    finally:
+        kill_group(launch)
+    bag = run_dir / 'bag'
+    assert not (bag / 'metadata.yaml').exists()         # the recorder never closed the bag
+    report = (run_dir / 'report.md').read_text(encoding='utf-8')
+    assert '| end to end (EEG sample -> command) |' in report, report + err[-3000:]
+    assert 'were not closed (the recorder was killed' in report, report
+    saved = json.loads((run_dir / 'latency.json').read_text(encoding='utf-8'))
+    assert saved['end_to_end']['count'] >= 20
+    # bag latency: the same figures; the damage said, exit 1 unless --allow-damaged
+    text = _latency_cli(run_dir)
+    assert text.returncode == 1, text.stderr
+    assert 'end to end (EEG sample -> command)' in text.stdout
+    assert 'without a footer (the recorder was killed)' in text.stderr
+    assert '--allow-damaged' in text.stderr.splitlines()[-1]
+    allowed = _latency_cli(run_dir, '--json', '--allow-damaged')
+    assert allowed.returncode == 0, allowed.stderr
+    figures = json.loads(allowed.stdout.strip().splitlines()[-1])
+    assert figures['end_to_end']['count'] == saved['end_to_end']['count']
+    assert figures['damage']['cut_files'] == 1
+    # the same bag cut at a random offset (a copy interrupted): what is before the cut is timed
+    cut = tmp_path / 'cut'
+    cut.mkdir()
+    data = (bag / 'bag_0.mcap').read_bytes()
+    at = random.Random(0).randrange(len(data) // 2, len(data))
+    (cut / 'bag_0.mcap').write_bytes(data[:at])
+    stamps = read_run_stamps(cut)
+    assert stamps.chunk_pub_ns.size > 0 and stamps.pred_pub_ns.size > 0
+    assert latency_report(stamps)['end_to_end']['count'] > 0
