@@ -58,6 +58,11 @@ class BagReader:
 
     def __init__(self, path: Path | str) -> None:
         self.path = Path(path)
+        self._reader: Reader | None = None
+        self._reset()
+
+    def _reset(self) -> None:
+        """Nothing read yet (also when opened again)."""
         self.topics: dict[str, TopicInfo] = {}
         self.start_ns = 0
         self.end_ns = 0
@@ -66,7 +71,6 @@ class BagReader:
         self.files: list[Path] = []
         self.notes: list[str] = []
         self.complete = True
-        self._reader: Reader | None = None
         self._contents: list[McapContents] = []
 
     @property
@@ -80,6 +84,8 @@ class BagReader:
         Raises:
             BagError: missing path, not a bag, or a corrupt bag; the message says what to do.
         """
+        self.close()
+        self._reset()                       # opened again: counted afresh
         if not self.path.exists():
             msg = (f'The bag {self.path} does not exist; pass the path of a bag directory (the '
                    'one holding metadata.yaml) or of an .mcap/.db3 file.')
