@@ -11,6 +11,7 @@ whole-file compressed ones are read with ``rosbags.rosbag2.Reader``.
 
 from __future__ import annotations
 
+import contextlib
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -161,11 +162,17 @@ class BagReader:
             self.notes.append(f'The file(s) {", ".join(unfinished)} were not closed (the recorder '
                               'was killed or the disk was full); their complete records were '
                               'recovered.')
+        declared: dict[str, dict[str, Any]] = {}
         if has_metadata:
             try:
-                load_metadata(self.path)
+                metadata = load_metadata(self.path)
             except BagError as exc:   # corrupt, not missing: the files are read all the same
                 self.notes.append(f'{exc} The .mcap files were read without it.')
+            else:
+                for entry in metadata.get('topics_with_message_count') or []:
+                    topic = (entry or {}).get('topic_metadata') if isinstance(entry, dict) else None
+                    if isinstance(topic, dict) and topic.get('name'):
+                        declared[str(topic['name'])] = topic
         elif self.path.is_dir():
             self.notes.append(f'metadata.yaml is missing; run `mindgrasp bag reindex {self.path}` '
                               'to write it.')
@@ -186,6 +193,15 @@ class BagReader:
                         channel.schema_data.decode('utf-8', 'replace'),
                         channel.message_encoding)
                 topic.message_count += contents.channel_counts.get(channel.id, 0)
+                # what metadata.yaml says of the topic fills what the channel lacks (rosbags and
+                # older rosbag2 put the type hash and QoS there only)
+                meta = declared.get(channel.topic, {})
+                topic.type_description_hash = (topic.type_description_hash
+                                               or str(meta.get('type_description_hash') or ''))
+                if not topic.offered_qos_profiles and meta.get('offered_qos_profiles'):
+                    with contextlib.suppress(*CORRUPT_RECORD_ERRORS, TypeError):
+                        topic.offered_qos_profiles = parse_offered_qos(
+                            meta['offered_qos_profiles'])
             if contents.message_count:
                 start = min(start, contents.start_ns)
                 end = max(end, contents.end_ns)
