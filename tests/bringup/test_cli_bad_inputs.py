@@ -44,8 +44,8 @@ def model_copy(tmp_path: Path) -> Path:
     """The shipped model's .json and .npz, copied (the checksum still matches)."""
     src = resolve_path(DEFAULT_MODEL, 'mindgrasp_classifier')
     for suffix in ('.json', '.npz'):
-        shutil.copy(src.with_suffix(suffix), tmp_path / f'm{suffix}')
-    return tmp_path / 'm.json'
+        shutil.copy(src.with_suffix(suffix), tmp_path / src.with_suffix(suffix).name)
+    return tmp_path / src.name
 
 
 def _rewrite_arrays(json_path: Path, change) -> None:
@@ -95,7 +95,7 @@ def test_an_arrays_file_outside_the_model_folder_is_one_line(model_copy, name, c
 
 def test_out_in_a_missing_folder_creates_nothing_and_names_out(tmp_path, capsys) -> None:
     out = tmp_path / 'missing' / 'x'
-    line = _one_line(capsys, _run(['experiment', 'random-locations', '--trials', '1',
+    line = _one_line(capsys, _run(['experiment', 'set-locations', '--trials', '1',
                                    '--subject', 'oracle', '--out', str(out)]))
     assert line.count('--out') >= 1 and '--run-dir' not in line, line
     assert 'does not exist' in line, line
@@ -148,6 +148,8 @@ READERS = [
 @pytest.mark.parametrize('argv', READERS, ids=lambda a: ' '.join(a[:3]))
 def test_hostile_paths_are_one_line(argv, tmp_path, capsys) -> None:
     for k, path in enumerate(_hostile_paths(tmp_path / 'inputs')):
+        if not path and '--realism' in argv:
+            continue             # an empty --realism is a valid value: none
         work = tmp_path / f'work{k}'
         work.mkdir()
         words = [w.format(p=path, d=work) for w in argv]

@@ -128,6 +128,9 @@ def load_plan(plan: str) -> Plan:
     except yaml.YAMLError as err:
         msg = f'The plan {path} is not valid YAML: {yaml_error_text(err)}'
         raise SessionError(msg) from None
+    except UnicodeDecodeError:
+        msg = f'The plan {path} is not a text (UTF-8) YAML file; give the path of a plan YAML file.'
+        raise SessionError(msg) from None
     where = f'plan {path.name}'
     if not isinstance(data, dict) or not isinstance(data.get('phases'), list) or \
             not data['phases']:

@@ -298,6 +298,10 @@ def resolve_model_path(path: str | Path) -> Path:
     ClassifierError
         A ``package://`` URI whose package or file does not exist.
     """
+    if not str(path).strip():
+        msg = ('The model path is empty; give the path of a model written by `mindgrasp train '
+               'classifier`.')
+        raise ClassifierError(msg)
     try:
         resolved = resolve_path(path, 'mindgrasp_classifier', ('.json',))
     except ResourceNotFoundError as exc:
