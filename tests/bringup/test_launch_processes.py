@@ -103,7 +103,8 @@ def test_an_arm_driver_that_exits_0_at_once_stops_the_hardware_launch(tmp_path: 
     """Issue 31, item 9: a driver that ended with exit code 0 left the launch running without
     an arm and ending with exit 0. A driver is a required node: its end stops every process,
     says so in one line, and the launch fails."""
-    result = run_launch('hardware', 'eeg_stream:=nobody', 'arm_driver:=true', 'record:=false',
+    result = run_launch('hardware', 'eeg_stream:=nobody', 'eeg_unpinned:=true', 'arm_driver:=true',
+                        'record:=false',
                         'model:=package://mindgrasp_classifier/models/default_classifier.json',
                         '--run-dir', str(tmp_path / 'run'), timeout=120.0)
     assert result.returncode == 1, result.stderr

@@ -49,13 +49,36 @@ def eeg_source_arguments() -> list[Any]:
 def virtual_amp_pin() -> tuple[dict[str, str], dict[str, str]]:
     """``(virtual amplifier parameters, acquisition parameters)`` that pin a launch's
     acquisition node to the launch's own virtual amplifier: a source id made for this launch
-    (``mindgrasp-<12 hex digits>``, a fresh uuid each time a description is generated, i.e.
-    once per run) and this host. LSL streams are visible across the machine and the lab's
+    (``mindgrasp-<12 hex digits>``, a uuid made once per launch when its parameters are
+    resolved) and this host. LSL streams are visible across the machine and the lab's
     network, so a second demo (another ROS domain, another rig) with the same stream name can
     no longer feed this one's classifier (issue 42). Lock-step runs have no LSL stream: their
     records do not depend on it."""
-    source_id = f'mindgrasp-{uuid.uuid4().hex[:12]}'
+    source_id = _run_source_id()
     return {'source_id': source_id}, {'source_id': source_id, 'hostname': 'local'}
+
+
+#: the launch configuration that keeps a launch's source id once made
+_RUN_SOURCE_ID = 'mindgrasp_eeg_run_source_id'
+
+
+def _run_source_id() -> Any:
+    """A substitution resolved once per launch (not per generated description, which a process
+    that launches several times keeps in a cache) to ``mindgrasp-<12 hex digits>``."""
+    if la.using_real_launch():
+        from launch import Substitution
+    else:
+        from mindgrasp_launch.substitutions import Substitution
+
+    class RunSourceId(Substitution):
+        def perform(self, context: Any) -> str:
+            return context.launch_configurations.setdefault(
+                _RUN_SOURCE_ID, f'mindgrasp-{uuid.uuid4().hex[:12]}')
+
+        def describe(self) -> str:
+            return 'RunSourceId()'
+
+    return RunSourceId()
 
 
 def eeg_source_nodes(files: list[Path], seed: object, subject_mode: object) -> list[Any]:

@@ -64,7 +64,6 @@ def generate_launch_description() -> LaunchDescription:
         DeclareLaunchArgument('eeg_stream',
                               description='LSL stream name of the amplifier (as its streaming '
                                           'software names it)'),
-        *eeg_pin_arguments(),   # eeg_source_id, eeg_host (or eeg_unpinned:=true): required
         DeclareLaunchArgument('arm_driver',
                               description='arm driver: an executable on PATH, a path, '
                                           'package/executable (as ros2 run) or, with '
@@ -88,6 +87,7 @@ def generate_launch_description() -> LaunchDescription:
         robot_argument(description="the driver's arm, whose description the controller reads "
                                    '(joints, limits, URDF kinematics, TCP, camera): '
                                    'mindgrasp_arm, xarm6 or a robot description YAML path'),
+        *eeg_pin_arguments(),   # eeg_source_id, eeg_host (or eeg_unpinned:=true): required
         *run_directory_actions(),  # ros2 launch: run directory, recorder, duration
         *driver_nodes('arm'),
         *driver_nodes('camera', condition=IfCondition(
