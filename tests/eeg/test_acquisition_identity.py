@@ -41,6 +41,7 @@ def test_a_stream_of_another_source_never_stands_in(lsl_source, stream_name) -> 
     assert not acq.connected and status.level == ERROR
     assert "source_id 'amp-b'" in status.message and "source_id 'amp-a'" in status.message
     assert 'accepts only that sender' in status.message
+    assert len(acq.refusals) == 1 and "source_id 'amp-b'" in acq.refusals[0]
     before = acq.counters['samples']
     # the same amplifier restarted (a new outlet, a new uid, the same source): taken back
     lsl_source(stream_name, '--source-id', 'amp-a', '--duration', '120')

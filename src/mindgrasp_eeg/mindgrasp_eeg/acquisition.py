@@ -204,6 +204,7 @@ class EEGAcquisition:
         #: (source_id, host, LSL session) of the first stream connected to; None before
         self.identity: tuple[str, str, str] | None = None
         self._refused: set[str] = set()          # uids of other senders' streams, refused
+        self.refusals: list[str] = []            # one sentence per refused stream, newest last
 
     # -- connection ----------------------------------------------------------------------------
     @property
@@ -418,6 +419,11 @@ class EEGAcquisition:
             self.counters['refused_streams'] += 1
             assert self.identity is not None
             with self._lock:
+                self.refusals.append(
+                    f"refused the LSL stream '{info.name()}' from "
+                    f'{identity_text(stream_identity(info))}: not the sender this node connected '
+                    f'to first ({identity_text(self.identity)}); restart the node to change '
+                    'amplifiers')
                 self._reconnect_error = (
                     f"refused the LSL stream '{info.name()}' from "
                     f'{identity_text(stream_identity(info))}: this node connected to '

@@ -131,6 +131,7 @@ class AcquisitionNode(rclpy.node.Node):
         self.get_logger().info(f'Searching for the LSL stream ({self._wanted}) for up to '
                                f'{p.resolve_timeout:g} s.')
         self._n_warnings = 0
+        self._n_refusals = 0
         self._last_level = -1
         self._last_stamp_ns = -1
         self._outbox: deque[EEGChunk] = deque()        # reader thread -> executor
@@ -250,6 +251,9 @@ class AcquisitionNode(rclpy.node.Node):
             return
         if not connected:
             return
+        while len(self.acq.refusals) > self._n_refusals:    # another sender's stream, refused
+            self.get_logger().warning(self.acq.refusals[self._n_refusals] + '.')
+            self._n_refusals += 1
         if len(self.acq.warnings) > self._n_warnings:
             for warning in self.acq.warnings[self._n_warnings:]:
                 self.get_logger().warning(warning)
