@@ -86,8 +86,8 @@ class VirtualAmpParams:
 
     stream_name: str = param(_STREAM, 'LSL stream name (output lsl)')
     stream_type: str = param('EEG', 'LSL stream type')
-    source_id: str = param('', "LSL source_id ('' = one made for this run: "
-                           "<stream_name>@<run directory name or uuid>)")
+    source_id: str = param('', "LSL source_id ('' = <stream_name>@<run directory name> in "
+                           'a launch, else the stream name)')
     channel_names: list[str] = param(list(NAUTILUS_32), 'channel labels (10-20 names)')
     sample_rate: float = param(250.0, 'sample rate (the synthetic EEG needs >= 60 Hz)',
                                unit='Hz', min=60.0, max=100000.0)

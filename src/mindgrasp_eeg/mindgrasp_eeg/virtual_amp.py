@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import math
 import os
-import uuid
 from pathlib import Path
 
 import numpy as np
@@ -29,11 +28,13 @@ from .synthetic import SyntheticEEG
 
 
 def run_source_id(stream_name: str) -> str:
-    """A source id of this run's amplifier, ``<stream_name>@<run>``: ``<run>`` is the run
-    directory's name (``$MINDGRASP_RUN_DIR``, set by the launcher), else a uuid made now. Two
-    runs never share it, so an acquisition node pinned to it hears only its own run's EEG."""
+    """The source id of an amplifier whose ``source_id`` is not given: ``<stream_name>@<run>``
+    in a launch, ``<run>`` the run directory's name (``$MINDGRASP_RUN_DIR``), so two runs never
+    share it and a respawned amplifier keeps it; outside a launch the stream name, so that an
+    amplifier started again by hand is the same sender (the acquisition takes back only the
+    sender it connected to first)."""
     run_dir = os.environ.get('MINDGRASP_RUN_DIR', '')
-    return f'{stream_name}@{Path(run_dir).name if run_dir else uuid.uuid4().hex[:12]}'
+    return f'{stream_name}@{Path(run_dir).name}' if run_dir else stream_name
 
 
 class VirtualAmplifier:

@@ -9,8 +9,8 @@ node reads it as any other amplifier. ``output:=ros`` (lock-step experiments): L
 time, so the node publishes ``/eeg/raw`` (mindgrasp_msgs/EEGChunk, volts, sensor-data QoS depth
 100) itself, each chunk stamped with the node-clock time of its first sample, and no acquisition
 node is needed.
-The stream's ``source_id`` is the parameter's, else one made for this run
-(``<stream_name>@<run directory name>``, or ``@<uuid>`` outside a launch): the launch profiles
+The stream's ``source_id`` is the parameter's (the launch profiles give one made per run), else
+``<stream_name>@<run directory name>`` in a launch, the stream name outside one: the profiles
 pin their acquisition node to it, so two demos with the same stream name (other ROS domains,
 other rigs on the network) never hear each other's amplifier.
 Subscriptions depend on ``subject_mode``: ``follow`` listens to ``/trainer/prompt``; ``pursue`` to
