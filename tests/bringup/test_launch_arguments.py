@@ -46,7 +46,7 @@ def test_every_profile_checks_its_numbers(profile, args, message):
 
 
 #: the arguments a profile cannot start without
-REQUIRED = {'hardware': ['eeg_stream:=amp', 'arm_driver:=true', 'model:=package://'
+REQUIRED = {'hardware': ['eeg_stream:=amp', 'eeg_unpinned:=true', 'arm_driver:=true', 'model:=package://'
                          'mindgrasp_classifier/models/default_classifier.json'],
             'replay': ['bag:=runs/x']}
 

@@ -38,13 +38,16 @@ def test_demo_starts_every_node_after_the_recorder() -> None:
     assert 'recorder' not in procs and procs['sim'].parameters['gui'] is True
 
 
+#: the amplifier's stream pinned (source id and host), as the hardware profile requires
+PIN = ('eeg_source_id:=amp-1', 'eeg_host:=local')
+
 #: every node that reads the robot description, per profile (plus what each profile needs)
 ROBOT_READERS = {
     'sim': ((), ('sim',)),
     'demo': ((), ('sim', 'fsm', 'foxglove_bridge')),
     'experiment': ((), ('sim', 'fsm')),
     'trainer': ((), ('sim', 'fsm', 'trainer')),
-    'hardware': (('eeg_stream:=amp', 'arm_driver:=true',
+    'hardware': (('eeg_stream:=amp', 'eeg_source_id:=amp-1', 'eeg_host:=local', 'arm_driver:=true',
                   'model:=package://mindgrasp_classifier/models/default_classifier.json'),
                  ('fsm',)),
     'replay': (('bag:=runs/x',), ('replay',)),
@@ -80,7 +83,7 @@ def test_hardware_has_drivers_and_no_simulator(tmp_path, monkeypatch) -> None:
     monkeypatch.chdir(tmp_path)            # model:= must name an existing file
     (tmp_path / 'models').mkdir()
     (tmp_path / 'models' / 'alice.json').write_text('{}')
-    procs = processes('hardware', 'eeg_stream:=gNautilus', 'arm_driver:=true',
+    procs = processes('hardware', 'eeg_stream:=gNautilus', *PIN, 'arm_driver:=true',
                       'arm_driver_args:=--ip "10.0.0.2" --rate 100', 'model:=models/alice.json')
     assert 'sim' not in procs and 'virtual_amp' not in procs and 'camera_driver' not in procs
     driver = procs['arm_driver']
@@ -89,18 +92,18 @@ def test_hardware_has_drivers_and_no_simulator(tmp_path, monkeypatch) -> None:
     assert driver.required and driver.shutdown_on_exit     # its end stops the launch
     assert procs['eeg_acquisition'].parameters['stream_name'] == 'gNautilus'
     assert procs['classifier'].parameters['model'] == 'models/alice.json'
-    procs = processes('hardware', 'eeg_stream:=a', 'arm_driver:=true', 'camera_driver:=true',
+    procs = processes('hardware', 'eeg_stream:=a', *PIN, 'arm_driver:=true', 'camera_driver:=true',
                       'model:=models/alice.json')
     assert 'camera_driver' in procs and procs['camera_driver'].required
     # package/executable: our module, else `ros2 run package executable`
-    procs = processes('hardware', 'eeg_stream:=a', 'arm_driver:=mindgrasp_sim/sim_node',
+    procs = processes('hardware', 'eeg_stream:=a', *PIN, 'arm_driver:=mindgrasp_sim/sim_node',
                       'model:=models/alice.json')
     assert procs['arm_driver'].module == 'mindgrasp_sim.sim_node'
     with pytest.raises(LaunchError, match=r"needs these arguments, which were not given: "
                                           r"eeg_stream:=<value>.*; arm_driver:=<value>"):
         LaunchService('hardware').plan()
     with pytest.raises(LaunchError, match="'no-such-arm-driver' was found neither on PATH"):
-        LaunchService('hardware', ['eeg_stream:=a', 'arm_driver:=no-such-arm-driver',
+        LaunchService('hardware', ['eeg_stream:=a', *PIN, 'arm_driver:=no-such-arm-driver',
                                    'model:=models/alice.json', 'record:=false']).plan()
 
 
@@ -116,7 +119,7 @@ def test_hardware_never_decodes_a_person_with_the_simulated_head_silently(tmp_pa
                                           r'default_classifier\.json\)'):
         LaunchService('hardware', ['eeg_stream:=a', 'arm_driver:=true']).plan()
     bench = 'package://mindgrasp_classifier/models/default_classifier.json'
-    procs = processes('hardware', 'eeg_stream:=a', 'arm_driver:=true', f'model:={bench}')
+    procs = processes('hardware', 'eeg_stream:=a', *PIN, 'arm_driver:=true', f'model:={bench}')
     assert procs['classifier'].parameters['model'] == bench
 
 
@@ -174,11 +177,41 @@ def test_command_interface_reaches_the_controller(profile: str, tmp_path, monkey
     that is not an interface is refused before anything starts, naming the choices."""
     monkeypatch.chdir(tmp_path)
     (tmp_path / 'alice.json').write_text('{}')
-    extra = {'hardware': ['eeg_stream:=a', 'arm_driver:=true', 'model:=alice.json']}.get(profile,
-                                                                                          [])
+    extra = {'hardware': ['eeg_stream:=a', *PIN, 'arm_driver:=true',
+                          'model:=alice.json']}.get(profile, [])
     assert processes(profile, *extra)['fsm'].parameters['command_interface'] == 'velocity'
     for interface in ('trajectory', 'servo_twist'):
         fsm = processes(profile, *extra, f'command_interface:={interface}')['fsm']
         assert fsm.parameters['command_interface'] == interface
     with pytest.raises(LaunchError, match=r"'joint_jog'.*velocity, trajectory, servo_twist"):
         processes(profile, *extra, 'command_interface:=joint_jog')
+
+
+def test_hardware_refuses_an_unpinned_stream_before_anything_starts(tmp_path, monkeypatch):
+    """Issue 42: any LSL sender of the stream's name (another rig, a demo's virtual amplifier)
+    could drive the arm. Without eeg_source_id and eeg_host the launch is refused in one line;
+    eeg_unpinned:=true accepts any sender on purpose (a bench test)."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / 'alice.json').write_text('{}')
+    args = ['eeg_stream:=gNautilus', 'arm_driver:=true', 'model:=alice.json']
+    with pytest.raises(LaunchError, match=r"the EEG stream 'gNautilus' is not pinned "
+                                          r"\(eeg_source_id and eeg_host not given\).*"
+                                          r'eeg_unpinned:=true for a bench test'):
+        LaunchService('hardware', args).plan()
+    with pytest.raises(LaunchError, match=r'not pinned \(eeg_host not given\)'):
+        LaunchService('hardware', [*args, 'eeg_source_id:=GN-1']).plan()
+    acquisition = processes('hardware', *args, *PIN)['eeg_acquisition'].parameters
+    assert (acquisition['source_id'], acquisition['hostname'], acquisition['allow_unpinned']) == \
+        ('amp-1', 'local', False)
+    acquisition = processes('hardware', *args, 'eeg_unpinned:=true')['eeg_acquisition'].parameters
+    assert acquisition['allow_unpinned'] is True and acquisition['source_id'] == ''
+
+
+def test_the_demo_pins_its_acquisition_to_its_own_amplifier() -> None:
+    """Issue 42: a source id made per run, the same for the amplifier and the acquisition (on
+    this host), another one for the next run."""
+    first, second = processes('demo'), processes('demo')
+    amp, acquisition = (first['virtual_amp'].parameters, first['eeg_acquisition'].parameters)
+    assert amp['source_id'] == acquisition['source_id'] and acquisition['hostname'] == 'local'
+    assert amp['source_id'].startswith('mindgrasp-')
+    assert second['virtual_amp'].parameters['source_id'] != amp['source_id']

@@ -199,6 +199,13 @@ def test_calibrate_runs_in_lockstep_end_to_end(tmp_path):
     assert final.provenance['heldout_temperature'] == temp
     assert temp['nll_after'] <= temp['nll_before'] + 1e-9     # the fit minimises the NLL
     assert 'probabilities calibrated on the held-out run' in res.stdout
+    # issue 42: the printed calibration error is measured on windows the temperature was not
+    # fitted on (two folds over the held-out run's halves), and the line says why it may rise
+    unseen = temp['unseen']
+    assert set(unseen) == {'ece_before', 'ece_after', 'nll_before', 'nll_after'}
+    assert f"expected calibration error {unseen['ece_before']:.3f} -> " in res.stdout
+    assert 'on windows it was not fitted on' in res.stdout
+    assert 'the temperature minimises the log loss' in res.stdout
     folder = tmp_path / 'subjects' / 'V1' / 's1'
     for run in ('01_graz', '02_heldout'):
         with BagReader(folder / run / 'bag') as reader:

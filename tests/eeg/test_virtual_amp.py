@@ -19,12 +19,21 @@ from mindgrasp_eeg.virtual_amp import VirtualAmplifier
 def test_paced_by_the_given_clock() -> None:
     subject = VirtualSubject('follow', reaction_delay=0.0, seed=0)
     amp = VirtualAmplifier(SyntheticEEG(seed=0), subject, None, block=5)
-    assert amp.step(100.0).shape == (1, 32)              # sample 0 is due at the first step
-    assert len(amp.step(100.5)) == 125
+    assert amp.step(100.0).shape == (0, 32)              # sample 0 is due, its block is not
+    assert len(amp.step(100.5)) == 125                   # 126 due: 25 whole blocks of 5
     subject.on_prompt(101.0, 2, 'cue', 1)
     amp.step(102.0)
-    assert amp.n_samples == 501 and amp.current_class == 2
+    assert amp.n_samples == 500 and amp.current_class == 2
     assert len(amp.step(102.0)) == 0                     # nothing new is due
+
+
+def test_an_lsl_amplifier_sends_whole_blocks_only() -> None:
+    """Pushes between block ends sent a partial block as a chunk of its own: /eeg/raw ran at
+    38.6 chunks/s instead of 250 / 8 = 31.25."""
+    amp = VirtualAmplifier(SyntheticEEG(seed=0), VirtualSubject('noise'), None, block=8)
+    sizes = [len(amp.step(t)) for t in np.arange(0.0, 3.0, 1 / 32 + 0.0007)]
+    assert sum(sizes) % 8 == 0 and all(n % 8 == 0 for n in sizes)
+    assert sum(sizes) >= 3.0 * 250 - 2 * 8
 
 
 def test_clock_jumps_re_anchor_in_simulated_time() -> None:

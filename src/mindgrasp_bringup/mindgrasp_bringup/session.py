@@ -128,6 +128,9 @@ def load_plan(plan: str) -> Plan:
     except yaml.YAMLError as err:
         msg = f'The plan {path} is not valid YAML: {yaml_error_text(err)}'
         raise SessionError(msg) from None
+    except UnicodeDecodeError:
+        msg = f'The plan {path} is not a text (UTF-8) YAML file; give the path of a plan YAML file.'
+        raise SessionError(msg) from None
     where = f'plan {path.name}'
     if not isinstance(data, dict) or not isinstance(data.get('phases'), list) or \
             not data['phases']:
@@ -562,12 +565,17 @@ class Session:
         so the temperature is fitted again on the held-out run's windows, decoded as online
         (re-centred on the run, as the classifier's default ``recenter: adaptive`` does). The
         accuracy is the argmax's and does not change with the temperature; the calibration
-        figures of the copy are measured on the run they were fitted on (``fitted_on``).
+        figures of the copy are measured on the run they were fitted on (``fitted_on``); those
+        in ``unseen`` on windows the temperature was not fitted on (two folds: fitted on one
+        half of the run, measured on the other, averaged), which is what the command prints.
+        The temperature minimises the log loss (NLL); the expected calibration error, a binned
+        gap between confidence and accuracy, can still rise when few windows fall in a bin.
 
         Returns ``heldout_accuracy``, ``heldout_trials``, ``model_path`` (the calibrated copy,
         relative to the session folder), ``trained_model_path`` and ``temperature``:
         ``{'before': T, 'after': T', 'ece_before', 'ece_after', 'nll_before', 'nll_after',
-        'fitted_on': run}`` (ECE and NLL in nats per window of the held-out run).
+        'fitted_on': run, 'unseen': {'ece_before', 'ece_after', 'nll_before', 'nll_after'}}``
+        (ECE and NLL in nats per window of the held-out run).
         """
         from mindgrasp_classifier.calibration import (
             calibration_summary,
@@ -595,11 +603,25 @@ class Session:
         trained_temperature, model.temperature = model.temperature, fit_temperature(
             logits, positions)
         after = calibration_summary(logits, positions, model.temperature)
+        # the figures a user reads are measured on windows the temperature was not fitted on:
+        # two folds, the run's first and second halves in time (fit on one, measure on the
+        # other), so the next run's drift is in them as it will be live
+        half = len(positions) // 2
+        folds = [(slice(0, half), slice(half, None)), (slice(half, None), slice(0, half))]
+        unseen = {'ece_before': 0.0, 'ece_after': 0.0, 'nll_before': 0.0, 'nll_after': 0.0}
+        for fit_on, test_on in folds if half > 0 else []:
+            t_fold = fit_temperature(logits[fit_on], positions[fit_on])
+            b = calibration_summary(logits[test_on], positions[test_on], trained_temperature)
+            a = calibration_summary(logits[test_on], positions[test_on], t_fold)
+            for key, value in (('ece_before', b['ece']), ('ece_after', a['ece']),
+                               ('nll_before', b['nll']), ('nll_after', a['nll'])):
+                unseen[key] += float(value) / len(folds)
         temperature = {'before': float(trained_temperature),
                        'after': float(model.temperature),
                        'ece_before': float(before['ece']), 'ece_after': float(after['ece']),
                        'nll_before': float(before['nll']), 'nll_after': float(after['nll']),
-                       'fitted_on': str(entry['run_dir'])}
+                       'fitted_on': str(entry['run_dir']),
+                       'unseen': unseen if half > 0 else None}
         model.provenance['heldout_temperature'] = temperature
         calibrated = Path(model.save(self.dir / 'models' / f'calibrated_on_{phase}'))
         return {'heldout_accuracy': float(report['accuracy']),

@@ -85,11 +85,15 @@ def _calibrate_result(session: Session, args: argparse.Namespace, t0: float) -> 
     cv = next(e['cv_accuracy'] for e in reversed(log['phases']) if 'cv_accuracy' in e)
     wall = time.monotonic() - t0
     temp = held['temperature']
+    unseen = temp.get('unseen') or temp
     print(f'Calibrated {session.dir}: cross-validated accuracy {100 * cv:.1f} %, held-out '
           f"accuracy {100 * held['heldout_accuracy']:.1f} % on {held['heldout_trials']} trials "
           f'(virtual subject {100 * args.virtual_accuracy:.0f} %); probabilities calibrated on '
-          f"the held-out run (temperature {temp['before']:.2f} -> {temp['after']:.2f}, expected "
-          f"calibration error {temp['ece_before']:.3f} -> {temp['ece_after']:.3f}), model "
+          f"the held-out run (temperature {temp['before']:.2f} -> {temp['after']:.2f}; on "
+          f'windows it was not fitted on, the other half of that run: log loss '
+          f"{unseen['nll_before']:.3f} -> {unseen['nll_after']:.3f} nats, expected calibration "
+          f"error {unseen['ece_before']:.3f} -> {unseen['ece_after']:.3f}; the temperature "
+          'minimises the log loss, the binned calibration error may still rise), model '
           f"{session.dir / held['model_path']}, {wall:.0f} s.")
     if args.json:
         print(json.dumps({'cv_accuracy': cv, 'heldout_accuracy': held['heldout_accuracy'],

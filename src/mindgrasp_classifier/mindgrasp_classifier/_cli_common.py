@@ -7,7 +7,7 @@ import json
 from typing import Any
 
 from mindgrasp_classifier.data import Recording, load_inputs
-from mindgrasp_common.cli_checks import finite_float
+from mindgrasp_common.cli_checks import bounded_int, finite_float
 from mindgrasp_ros.topics import EEG_RAW, TRAINER_PROMPT, VIRTUAL_SUBJECT_INTENT
 
 
@@ -23,9 +23,9 @@ def add_data_arguments(parser: argparse.ArgumentParser) -> None:
     g.add_argument('--bag', nargs='+', default=[], metavar='RUN',
                    help='recorded runs (rosbag2 folders or run directories) with /eeg/raw and '
                         '/trainer/prompt')
-    g.add_argument('--eegbci', type=int, metavar='SUBJECT',
+    g.add_argument('--eegbci', type=bounded_int(1, 109), metavar='SUBJECT',
                    help='EEGMMIDB subject loaded through MNE (MNE_DATASETS_EEGBCI_PATH)')
-    g.add_argument('--runs', type=int, nargs='+', default=[], metavar='RUN',
+    g.add_argument('--runs', type=bounded_int(1, 14), nargs='+', default=[], metavar='RUN',
                    help='EEGMMIDB runs for --eegbci (default 4 6 8 10)')
     g.add_argument('--event-map', metavar='MAP',
                    help='annotation to class for other files, e.g. T1=left_hand,T2=right_hand')

@@ -207,8 +207,15 @@ class MiModel:
             msg = (f'The model {json_path} has format version {meta.get("format_version")}, this '
                    f'software reads version {FORMAT_VERSION}; retrain the model with this version.')
             raise ClassifierError(msg)
-        npz_path = json_path.with_name(str(meta.get('arrays_file', '')))
-        if not meta.get('arrays_file') or not npz_path.is_file():
+        arrays_file = str(meta.get('arrays_file', ''))
+        if arrays_file and (Path(arrays_file).name != arrays_file or arrays_file in ('.', '..')
+                            or '\\' in arrays_file):
+            msg = (f'The model {json_path} names its arrays file {arrays_file!r}, which is not a '
+                   'file name beside the .json (a path elsewhere is never read); set '
+                   'arrays_file to the .npz file name written with it, or retrain.')
+            raise ClassifierError(msg)
+        npz_path = json_path.with_name(arrays_file) if arrays_file else json_path
+        if not arrays_file or not npz_path.is_file():
             msg = (f'The arrays file {npz_path} of model {json_path} is missing; keep the .npz '
                    'next to the .json (copy both files).')
             raise ClassifierError(msg)
@@ -220,6 +227,7 @@ class MiModel:
         try:
             with np.load(npz_path, allow_pickle=False) as z:
                 arrays = {k: z[k] for k in z.files}
+            _check_arrays(arrays, json_path)
             classes = [int(c) for c in meta['classes']]
             channels = [str(c) for c in meta['channels']]
             clf = classifier_from_arrays(
@@ -253,6 +261,32 @@ class MiModel:
         return model
 
 
+def _check_arrays(arrays: dict[str, np.ndarray], json_path: Path) -> None:
+    """Refuse arrays no decoder can use: non-finite numbers (NaN, inf) anywhere, and square
+    matrices (the reference, class means of shape (n_classes, n_channels, n_channels)) that are
+    not symmetric positive definite, which pyriemann rejects only when the first window is
+    classified."""
+    for key, value in arrays.items():
+        if value.dtype.kind in 'fc' and not np.all(np.isfinite(value)):
+            msg = (f'The model {json_path} holds non-finite numbers (NaN or inf) in its array '
+                   f'{key!r}; the model is damaged: retrain it with `mindgrasp train '
+                   'classifier`.')
+            raise ClassifierError(msg)
+        if value.dtype.kind == 'f' and value.ndim in (2, 3) and value.shape[-1] == \
+                value.shape[-2] > 1 and (key == 'reference' or value.ndim == 3):
+            try:
+                np.linalg.cholesky((value + np.swapaxes(value, -1, -2)) / 2)
+                symmetric = np.allclose(value, np.swapaxes(value, -1, -2), rtol=1e-6,
+                                        atol=1e-12 * max(1.0, float(np.abs(value).max())))
+            except np.linalg.LinAlgError:
+                symmetric = False
+            if not symmetric:
+                msg = (f'The model {json_path} has matrices in its array {key!r} that are not '
+                       'symmetric positive definite covariances; the model is damaged: retrain '
+                       'it with `mindgrasp train classifier`.')
+                raise ClassifierError(msg)
+
+
 def resolve_model_path(path: str | Path) -> Path:
     """The absolute path of a model's .json, for a path a user gave: with or without the suffix,
     relative to the working directory, a data file of this package (``models/...``) or a
@@ -264,6 +298,10 @@ def resolve_model_path(path: str | Path) -> Path:
     ClassifierError
         A ``package://`` URI whose package or file does not exist.
     """
+    if not str(path).strip():
+        msg = ('The model path is empty; give the path of a model written by `mindgrasp train '
+               'classifier`.')
+        raise ClassifierError(msg)
     try:
         resolved = resolve_path(path, 'mindgrasp_classifier', ('.json',))
     except ResourceNotFoundError as exc:

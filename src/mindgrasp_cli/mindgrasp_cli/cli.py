@@ -152,6 +152,25 @@ def version_text() -> str:
 EXIT_PIPE_CLOSED = 141
 
 
+def _prog(argv: Sequence[str]) -> str:
+    """``command verb`` of ``argv`` (the words before the first option)."""
+    words = []
+    for word in argv[:2]:
+        if word.startswith('-'):
+            break
+        words.append(word)
+    return ' '.join(words) or 'mindgrasp'
+
+
+def _os_error_text(exc: OSError) -> str:
+    """``<reason>: <file>`` of an OSError, a long file name shortened to 80 characters."""
+    name = exc.filename if isinstance(exc.filename, str) else ''
+    if len(name) > 80:
+        name = f'{name[:40]}...{name[-30:]} ({len(name)} characters)'
+    reason = exc.strerror or type(exc).__name__
+    return f'{reason}: {name}' if name else reason
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``mindgrasp`` console script.
 
@@ -201,3 +220,11 @@ def _main(argv: Sequence[str] | None) -> int:
         return int(module.main(args) or 0)
     except KeyboardInterrupt:
         return 130
+    except BrokenPipeError:
+        raise                # stdout's reader went away: the entry point's own exit
+    except OSError as exc:
+        # a path the system cannot use (a name too long, a folder given for a file, no
+        # permission, a full disk) that the command did not check itself: one line
+        print(f'mindgrasp {_prog(argv)}: error: {_os_error_text(exc)}; check the path and '
+              'try again.', file=sys.stderr)
+        return 1

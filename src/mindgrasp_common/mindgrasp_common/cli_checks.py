@@ -13,11 +13,19 @@ from __future__ import annotations
 
 import argparse
 import math
+from collections.abc import Callable
 from pathlib import Path
 from typing import NoReturn
 
-__all__ = ['OneLineParser', 'existing_directory', 'finite_float', 'non_negative_float',
-           'non_negative_int', 'positive_float', 'positive_int', 'probability', 'yaml_error_text']
+__all__ = ['MAX_FLOAT', 'MAX_INT', 'OneLineParser', 'bounded_float', 'bounded_int',
+           'existing_directory', 'finite_float', 'non_negative_float', 'non_negative_int',
+           'positive_float', 'positive_int', 'probability', 'yaml_error_text']
+
+#: the largest whole number any option takes (a signed 32-bit int: counts, seeds, sizes): a
+#: larger one (``--trials 99999999999999999999``) ended in an OverflowError deep in numpy
+MAX_INT = 2**31 - 1
+#: the largest magnitude any number option takes (s, Hz, m ...): 1e9 s is 31 years
+MAX_FLOAT = 1e9
 
 
 class OneLineParser(argparse.ArgumentParser):
@@ -33,15 +41,19 @@ class OneLineParser(argparse.ArgumentParser):
         self.exit(2, f'{self.prog}: error: {message} (see {self.prog} --help)\n')
 
 
-def _int(text: str) -> int:
+def _int(text: str, maximum: int = MAX_INT) -> int:
     try:
-        return int(text)
+        value = int(text)
     except ValueError:
         msg = f'{text!r} is not a whole number'
         raise argparse.ArgumentTypeError(msg) from None
+    if value > maximum:
+        msg = f'must be <= {maximum}, got {text.strip()}'
+        raise argparse.ArgumentTypeError(msg)
+    return value
 
 
-def _float(text: str) -> float:
+def _float(text: str, maximum: float = MAX_FLOAT) -> float:
     try:
         value = float(text)
     except ValueError:
@@ -50,7 +62,39 @@ def _float(text: str) -> float:
     if not math.isfinite(value):
         msg = f'{text!r} is not a finite number'
         raise argparse.ArgumentTypeError(msg)
+    if abs(value) > maximum:
+        msg = f'must be between {-maximum:g} and {maximum:g}, got {text.strip()}'
+        raise argparse.ArgumentTypeError(msg)
     return value
+
+
+def bounded_int(minimum: int, maximum: int) -> Callable[[str], int]:
+    """A checker of whole numbers from ``minimum`` to ``maximum``: ``type=bounded_int(1, 10000)``
+    (``--trials``: a number of trials that could never run is refused at once)."""
+    def check(text: str) -> int:
+        value = _int(text, maximum)
+        if value < minimum:
+            msg = f'must be >= {minimum}, got {value}'
+            raise argparse.ArgumentTypeError(msg)
+        return value
+
+    check.__name__ = f'bounded_int({minimum}, {maximum})'
+    check.bounds = (minimum, maximum)          # type: ignore[attr-defined]
+    return check
+
+
+def bounded_float(minimum: float, maximum: float) -> Callable[[str], float]:
+    """A checker of finite numbers from ``minimum`` to ``maximum``."""
+    def check(text: str) -> float:
+        value = _float(text)
+        if not minimum <= value <= maximum:
+            msg = f'must be between {minimum:g} and {maximum:g}, got {value:g}'
+            raise argparse.ArgumentTypeError(msg)
+        return value
+
+    check.__name__ = f'bounded_float({minimum:g}, {maximum:g})'
+    check.bounds = (minimum, maximum)          # type: ignore[attr-defined]
+    return check
 
 
 def finite_float(text: str) -> float:

@@ -54,9 +54,11 @@ from .lsl import (
     StreamFinder,
     check_stream,
     clocksync_for,
+    identity_text,
     not_found_error,
     open_inlet,
     resolve_stream,
+    stream_identity,
     unit_scale,
 )
 from .quality import QualityMonitor
@@ -143,6 +145,13 @@ class EEGAcquisition:
         LSL timestamp post-processing.
     quality_window, flat_threshold, rail_threshold :
         See :class:`~mindgrasp_eeg.quality.QualityMonitor` (s, V, V).
+    hostname : str
+        Also match the sender's host ('' = any).
+
+    Which sender: the first stream connected to fixes the sender (:attr:`identity`: its
+    source_id, host and LSL session). After a loss only a stream of that sender is taken back (a
+    restarted amplifier, with a new ``uid``); a stream of the same name from another host, source
+    or session is refused, counted (``refused_streams``) and named in the status.
     """
 
     def __init__(self, name: str = '', stream_type: str = 'EEG', source_id: str = '', *,
@@ -191,7 +200,11 @@ class EEGAcquisition:
         self.lost = False
         self._lost_reason = ''
         self.counters = {'samples': 0, 'dropped': 0, 'out_of_order': 0, 'nonfinite_samples': 0,
-                         'nan_dropped': 0, 'reconnects': 0, 'losses': 0}
+                         'nan_dropped': 0, 'reconnects': 0, 'losses': 0, 'refused_streams': 0}
+        #: (source_id, host, LSL session) of the first stream connected to; None before
+        self.identity: tuple[str, str, str] | None = None
+        self._refused: set[str] = set()          # uids of other senders' streams, refused
+        self.refusals: list[str] = []            # one sentence per refused stream, newest last
 
     # -- connection ----------------------------------------------------------------------------
     @property
@@ -320,6 +333,13 @@ class EEGAcquisition:
             self.warnings.append(f"The LSL stream '{desc.name}' declares no channel unit; "
                                  'assuming microvolts. Set stream_unit if that is wrong.')
         self.scale = unit_scale(unit)
+        if self.identity is None:
+            self.identity = desc.identity     # the sender, kept for every reconnection
+        elif desc.identity != self.identity:
+            msg = (f"The LSL stream '{desc.name}' comes from {identity_text(desc.identity)}, "
+                   f'not from {identity_text(self.identity)}, which this node connected to '
+                   'first; restart the node to change amplifiers.')
+            raise EEGError(msg)
         if self.desc is None or self.desc.n_channels != desc.n_channels or \
                 self.desc.sample_rate != desc.sample_rate:
             self.quality = QualityMonitor(desc.channel_names, desc.sample_rate,
@@ -356,7 +376,8 @@ class EEGAcquisition:
                 try:
                     # a closed outlet never sends again, but the resolver may still list it for
                     # a while: a new stream (a restarted amplifier) has a new uid
-                    info = finder.newest(exclude_uids=(lost_uid,) if closed else ())
+                    info = self._same_sender(finder.found(
+                        exclude_uids=(lost_uid,) if closed else ()))
                     if info is None:
                         self._stop.wait(0.1)
                         continue
@@ -383,6 +404,32 @@ class EEGAcquisition:
 
         self._reconnect_thread = threading.Thread(target=run, name='eeg-reconnect', daemon=True)
         self._reconnect_thread.start()
+
+    def _same_sender(self, found: list[pylsl.StreamInfo]) -> pylsl.StreamInfo | None:
+        """The newest of ``found`` sent by the amplifier this node connected to first (same
+        source_id, host and LSL session: :attr:`StreamDescription.identity`); the others are
+        refused, counted once each, and named in the status (a stream of the same name from
+        another rig or another run must never stand in for this one)."""
+        ours = [i for i in found if self.identity is None or stream_identity(i) == self.identity]
+        kept = {i.uid() for i in ours}
+        for info in found:
+            if info.uid() in kept or info.uid() in self._refused:
+                continue
+            self._refused.add(info.uid())
+            self.counters['refused_streams'] += 1
+            assert self.identity is not None
+            with self._lock:
+                self.refusals.append(
+                    f"refused the LSL stream '{info.name()}' from "
+                    f'{identity_text(stream_identity(info))}: not the sender this node connected '
+                    f'to first ({identity_text(self.identity)}); restart the node to change '
+                    'amplifiers')
+                self._reconnect_error = (
+                    f"refused the LSL stream '{info.name()}' from "
+                    f'{identity_text(stream_identity(info))}: this node connected to '
+                    f'{identity_text(self.identity)} first and accepts only that sender; '
+                    'restart the node to change amplifiers')
+        return max(ours, key=lambda i: i.created_at()) if ours else None
 
     def _mark_lost(self, closed: bool = False) -> None:
         """The stream is lost; ``closed``: its sender closed the connection (its outlet is
@@ -524,6 +571,7 @@ class EEGAcquisition:
         desc = self.desc
         if desc is not None:
             values.update(stream=desc.name, source_id=desc.source_id, hostname=desc.hostname,
+                          session_id=desc.session_id, uid=desc.uid,
                           n_channels=str(desc.n_channels), sample_rate=f'{desc.sample_rate:g}',
                           unit_scale_to_volts=f'{self.scale:g}')
         if self._inlet is not None and self.clocksync and desc is not None and \

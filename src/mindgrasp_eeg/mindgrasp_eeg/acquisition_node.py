@@ -29,9 +29,14 @@ The amplifier's metadata (``<acquisition>`` manufacturer, model, reference; each
 label, unit and type) goes to ``$MINDGRASP_RUN_DIR/eeg_stream.json`` once connected
 (:mod:`mindgrasp_eeg.stream_metadata`), for ``mindgrasp export bids``.
 
-Which sender is trusted: by default any stream with the right name (a warning says so). Pin the
+Which sender is trusted: by default any stream with the right name (a warning says so;
+``allow_unpinned:=false`` refuses to start instead, as the hardware profile does). Pin the
 amplifier with ``source_id`` and ``hostname`` (``hostname:=local`` means this host), so no other
-sender on the network can stand in for it.
+sender on the network can stand in for it; the launch profiles that start the virtual amplifier
+pin the node to it (a source id made per run). Whatever the selector, the first stream connected
+to fixes the sender (source_id, host, LSL session): after a loss only that sender is taken back,
+a stream of the same name from another host, source or session is refused (``refused_streams``
+on /eeg/status, and the status names it).
 """
 
 from __future__ import annotations
@@ -113,6 +118,11 @@ class AcquisitionNode(rclpy.node.Node):
                                    f'Markers) to relay to {EEG_MARKERS.name}.')
         self._wanted = (f'name {p.stream_name!r}, type {p.stream_type!r}, source_id '
                         f'{p.source_id!r}, host {self.acq.hostname!r}')
+        if not self.acq.pinned and not p.allow_unpinned:
+            msg = (f'The EEG stream {p.stream_name!r} is not pinned: set source_id and hostname '
+                   '(hostname:=local for this host) to accept only your amplifier, or '
+                   'allow_unpinned:=true to accept any sender of that name.')
+            raise EEGError(msg)
         if not self.acq.pinned:
             self.get_logger().warning(
                 'The EEG stream is not pinned: any LSL sender with this name is accepted. Set '
@@ -121,6 +131,7 @@ class AcquisitionNode(rclpy.node.Node):
         self.get_logger().info(f'Searching for the LSL stream ({self._wanted}) for up to '
                                f'{p.resolve_timeout:g} s.')
         self._n_warnings = 0
+        self._n_refusals = 0
         self._last_level = -1
         self._last_stamp_ns = -1
         self._outbox: deque[EEGChunk] = deque()        # reader thread -> executor
@@ -240,6 +251,9 @@ class AcquisitionNode(rclpy.node.Node):
             return
         if not connected:
             return
+        while len(self.acq.refusals) > self._n_refusals:    # another sender's stream, refused
+            self.get_logger().warning(self.acq.refusals[self._n_refusals] + '.')
+            self._n_refusals += 1
         if len(self.acq.warnings) > self._n_warnings:
             for warning in self.acq.warnings[self._n_warnings:]:
                 self.get_logger().warning(warning)

@@ -90,6 +90,14 @@ class StreamDescription:
     reference: str = ''
     channel_units: tuple[str, ...] = ()
     channel_types: tuple[str, ...] = ()
+    session_id: str = ''
+
+    @property
+    def identity(self) -> tuple[str, str, str]:
+        """``(source_id, hostname, session_id)``: who sends the stream. A restarted amplifier
+        keeps it (its new outlet has a new ``uid``); another amplifier of the same name, on
+        another host or with another source id, does not."""
+        return (self.source_id, self.hostname, self.session_id)
 
     @classmethod
     def from_info(cls, info: pylsl.StreamInfo) -> StreamDescription:
@@ -119,12 +127,25 @@ class StreamDescription:
                    common.pop() if len(common) == 1 else '', info.channel_format(),
                    info.hostname(), info.uid(), info.created_at(),
                    manufacturer=acq.child_value('manufacturer'), model=acq.child_value('model'),
-                   reference=reference, channel_units=tuple(units), channel_types=tuple(types))
+                   reference=reference, channel_units=tuple(units), channel_types=tuple(types),
+                   session_id=info.session_id())
 
     def summary(self) -> str:
         """One line: ``'name' (type, n ch @ rate Hz, source_id, host)``."""
         return (f"'{self.name}' (type {self.type!r}, {self.n_channels} ch @ "
                 f"{self.sample_rate:g} Hz, source_id {self.source_id!r}, host {self.hostname!r})")
+
+
+def stream_identity(info: pylsl.StreamInfo) -> tuple[str, str, str]:
+    """``(source_id, hostname, session_id)`` of a resolved stream (see
+    :attr:`StreamDescription.identity`)."""
+    return (info.source_id(), info.hostname(), info.session_id())
+
+
+def identity_text(identity: Sequence[str]) -> str:
+    """``source_id 'x', host 'y', session 'z'`` for messages."""
+    source_id, hostname, session_id = identity
+    return f'source_id {source_id!r}, host {hostname!r}, session {session_id!r}'
 
 
 def stream_predicate(name: str, stream_type: str, source_id: str, hostname: str = '') -> str:
@@ -196,8 +217,12 @@ class StreamFinder:
 
     def newest(self, exclude_uids: Sequence[str] = ()) -> pylsl.StreamInfo | None:
         """The most recently created matching stream seen so far, or None."""
-        found = [i for i in self._resolver.results() if i.uid() not in exclude_uids]
+        found = self.found(exclude_uids)
         return max(found, key=lambda i: i.created_at()) if found else None
+
+    def found(self, exclude_uids: Sequence[str] = ()) -> list[pylsl.StreamInfo]:
+        """Every matching stream seen so far (but those of ``exclude_uids``)."""
+        return [i for i in self._resolver.results() if i.uid() not in exclude_uids]
 
     def close(self) -> None:
         """Stop the background search."""

@@ -39,6 +39,8 @@ class AcquisitionParams:
     stream_type: str = param('', "also match this LSL type, e.g. EEG ('' = any)")
     source_id: str = param('', "also match this LSL source_id ('' = any)")
     hostname: str = param('', "also match the sender's host ('' = any, local = this host)")
+    allow_unpinned: bool = param(True, 'false: refuse to start unless source_id and hostname '
+                                 'pin the sender (the hardware profile)')
     n_channels: int = param(32, 'expected channel count (0 = the stream\'s)', min=0)
     sample_rate: float = param(250.0, "expected sample rate (0 = the stream's)", unit='Hz',
                                min=0.0)
@@ -84,7 +86,8 @@ class VirtualAmpParams:
 
     stream_name: str = param(_STREAM, 'LSL stream name (output lsl)')
     stream_type: str = param('EEG', 'LSL stream type')
-    source_id: str = param('', "LSL source_id ('' = the stream name)")
+    source_id: str = param('', "LSL source_id ('' = <stream_name>@<run directory name> in "
+                           'a launch, else the stream name)')
     channel_names: list[str] = param(list(NAUTILUS_32), 'channel labels (10-20 names)')
     sample_rate: float = param(250.0, 'sample rate (the synthetic EEG needs >= 60 Hz)',
                                unit='Hz', min=60.0, max=100000.0)

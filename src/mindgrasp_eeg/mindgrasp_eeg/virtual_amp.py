@@ -4,7 +4,8 @@
 :class:`~mindgrasp_eeg.subject.VirtualSubject` and an :class:`~mindgrasp_eeg.lsl.EEGOutlet`.
 Call :meth:`VirtualAmplifier.step` with the pacing clock (s): it generates every sample due by then,
 in blocks of at most ``block`` samples so imagery onsets are resolved to ``block / rate`` seconds,
-and pushes them.
+and pushes them. With real-time stamps (an LSL stream) only whole blocks go out, as an amplifier
+sends them: ``/eeg/raw`` then carries ``rate / block`` chunks a second (31.25 at 250 Hz, 8).
 
 Timestamps: in real-time pacing, sample ``k`` gets the LSL timestamp ``t0 + k / rate``, where
 ``t0`` is ``local_clock()`` at the first step, like an amplifier with its own sample clock. In
@@ -15,6 +16,8 @@ has no notion of simulated time.
 from __future__ import annotations
 
 import math
+import os
+from pathlib import Path
 
 import numpy as np
 import pylsl
@@ -22,6 +25,16 @@ import pylsl
 from .lsl import EEGOutlet
 from .subject import VirtualSubject
 from .synthetic import SyntheticEEG
+
+
+def run_source_id(stream_name: str) -> str:
+    """The source id of an amplifier whose ``source_id`` is not given: ``<stream_name>@<run>``
+    in a launch, ``<run>`` the run directory's name (``$MINDGRASP_RUN_DIR``), so two runs never
+    share it and a respawned amplifier keeps it; outside a launch the stream name, so that an
+    amplifier started again by hand is the same sender (the acquisition takes back only the
+    sender it connected to first)."""
+    run_dir = os.environ.get('MINDGRASP_RUN_DIR', '')
+    return f'{stream_name}@{Path(run_dir).name}' if run_dir else stream_name
 
 
 class VirtualAmplifier:
@@ -79,7 +92,11 @@ class VirtualAmplifier:
             self.t_start = now - self.n_samples / fs
             due = self.n_samples + 1
         out = []
-        while self.n_samples < due:
+        # on the amplifier's own sample clock (LSL, wall time) only whole blocks leave, as an
+        # amplifier sends them: a partial block (a push between block ends) sent its samples
+        # as two LSL chunks, and /eeg/raw ran at 38.6 chunks/s instead of rate / block (31.25)
+        whole = self.block if self.realtime_stamps else 1
+        while due - self.n_samples >= whole:
             k = self.n_samples
             n = min(self.block, due - k)
             self.current_class = self.subject.intent(self.t_start + k / fs)

@@ -9,6 +9,10 @@ node reads it as any other amplifier. ``output:=ros`` (lock-step experiments): L
 time, so the node publishes ``/eeg/raw`` (mindgrasp_msgs/EEGChunk, volts, sensor-data QoS depth
 100) itself, each chunk stamped with the node-clock time of its first sample, and no acquisition
 node is needed.
+The stream's ``source_id`` is the parameter's (the launch profiles give one made per run), else
+``<stream_name>@<run directory name>`` in a launch, the stream name outside one: the profiles
+pin their acquisition node to it, so two demos with the same stream name (other ROS domains,
+other rigs on the network) never hear each other's amplifier.
 Subscriptions depend on ``subject_mode``: ``follow`` listens to ``/trainer/prompt``; ``pursue`` to
 ``/task/target``, ``/sim/objects``, ``/joint_states`` and ``/fsm/state``; ``noise`` to nothing.
 Samples are paced by the node clock: wall time, or ``/clock`` with ``use_sim_time``. The imagined
@@ -33,7 +37,7 @@ from mindgrasp_eeg.replay_eeg import ReplayEEG
 from mindgrasp_eeg.ros_conversions import base_yaw_from_joint_state, ns_to_time_fields, time_to_s
 from mindgrasp_eeg.subject import VirtualSubject
 from mindgrasp_eeg.synthetic import SyntheticEEG
-from mindgrasp_eeg.virtual_amp import VirtualAmplifier
+from mindgrasp_eeg.virtual_amp import VirtualAmplifier, run_source_id
 from mindgrasp_ros import rclpy
 from mindgrasp_ros.node_main import end_after, run_node
 from mindgrasp_ros.node_traits import NodeTraits
@@ -94,15 +98,16 @@ class VirtualAmpNode(rclpy.node.Node):
             self.create_subscription(FsmState, FSM_STATE.name, self.fsm_callback, latched)
         self.pub_intent = self.create_publisher(String, VIRTUAL_SUBJECT_INTENT.name, latched)
         outlet, self.markers, self.pub_raw = None, None, None
+        self.source_id = ''
         if p.output == 'ros':
             self.pub_raw = self.create_publisher(EEGChunk, EEG_RAW.name, EEG_RAW.qos)
         else:
             # the outlets last, so streaming starts soon after the stream becomes visible
+            self.source_id = p.source_id or run_source_id(p.stream_name)
             outlet = EEGOutlet(p.stream_name, self.channel_names, self.sample_rate,
-                               stream_type=p.stream_type, source_id=p.source_id, unit=p.unit,
+                               stream_type=p.stream_type, source_id=self.source_id, unit=p.unit,
                                reference=p.reference)
-            self.markers = MarkerOutlet(f'{p.stream_name}-markers',
-                                        f'{p.source_id or p.stream_name}-markers')
+            self.markers = MarkerOutlet(f'{p.stream_name}-markers', f'{self.source_id}-markers')
         sim_time = bool(self.get_parameter('use_sim_time').value)
         self.amp = VirtualAmplifier(gen, self.subject, outlet, realtime_stamps=not sim_time,
                                     block=p.block, max_catch_up=1.0 if sim_time else None)
@@ -110,7 +115,8 @@ class VirtualAmpNode(rclpy.node.Node):
         self._last_intent: object = 'unset'
         self.create_timer(p.push_period, self.push_callback)
         end_after(self, p.duration)
-        where = f"LSL stream '{p.stream_name}'" if outlet is not None else '/eeg/raw'
+        where = (f"LSL stream '{p.stream_name}' (source_id {self.source_id!r})"
+                 if outlet is not None else '/eeg/raw')
         self.get_logger().info(
             f'Virtual amplifier on {where}: {len(self.channel_names)} channels at '
             f'{self.sample_rate:g} Hz, subject mode {mode!r}, seed {p.seed}, '

@@ -24,6 +24,9 @@ if TYPE_CHECKING:
 PROTOCOL_SUBJECTS = {'set_locations': ('noise', 'virtual', 'oracle'),
                      'random_locations': ('autonomous',)}
 #: the classifier trained on labelled noise (mindgrasp_experiments.subjects.noise_model)
+#: the most trials one command runs (a paper protocol has 90): a larger count could never
+#: finish, and 99999999999999999999 ended in numpy's OverflowError
+MAX_TRIALS = 100_000
 NOISE_MODEL = 'package://mindgrasp_classifier/models/noise_classifier.json'
 
 
@@ -87,13 +90,13 @@ def subject_type(text: str) -> str:
 
 def add_common_arguments(parser: argparse.ArgumentParser, trials: int) -> None:
     """Options of every ``mindgrasp experiment`` protocol (numbers checked by argparse)."""
-    from mindgrasp_common.cli_checks import non_negative_int, positive_float, positive_int
+    from mindgrasp_common.cli_checks import bounded_int, non_negative_int, positive_float
 
-    parser.add_argument('--trials', type=positive_int, default=trials,
-                        help=f'number of trials (default {trials})')
+    parser.add_argument('--trials', type=bounded_int(1, MAX_TRIALS), default=trials,
+                        help=f'number of trials, 1-{MAX_TRIALS} (default {trials})')
     parser.add_argument('--seed', type=non_negative_int, default=0,
                         help='seed of the trial draws, the EEG and the subject (default 0)')
-    parser.add_argument('--workers', type=positive_int, default=1,
+    parser.add_argument('--workers', type=bounded_int(1, 256), default=1,
                         help='worker processes; the same seed gives the same records whatever '
                              'the number (default 1)')
     parser.add_argument('--out', metavar='DIR', default=None,

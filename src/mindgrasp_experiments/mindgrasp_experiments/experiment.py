@@ -137,7 +137,7 @@ class Experiment:
         from mindgrasp_launch.rundir import create_run_dir
 
         try:
-            out = create_run_dir(self.protocol, run_dir)
+            out = create_run_dir(self.protocol, run_dir, option='--out')
             if subject_args is None:
                 subject_args = subject_launch_args(self.subject, out)
         except (LaunchError, EEGError) as exc:

@@ -21,6 +21,7 @@ that time, for launch tests).
 from __future__ import annotations
 
 import re
+import time
 
 import numpy as np
 from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import DetectionArray, FsmState, MIPrediction
@@ -46,6 +47,7 @@ from mindgrasp_fsm.types import (
     StopKind,
 )
 from mindgrasp_ros import rclpy
+from mindgrasp_ros.graph_check import declare_graph_check, refuse_second_graph
 from mindgrasp_ros.logs import log_at
 from mindgrasp_ros.node_main import declare_duration, run_node
 from mindgrasp_ros.node_traits import NodeTraits
@@ -76,6 +78,7 @@ class FsmNode(rclpy.node.Node):
         super().__init__(self.node_traits.name, **kwargs)
         # one FsmParams object, shared with the controller: live changes apply at the next tick
         self.params = declare_params(self, FsmParams)
+        started, graph_check_wait = time.monotonic(), declare_graph_check(self)
         self.fsm = GraspFsm.from_params(self.params)
         # open and closed positions (rad) of the gripper's first (driving) joint: the others
         # move with it over the same range (the shipped hand's fingers, the xArm's linkage)
@@ -108,6 +111,10 @@ class FsmNode(rclpy.node.Node):
         self.create_subscription(CameraInfo, COLOR_INFO.name, self.info_callback, COLOR_INFO.qos)
         self.create_timer(self.params.control_period, self.control_callback)
         declare_duration(self)
+        # a second /fsm or commander of the arm (another graph on this domain): refused before
+        # the first command
+        refuse_second_graph(self, FsmError, started=started, wait=graph_check_wait,
+                            own_publishers={self.arm.topic: 1})
         mode = 'autonomous' if self.params.autonomous else 'BCI'
         self.get_logger().info(f'Grasp controller ready ({mode} mode, arm commands on '
                                f'{self.arm.topic} ({self.arm.interface}), '

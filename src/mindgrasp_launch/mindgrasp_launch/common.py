@@ -3,6 +3,7 @@ launch_ros actions under ``ros2 launch``, ours under ``mindgrasp launch``."""
 
 from __future__ import annotations
 
+import uuid
 from pathlib import Path
 from typing import Any
 
@@ -45,18 +46,89 @@ def eeg_source_arguments() -> list[Any]:
     ]
 
 
+def virtual_amp_pin() -> tuple[dict[str, str], dict[str, str]]:
+    """``(virtual amplifier parameters, acquisition parameters)`` that pin a launch's
+    acquisition node to the launch's own virtual amplifier: a source id made for this launch
+    (``mindgrasp-<12 hex digits>``, a uuid made once per launch when its parameters are
+    resolved) and this host. LSL streams are visible across the machine and the lab's
+    network, so a second demo (another ROS domain, another rig) with the same stream name can
+    no longer feed this one's classifier (issue 42). Lock-step runs have no LSL stream: their
+    records do not depend on it."""
+    source_id = _run_source_id()
+    return {'source_id': source_id}, {'source_id': source_id, 'hostname': 'local'}
+
+
+#: the launch configuration that keeps a launch's source id once made
+_RUN_SOURCE_ID = 'mindgrasp_eeg_run_source_id'
+
+
+def _run_source_id() -> Any:
+    """A substitution resolved once per launch (not per generated description, which a process
+    that launches several times keeps in a cache) to ``mindgrasp-<12 hex digits>``."""
+    if la.using_real_launch():
+        from launch import Substitution
+    else:
+        from mindgrasp_launch.substitutions import Substitution
+
+    class RunSourceId(Substitution):
+        def perform(self, context: Any) -> str:
+            return context.launch_configurations.setdefault(
+                _RUN_SOURCE_ID, f'mindgrasp-{uuid.uuid4().hex[:12]}')
+
+        def describe(self) -> str:
+            return 'RunSourceId()'
+
+    return RunSourceId()
+
+
 def eeg_source_nodes(files: list[Path], seed: object, subject_mode: object) -> list[Any]:
     """The virtual amplifier (only with ``amp:=virtual``) and the acquisition node on
-    ``eeg_stream``; declare :func:`eeg_source_arguments` in the profile."""
+    ``eeg_stream``, pinned to that amplifier (:func:`virtual_amp_pin`) with ``amp:=virtual``;
+    declare :func:`eeg_source_arguments` in the profile."""
     stream = la.LaunchConfiguration('eeg_stream')
+    amp_pin, acquisition_pin = virtual_amp_pin()
     return [
         la.Node(package='mindgrasp_eeg', executable='virtual_amp_node', name='virtual_amp',
                 parameters=[*files, {'stream_name': stream, 'seed': seed,
-                                     'subject_mode': subject_mode}],
+                                     'subject_mode': subject_mode, **amp_pin}],
                 condition=_if_equal('amp', 'virtual')),
         la.Node(package='mindgrasp_eeg', executable='acquisition_node', name='eeg_acquisition',
-                parameters=[*files, {'stream_name': stream}]),
+                parameters=[*files, {'stream_name': stream, **acquisition_pin}],
+                condition=_if_equal('amp', 'virtual')),
+        la.Node(package='mindgrasp_eeg', executable='acquisition_node', name='eeg_acquisition',
+                parameters=[*files, {'stream_name': stream}],
+                condition=_if_differs('amp', 'virtual')),
     ]
+
+
+def eeg_pin_arguments() -> list[Any]:
+    """``eeg_source_id:=``, ``eeg_host:=`` and ``eeg_unpinned:=false`` of a profile that reads
+    a real amplifier: under ``mindgrasp launch`` the launch is refused in one line, before any
+    process starts, unless both are given or ``eeg_unpinned:=true`` says on purpose that any
+    sender of the stream name is accepted (the acquisition node refuses the same at its start
+    under ``ros2 launch``: :func:`eeg_pin_parameters`)."""
+    from mindgrasp_launch.number_argument import pin_check_argument
+
+    return [
+        la.DeclareLaunchArgument('eeg_source_id', default_value='',
+                                 description="the amplifier's LSL source_id (`mindgrasp "
+                                             'launch eeg eeg_stream:=NAME` logs it on '
+                                             'connecting)'),
+        la.DeclareLaunchArgument('eeg_host', default_value='',
+                                 description="the host the amplifier's LSL app runs on (local: "
+                                             'this host)'),
+        pin_check_argument('eeg_unpinned', default_value='false',
+                           description='true: accept any LSL sender of eeg_stream (a bench '
+                                       'test; another rig or demo with the same stream name '
+                                       'could drive the arm)'),
+    ]
+
+
+def eeg_pin_parameters() -> dict[str, Any]:
+    """The acquisition node's pinning parameters from :func:`eeg_pin_arguments`."""
+    return {'source_id': la.LaunchConfiguration('eeg_source_id'),
+            'hostname': la.LaunchConfiguration('eeg_host'),
+            'allow_unpinned': la.LaunchConfiguration('eeg_unpinned')}
 
 
 #: values of the ``display:=`` launch argument

@@ -28,7 +28,8 @@ from mindgrasp_launch.actions.declare_launch_argument import (
 from mindgrasp_launch.errors import LaunchError
 
 __all__ = ['CheckedLaunchArgument', 'FileLaunchArgument', 'NumberLaunchArgument',
-           'check_number', 'checked_argument', 'file_argument', 'number_argument']
+           'PinCheckArgument', 'check_number', 'checked_argument', 'file_argument',
+           'number_argument', 'pin_check_argument']
 
 
 def check_number(name: str, text: str, kind: type, minimum: float | None,
@@ -145,3 +146,36 @@ def checked_argument(name: str, *, check: Callable[[str], object], default_value
                                                 description=description)
     return CheckedLaunchArgument(name, check=check, default_value=default_value,
                                  description=description)
+
+
+class PinCheckArgument(DeclareLaunchArgument):
+    """``eeg_unpinned:=true|false``, declared after ``eeg_source_id`` and ``eeg_host``: false
+    (the default) refuses the launch unless both are given, in one line naming the fix."""
+
+    def execute(self, context: Any) -> None:
+        super().execute(context)
+        if context.launch_configurations[self.name].strip().lower() == 'true':
+            return
+        missing = [name for name in ('eeg_source_id', 'eeg_host')
+                   if not context.launch_configurations.get(name, '').strip()]
+        if missing:
+            stream = context.launch_configurations.get('eeg_stream', '')
+            msg = (f"the EEG stream {stream!r} is not pinned ({' and '.join(missing)} not "
+                   'given): any LSL sender of that name on the network would drive the arm. '
+                   'Give eeg_source_id:=<source_id> eeg_host:=<host> (`mindgrasp launch eeg '
+                   'eeg_stream:=NAME` logs both on connecting), or eeg_unpinned:=true for a '
+                   'bench test.')
+            raise LaunchError(msg)
+
+
+def pin_check_argument(name: str, *, default_value: str, description: str) -> Any:
+    """Declare ``name`` as the pinning check of :class:`PinCheckArgument` (a plain argument
+    under ``ros2 launch``, where the acquisition node refuses an unpinned stream itself)."""
+    from mindgrasp_launch import launch_api
+
+    if launch_api.using_real_launch():
+        return launch_api.DeclareLaunchArgument(name, default_value=default_value,
+                                                description=description,
+                                                choices=['true', 'false'])
+    return PinCheckArgument(name, default_value=default_value, description=description,
+                            choices=['true', 'false'])

@@ -51,14 +51,28 @@ def default_runs_root() -> Path:
 
 
 def create_run_dir(profile: str, run_dir: str | Path | None = None,
-                   runs_root: str | Path | None = None) -> Path:
-    """Create the run directory; an explicit ``run_dir`` must not hold files already."""
+                   runs_root: str | Path | None = None, option: str = '--run-dir') -> Path:
+    """Create the run directory; an explicit ``run_dir`` must not hold files already, and only
+    the run directory itself is created: its parent folder must exist (``--out /nonexistent/x``
+    created /nonexistent at the filesystem root). ``option`` names the command's option in the
+    errors (``--run-dir``, ``--out``)."""
     if run_dir is not None:
         path = Path(run_dir).expanduser()
         if path.exists() and (not path.is_dir() or any(path.iterdir())):
-            msg = (f'run directory {path} exists and is not empty: choose a new --run-dir or '
+            msg = (f'{option} {path} exists and is not empty: choose a new {option} or '
                    f'remove it (a run never overwrites recorded data).')
             raise LaunchError(msg)
+        parent = path.absolute().parent
+        if not parent.is_dir():
+            msg = (f'{option} {path}: the folder {parent} does not exist; give a run directory '
+                   f'in an existing folder (only the run directory itself is created).')
+            raise LaunchError(msg)
+        try:
+            path.mkdir(exist_ok=True)
+        except OSError as exc:
+            msg = (f'cannot create the run directory {path} ({exc.strerror or exc}): give a '
+                   f'writable {option}.')
+            raise LaunchError(msg) from None
     else:
         root = Path(runs_root) if runs_root is not None else default_runs_root()
         safe = re.sub(r'[^A-Za-z0-9_.-]+', '_', profile) or 'launch'
@@ -75,13 +89,15 @@ def create_run_dir(profile: str, run_dir: str | Path | None = None,
                 n += 1
                 path = base.with_name(f'{base.name}-{n}')
             except OSError as exc:
-                msg = f'cannot create the run directory {path} ({exc}): give a writable --run-dir.'
-                raise LaunchError(msg) from exc
+                msg = (f'cannot create the run directory {path} ({exc.strerror or exc}): give a '
+                       f'writable {option}.')
+                raise LaunchError(msg) from None
     try:
-        (path / 'logs').mkdir(parents=True, exist_ok=True)
+        (path / 'logs').mkdir(exist_ok=True)
     except OSError as exc:
-        msg = f'cannot create the run directory {path} ({exc}): give a writable --run-dir.'
-        raise LaunchError(msg) from exc
+        msg = (f'cannot create the run directory {path} ({exc.strerror or exc}): give a '
+               f'writable {option}.')
+        raise LaunchError(msg) from None
     return path.resolve()
 
 

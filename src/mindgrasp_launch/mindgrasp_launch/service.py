@@ -12,6 +12,7 @@ import datetime as dt
 import logging
 import os
 import re
+import signal
 import sys
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -31,6 +32,7 @@ from mindgrasp_launch.description import (
     find_launch_file,
     load_launch_file,
 )
+from mindgrasp_launch.domain_check import check_domain_free
 from mindgrasp_launch.errors import LaunchError
 from mindgrasp_launch.output import (
     Printer,
@@ -112,6 +114,8 @@ class LaunchService:
         composed: run the node modules in one process (``mindgrasp_ros.composition``).
         sigint_timeout, sigterm_timeout: s before escalating to SIGTERM, then SIGKILL.
         argv: the command line, stored in the run directory.
+        graph_check: s to look for another graph's ``/sim`` or ``/fsm`` on the ROS domain
+            before anything starts (:mod:`.domain_check`; 0: not looked for).
     """
 
     def __init__(self, description: str | Path | LaunchDescription,
@@ -119,7 +123,7 @@ class LaunchService:
                  run_dir: str | Path | None = None, runs_root: str | Path | None = None,
                  composed: bool = False, sigint_timeout: float = 10.0,
                  sigterm_timeout: float = 5.0, printer: Printer | None = None,
-                 argv: Sequence[str] | None = None) -> None:
+                 argv: Sequence[str] | None = None, graph_check: float = 1.0) -> None:
         if isinstance(description, LaunchDescription):
             self.description = description
             self.launch_file = description.source
@@ -139,9 +143,11 @@ class LaunchService:
         self.sigterm_timeout = sigterm_timeout
         self.printer = printer
         self.argv = list(argv) if argv is not None else list(sys.argv)
+        self.graph_check = graph_check
         self.run_dir: Path | None = None
         self.results: list[ProcessResult] = []
         self.stop_reason: str | None = None
+        self.interrupted_by: int | None = None
 
     # -- arguments -----------------------------------------------------------------------------
     def declared_arguments(self) -> list[DeclareLaunchArgument]:
@@ -272,8 +278,13 @@ class LaunchService:
         return item
 
     def run(self) -> int:
-        """Run the launch; 0 when every process ended cleanly, 1 otherwise."""
+        """Run the launch; 0 when every process ended cleanly, 1 otherwise; 128 + the signal
+        (130 Ctrl-C/SIGINT, 143 SIGTERM, 129 SIGHUP) when a signal stopped it and every process
+        stopped cleanly."""
         plan = self.plan()  # problems are reported before anything is created
+        # a second graph on this domain (another demo's /sim or /fsm): refused, nothing created
+        check_domain_free((p.fully_qualified_name for p in plan.processes if p.is_node),
+                          self.graph_check)
         run_dir = rundir.create_run_dir(self.name, self.run_dir_option, self.runs_root)
         self.run_dir = run_dir
         if plan.record:
@@ -304,9 +315,16 @@ class LaunchService:
             # a process that died is a failure even when respawn brought it back: the run lost
             # that node's work for a while (a controller, a recorder), so it is not clean
             code = 0 if all(r.clean and not r.restarts for r in self.results) else 1
+            interrupted = self.interrupted_by = supervisor.interrupted_by
+            if interrupted is not None and code == 0:
+                code = 128 + int(interrupted)   # as a shell reports it: 130 SIGINT, 143 SIGTERM
             self._write_summary(run_dir, code)
             write_run_report(run_dir, self.name)
-            if code == 0:
+            if interrupted is not None and code != 1:
+                logger.warning('the launch was interrupted (%s) before its end; every process '
+                               'stopped cleanly, what ran is recorded. Run directory: %s',
+                               signal.Signals(interrupted).name, run_dir)
+            elif code == 0:
                 logger.info('every process ended cleanly; run directory: %s', run_dir)
             else:
                 bad = ', '.join(
@@ -325,6 +343,9 @@ class LaunchService:
             'ended_utc': dt.datetime.now(dt.timezone.utc).isoformat(timespec='seconds'),
             'exit_code': code,
             'clean': code == 0,
+            # the signal that stopped the launch before its end (exit code 128 + its number)
+            'interrupted_by': (None if self.interrupted_by is None
+                               else signal.Signals(self.interrupted_by).name),
             'stop_reason': self.stop_reason,
             # clean: the process ended cleanly and never died (a respawned process is not clean)
             'processes': [{'label': r.label, 'returncode': r.returncode,

@@ -184,6 +184,8 @@ class Supervisor:
             self.procs.append(ManagedProcess(spec=spec, command=command, env=penv,
                                              log_path=self.log_dir / f'{spec.label}.log'))
         self._stop_reason: str | None = None
+        #: the signal (SIGINT, SIGTERM, SIGHUP) that ended the launch before its end, or None
+        self.interrupted_by: int | None = None
         self._signals = 0
         self._started_at = 0.0
         self.on_started: Callable[[ManagedProcess], None] | None = None
@@ -198,6 +200,8 @@ class Supervisor:
         self._signals += 1
         name = signal.Signals(signum).name
         if self._signals == 1:
+            if self._stop_reason is None:
+                self.interrupted_by = signum
             self.request_shutdown(f'{name} received')
         # a second signal: the stop loop escalates to the next stage at once
 

@@ -30,7 +30,9 @@ Exit codes (one convention for every node, as the launcher reports them):
 - ``1`` the node failed while running: ``done`` completed with an exception (its message is printed
   as one line ``[node] ERROR: ...``) or with a non-zero exit code;
 - ``2`` the node refused to start: its ``--ros-args`` are malformed (``-p bogus``, a missing or
-  bad ``--params-file``), or its constructor raised a parameter error (rclpy's
+  bad ``--params-file``), a parameter file or ``-p`` names a parameter the node does not
+  declare (``lock_durtion``: :func:`~mindgrasp_ros.params.refuse_undeclared_overrides`), or its
+  constructor raised a parameter error (rclpy's
   ``ParameterException`` family, :class:`~mindgrasp_ros.params.ParameterError`) or one of the
   ``errors`` the caller names (the package's own error class); one line, no traceback.
 
@@ -59,6 +61,7 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 from mindgrasp_ros import rclpy
+from mindgrasp_ros.params import refuse_undeclared_overrides
 from mindgrasp_ros.process import exit_if_main_program, stop_requested
 
 __all__ = ['EXIT_FAILED', 'EXIT_OK', 'EXIT_REFUSED', 'NodeFailure', 'declare_duration',
@@ -277,6 +280,8 @@ def run_node(node_class: Callable[[], Any], args: list[str] | None = None, *,
     try:
         try:
             node = node_class()
+            # a key of a parameter file or -p that the node does not declare (a typo): refused
+            refuse_undeclared_overrides(node)
         except (*_parameter_errors(), *errors) as exc:
             print(f'[{label}] ERROR: {exc}', file=sys.stderr, flush=True)
             return EXIT_REFUSED

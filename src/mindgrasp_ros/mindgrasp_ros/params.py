@@ -40,7 +40,7 @@ from pathlib import Path
 from typing import Any, TypeVar
 
 __all__ = ['ParameterError', 'declare_params', 'describe', 'from_mapping', 'param',
-           'parameter_type', 'read_yaml_section', 'type_code']
+           'parameter_type', 'read_yaml_section', 'refuse_undeclared_overrides', 'type_code']
 
 T = TypeVar('T')
 
@@ -341,4 +341,45 @@ def read_yaml_section(path: str | Path, node_name: str) -> dict[str, Any]:
         if isinstance(section, dict) and 'ros__parameters' in section:
             return dict(section['ros__parameters'] or {})
     msg = f"{path} has no '{node_name}: ros__parameters:' section; add one."
+    raise ParameterError(msg)
+
+
+#: override keys a node may receive without declaring them: rclpy declares ``qos_overrides.*``
+#: only for publishers that opt in, and ignores the others
+_TOLERATED_PREFIXES = ('qos_overrides.',)
+
+
+def refuse_undeclared_overrides(node: Any) -> None:
+    """Raise :class:`ParameterError` when the node's parameter files or ``-p`` name a parameter
+    it did not declare (``lock_durtion`` for ``lock_duration``), naming the key and the declared
+    names closest to it; nothing for a node made with ``allow_undeclared_parameters`` or
+    ``automatically_declare_parameters_from_overrides``.
+
+    rclpy keeps such an override unused and raises ``ParameterNotDeclaredException`` only when
+    code asks for the name, so a typo in a parameter file was silently ignored and the node ran
+    on its default. ``run_node`` calls this once the node is constructed (every parameter is
+    declared then): exit 2 and one line.
+    """
+    import difflib
+
+    if getattr(node, '_allow_undeclared', False) or getattr(
+            node, '_allow_undeclared_parameters', False):
+        return
+    # ours keeps the overrides in ``_overrides``, rclpy in ``_parameter_overrides``
+    overrides = getattr(node, '_overrides', None)
+    if overrides is None:
+        overrides = getattr(node, '_parameter_overrides', {}) or {}
+    unknown = sorted(name for name in overrides if not node.has_parameter(name)
+                     and not name.startswith(_TOLERATED_PREFIXES))
+    if not unknown:
+        return
+    declared = sorted(getattr(node, '_parameters', {}))
+    name = unknown[0]
+    close = difflib.get_close_matches(name, declared, n=3, cutoff=0.6)
+    hint = (f"did you mean {' or '.join(repr(c) for c in close)}?" if close
+            else f"it declares {', '.join(declared[:12])}{', ...' if len(declared) > 12 else ''}")
+    more = f' (and {len(unknown) - 1} more: {", ".join(unknown[1:4])})' if len(unknown) > 1 else ''
+    msg = (f"Parameter {name!r}{more} is not declared by node '{node.get_name()}' ({hint}); fix "
+           'the name in the parameter file or -p (`mindgrasp param list` lists a running node\'s '
+           'parameters).')
     raise ParameterError(msg)

@@ -75,6 +75,7 @@ from mindgrasp_ros.interfaces.visualization_msgs.msg import MarkerArray
 from scipy.spatial.transform import Rotation
 
 from mindgrasp_ros import rclpy
+from mindgrasp_ros.graph_check import declare_graph_check, refuse_second_graph
 from mindgrasp_ros.node_main import end_after, run_node
 from mindgrasp_ros.node_traits import NodeTraits
 from mindgrasp_ros.params import declare_params, param
@@ -220,6 +221,7 @@ class SimNode(rclpy.node.Node):
         super().__init__(self.node_traits.name, **kwargs)
         self.params = declare_params(self, SimParams)
         p = self.params
+        started, graph_check_wait = time.monotonic(), declare_graph_check(self)
         try:
             gui = bool(p.gui)
             if gui and not os.environ.get('DISPLAY') and sys.platform.startswith('linux'):
@@ -313,6 +315,9 @@ class SimNode(rclpy.node.Node):
             # always ready; each call steps for ~2 ms of wall time, then lets the executor take
             # commands and requests (works under main() and in a composed process alike)
             self.create_timer(0.0, self.fast_callback)
+        # a second /sim (another graph on this domain): refused before the first message
+        refuse_second_graph(self, SimError, started=started, wait=graph_check_wait,
+                            own_publishers={SIM_STATUS.name: 1})
         end_after(self, p.duration)
         self._publish_robot_description()
         self.publish_all()

@@ -17,6 +17,7 @@ import sys
 
 from mindgrasp_common.cli_checks import (
     OneLineParser,
+    bounded_int,
     non_negative_float,
     non_negative_int,
     positive_int,
@@ -32,7 +33,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              '(resets are not known in advance)')  # fmt: skip
     parser.add_argument('--n-trials', type=positive_int, default=40,
                         help='total trials (default 40)')
-    parser.add_argument('--classes', type=int, nargs='+', default=[0, 1, 2, 3],
+    parser.add_argument('--classes', type=bounded_int(0, 3), nargs='+', default=[0, 1, 2, 3],
                         help='class indices (0 left hand, 1 right hand, 2 both hands, 3 feet)')
     parser.add_argument('--seed', type=non_negative_int, default=0)
     parser.add_argument('--start-delay', type=non_negative_float, default=5.0,

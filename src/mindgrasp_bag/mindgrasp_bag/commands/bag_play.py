@@ -7,7 +7,7 @@ import sys
 
 from mindgrasp_bag.damage import ALLOW_DAMAGED_HELP
 from mindgrasp_bag.ros_glue import param_args
-from mindgrasp_common.cli_checks import non_negative_float, positive_float
+from mindgrasp_common.cli_checks import bounded_int, non_negative_float, positive_float
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -28,7 +28,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--clock', nargs='?', type=non_negative_float, const=40.0, default=0.0,
                         metavar='HZ',
                         help='publish /clock with the bag time (default 40 Hz when given)')
-    parser.add_argument('--priority', type=int, default=0, metavar='1-99',
+    parser.add_argument('--priority', type=bounded_int(0, 99), default=0, metavar='1-99',
                         help='real-time (SCHED_FIFO) priority of the playback thread, for timing '
                              'within ~0.1 ms on a loaded machine (needs root or CAP_SYS_NICE)')
     parser.add_argument('--delay', type=non_negative_float, default=0.5,

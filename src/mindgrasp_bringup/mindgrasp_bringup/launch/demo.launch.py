@@ -39,6 +39,7 @@ from mindgrasp_launch.launch_api import (
     robot_argument,
     run_directory_actions,
     sim_scene_camera,
+    virtual_amp_pin,
 )
 
 
@@ -46,6 +47,7 @@ def generate_launch_description() -> LaunchDescription:
     gui = LaunchConfiguration('gui')
     seed = LaunchConfiguration('seed')
     eeg_stream = LaunchConfiguration('eeg_stream')
+    amp_pin, acquisition_pin = virtual_amp_pin()   # this run's amplifier only
     return LaunchDescription([
         DeclareLaunchArgument('gui', default_value='false', choices=['true', 'false'],
                               description='open the PyBullet window (needs a display)'),
@@ -58,8 +60,10 @@ def generate_launch_description() -> LaunchDescription:
                                           'path (noisy camera, miscalibration, arm lag, object '
                                           'spread; mindgrasp_sim.realism), seeded by seed'),
         DeclareLaunchArgument('eeg_stream', default_value='MIndGrasp-VirtualAmp',
-                              description='LSL stream name of the virtual amplifier (unique per '
-                                          'host when several demos run at once)'),
+                              description='LSL stream name of the virtual amplifier (the '
+                                          "acquisition is pinned to this run's amplifier by a "
+                                          'source id made per run, so several demos may share '
+                                          'it)'),
         DeclareLaunchArgument('subject', default_value='pursue',
                               choices=['noise', 'follow', 'pursue'],
                               description='virtual subject: noise (no imagery), follow (imagines '
@@ -96,10 +100,11 @@ def generate_launch_description() -> LaunchDescription:
         Node(package='mindgrasp_eeg', executable='virtual_amp_node', name='virtual_amp',
              parameters=[*config_files('eeg', 'demo'),
                          {'stream_name': eeg_stream, 'seed': seed,
-                          'subject_mode': LaunchConfiguration('subject')}]),
-        # 3 acquisition: LSL inlet -> /eeg/raw
+                          'subject_mode': LaunchConfiguration('subject'), **amp_pin}]),
+        # 3 acquisition: LSL inlet -> /eeg/raw, pinned to this run's amplifier (source id, host)
         Node(package='mindgrasp_eeg', executable='acquisition_node', name='eeg_acquisition',
-             parameters=[*config_files('eeg', 'demo'), {'stream_name': eeg_stream}]),
+             parameters=[*config_files('eeg', 'demo'),
+                         {'stream_name': eeg_stream, **acquisition_pin}]),
         # the participant's screen (display:=window|fullscreen|headless)
         *display_nodes(config_files('trainer'), LaunchConfiguration('trials')),
         # 4 classifier: /eeg/raw -> /bci/prediction

@@ -37,6 +37,7 @@ from mindgrasp_launch.launch_api import (
     number_argument,
     robot_argument,
     run_directory_actions,
+    virtual_amp_pin,
 )
 
 
@@ -58,6 +59,7 @@ def generate_launch_description() -> LaunchDescription:
              'oracle': ['/bci/prediction', '/vision/detections'],
              'autonomous': ['/vision/detections']}
     eeg = config_files('eeg', 'experiment')
+    amp_pin, acquisition_pin = virtual_amp_pin()   # this run's amplifier only (live runs)
     classifier = config_files('classifier', 'experiment')
     return LaunchDescription([
         DeclareLaunchArgument('protocol', default_value='set_locations',
@@ -111,12 +113,12 @@ def generate_launch_description() -> LaunchDescription:
         # cap), acquisition and the classifier
         *[GroupAction([
             Node(package='mindgrasp_eeg', executable='virtual_amp_node', name='virtual_amp',
-                 parameters=[*eeg, {'stream_name': stream, 'source_id': stream, 'seed': seed,
+                 parameters=[*eeg, {'stream_name': stream, **amp_pin, 'seed': seed,
                                     'accuracy': LaunchConfiguration('accuracy'),
                                     'eeg_source': LaunchConfiguration('eeg_source'),
                                     'subject_mode': mode}]),
             Node(package='mindgrasp_eeg', executable='acquisition_node', name='eeg_acquisition',
-                 parameters=[*eeg, {'stream_name': stream, 'source_id': stream}]),
+                 parameters=[*eeg, {'stream_name': stream, **acquisition_pin}]),
             Node(package='mindgrasp_classifier', executable='classifier_node', name='classifier',
                  parameters=classifier, condition=IfCondition(EqualsSubstitution(model, ''))),
             Node(package='mindgrasp_classifier', executable='classifier_node', name='classifier',

@@ -1,17 +1,27 @@
 """Real hardware: an LSL amplifier and an external arm driver (no simulator), with acquisition,
 classifier, vision and the grasp controller.
 
-    mindgrasp launch hardware eeg_stream:=gNautilus arm_driver:=my_arm_driver \\
+    mindgrasp launch hardware eeg_stream:=gNautilus eeg_source_id:=GN-2021.06.12 \\
+        eeg_host:=amp-pc arm_driver:=my_arm_driver \\
         model:=models/alice.json               # her classifier (mindgrasp train classifier)
-    mindgrasp launch hardware eeg_stream:=gNautilus arm_driver:=/opt/arm/bin/driver \\
+    mindgrasp launch hardware eeg_stream:=gNautilus eeg_source_id:=GN-2021.06.12 \\
+        eeg_host:=local arm_driver:=/opt/arm/bin/driver \\
         arm_driver_args:="--ip 192.168.1.10" camera_driver:=my_camera_node \\
         model:=models/alice.json
-    mindgrasp launch hardware eeg_stream:=gNautilus arm_driver:=my_ros_pkg/arm_node \\
+    mindgrasp launch hardware eeg_stream:=gNautilus eeg_unpinned:=true \\
+        arm_driver:=my_ros_pkg/arm_node \\
         model:=package://mindgrasp_classifier/models/default_classifier.json   # bench test only
-    mindgrasp launch hardware eeg_stream:=gNautilus arm_driver:=my_arm_driver \
+    mindgrasp launch hardware eeg_stream:=gNautilus eeg_source_id:=GN-2021.06.12 \\
+        eeg_host:=amp-pc arm_driver:=my_arm_driver \\
         model:=models/alice.json command_interface:=servo_twist    # the arm behind MoveIt Servo
-    mindgrasp launch hardware eeg_stream:=gNautilus arm_driver:=my_xarm_driver \
+    mindgrasp launch hardware eeg_stream:=gNautilus eeg_source_id:=GN-2021.06.12 \\
+        eeg_host:=amp-pc arm_driver:=my_xarm_driver \\
         model:=models/alice.json robot:=xarm6     # the controller's kinematics: the lab's arm
+
+The amplifier's stream is pinned: ``eeg_source_id:=`` and ``eeg_host:=`` (``local``: this host)
+are required, so no other sender of the same stream name (another rig, a demo's virtual
+amplifier) can drive the arm; ``eeg_unpinned:=true`` accepts any sender on purpose (a bench
+test). Without them the launch is refused in one line before anything starts.
 
 ``model:=`` is required: a real person's EEG is never decoded by the classifier trained on the
 simulated head unless it is named on purpose (the last line, for a bench test without a person).
@@ -40,6 +50,8 @@ from mindgrasp_launch.launch_api import (
     command_interface_argument,
     config_files,
     driver_nodes,
+    eeg_pin_arguments,
+    eeg_pin_parameters,
     file_argument,
     fsm_node,
     robot_argument,
@@ -75,13 +87,15 @@ def generate_launch_description() -> LaunchDescription:
         robot_argument(description="the driver's arm, whose description the controller reads "
                                    '(joints, limits, URDF kinematics, TCP, camera): '
                                    'mindgrasp_arm, xarm6 or a robot description YAML path'),
+        *eeg_pin_arguments(),   # eeg_source_id, eeg_host (or eeg_unpinned:=true): required
         *run_directory_actions(),  # ros2 launch: run directory, recorder, duration
         *driver_nodes('arm'),
         *driver_nodes('camera', condition=IfCondition(
             NotEqualsSubstitution(LaunchConfiguration('camera_driver'), ''))),
         Node(package='mindgrasp_eeg', executable='acquisition_node', name='eeg_acquisition',
              parameters=[*config_files('eeg', 'hardware'),
-                         {'stream_name': LaunchConfiguration('eeg_stream')}]),
+                         {'stream_name': LaunchConfiguration('eeg_stream'),
+                          **eeg_pin_parameters()}]),
         *classifier_nodes(config_files('classifier', 'hardware')),
         Node(package='mindgrasp_vision', executable='vision_node', name='vision',
              parameters=config_files('vision', 'hardware')),

@@ -87,7 +87,7 @@ def main(args: argparse.Namespace) -> int:
     if problem:
         return fail(COMMAND, problem)
     try:
-        out = create_run_dir('sweep', args.out)
+        out = create_run_dir('sweep', args.out, option='--out')
     except LaunchError as exc:
         return fail(COMMAND, str(exc))
     for subject in subjects:

@@ -7,7 +7,12 @@ import ast
 import shlex
 import sys
 
-from mindgrasp_common.cli_checks import OneLineParser, non_negative_float, positive_float
+from mindgrasp_common.cli_checks import (
+    OneLineParser,
+    bounded_float,
+    non_negative_float,
+    positive_float,
+)
 from mindgrasp_launch import LaunchError, LaunchService, profiles
 from mindgrasp_launch.description import LAUNCH_SUFFIX, PROFILE_DIR
 from mindgrasp_launch.service import format_arguments
@@ -44,6 +49,11 @@ def _options(parser: argparse.ArgumentParser) -> None:
                              'loaded machine)')
     parser.add_argument('--sigterm-timeout', type=positive_float, default=5.0, metavar='S',
                         help='seconds after SIGTERM before SIGKILL (default 5)')
+    parser.add_argument('--graph-check', type=bounded_float(0.0, 60.0), default=1.0,
+                        metavar='S',
+                        help='seconds to look for another graph (a /sim or /fsm node) on the '
+                             'ROS domain before anything starts; one is refused in one line '
+                             'naming the domain to change (default 1; 0: not looked for)')
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -71,7 +81,8 @@ def _split_remainder(args: argparse.Namespace) -> argparse.Namespace:
     return args
 
 
-_TAKES_VALUE = ('--run-dir', '--duration', '--sigint-timeout', '--sigterm-timeout')
+_TAKES_VALUE = ('--run-dir', '--duration', '--sigint-timeout', '--sigterm-timeout',
+                '--graph-check')
 
 
 def profile_summaries() -> list[tuple[str, str]]:
@@ -106,6 +117,7 @@ def main(args: argparse.Namespace) -> int:
         service = LaunchService(args.profile, launch_arguments, run_dir=args.run_dir,
                                 composed=args.composed, sigint_timeout=args.sigint_timeout,
                                 sigterm_timeout=args.sigterm_timeout,
+                                graph_check=args.graph_check,
                                 argv=['mindgrasp', 'launch', *sys.argv[2:]])
         if args.show_args:
             print(format_arguments(service.declared_arguments()))

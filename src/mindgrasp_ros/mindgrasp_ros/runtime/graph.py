@@ -193,10 +193,12 @@ class GraphCache:
 
     # ------------------------------------------------------------------ queries
     def node_names_and_namespaces(self) -> list[tuple[str, str]]:
+        """Every node of every participant; two nodes of one name in two participants are
+        listed twice, as rcl lists them (``ros2 node list`` shows both, with a warning)."""
         self._update()
         with self._lock:
-            out = {(name, ns) for nodes in self._participants.values()
-                   for ns, name, _r, _w in nodes}
+            out = [(name, ns) for nodes in self._participants.values()
+                   for ns, name, _r, _w in nodes]
         return sorted(out, key=lambda x: (x[1], x[0]))
 
     def _names_and_types(self, kinds: set[str]) -> list[tuple[str, list[str]]]:
