@@ -9,8 +9,8 @@ from pathlib import Path
 
 import pytest
 
-from mindgrasp_ros.graph_host import GraphRunner, InProcess, Lockstep, Processes
-from mindgrasp_ros.node_spec import NodeSpec
+from mindgrasp_ros.graph.host import GraphRunner, InProcess, Lockstep, Processes
+from mindgrasp_ros.graph.spec import NodeSpec
 
 HERE = Path(__file__).resolve().parent
 #: the fixture node ends after 3 ticks with exit code 3; its label is text that reads as a number

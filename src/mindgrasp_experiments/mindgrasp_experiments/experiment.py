@@ -27,7 +27,7 @@ from typing import Any
 from mindgrasp_experiments import ExperimentError
 from mindgrasp_experiments.engine import TrialRun
 from mindgrasp_experiments.records import TrialRecord
-from mindgrasp_ros.node_spec import NodeSpec
+from mindgrasp_ros.graph.spec import NodeSpec
 
 __all__ = ['Experiment', 'Results']
 

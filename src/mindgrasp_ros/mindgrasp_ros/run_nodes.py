@@ -39,7 +39,8 @@ def run_nodes(run_dir: str | Path) -> list[RunNode]:
     """The nodes ``run_dir/launch.yaml`` lists (none without the file or a readable list)."""
     import yaml
 
-    from mindgrasp_ros.composition import CompositionError, load_node_class
+    from mindgrasp_ros.errors import CompositionError
+    from mindgrasp_ros.graph.loader import load_node_class
 
     try:
         launch = yaml.safe_load((Path(run_dir) / 'launch.yaml').read_text(encoding='utf-8'))

@@ -4,7 +4,7 @@
     result.report_path      # runs/<run>/replays/<time>/report.md
 
 Why it reproduces exactly: the chosen nodes (the classifier; the controller when asked) run in
-one process under the one graph host (:class:`~mindgrasp_ros.graph_host.GraphRunner`, ``Lockstep``
+one process under the one graph host (:class:`~mindgrasp_ros.graph.host.GraphRunner`, ``Lockstep``
 scheduler) on the bag's clock. Every
 recorded input message (the /eeg/raw chunks with their stamps and sample indices, exactly as
 recorded, never re-chunked) is published at its recorded time, and the graph runs until it is
@@ -154,8 +154,8 @@ def replay(cfg: ReplayConfig) -> ReplayResult:
         BagError: the run or bag cannot be read, or has nothing to replay.
     """
     from mindgrasp_ros import rclpy
-    from mindgrasp_ros.graph_host import GraphRunner, Lockstep
-    from mindgrasp_ros.node_spec import NodeSpec
+    from mindgrasp_ros.graph.host import GraphRunner, Lockstep
+    from mindgrasp_ros.graph.spec import NodeSpec
     from mindgrasp_ros.node_traits import traits_of
     from mindgrasp_ros.runtime.arguments import load_params_file
 
