@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from import_circles import import_circles, module_graph  # noqa: E402
+from import_circles import import_circles, module_graph
 
 SRC = Path(__file__).resolve().parents[2] / 'src'
 PACKAGES = sorted(p for p in SRC.glob('mindgrasp_*/mindgrasp_*') if (p / '__init__.py').is_file())
