@@ -61,9 +61,9 @@ setup(
             'replay = mindgrasp_bringup.commands.replay',
         ],
         'mindgrasp.verb': [
-            'session run = mindgrasp_bringup.session_cli',
-            'session resume = mindgrasp_bringup.session_cli',
-            'session calibrate = mindgrasp_bringup.session_cli',
+            'session run = mindgrasp_bringup.commands.session',
+            'session resume = mindgrasp_bringup.commands.session',
+            'session calibrate = mindgrasp_bringup.commands.session',
         ],
     },
 )

@@ -51,8 +51,8 @@ setup(
         ],
         # verbs of the mindgrasp command: 'COMMAND VERB = module' (add_arguments, main)
         'mindgrasp.verb': [
-            'train classifier = mindgrasp_classifier.train_cli',
-            'evaluate classifier = mindgrasp_classifier.evaluate_cli',
+            'train classifier = mindgrasp_classifier.commands.train_classifier',
+            'evaluate classifier = mindgrasp_classifier.commands.evaluate_classifier',
         ],
     },
 )

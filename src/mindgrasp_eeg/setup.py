@@ -53,10 +53,10 @@ setup(
         ],
         # verbs of the mindgrasp command: 'COMMAND VERB = module' (add_arguments, main)
         'mindgrasp.verb': [
-            'eeg virtual-amp = mindgrasp_eeg.virtual_amp_cli',
-            'eeg play = mindgrasp_eeg.player_cli',
-            'export eeg = mindgrasp_eeg.export_cli',
-            'export bids = mindgrasp_eeg.bids_cli',
+            'eeg virtual-amp = mindgrasp_eeg.commands.eeg_virtual_amp',
+            'eeg play = mindgrasp_eeg.commands.eeg_play',
+            'export eeg = mindgrasp_eeg.commands.export_eeg',
+            'export bids = mindgrasp_eeg.commands.export_bids',
         ],
     },
 )

@@ -52,11 +52,12 @@ setup(
         ],
         # verbs of the mindgrasp command: 'COMMAND VERB = module' (add_arguments, main)
         'mindgrasp.verb': [
-            'eeg fit-virtual = mindgrasp_experiments.fit_virtual_cli',
-            'experiment set-locations = mindgrasp_experiments.commands.set_locations',
-            'experiment random-locations = mindgrasp_experiments.commands.random_locations',
-            'experiment report = mindgrasp_experiments.commands.report',
-            'experiment sweep = mindgrasp_experiments.commands.sweep',
+            'eeg fit-virtual = mindgrasp_experiments.commands.eeg_fit_virtual',
+            'experiment set-locations = mindgrasp_experiments.commands.experiment_set_locations',
+            ('experiment random-locations = '
+             'mindgrasp_experiments.commands.experiment_random_locations'),
+            'experiment report = mindgrasp_experiments.commands.experiment_report',
+            'experiment sweep = mindgrasp_experiments.commands.experiment_sweep',
         ],
     },
 )

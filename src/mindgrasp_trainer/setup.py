@@ -53,7 +53,7 @@ setup(
         ],
         # verbs of the mindgrasp command: 'COMMAND VERB = module' (add_arguments, main)
         'mindgrasp.verb': [
-            'trainer schedule = mindgrasp_trainer.schedule_cli',
+            'trainer schedule = mindgrasp_trainer.commands.trainer_schedule',
         ],
     },
 )

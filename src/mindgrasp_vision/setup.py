@@ -51,7 +51,7 @@ setup(
         ],
         # verbs of the mindgrasp command: 'COMMAND VERB = module' (add_arguments, main)
         'mindgrasp.verb': [
-            'train vision = mindgrasp_vision.train_cli',
+            'train vision = mindgrasp_vision.commands.train_vision',
         ],
     },
 )
