@@ -72,3 +72,19 @@ def test_cyclonedds_is_imported_only_by_the_dds_modules() -> None:
             if any(n.split('.')[0] == 'cyclonedds' for n in names):
                 found.append(f'{path.relative_to(SRC)}:{node.lineno}')
     assert not found, found
+
+
+def test_the_experiments_domain_imports_nothing_from_its_command_line() -> None:
+    """``Experiment``, subjects, engine, records ... (everything but ``cli.py`` and the verbs in
+    ``commands/``) import neither, at any depth: the command line only parses and prints, as
+    MOABB's evaluations and ros2cli's ``api/`` modules never import their verbs."""
+    package = SRC / 'mindgrasp_experiments' / 'mindgrasp_experiments'
+
+    def is_verb(module: str) -> bool:
+        return module.endswith('.cli') or '.commands' in module
+
+    graph = module_graph(package)
+    found = {m: sorted(t for t in targets if is_verb(t))
+             for m, targets in graph.items() if not is_verb(m)}
+    assert 'mindgrasp_experiments.experiment' in found
+    assert not {m: t for m, t in found.items() if t}, found
