@@ -122,6 +122,43 @@ def test_ament_python_layout(package_dir: Path) -> None:
     assert config['install']['install_scripts'] == f'$base/lib/{name}'
 
 
+def _data_files_wanted(package_dir: Path) -> set[tuple[str, str]]:
+    """(share folder, file relative to the package folder) of every data file: the files in
+    the Python package's subfolders but modules (launch files are data), and for the bringup
+    package the whole top-level config/ under share/<package>/config/."""
+    name = package_dir.name
+    roots = [(package_dir / name, Path('share', name), True)]
+    if name == 'mindgrasp_bringup':
+        roots.append((REPO / 'config', Path('share', name, 'config'), False))
+    wanted = {('share/ament_index/resource_index/packages', f'resource/{name}'),
+              (f'share/{name}', 'package.xml')}
+    for root, share, subfolders_only in roots:
+        for path in root.rglob('*'):
+            rel = path.relative_to(root)
+            if (path.is_file() and '__pycache__' not in rel.parts
+                    and not rel.parts[0].startswith('.')
+                    and (path.suffix != '.py' or path.name.endswith('.launch.py'))
+                    and not (subfolders_only and len(rel.parts) == 1)):
+                wanted.add(((share / rel.parent).as_posix(),
+                            os.path.relpath(path, package_dir).replace(os.sep, '/')))
+    return wanted
+
+
+@pytest.mark.parametrize('package_dir', PYTHON_PACKAGES, ids=lambda p: p.name)
+def test_setup_cfg_installs_every_data_file(package_dir: Path) -> None:
+    """One declarative list per package (setup.cfg ``[options.data_files]``, globs): setuptools
+    reads it in a standalone build of the package, so no setup.py carries a copy of a helper.
+    A new data folder (a new config/ subfolder) needs its line there: this test names it."""
+    from setuptools.config.setupcfg import read_configuration
+
+    declared = read_configuration(package_dir / 'setup.cfg')['options']['data_files']
+    installed = {(dest, src) for dest, sources in declared for src in sources}
+    wanted = _data_files_wanted(package_dir)
+    assert installed == wanted, (f'missing from setup.cfg: {sorted(wanted - installed)}; '
+                                 f'not data: {sorted(installed - wanted)}')
+    assert 'data_files=' not in (package_dir / 'setup.py').read_text(encoding='utf-8')
+
+
 @pytest.mark.parametrize('package_dir', PYTHON_PACKAGES, ids=lambda p: p.name)
 def test_every_node_has_a_console_script_our_launcher_resolves(package_dir: Path) -> None:
     name = package_dir.name
