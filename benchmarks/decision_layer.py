@@ -36,9 +36,9 @@ from pathlib import Path
 
 import numpy as np
 
-from mindgrasp_classifier.classifier_node import ClassifierParams
 from mindgrasp_classifier.decoder import AdaptationConfig, MiDecoder
 from mindgrasp_classifier.model import MiModel
+from mindgrasp_classifier.params import ClassifierParams
 from mindgrasp_common.mi import MiClass
 from mindgrasp_common.types import Prediction
 from mindgrasp_fsm.evidence import Evidence

@@ -43,6 +43,7 @@ def subject_type(text: str) -> str:
 def add_common_arguments(parser: argparse.ArgumentParser, trials: int) -> None:
     """Options of every ``mindgrasp experiment`` protocol (numbers checked by argparse)."""
     from mindgrasp_common.cli_checks import non_negative_int, positive_float, positive_int
+    from mindgrasp_common.robot_description import robot_choices
 
     parser.add_argument('--trials', type=positive_int, default=trials,
                         help=f'number of trials (default {trials})')
@@ -71,8 +72,8 @@ def add_common_arguments(parser: argparse.ArgumentParser, trials: int) -> None:
                              '(a local Ray instance of this run) or '
                              'HOST:PORT of a cluster\'s head node; same records as --workers')
     parser.add_argument('--robot', default='mindgrasp_arm', metavar='NAME|YAML',
-                        help='the arm: mindgrasp_arm (default), xarm6 or a robot description '
-                             'YAML path (mindgrasp_common.robot_description)')
+                        help=f'the arm (default mindgrasp_arm): {robot_choices()} '
+                             '(mindgrasp_common.robot_description)')
     parser.add_argument('--realism', default='none',
                         help='sensor noise and physical spread: none (default), default or a '
                              'profile YAML path (mindgrasp_sim.realism), seeded per trial')
