@@ -23,11 +23,15 @@ __all__ = ['RunNode', 'run_nodes']
 class RunNode:
     """One node of a run.
 
-    Attributes:
-        label: The run's label of the node (its ``params/<label>.yaml`` and log).
-        name: Fully qualified node name (``/classifier``), the section of ``params.yaml``.
-        traits: What its class declares (the defaults when its module no longer loads: an old
-            run still reads).
+    Attributes
+    ----------
+    label
+        The run's label of the node (its ``params/<label>.yaml`` and log).
+    name
+        Fully qualified node name (``/classifier``), the section of ``params.yaml``.
+    traits
+        What its class declares (the defaults when its module no longer loads: an old
+        run still reads).
     """
 
     label: str
