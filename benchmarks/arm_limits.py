@@ -73,7 +73,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
 
     from mindgrasp_experiments.engine import lockstep_components, run_trial
-    from mindgrasp_ros.node_spec import NodeSpec
+    from mindgrasp_ros.graph.spec import NodeSpec
 
     comps = lockstep_components('experiment', {'subject': args.subject, 'seed': str(args.seed)},
                                 Path(tempfile.mkdtemp()) / 'params', log=lambda _text: None)

@@ -36,9 +36,9 @@ from pathlib import Path
 
 import numpy as np
 
-from mindgrasp_classifier.classifier_node import ClassifierParams
 from mindgrasp_classifier.decoder import AdaptationConfig, MiDecoder
 from mindgrasp_classifier.model import MiModel
+from mindgrasp_classifier.params import ClassifierParams
 from mindgrasp_common.mi import MiClass
 from mindgrasp_common.types import Prediction
 from mindgrasp_fsm.evidence import Evidence
@@ -53,7 +53,7 @@ def source(subject: str, seed: int, cache: Path):
     if subject == 'noise':
         from mindgrasp_eeg.montage import NAUTILUS_32, NAUTILUS_RATE
         from mindgrasp_eeg.synthetic import SyntheticEEG
-        from mindgrasp_experiments.cli import noise_model_path
+        from mindgrasp_experiments.subject_launch import noise_model_path
 
         gen = SyntheticEEG(list(NAUTILUS_32), NAUTILUS_RATE, seed=seed)
         return (lambda n, _cls: gen.generate(n, None)), gen, MiModel.load(noise_model_path(cache))

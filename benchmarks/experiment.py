@@ -44,8 +44,8 @@ def main(argv: list[str] | None = None) -> int:
                              '(--ray auto; needs the cluster extra), and the ratio to 1 worker')
     args = parser.parse_args(argv)
 
-    from mindgrasp_experiments.cli import noise_model_path
     from mindgrasp_experiments.engine import lockstep_components, run_trial
+    from mindgrasp_experiments.subject_launch import noise_model_path
 
     launch_args = {'protocol': args.protocol, 'subject': args.subject,
                    'accuracy': str(args.accuracy), 'seed': str(args.seed),

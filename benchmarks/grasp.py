@@ -51,7 +51,7 @@ def grasp_figures(trials: int, seed: int) -> None:
 
 def vision_figures(frames: int = 50) -> None:
     from mindgrasp_sim.simulation import CameraConfig, Simulation
-    from mindgrasp_vision.config import VisionConfig
+    from mindgrasp_vision.params import VisionConfig
 
     cfg = VisionConfig()
     try:

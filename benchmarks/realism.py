@@ -221,8 +221,8 @@ def cnn(args: argparse.Namespace) -> dict:
     import numpy as np
 
     from mindgrasp_sim.realism import RealismProfile
-    from mindgrasp_vision.config import DEFAULT_SHAPE_MODEL
     from mindgrasp_vision.dataset import collect_shape_dataset
+    from mindgrasp_vision.params import DEFAULT_SHAPE_MODEL
     from mindgrasp_vision.shape_cnn import SHAPES as CNN_SHAPES
     from mindgrasp_vision.shape_cnn import ShapeClassifier
 

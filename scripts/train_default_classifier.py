@@ -18,7 +18,7 @@ import sys
 
 import numpy as np
 
-from mindgrasp_classifier._cli_common import format_report
+from mindgrasp_classifier.commands._common import format_report
 from mindgrasp_classifier.data import Recording
 from mindgrasp_classifier.training import TrainingConfig, train
 from mindgrasp_common.resources import resource_path

@@ -14,8 +14,6 @@ package_xml = (Path(__file__).resolve().parent / 'package.xml').read_text(encodi
 
 setup(
     packages=find_packages(exclude=['test']),
-    data_files=[('share/ament_index/resource_index/packages', ['resource/' + package_name]),
-                ('share/' + package_name, ['package.xml'])],
     # one description: package.xml's
     description=re.search(r'<description>(.*?)</description>', package_xml, re.S).group(1),
     entry_points={

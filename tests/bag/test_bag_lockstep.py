@@ -26,23 +26,23 @@ GRAZ_PARAMS = {'graz_prompter': {'ros__parameters': {
 def test_intra_graph_and_raw_subscriptions_in_lockstep() -> None:
     from mindgrasp_ros.interfaces.std_msgs.msg import String
 
-    from mindgrasp_ros import composition, rclpy
+    from mindgrasp_ros import graph, rclpy
     from mindgrasp_ros.typesupport import serialize
 
     got: list[bytes] = []
     qos = rclpy.qos.QoSProfile(depth=5, reliability=rclpy.qos.ReliabilityPolicy.BEST_EFFORT)
 
     class Talker(rclpy.node.Node):
-        def __init__(self) -> None:
-            super().__init__('talker', namespace='/ns')
+        def __init__(self, **kwargs: object) -> None:
+            super().__init__('talker', namespace='/ns', **kwargs)
             self.pub = self.create_publisher(String, '/chatter', qos)
 
     class Listener(rclpy.node.Node):
-        def __init__(self) -> None:
-            super().__init__('listener')
+        def __init__(self, **kwargs: object) -> None:
+            super().__init__('listener', **kwargs)
             self.create_subscription(String, '/chatter', got.append, qos, raw=True)
 
-    with composition.LockstepRunner() as runner:
+    with graph.LockstepRunner() as runner:
         talker = runner.add(Talker)
         listener = runner.add(Listener)
         assert ('/chatter', ['std_msgs/msg/String']) in listener.get_topic_names_and_types()

@@ -38,6 +38,26 @@ def test_each_package_registers_only_its_own_modules() -> None:
             assert (SRC / package / Path(*module.split('.'))).with_suffix('.py').is_file(), item
 
 
+def test_verb_modules_follow_one_naming_scheme() -> None:
+    """Every package keeps its verbs in ``<package>/commands/``, one module named after what the
+    user types (``mindgrasp bag record`` -> ``commands/bag_record.py``, ``mindgrasp launch`` ->
+    ``commands/launch.py``; a module serving all verbs of a command is named after the command:
+    ``commands/session.py``), as ros2cli keeps them in ``<package>/verb/``; no ``*_cli.py``."""
+    wrong = []
+    for package, groups in _declared().items():
+        for item in (i for items in groups.values() for i in items):
+            name, _, module = (s.strip() for s in item.partition('='))
+            words = name.replace('-', '_').split(' ')
+            allowed = sorted({f'{package}.commands.{"_".join(words)}',
+                              f'{package}.commands.{words[0]}'})
+            if module not in allowed:
+                wrong.append(f'{package}/setup.py: {item!r} (expected {" or ".join(allowed)})')
+    # the command line's own package has ros_cli.py, its ROS helpers (no verb)
+    stray = [str(p.relative_to(SRC)) for p in SRC.glob('mindgrasp_*/mindgrasp_*/**/*_cli.py')
+             if p.parts[-3] != 'mindgrasp_cli']
+    assert not wrong and not stray, '\n'.join([*wrong, *stray])
+
+
 def test_installed_commands_are_the_declared_ones_in_name_order() -> None:
     """The installed entry points (scripts/setup.sh re-installs when a setup.py changes) are
     those of the sources; the verbs come from several packages (eeg: mindgrasp_eeg and
@@ -55,8 +75,8 @@ def test_installed_commands_are_the_declared_ones_in_name_order() -> None:
     assert list(found) == COMMANDS
     assert found == declared, 'the installed entry points are stale: run bash scripts/setup.sh'
     assert list(found['eeg']) == ['fit-virtual', 'play', 'virtual-amp']
-    assert found['train'] == {'classifier': 'mindgrasp_classifier.train_cli',
-                              'vision': 'mindgrasp_vision.train_cli'}
+    assert found['train'] == {'classifier': 'mindgrasp_classifier.commands.train_classifier',
+                              'vision': 'mindgrasp_vision.commands.train_vision'}
 
 
 def test_cli_names_no_command_module() -> None:

@@ -314,7 +314,7 @@ def test_real_processes(argv, message):
 
 
 def test_virtual_amp_passes_ros_args_on():
-    from mindgrasp_eeg.virtual_amp_cli import _ros_argv
+    from mindgrasp_eeg.commands.eeg_virtual_amp import _ros_argv
 
     argv = ['eeg', 'virtual-amp', '--seed', '3', '--ros-args', '-p', 'seed:=1', '-r',
             '__node:=amp2']

@@ -7,6 +7,7 @@ console scripts for their nodes, and a real ``colcon build`` whose installed exe
 
 from __future__ import annotations
 
+import ast
 import configparser
 import os
 import re
@@ -60,6 +61,71 @@ def test_package_xml_is_valid_format_3(package_dir: Path) -> None:
     used = _used(package_dir) if build_type == 'ament_python' else set()
     declared = _declared(package_dir)
     assert used <= declared, f'{package.name}: declare {sorted(used - declared)}'
+
+
+#: rosdep keys of Python libraries -> the module the code imports
+ROSDEP_MODULES = {
+    'python3-numpy': 'numpy', 'python3-scipy': 'scipy', 'python3-yaml': 'yaml',
+    'python3-tqdm': 'tqdm', 'python3-matplotlib': 'matplotlib', 'python3-sklearn': 'sklearn',
+    'python3-psutil': 'psutil', 'python3-rosbags-pip': 'rosbags', 'python3-pyarrow-pip': 'pyarrow',
+    'python3-pybullet-pip': 'pybullet', 'python3-opencv': 'cv2', 'python3-pygame': 'pygame',
+    'python3-torch': 'torch', 'rclpy': 'rclpy', 'launch': 'launch', 'launch_ros': 'launch_ros'}
+#: declared without an import, each with why
+DECLARED_UNUSED = {
+    ('mindgrasp_bringup', 'mindgrasp_cli'): 'its verbs (replay, session) are commands of the '
+                                            'mindgrasp command line',
+}
+
+
+def _imports(package_dir: Path) -> set[str]:
+    """Every module name the package's code imports (at any depth, lazy ones included)."""
+    found = set()
+    for path in (package_dir / package_dir.name).rglob('*.py'):
+        for node in ast.walk(ast.parse(path.read_text(encoding='utf-8'))):
+            if isinstance(node, ast.Import):
+                found |= {a.name for a in node.names}
+            elif isinstance(node, ast.ImportFrom) and node.module and not node.level:
+                found.add(node.module)
+    return found
+
+
+def _needed(package_dir: Path) -> set[str]:
+    """What the package's code needs at run time: our packages it imports or runs (-m), the
+    ones its launch files start, ``mindgrasp_msgs`` when it uses its messages, and the
+    libraries of :data:`ROSDEP_MODULES` it imports."""
+    imports = _imports(package_dir)
+    tops = {m.split('.')[0] for m in imports}
+    needed = _used(package_dir) | {t for t in tops if t.startswith('mindgrasp_')}
+    code = ''.join(p.read_text(encoding='utf-8')
+                   for p in (package_dir / package_dir.name).rglob('*.py'))
+    if any('.mindgrasp_msgs' in m for m in imports) or "'mindgrasp_msgs/" in code:
+        needed.add('mindgrasp_msgs')     # its messages, or their type names (get_message_class)
+    for launch_file in (package_dir / package_dir.name).rglob('*.launch.py'):
+        needed |= set(re.findall(r"package='(mindgrasp_\w+)'", launch_file.read_text()))
+        needed |= {'launch', 'launch_ros'}      # run by ros2 launch
+    needed |= {key for key, module in ROSDEP_MODULES.items() if module in tops}
+    return needed - {package_dir.name}
+
+
+@pytest.mark.parametrize('package_dir', PYTHON_PACKAGES, ids=lambda p: p.name)
+def test_package_xml_declares_what_the_code_needs_and_no_more(package_dir: Path) -> None:
+    """Our packages and the Python libraries of :data:`ROSDEP_MODULES` (message packages and
+    pip-only libraries without a rosdep key are not compared): declared exactly when needed
+    (a launch file may start a package that may not be declared: one that depends on this one,
+    as mindgrasp_experiments' nodes in mindgrasp_bringup's launch files)."""
+    name = package_dir.name
+    declared = {d for d in _declared(package_dir)
+                if d.startswith('mindgrasp_') or d in ROSDEP_MODULES}
+    needed = _needed(package_dir)
+    imported = {d for d in needed if d in ROSDEP_MODULES} | (_used(package_dir) & {
+        p.name for p in PACKAGES})
+    if any('.mindgrasp_msgs' in m for m in _imports(package_dir)):
+        imported.add('mindgrasp_msgs')
+    unused = {d for d in declared - needed if (name, d) not in DECLARED_UNUSED}
+    undeclared = {d for d in imported - declared if d.startswith(('mindgrasp_', 'python3-'))
+                  or d == 'rclpy'}
+    assert not unused and not undeclared, (f'{name}/package.xml: declares {sorted(unused)} '
+                                           f'that nothing needs; misses {sorted(undeclared)}')
 
 
 def test_no_package_uses_a_package_that_depends_on_it() -> None:
@@ -120,6 +186,43 @@ def test_ament_python_layout(package_dir: Path) -> None:
     # console scripts go to lib/<package>/, where `ros2 run <package> <executable>` looks
     assert config['develop']['script_dir'] == f'$base/lib/{name}'
     assert config['install']['install_scripts'] == f'$base/lib/{name}'
+
+
+def _data_files_wanted(package_dir: Path) -> set[tuple[str, str]]:
+    """(share folder, file relative to the package folder) of every data file: the files in
+    the Python package's subfolders but modules (launch files are data), and for the bringup
+    package the whole top-level config/ under share/<package>/config/."""
+    name = package_dir.name
+    roots = [(package_dir / name, Path('share', name), True)]
+    if name == 'mindgrasp_bringup':
+        roots.append((REPO / 'config', Path('share', name, 'config'), False))
+    wanted = {('share/ament_index/resource_index/packages', f'resource/{name}'),
+              (f'share/{name}', 'package.xml')}
+    for root, share, subfolders_only in roots:
+        for path in root.rglob('*'):
+            rel = path.relative_to(root)
+            if (path.is_file() and '__pycache__' not in rel.parts
+                    and not rel.parts[0].startswith('.')
+                    and (path.suffix != '.py' or path.name.endswith('.launch.py'))
+                    and not (subfolders_only and len(rel.parts) == 1)):
+                wanted.add(((share / rel.parent).as_posix(),
+                            os.path.relpath(path, package_dir).replace(os.sep, '/')))
+    return wanted
+
+
+@pytest.mark.parametrize('package_dir', PYTHON_PACKAGES, ids=lambda p: p.name)
+def test_setup_cfg_installs_every_data_file(package_dir: Path) -> None:
+    """One declarative list per package (setup.cfg ``[options.data_files]``, globs): setuptools
+    reads it in a standalone build of the package, so no setup.py carries a copy of a helper.
+    A new data folder (a new config/ subfolder) needs its line there: this test names it."""
+    from setuptools.config.setupcfg import read_configuration
+
+    declared = read_configuration(package_dir / 'setup.cfg')['options']['data_files']
+    installed = {(dest, src) for dest, sources in declared for src in sources}
+    wanted = _data_files_wanted(package_dir)
+    assert installed == wanted, (f'missing from setup.cfg: {sorted(wanted - installed)}; '
+                                 f'not data: {sorted(installed - wanted)}')
+    assert 'data_files=' not in (package_dir / 'setup.py').read_text(encoding='utf-8')
 
 
 @pytest.mark.parametrize('package_dir', PYTHON_PACKAGES, ids=lambda p: p.name)

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from mindgrasp_launch.lockstep import run_lockstep
 from mindgrasp_ros import rclpy
-from mindgrasp_ros.node_spec import NodeSpec
+from mindgrasp_ros.graph.spec import NodeSpec
 
 
 class CtrlCWhileComposing(rclpy.node.Node):

@@ -10,7 +10,6 @@ import sys
 import numpy as np
 import pytest
 
-from mindgrasp_classifier._cli_common import format_cv_report
 from mindgrasp_classifier.calibration import (
     calibration_bins,
     expected_calibration_error,
@@ -18,10 +17,11 @@ from mindgrasp_classifier.calibration import (
     nll,
     plot_reliability,
 )
-from mindgrasp_classifier.classifier_node import ClassifierParams
+from mindgrasp_classifier.commands._common import format_cv_report
 from mindgrasp_classifier.data import add_rest_events
 from mindgrasp_classifier.errors import ClassifierError
 from mindgrasp_classifier.model import MiModel
+from mindgrasp_classifier.params import ClassifierParams
 from mindgrasp_classifier.pipelines import softmax
 from mindgrasp_classifier.pseudo_online import (
     format_pseudo_online,

@@ -90,7 +90,7 @@ def test_a_running_virtual_amp_shows_its_descriptors_and_refuses_a_change() -> N
     ParameterDescriptors; a change while it runs is refused with the reason."""
     from mindgrasp_eeg.virtual_amp_node import VirtualAmpNode
     from mindgrasp_ros import rclpy
-    from mindgrasp_ros.composition import LockstepRunner
+    from mindgrasp_ros.graph.lockstep import LockstepRunner
 
     with LockstepRunner(start_time_s=1.0) as runner:
         node = runner.add(VirtualAmpNode, ros_args=['-p', 'output:=ros', '-p', 'accuracy:=0.7'])

@@ -7,12 +7,12 @@ from __future__ import annotations
 import pytest
 
 from mindgrasp_ros import rclpy
-from mindgrasp_ros.composition import LockstepRunner, NodeCallbackError
+from mindgrasp_ros.graph import LockstepRunner, NodeCallbackError
 
 
 class Listener(rclpy.node.Node):
-    def __init__(self, msg_type: type, topic: str, qos: object = 10) -> None:
-        super().__init__('listener')
+    def __init__(self, msg_type: type, topic: str, qos: object = 10, **kwargs: object) -> None:
+        super().__init__('listener', **kwargs)
         self.got: list = []
         self.create_subscription(msg_type, topic, self.got.append, qos)
 
@@ -68,8 +68,8 @@ def test_trial_manager_waits_for_the_eeg_says_so_and_gives_up(caplog) -> None:
 
 def test_a_raising_callback_names_its_node() -> None:
     class Faulty(rclpy.node.Node):
-        def __init__(self) -> None:
-            super().__init__('faulty')
+        def __init__(self, **kwargs: object) -> None:
+            super().__init__('faulty', **kwargs)
             self.create_timer(0.1, self.boom)
 
         def boom(self) -> None:

@@ -10,9 +10,9 @@ from pathlib import Path
 
 import pytest
 
-from mindgrasp_experiments.cli import subject_launch_args
 from mindgrasp_experiments.engine import run_trial
 from mindgrasp_experiments.experiment import Experiment
+from mindgrasp_experiments.subject_launch import subject_launch_args
 
 
 @pytest.mark.slow

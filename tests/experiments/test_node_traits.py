@@ -15,7 +15,8 @@ from mindgrasp_experiments.trial_manager_node import TrialManagerNode
 from mindgrasp_launch import LaunchError, lockstep
 from mindgrasp_launch.lockstep import check_left_out_nodes, node_traits
 from mindgrasp_ros.node_traits import NodeTraits, traits_of
-from mindgrasp_sim.sim_node import SimNode, SimParams
+from mindgrasp_sim.params import SimParams
+from mindgrasp_sim.sim_node import SimNode
 
 SEEDED = [(VirtualAmpNode, VirtualAmpParams), (OracleSubjectNode, OracleParams),
           (SimNode, SimParams)]

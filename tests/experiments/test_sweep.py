@@ -223,8 +223,8 @@ def test_experiment_params_stay_typed_to_the_node(monkeypatch) -> None:
     reads as a number became a double the node refused), and a typed value of the wrong kind is
     one clear line before any trial."""
     from mindgrasp_experiments.sweep import apply_params, check_params
-    from mindgrasp_ros.graph_host import GraphRunner, Lockstep
-    from mindgrasp_ros.node_spec import NodeSpec
+    from mindgrasp_ros.graph.host import GraphRunner, Lockstep
+    from mindgrasp_ros.graph.spec import NodeSpec
 
     monkeypatch.syspath_prepend(str(Path(__file__).resolve().parents[1] / 'ros'))
     spec = NodeSpec('ticker', 'skeleton_node', parameters={'label': 'tick', 'rate': 20.0})

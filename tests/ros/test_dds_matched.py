@@ -3,7 +3,7 @@ before a new reader matches and filled after (IndexError); the runtime must not 
 
 from __future__ import annotations
 
-from mindgrasp_ros.runtime.dds import _matched
+from mindgrasp_ros.runtime.dds.participant import _matched
 
 
 def test_matched_count_survives_a_reader_matching_between_the_two_calls() -> None:

@@ -41,7 +41,7 @@ def test_a_composed_graph_fails_when_a_node_ends_with_a_code(spawn_node, tmp_pat
 
 def test_a_lockstep_graph_fails_when_a_node_ends_with_a_code(monkeypatch):
     from mindgrasp_launch.lockstep import run_lockstep
-    from mindgrasp_ros.node_spec import NodeSpec
+    from mindgrasp_ros.graph.spec import NodeSpec
 
     monkeypatch.syspath_prepend(str(HERE))
     lines: list[str] = []
@@ -51,7 +51,7 @@ def test_a_lockstep_graph_fails_when_a_node_ends_with_a_code(monkeypatch):
 
 
 def test_the_lockstep_scheduler_is_an_executor_of_the_runtime():
-    from mindgrasp_ros.composition import LockstepRunner
+    from mindgrasp_ros.graph.lockstep import LockstepRunner
 
     with LockstepRunner() as runner:
         assert isinstance(runner.executor, LockstepExecutor)
@@ -60,7 +60,7 @@ def test_the_lockstep_scheduler_is_an_executor_of_the_runtime():
 
 def test_lockstep_runs_guards_and_skips_canceled_timers():
     """Through the entities' own API: a triggered guard runs once, a canceled timer never."""
-    from mindgrasp_ros.composition import LockstepRunner
+    from mindgrasp_ros.graph.lockstep import LockstepRunner
     from mindgrasp_ros.runtime.node import Node
 
     calls: list[str] = []
@@ -82,7 +82,7 @@ _FOREIGN_PRIVATE = re.compile(r'\b(?!self\b|cls\b)[A-Za-z_]\w*\._[a-z]\w*')
 
 
 def test_the_graph_hosts_read_no_private_field_of_another_object():
-    hosts = [SRC / 'mindgrasp_ros' / 'mindgrasp_ros' / 'composition.py',
+    hosts = [*(SRC / 'mindgrasp_ros' / 'mindgrasp_ros' / 'graph').glob('*.py'),
              SRC / 'mindgrasp_launch' / 'mindgrasp_launch' / 'lockstep.py']
     found = [f'{path.name}:{n}: {line.strip()}' for path in hosts
              for n, line in enumerate(path.read_text().splitlines(), 1)
@@ -95,7 +95,7 @@ def test_a_node_reports_the_entities_given_work_in_the_executors_order():
     in creation order, as a full scan would take them (the lock-step order, hence the records)."""
     from mindgrasp_ros.interfaces.std_msgs.msg import String
 
-    from mindgrasp_ros.composition import LockstepRunner
+    from mindgrasp_ros.graph.lockstep import LockstepRunner
     from mindgrasp_ros.runtime.node import Node
 
     with LockstepRunner() as runner:

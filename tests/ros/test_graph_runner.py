@@ -9,8 +9,8 @@ from pathlib import Path
 
 import pytest
 
-from mindgrasp_ros.graph_host import GraphRunner, InProcess, Lockstep, Processes
-from mindgrasp_ros.node_spec import NodeSpec
+from mindgrasp_ros.graph.host import GraphRunner, InProcess, Lockstep, Processes
+from mindgrasp_ros.graph.spec import NodeSpec
 
 HERE = Path(__file__).resolve().parent
 #: the fixture node ends after 3 ticks with exit code 3; its label is text that reads as a number
@@ -110,3 +110,39 @@ def test_processes_host_a_callers_own_processes_in_the_same_order(tmp_path):
     runner.close()
     assert stopped == ['last', 'middle', 'first']
     assert all(is_done(c) for c in (first, middle, last))
+
+
+@pytest.mark.parametrize('scheduler', [lambda: Lockstep(0.02), InProcess], ids=['lockstep',
+                                                                               'in_process'])
+def test_a_composed_graph_keeps_its_names_remaps_and_typed_parameters(monkeypatch, scheduler):
+    """What tests/ros2_real/test_ros2_composed.py checks on the real rclpy: the host passes
+    ``cli_args`` and ``parameter_overrides`` to the node classes, as rclpy's Node takes them."""
+    monkeypatch.syspath_prepend(str(HERE.parent / 'bringup'))
+    remaps = {'chatter': '/composed/chatter'}
+    with GraphRunner(scheduler()) as graph:
+        talker = graph.add(NodeSpec('talker', 'launch_fixtures.talker', name='speaker',
+                                    remaps=remaps, parameters={
+                                        'count': 10000, 'period': 0.05, 'prefix': 'composed'}))
+        listener = graph.add(NodeSpec('listener', 'launch_fixtures.listener', remaps=remaps,
+                                      parameters={'expect': 5, 'prefix': 'composed',
+                                                  'timeout': 90.0}))
+        graph.spin_until(lambda: listener.heard >= 5, limit_s=90.0)
+        assert talker.get_fully_qualified_name() == '/speaker'
+        assert talker.publisher.topic_name == '/composed/chatter'
+        assert [s.topic_name for s in listener.subscriptions if 'chatter' in s.topic_name] == \
+            ['/composed/chatter']
+        assert (talker.get_parameter('count').value, talker.get_parameter('period').value,
+                listener.get_parameter('timeout').value) == (10000, 0.05, 90.0)
+        assert listener.heard >= 5
+
+
+def test_a_node_class_that_takes_no_kwargs_is_refused_with_the_fix(monkeypatch, tmp_path):
+    from mindgrasp_ros.errors import CompositionError
+
+    (tmp_path / 'closed_node.py').write_text(
+        'from mindgrasp_ros import rclpy\n\n\nclass Closed(rclpy.node.Node):\n'
+        '    def __init__(self):\n        super().__init__("closed")\n')
+    monkeypatch.syspath_prepend(str(tmp_path))
+    with GraphRunner(Lockstep(0.02)) as graph, pytest.raises(
+            CompositionError, match=r'closed_node.Closed cannot be composed: .*\*\*kwargs'):
+        graph.add(NodeSpec('closed', 'closed_node'))

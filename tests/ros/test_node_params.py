@@ -17,10 +17,10 @@ from mindgrasp_ros.params import _flat_fields, _info, describe
 #: node name, parameter dataclass (module, class), parameter file (package, file)
 NODES = [
     ('fsm', 'mindgrasp_fsm.params', 'FsmParams', 'mindgrasp_fsm', 'fsm.yaml'),
-    ('vision', 'mindgrasp_vision.config', 'VisionConfig', 'mindgrasp_vision', 'vision.yaml'),
-    ('classifier', 'mindgrasp_classifier.classifier_node', 'ClassifierParams',
+    ('vision', 'mindgrasp_vision.params', 'VisionConfig', 'mindgrasp_vision', 'vision.yaml'),
+    ('classifier', 'mindgrasp_classifier.params', 'ClassifierParams',
      'mindgrasp_classifier', 'classifier.yaml'),
-    ('sim', 'mindgrasp_sim.sim_node', 'SimParams', 'mindgrasp_sim', 'sim.yaml'),
+    ('sim', 'mindgrasp_sim.params', 'SimParams', 'mindgrasp_sim', 'sim.yaml'),
     ('graz_prompter', 'mindgrasp_trainer.graz_node', 'GrazParams', 'mindgrasp_trainer',
      'trainer.yaml'),
     ('trainer', 'mindgrasp_trainer.trainer_node', 'TrainerParams', 'mindgrasp_trainer',

@@ -126,7 +126,7 @@ def test_a_reply_waits_for_the_callers_reply_reader(rclpy_ctx, spawn_node):
     from mindgrasp_ros.interfaces.std_srvs.srv import SetBool
 
     from mindgrasp_ros import using_real_rclpy
-    from mindgrasp_ros.runtime.entities import _pack_service, _service_topics, _unpack_service
+    from mindgrasp_ros.runtime.service import pack_service, service_topics, unpack_service
     from mindgrasp_ros.typesupport import deserialize, serialize
 
     if using_real_rclpy():
@@ -135,12 +135,12 @@ def test_a_reply_waits_for_the_callers_reply_reader(rclpy_ctx, spawn_node):
     node = rclpy_ctx.node.Node('late_reader_client')
     assert node.create_client(SetBool, '/toggle').wait_for_service(timeout_sec=60), peer.output()
     dds = node.context.dds
-    req_topic, rep_topic = _service_topics('/toggle')
+    req_topic, rep_topic = service_topics('/toggle')
     qos = rclpy_ctx.qos.QoSProfile(depth=10)
     writer = dds.create_writer(req_topic, 'std_srvs/srv/SetBool_Request', qos,
                                service_role='request')
     assert spin_until(node, lambda: writer.matched_count() > 0, timeout=60)
-    writer.write(_pack_service(99, 1, serialize(SetBool.Request(data=True),
+    writer.write(pack_service(99, 1, serialize(SetBool.Request(data=True),
                                                 'std_srvs/srv/SetBool_Request')))
     time.sleep(0.5)   # the condition under test: no reply reader when the request arrives
     reader = dds.create_reader(rep_topic, 'std_srvs/srv/SetBool_Response', qos,
@@ -152,7 +152,7 @@ def test_a_reply_waits_for_the_callers_reply_reader(rclpy_ctx, spawn_node):
         return bool(replies)
 
     assert spin_until(node, replied, timeout=60), peer.output()
-    guid, seq, payload = _unpack_service(replies[0][0])
+    guid, seq, payload = unpack_service(replies[0][0])
     assert (guid, seq) == (99, 1)
     assert deserialize(payload, 'std_srvs/srv/SetBool_Response').message.startswith('on=True')
     dds.delete_reader(reader)

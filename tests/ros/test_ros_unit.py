@@ -218,7 +218,7 @@ def test_in_process_delivery_skips_serialisation(rclpy_ctx, monkeypatch):
 
     calls = []
     real = typesupport.serialize
-    monkeypatch.setattr('mindgrasp_ros.runtime.entities.serialize',
+    monkeypatch.setattr('mindgrasp_ros.runtime.publisher.serialize',
                         lambda *a, **k: calls.append(1) or real(*a, **k))
     a, b = rclpy.node.Node('producer'), rclpy.node.Node('consumer')
     got = []
@@ -282,11 +282,11 @@ def test_lockstep_is_deterministic_and_serves_services():
     from mindgrasp_ros.interfaces.std_srvs.srv import Trigger
 
     from mindgrasp_ros import rclpy
-    from mindgrasp_ros.composition import LockstepRunner
+    from mindgrasp_ros.graph.lockstep import LockstepRunner
 
     class Noise(rclpy.node.Node):
-        def __init__(self) -> None:
-            super().__init__('noise')
+        def __init__(self, **kwargs: object) -> None:
+            super().__init__('noise', **kwargs)
             self.rng = random.Random(self.declare_parameter('seed', 0).value)
             pub = self.create_publisher(Float64, 'x', 10)
             self.create_timer(0.01, lambda: pub.publish(Float64(data=self.rng.random())))
@@ -298,8 +298,8 @@ def test_lockstep_is_deterministic_and_serves_services():
             return res
 
     class Log(rclpy.node.Node):
-        def __init__(self) -> None:
-            super().__init__('log')
+        def __init__(self, **kwargs: object) -> None:
+            super().__init__('log', **kwargs)
             self.values: list[tuple[int, float]] = []
             self.create_subscription(Float64, 'x', lambda m: self.values.append(
                 (self.get_clock().now().nanoseconds, m.data)), 10)
@@ -408,7 +408,7 @@ def test_a_ctrl_c_during_a_graph_query_is_not_lost(rclpy_ctx):
 
     from mindgrasp_ros.interfaces.std_msgs.msg import String
 
-    from mindgrasp_ros.runtime.graph import _endpoint_without_type_id
+    from mindgrasp_ros.runtime.dds.discovery import _endpoint_without_type_id
 
     node = rclpy_ctx.node.Node('graph_interrupt')
     node.create_publisher(String, '/graph_interrupt', 10)

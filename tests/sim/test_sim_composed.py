@@ -1,4 +1,4 @@
-"""The simulator node composed in one process on a lock-step clock (mindgrasp_ros composition):
+"""The simulator node composed in one process on a lock-step clock (mindgrasp_ros.graph):
 a controller node grasps through the ROS topics and the node reports /task/result; two runs with
 one seed give identical messages."""
 
@@ -11,7 +11,7 @@ import pytest
 import yaml
 
 from mindgrasp_ros import rclpy
-from mindgrasp_ros.composition import LockstepRunner
+from mindgrasp_ros.graph.lockstep import LockstepRunner
 from mindgrasp_sim.sim_node import SimNode
 from mindgrasp_sim.simulation import Simulation, top_down_quat
 

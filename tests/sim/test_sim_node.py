@@ -471,7 +471,7 @@ def test_a_nan_publisher_beside_the_controller_holds_the_arm(rclpy_ctx, spawn_no
 def test_a_stop_before_the_first_step_reports_no_rate(capfd):
     """Stopped before it stepped, the node said "real-time factor 0.00x"; now it says what
     happened, and a run that stepped keeps its factor (test_fast_mode_...)."""
-    from mindgrasp_ros.composition import LockstepRunner
+    from mindgrasp_ros.graph.lockstep import LockstepRunner
     from mindgrasp_sim.sim_node import SimNode
 
     with LockstepRunner(start_time_s=0.0) as runner:

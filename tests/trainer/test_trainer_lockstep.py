@@ -1,4 +1,4 @@
-"""Both nodes composed in lock-step on sim time (mindgrasp_ros.composition): prompt stamps fall on
+"""Both nodes composed in lock-step on sim time (mindgrasp_ros.graph): prompt stamps fall on
 the planned onsets, and a second run with the same seed publishes the same prompts."""
 
 from __future__ import annotations
@@ -15,9 +15,9 @@ STEP = 0.005  # s, the prompt timer's period at rate 200 Hz
 
 @pytest.fixture
 def runner():
-    from mindgrasp_ros import composition
+    from mindgrasp_ros import graph
 
-    return composition.LockstepRunner(start_time_s=100.0)
+    return graph.LockstepRunner(start_time_s=100.0)
 
 
 def run_graz(runner) -> list:
@@ -29,8 +29,8 @@ def run_graz(runner) -> list:
     got = []
 
     class Listener(rclpy.node.Node):
-        def __init__(self) -> None:
-            super().__init__('prompt_listener')
+        def __init__(self, **kwargs: object) -> None:
+            super().__init__('prompt_listener', **kwargs)
             qos = rclpy.qos.QoSProfile(
                 depth=10,
                 reliability=rclpy.qos.ReliabilityPolicy.RELIABLE,
@@ -63,11 +63,11 @@ def test_graz_in_lockstep_hits_the_planned_onsets(runner):
 
 
 def test_same_seed_same_prompts_in_lockstep():
-    from mindgrasp_ros import composition
+    from mindgrasp_ros import graph
 
     runs = []
     for _ in range(2):
-        runner = composition.LockstepRunner(start_time_s=100.0)
+        runner = graph.LockstepRunner(start_time_s=100.0)
         runs.append([(m.phase, m.class_index, m.trial, m.header.stamp.sec,
                       m.header.stamp.nanosec) for m in run_graz(runner)])  # fmt: skip
     assert runs[0] == runs[1]
@@ -77,15 +77,15 @@ def run_trainer_with_sim() -> tuple[list, dict]:
     """Simulator (training robot) and trainer composed in lock-step; returns prompts, summary."""
     from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import Prompt
 
-    from mindgrasp_ros import composition, rclpy
+    from mindgrasp_ros import graph, rclpy
     from mindgrasp_sim import sim_node
     from mindgrasp_trainer.trainer_node import TrainerNode
 
     got = []
 
     class Listener(rclpy.node.Node):
-        def __init__(self) -> None:
-            super().__init__('prompt_listener')
+        def __init__(self, **kwargs: object) -> None:
+            super().__init__('prompt_listener', **kwargs)
             qos = rclpy.qos.QoSProfile(
                 depth=10,
                 reliability=rclpy.qos.ReliabilityPolicy.RELIABLE,
@@ -93,7 +93,7 @@ def run_trainer_with_sim() -> tuple[list, dict]:
             )
             self.create_subscription(Prompt, '/trainer/prompt', got.append, qos)
 
-    runner = composition.LockstepRunner(start_time_s=100.0)
+    runner = graph.LockstepRunner(start_time_s=100.0)
     runner.add(Listener)
     runner.add(sim_node.SimNode, ros_args=['-p', 'trainer_robot:=true', '-p', 'camera_rate:=1.0'])
     trainer = runner.add(TrainerNode, ros_args=[
@@ -129,19 +129,19 @@ def test_display_in_lockstep_draws_every_prompt_on_sim_time(tmp_path):
     and PNGs at ``png_rate`` count simulated seconds."""
     from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import Prompt
 
-    from mindgrasp_ros import composition, rclpy
+    from mindgrasp_ros import graph, rclpy
     from mindgrasp_trainer.display_node import DisplayNode
     from mindgrasp_trainer.graz_node import GrazNode
 
     flips = []
 
     class Listener(rclpy.node.Node):
-        def __init__(self) -> None:
-            super().__init__('flip_listener')
+        def __init__(self, **kwargs: object) -> None:
+            super().__init__('flip_listener', **kwargs)
             self.create_subscription(Prompt, '/display/flip', flips.append, 50)
 
     png = tmp_path / 'png'
-    runner = composition.LockstepRunner(start_time_s=100.0)
+    runner = graph.LockstepRunner(start_time_s=100.0)
     runner.add(Listener)
     runner.add(DisplayNode, ros_args=['-p', 'headless:=true', '-p', f'png_dir:={png}',
                                       '-p', 'rate:=10.0', '-p', 'png_rate:=0.5',

@@ -1,4 +1,4 @@
-"""`mindgrasp trainer schedule` (schedule_cli): the schedule the nodes will use."""
+"""`mindgrasp trainer schedule` (commands/trainer_schedule.py): the schedule the nodes will use."""
 
 from __future__ import annotations
 
@@ -9,15 +9,15 @@ import json
 
 import pytest
 
-from mindgrasp_trainer import schedule_cli
+from mindgrasp_trainer.commands import trainer_schedule
 from mindgrasp_trainer.graz import GrazProtocol
 from mindgrasp_trainer.trainer import TrainerProtocol
 
 
 def run(capsys, *argv: str) -> tuple[int, str, str]:
     parser = argparse.ArgumentParser()
-    schedule_cli.add_arguments(parser)
-    code = schedule_cli.main(parser.parse_args(argv))
+    trainer_schedule.add_arguments(parser)
+    code = trainer_schedule.main(parser.parse_args(argv))
     out, err = capsys.readouterr()
     return code, out, err
 

@@ -7,7 +7,7 @@ import pytest
 
 from mindgrasp_common.resources import resource_path
 from mindgrasp_vision import VisionError
-from mindgrasp_vision.config import VisionConfig
+from mindgrasp_vision.params import VisionConfig
 from mindgrasp_vision.pipeline import VisionPipeline
 from mindgrasp_vision.shape_cnn import SHAPES
 

@@ -9,7 +9,7 @@ import pytest
 
 from mindgrasp_common.resources import resource_path
 from mindgrasp_vision import VisionError
-from mindgrasp_vision.config import DEFAULT_SHAPE_MODEL
+from mindgrasp_vision.params import DEFAULT_SHAPE_MODEL
 from mindgrasp_vision.shape_cnn import (
     SHAPES,
     Preprocessing,

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from mindgrasp_cli.cli import main as mindgrasp
+from mindgrasp_vision.commands.train_vision import split_indices
 from mindgrasp_vision.shape_cnn import ShapeClassifier
-from mindgrasp_vision.train_cli import split_indices
 
 pytestmark = pytest.mark.slow
 

@@ -31,8 +31,10 @@ EVENT_TYPE = 'rcl_interfaces/msg/ParameterEvent'
 class ParameterChangeLog:
     """Appends the changes of ``/parameter_events`` to a JSONL file.
 
-    Args:
-        path: the file; its folder is created, an existing file is appended to.
+    Parameters
+    ----------
+    path
+        The file; its folder is created, an existing file is appended to.
     """
 
     def __init__(self, path: str | Path) -> None:

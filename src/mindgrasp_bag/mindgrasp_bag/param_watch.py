@@ -20,9 +20,12 @@ class ParameterWatch:
     """Feeds a change log from a node (the recorder): :meth:`event` with each raw
     ``/parameter_events`` message, :meth:`poll` now and then to read the values of new nodes.
 
-    Args:
-        node: the node whose clients read the parameters.
-        log: where the changes go.
+    Parameters
+    ----------
+    node
+        The node whose clients read the parameters.
+    log
+        Where the changes go.
     """
 
     def __init__(self, node: Any, log: ParameterChangeLog) -> None:

@@ -15,8 +15,10 @@ def resolve_bag(path: str | Path) -> Path:
 
     A bag is a directory with metadata.yaml or .mcap/.db3 files, or one such file.
 
-    Raises:
-        BagError: ``path`` does not exist.
+    Raises
+    ------
+    BagError
+        ``path`` does not exist.
     """
     p = Path(path).expanduser()
     if not p.exists():

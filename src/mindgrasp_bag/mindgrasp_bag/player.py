@@ -82,8 +82,10 @@ def type_problem(info: TopicInfo, store: Any = None) -> str | None:
 def parse_remaps(items: Iterable[str]) -> dict[str, str]:
     """``['/from:=/to', ...]`` -> ``{'/from': '/to'}``.
 
-    Raises:
-        BagError: an item without ``:=``.
+    Raises
+    ------
+    BagError
+        An item without ``:=``.
     """
     out = {}
     for item in items:
@@ -98,18 +100,29 @@ def parse_remaps(items: Iterable[str]) -> dict[str, str]:
 class Player:
     """Plan and run the playback of one bag.
 
-    Args:
-        reader: An opened :class:`BagReader`.
-        rate: Playback speed factor (2.0 = twice as fast); > 0.
-        loop: Start again at the end, until stopped.
-        start_offset: Skip this much of the bag's beginning (s).
-        topics: Play only these topics (default: all).
-        regex: Play only topics matching this regular expression.
-        exclude_regex: Do not play topics matching this regular expression.
-        remap: Output topic names, ``{'/from': '/to'}``.
-        can_publish: ``f(topic_info) -> None or reason``: says whether the ROS layer can publish
-            a topic's type; default: the type is in the type store with the bag's type hash.
-        typestore: The type store for the default ``can_publish``.
+    Parameters
+    ----------
+    reader
+        An opened :class:`BagReader`.
+    rate
+        Playback speed factor (2.0 = twice as fast); > 0.
+    loop
+        Start again at the end, until stopped.
+    start_offset
+        Skip this much of the bag's beginning (s).
+    topics
+        Play only these topics (default: all).
+    regex
+        Play only topics matching this regular expression.
+    exclude_regex
+        Do not play topics matching this regular expression.
+    remap
+        Output topic names, ``{'/from': '/to'}``.
+    can_publish
+        ``f(topic_info) -> None or reason``: says whether the ROS layer can publish
+        a topic's type; default: the type is in the type store with the bag's type hash.
+    typestore
+        The type store for the default ``can_publish``.
     """
 
     def __init__(self, reader: BagReader, *, rate: float = 1.0, loop: bool = False,
@@ -173,16 +186,23 @@ class Player:
             sleep: Callable[[float], None] = time.sleep) -> PlayStats:
         """Play until the end (or ``stop`` is set; with ``loop``, until stopped or max_loops).
 
-        Args:
-            publish: Called with (output topic, CDR bytes) for every message.
-            publish_clock: Called with the bag time (ns) at ``clock_hz`` when given (/clock).
-            clock_hz: /clock publication rate (Hz).
-            stop: Set it to stop early.
-            max_loops: With ``loop``, stop after this many passes (0 = endless).
-            priority: Real-time (SCHED_FIFO) priority 1-99 of the calling thread while playing;
-                0 = normal scheduling. On a loaded machine normal scheduling wakes the player up
-                to several ms late; real-time priority keeps it within ~0.1 ms. Needs root or
-                CAP_SYS_NICE; without, playback runs normally and ``stats.notes`` says so.
+        Parameters
+        ----------
+        publish
+            Called with (output topic, CDR bytes) for every message.
+        publish_clock
+            Called with the bag time (ns) at ``clock_hz`` when given (/clock).
+        clock_hz
+            /clock publication rate (Hz).
+        stop
+            Set it to stop early.
+        max_loops
+            With ``loop``, stop after this many passes (0 = endless).
+        priority
+            Real-time (SCHED_FIFO) priority 1-99 of the calling thread while playing;
+            0 = normal scheduling. On a loaded machine normal scheduling wakes the player up
+            to several ms late; real-time priority keeps it within ~0.1 ms. Needs root or
+            CAP_SYS_NICE; without, playback runs normally and ``stats.notes`` says so.
         """
         if priority <= 0:
             return self._run(publish, publish_clock, clock_hz, stop, max_loops, now, sleep)

@@ -42,14 +42,19 @@ class TopicCounters:
 class Recorder:
     """Queue + writer thread in front of a :class:`BagWriter`.
 
-    Args:
-        writer: A bag writer, not yet opened (the thread opens and closes it).
-        max_queue_bytes: Memory for messages waiting to be written (bytes); beyond it new
-            messages are dropped and counted. Default 512 MiB (~8 s of 30 Hz RGB-D).
-        on_error: Called once, from the writer thread, with a sentence when recording stops
-            because of an error (e.g. disk full).
-        typestore: rosbags type store used to decode EEG chunks for the gap check (default: the
-            writer's).
+    Parameters
+    ----------
+    writer
+        A bag writer, not yet opened (the thread opens and closes it).
+    max_queue_bytes
+        Memory for messages waiting to be written (bytes); beyond it new
+        messages are dropped and counted. Default 512 MiB (~8 s of 30 Hz RGB-D).
+    on_error
+        Called once, from the writer thread, with a sentence when recording stops
+        because of an error (e.g. disk full).
+    typestore
+        Rosbags type store used to decode EEG chunks for the gap check (default: the
+        writer's).
     """
 
     def __init__(self, writer: BagWriter, *, max_queue_bytes: int = 512 << 20,
@@ -94,12 +99,17 @@ class Recorder:
              publish_time_ns: int | None = None) -> bool:
         """Queue one message for writing; never blocks. False when dropped (or stopped).
 
-        Args:
-            topic: A topic passed to :meth:`add_topic` before.
-            data: CDR bytes of the message.
-            timestamp_ns: Receive time (ns); default now (system clock). MCAP log_time.
-            publish_time_ns: Send time (ns) when the middleware gives it (DDS source
-                timestamp); MCAP publish_time, as rosbag2 Jazzy stores it.
+        Parameters
+        ----------
+        topic
+            A topic passed to :meth:`add_topic` before.
+        data
+            CDR bytes of the message.
+        timestamp_ns
+            Receive time (ns); default now (system clock). MCAP log_time.
+        publish_time_ns
+            Send time (ns) when the middleware gives it (DDS source
+            timestamp); MCAP publish_time, as rosbag2 Jazzy stores it.
         """
         if timestamp_ns is None:
             timestamp_ns = time.time_ns()

@@ -12,8 +12,10 @@ __all__ = ['message_class', 'param_args', 'qos_profile']
 def message_class(type_name: str) -> Any:
     """The message class of ``'pkg/msg/Type'`` from ``mindgrasp_ros.interfaces``.
 
-    Raises:
-        ImportError, AttributeError: the client layer does not know the type.
+    Raises
+    ------
+    ImportError, AttributeError
+        The client layer does not know the type.
     """
     package, kind, name = type_name.split('/')
     module = importlib.import_module(f'mindgrasp_ros.interfaces.{package}.{kind}')

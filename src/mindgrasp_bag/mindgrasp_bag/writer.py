@@ -42,20 +42,29 @@ class _Topic:
 class BagWriter:
     """Write a rosbag2 bag incrementally: open, add_topic, write, close (or a ``with`` block).
 
-    Args:
-        path: Bag directory to create (must not exist).
-        typestore: rosbags type store giving message definitions and type hashes (default: the
-            project's store, ROS 2 Jazzy types + mindgrasp_msgs).
-        chunk_size: Bytes of messages per MCAP chunk before it is written out.
-        compression: 'none', 'zstd' or 'lz4': MCAP chunk compression (what rosbag2 does with the
-            zstd_fast storage preset; metadata compression fields stay empty, as in rosbag2).
-        flush_interval: Longest time (s) written messages stay in memory; bounds what a SIGKILL
-            loses. 0 flushes after every message.
-        max_bag_size: Start a new .mcap file when the current one reaches this size (bytes);
-            0 = never.
-        max_bag_duration: Start a new .mcap file when the current one spans this long (s);
-            0 = never.
-        custom_data: String pairs stored in metadata.yaml ``custom_data``.
+    Parameters
+    ----------
+    path
+        Bag directory to create (must not exist).
+    typestore
+        Rosbags type store giving message definitions and type hashes (default: the
+        project's store, ROS 2 Jazzy types + mindgrasp_msgs).
+    chunk_size
+        Bytes of messages per MCAP chunk before it is written out.
+    compression
+        'none', 'zstd' or 'lz4': MCAP chunk compression (what rosbag2 does with the
+        zstd_fast storage preset; metadata compression fields stay empty, as in rosbag2).
+    flush_interval
+        Longest time (s) written messages stay in memory; bounds what a SIGKILL
+        loses. 0 flushes after every message.
+    max_bag_size
+        Start a new .mcap file when the current one reaches this size (bytes);
+        0 = never.
+    max_bag_duration
+        Start a new .mcap file when the current one spans this long (s);
+        0 = never.
+    custom_data
+        String pairs stored in metadata.yaml ``custom_data``.
     """
 
     def __init__(self, path: Path | str, *, typestore: Any = None, chunk_size: int = 1 << 20,
@@ -153,15 +162,23 @@ class BagWriter:
                   msgdef: str | None = None, type_hash: str | None = None) -> None:
         """Declare a topic before writing to it.
 
-        Args:
-            topic: Topic name, e.g. '/eeg/raw'.
-            msgtype: ROS 2 type name, 'pkg/msg/Type'.
-            offered_qos_profiles: The publishers' QoS (rclpy QoSProfile, rosbags Qos or dicts).
-            msgdef: Concatenated message definition; default: generated from the type store.
-            type_hash: 'RIHS01_...' type description hash; default: from the type store.
+        Parameters
+        ----------
+        topic
+            Topic name, e.g. '/eeg/raw'.
+        msgtype
+            ROS 2 type name, 'pkg/msg/Type'.
+        offered_qos_profiles
+            The publishers' QoS (rclpy QoSProfile, rosbags Qos or dicts).
+        msgdef
+            Concatenated message definition; default: generated from the type store.
+        type_hash
+            'RIHS01_...' type description hash; default: from the type store.
 
-        Raises:
-            BagError: unknown type without msgdef, or the topic exists with another type.
+        Raises
+        ------
+        BagError
+            Unknown type without msgdef, or the topic exists with another type.
         """
         self._check_open()
         if topic in self.topics:
@@ -189,15 +206,22 @@ class BagWriter:
               publish_time: int | None = None) -> None:
         """Write one serialized (CDR) message.
 
-        Args:
-            topic: A topic declared with :meth:`add_topic`.
-            timestamp: Receive time (ns since the epoch or since sim start); MCAP log_time.
-            data: CDR bytes as published.
-            publish_time: Send time (ns) when known; default ``timestamp``.
+        Parameters
+        ----------
+        topic
+            A topic declared with :meth:`add_topic`.
+        timestamp
+            Receive time (ns since the epoch or since sim start); MCAP log_time.
+        data
+            CDR bytes as published.
+        publish_time
+            Send time (ns) when known; default ``timestamp``.
 
-        Raises:
-            BagError: bag not open, topic not declared, or a write error (``__cause__`` is the
-                OSError, e.g. ENOSPC for a full disk).
+        Raises
+        ------
+        BagError
+            Bag not open, topic not declared, or a write error (``__cause__`` is the
+            OSError, e.g. ENOSPC for a full disk).
         """
         self._check_open()
         channel = self._channel_ids.get(topic)

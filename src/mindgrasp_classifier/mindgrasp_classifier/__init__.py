@@ -12,8 +12,9 @@ Layers (ROS-free unless named ``*_node``):
   the same filter and window code.
 - :mod:`.data`, :mod:`.training`: labelled recordings (EDF via MNE, EEGMMIDB, rosbag2 runs),
   training with grouped cross-validation, evaluation.
-- :mod:`.classifier_node`: the ROS 2 node; :mod:`.train_cli`, :mod:`.evaluate_cli`: the
-  ``mindgrasp train|evaluate classifier`` commands; :mod:`.live`: ``evaluate --live``.
+- :mod:`.classifier_node`: the ROS 2 node; :mod:`.commands.train_classifier`,
+  :mod:`.commands.evaluate_classifier`: the ``mindgrasp train|evaluate classifier`` commands;
+  :mod:`.live`: ``evaluate --live``.
 """
 
 from mindgrasp_classifier.errors import ClassifierError

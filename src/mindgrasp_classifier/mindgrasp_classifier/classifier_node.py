@@ -15,16 +15,12 @@ All decoding is done by :class:`~mindgrasp_classifier.decoder.MiDecoder`.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 from mindgrasp_ros.interfaces.diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import EEGChunk, MIPrediction, Prompt
 from threadpoolctl import threadpool_limits
 
 from mindgrasp_classifier.decoder import (
-    ADAPT_MODES,
-    RECENTER_MODES,
     AdaptationConfig,
     CueLabels,
     MiDecoder,
@@ -32,55 +28,13 @@ from mindgrasp_classifier.decoder import (
     check_classes,
 )
 from mindgrasp_classifier.errors import ClassifierError
-from mindgrasp_classifier.model import CLASS_NAMES, DEFAULT_MODEL, MiModel
+from mindgrasp_classifier.model import MiModel
+from mindgrasp_classifier.params import ClassifierParams
 from mindgrasp_ros import rclpy
 from mindgrasp_ros.node_main import declare_duration, fail, run_node
 from mindgrasp_ros.node_traits import NodeTraits
-from mindgrasp_ros.params import declare_params, param
+from mindgrasp_ros.params import declare_params
 from mindgrasp_ros.topics import BCI_PREDICTION, BCI_STATUS, EEG_RAW, TRAINER_PROMPT
-
-
-@dataclass
-class ClassifierParams:
-    """ROS parameters of the classifier node (read-only: the model and decoder are built at
-    start; restart the node to change them)."""
-
-    model: str = param(DEFAULT_MODEL, 'model written by `mindgrasp train classifier` (.json next '
-                       'to its .npz): a path or a package:// URI')
-    classes: list[str] = param(list(CLASS_NAMES), 'classes the application needs; a model with '
-                               'other classes (besides rest) is refused ([] = any)')
-    adaptation: str = param('none', 'adaptive class means', choices=ADAPT_MODES)
-    adaptation_rate: float = param(0.005, 'geodesic step of an adaptive update per window',
-                                   min=0.0, max=1.0)
-    min_certainty: float = param(0.5, 'certainty needed for an unsupervised update', min=0.0,
-                                 max=1000.0)
-    recenter: str = param('adaptive', 'Riemannian re-centering: the training reference or the '
-                          "session's running mean", choices=RECENTER_MODES)
-    # slow forgetting (horizon ~2 min at 16 windows/s): a shorter memory follows the class mix of
-    # the last seconds (a scan answers 'no' far more often than 'yes') instead of the session
-    recenter_rate: float = param(0.0005, 'smallest weight of a new window in the running session '
-                                 'mean', min=0.0, max=1.0)
-    recenter_prior: float = param(60.0, 'adaptive re-centering starts from the training '
-                                  'reference weighted as this many seconds of windows',
-                                  unit='s', min=0.0, max=3600.0)
-    label_tmin: float = param(0.5, 'windows in [cue + label_tmin, cue + label_tmax] get the '
-                              "cue's class for supervised adaptation", unit='s', min=-60.0,
-                              max=60.0)
-    label_tmax: float = param(2.5, 'end of the labelled span after a cue', unit='s', min=-60.0,
-                              max=60.0)
-    flat_threshold: float = param(1e-8, 'filtered channel std below this = flat electrode',
-                                  unit='V', min=0.0, max=1.0)
-    status_period: float = param(1.0, 'between /bci/status messages', unit='s', min=0.01,
-                                 max=3600.0)
-    frame_id: str = param('eeg', 'frame_id of the predictions')
-    blas_threads: int = param(1, 'BLAS threads (small matrices: 1 gives the lowest latency; 0 '
-                              'leaves the default)', min=0, max=256)
-
-    def __post_init__(self) -> None:
-        if self.label_tmax <= self.label_tmin:
-            msg = (f"'label_tmax' ({self.label_tmax} s) must be after 'label_tmin' "
-                   f'({self.label_tmin} s).')
-            raise ClassifierError(msg)
 
 
 class ClassifierNode(rclpy.node.Node):

@@ -139,7 +139,7 @@ def _per_class(classes: Sequence[int], confusion: np.ndarray) -> dict[str, float
 def node_adaptation() -> AdaptationConfig:
     """The classifier node's default adaptation and re-centering (its parameter defaults), so
     a pseudo-online evaluation decodes as the loop does."""
-    from mindgrasp_classifier.classifier_node import ClassifierParams
+    from mindgrasp_classifier.params import ClassifierParams
 
     # node parameter -> AdaptationConfig field where the names differ; the others match
     renamed = {'adaptation': 'mode', 'adaptation_rate': 'rate'}

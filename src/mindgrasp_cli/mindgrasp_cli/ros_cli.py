@@ -1,7 +1,7 @@
 """Shared helpers of the ``topic``, ``node`` and ``param`` commands (the ``ros2`` CLI's verbs).
 
 They work against any ROS 2 graph on the domain: endpoints come from DDS discovery and node
-names from ``ros_discovery_info`` (see :mod:`mindgrasp_ros.runtime.graph`).
+names from ``ros_discovery_info`` (see :mod:`mindgrasp_ros.runtime.dds.discovery`).
 """
 
 from __future__ import annotations

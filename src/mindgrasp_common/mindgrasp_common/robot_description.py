@@ -41,6 +41,7 @@ __all__ = [
     'RobotDescription',
     'RobotDescriptionError',
     'load_robot',
+    'robot_choices',
     'robot_names',
 ]
 
@@ -187,6 +188,12 @@ def _read_urdf(path: Path, where: str) -> tuple[set[str], dict[str, _UrdfJoint]]
 def robot_names() -> list[str]:
     """Names of the shipped descriptions (``robot:=NAME``)."""
     return sorted(p.stem for p in resource_path(ROBOTS_PACKAGE, 'robots').glob('*.yaml'))
+
+
+def robot_choices() -> str:
+    """What a ``robot`` option takes, for help texts: the shipped names (:func:`robot_names`)
+    or a path, e.g. ``'mindgrasp_arm, panda, xarm6 or a robot description YAML path'``."""
+    return f'{", ".join(robot_names())} or a robot description YAML path'
 
 
 def _find(spec: str | Path) -> Path:

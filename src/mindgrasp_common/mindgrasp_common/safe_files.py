@@ -34,14 +34,19 @@ DISK_ERRNOS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EROFS, errno.EIO, err
 def write_atomic(path: Path, write: Callable[[Path], object]) -> Path:
     """Write ``path`` through ``write(tmp)`` and a rename, so it is never left half written.
 
-    Args:
-        path: The file to (re)place.
-        write: Writes the whole content to the path it is given (a temporary file beside
-            ``path``).
+    Parameters
+    ----------
+    path
+        The file to (re)place.
+    write
+        Writes the whole content to the path it is given (a temporary file beside
+        ``path``).
 
-    Raises:
-        OSError: the write or the rename failed; ``path`` is unchanged and the temporary file
-            is removed.
+    Raises
+    ------
+    OSError
+        The write or the rename failed; ``path`` is unchanged and the temporary file
+        is removed.
     """
     path = Path(path)
     tmp = path.with_name(f'.{path.name}.tmp')
@@ -82,9 +87,12 @@ class DeferredWriter:
     write with the same directory and name replaces a pending one (records grow, the newest
     holds all).
 
-    Args:
-        run_dir: The run directory; names the fallback folder and relative paths in it.
-        fallback: Fallback root (default :func:`fallback_root`).
+    Parameters
+    ----------
+    run_dir
+        The run directory; names the fallback folder and relative paths in it.
+    fallback
+        Fallback root (default :func:`fallback_root`).
     """
 
     def __init__(self, run_dir: Path | None = None, fallback: Path | None = None) -> None:

@@ -1,24 +1,14 @@
 """A second-order-sections filter applied chunk by chunk (EEG synthesis, online band-pass).
 
-``scipy.signal.sosfilt(sos, x, axis=0, zi=zi)`` on a chunk of a few samples spends most of its
-time validating ``sos`` and moving axes in and out of the layout its C kernel works in. A
-stream calls for the same filter again and again, so :class:`SosStream` validates once, keeps
-the state in the kernel's layout and calls that kernel directly. The arithmetic is sosfilt's:
-the output is identical to the last bit (a test checks it against ``scipy.signal.sosfilt``).
-
-The kernel is a private scipy function. Should a scipy release move it, the stream falls back
-to the public ``sosfilt``: slower, same output.
+:class:`SosStream` keeps a filter's state from one chunk to the next and calls SciPy's public
+``scipy.signal.sosfilt(sos, x, axis=0, zi=zi)``, with the state kept in that function's layout so
+nothing is copied between calls: the output is sosfilt's, to the last bit (a test checks it).
 """
 
 from __future__ import annotations
 
 import numpy as np
 from scipy import signal
-
-try:
-    from scipy.signal._sosfilt import _sosfilt as _kernel
-except ImportError:     # pragma: no cover - depends on the scipy release
-    _kernel = None
 
 __all__ = ['SosStream']
 
@@ -49,17 +39,16 @@ class SosStream:
     @property
     def state(self) -> np.ndarray:
         """The filter state (n_sections, 2, n_signals), as ``sosfilt(..., axis=0)`` returns it."""
-        return self._zi.transpose(1, 2, 0).copy()
+        return self._zi.copy()
 
     def set_state(self, zi: np.ndarray) -> None:
         """Replace the state with ``zi`` (n_sections, 2, n_signals)."""
-        zi = np.asarray(zi, dtype=float)
+        zi = np.array(zi, dtype=float)
         shape = (self.sos.shape[0], 2, self.n_signals)
         if zi.shape != shape:
             msg = f'The filter state must have shape {shape}; got {zi.shape}.'
             raise ValueError(msg)
-        # the kernel's layout: (n_signals, n_sections, 2), C-contiguous, updated in place
-        self._zi = np.ascontiguousarray(zi.transpose(2, 0, 1))
+        self._zi = zi
 
     def __call__(self, x: np.ndarray) -> np.ndarray:
         """Filter the next chunk ``x`` (n_samples, n_signals); returns the output, same shape
@@ -67,10 +56,5 @@ class SosStream:
         if x.ndim != 2 or x.shape[1] != self.n_signals:
             msg = f'Chunks must have shape (n_samples, {self.n_signals}); got {x.shape}.'
             raise ValueError(msg)
-        if _kernel is None:
-            y, zi = signal.sosfilt(self.sos, x, axis=0, zi=self.state)
-            self.set_state(zi)
-            return y
-        y = np.array(x.T, dtype=float, order='C')    # (n_signals, n_samples), filtered in place
-        _kernel(self.sos, y, self._zi)
-        return y.T
+        y, self._zi = signal.sosfilt(self.sos, x, axis=0, zi=self._zi)
+        return y

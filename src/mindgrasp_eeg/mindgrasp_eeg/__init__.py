@@ -26,10 +26,7 @@ Layers (ROS-free unless the module name ends in ``_node``):
 
 import sys
 
-
-class EEGError(Exception):
-    """Any problem of the EEG package; the message names the problem and the fix."""
-
+from mindgrasp_eeg.errors import EEGError
 
 __all__ = ['EEGError']
 

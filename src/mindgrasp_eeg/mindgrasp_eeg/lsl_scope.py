@@ -26,7 +26,7 @@ import os
 import tempfile
 from pathlib import Path
 
-from . import EEGError
+from mindgrasp_eeg.errors import EEGError
 
 #: environment variable choosing the scope: ``machine`` (default) or ``network``
 SCOPE_ENV = 'MINDGRASP_LSL_SCOPE'

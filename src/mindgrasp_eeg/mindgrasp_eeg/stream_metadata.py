@@ -45,9 +45,11 @@ def stream_metadata(desc: StreamDescription) -> dict[str, Any]:
 def write_stream_metadata(desc: StreamDescription, run_dir: str | Path) -> Path:
     """Write ``<run_dir>/eeg_stream.json`` (atomically: whole or absent); returns its path.
 
-    Raises:
-        OSError: the disk refused it (the caller keeps it, see
-            :class:`mindgrasp_common.safe_files.DeferredWriter`).
+    Raises
+    ------
+    OSError
+        The disk refused it (the caller keeps it, see
+        :class:`mindgrasp_common.safe_files.DeferredWriter`).
     """
     text = json.dumps(stream_metadata(desc), indent=1) + '\n'
     return write_atomic(Path(run_dir) / FILE_NAME,

@@ -11,7 +11,7 @@ Layers:
 - :mod:`~mindgrasp_experiments.subjects`: noise, virtual and oracle subjects (launch arguments,
   the noise-trained classifier, the oracle node).
 - :mod:`~mindgrasp_experiments.engine`: a launch profile composed in one process on simulated
-  time (``mindgrasp_ros.composition.LockstepRunner``), one trial per composed graph.
+  time (``mindgrasp_ros.graph.lockstep.LockstepRunner``), one trial per composed graph.
 - :mod:`~mindgrasp_experiments.workers`: trials spread over worker processes.
 - :mod:`~mindgrasp_experiments.report`, :mod:`~mindgrasp_experiments.plots`: summary.json,
   report.md, PNG and SVG plots.

@@ -15,6 +15,7 @@ import json
 import math
 import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -23,53 +24,9 @@ if TYPE_CHECKING:
 
 PROTOCOL_SUBJECTS = {'set_locations': ('noise', 'virtual', 'oracle'),
                      'random_locations': ('autonomous',)}
-#: the classifier trained on labelled noise (mindgrasp_experiments.subjects.noise_model)
 #: the most trials one command runs (a paper protocol has 90): a larger count could never
 #: finish, and 99999999999999999999 ended in numpy's OverflowError
 MAX_TRIALS = 100_000
-NOISE_MODEL = 'package://mindgrasp_classifier/models/noise_classifier.json'
-
-
-def noise_model_path(fallback_dir: Path) -> str:
-    """The packaged noise-trained model, else one trained now into ``fallback_dir``."""
-    from mindgrasp_common.resources import ResourceNotFoundError, resource_path
-
-    try:
-        return str(resource_path('mindgrasp_classifier', 'models', 'noise_classifier.json'))
-    except ResourceNotFoundError:
-        from mindgrasp_experiments.subjects import noise_model
-
-        print('Training the classifier on noise (once) ...', file=sys.stderr)
-        return str(noise_model(fallback_dir / 'noise_classifier'))
-
-
-def subject_launch_args(subject: str, out: Path) -> dict[str, str]:
-    """The experiment profile's launch arguments for ``subject``: a replay subject
-    (``eegmmidb:<n>`` or a subject file) is the pursuing virtual subject streaming that subject's
-    real EEG, decoded by a model calibrated on its calibration recordings; a fitted virtual subject
-    (``virtual:FILE.yaml``) is the virtual subject decoded by a model calibrated on its head
-    (:func:`~mindgrasp_experiments.fitted_subject.fitted_model`, cached); the noise subject
-    gets the noise-trained model."""
-    from mindgrasp_experiments.fitted_subject import fitted_model, is_fitted, load_fitted
-    from mindgrasp_experiments.subjects import is_replay, replay_model
-
-    if is_fitted(subject):
-        import shutil
-
-        model = fitted_model(load_fitted(subject))
-        for suffix in ('.json', '.npz'):    # a copy in the run: it names the decoder it used
-            shutil.copy2(model.with_suffix(suffix), out / model.with_suffix(suffix).name)
-        return {'subject': 'virtual', 'model': str(out / model.name)}
-    if is_replay(subject):
-        from mindgrasp_eeg.subject_file import replay_subject
-
-        files = replay_subject(subject)
-        print(f'Calibrating the classifier on {files.name} (once) ...', file=sys.stderr)
-        model = replay_model(files, out)
-        return {'subject': 'virtual', 'eeg_source': files.source, 'model': str(model)}
-    if subject == 'noise':
-        return {'subject': 'noise', 'model': noise_model_path(out)}
-    return {'subject': subject}
 
 
 def subject_type(text: str) -> str:
@@ -91,6 +48,7 @@ def subject_type(text: str) -> str:
 def add_common_arguments(parser: argparse.ArgumentParser, trials: int) -> None:
     """Options of every ``mindgrasp experiment`` protocol (numbers checked by argparse)."""
     from mindgrasp_common.cli_checks import bounded_int, non_negative_int, positive_float
+    from mindgrasp_common.robot_description import robot_choices
 
     parser.add_argument('--trials', type=bounded_int(1, MAX_TRIALS), default=trials,
                         help=f'number of trials, 1-{MAX_TRIALS} (default {trials})')
@@ -119,8 +77,8 @@ def add_common_arguments(parser: argparse.ArgumentParser, trials: int) -> None:
                              '(a local Ray instance of this run) or '
                              'HOST:PORT of a cluster\'s head node; same records as --workers')
     parser.add_argument('--robot', default='mindgrasp_arm', metavar='NAME|YAML',
-                        help='the arm: mindgrasp_arm (default), xarm6 or a robot description '
-                             'YAML path (mindgrasp_common.robot_description)')
+                        help=f'the arm (default mindgrasp_arm): {robot_choices()} '
+                             '(mindgrasp_common.robot_description)')
     parser.add_argument('--realism', default='none',
                         help='sensor noise and physical spread: none (default), default or a '
                              'profile YAML path (mindgrasp_sim.realism), seeded per trial')
@@ -188,22 +146,6 @@ def add_param_argument(parser: argparse.ArgumentParser) -> None:
                              '(mindgrasp experiment sweep) and compare them; repeat for more')
 
 
-def compare_by_sweep(args: argparse.Namespace, command: str) -> int:
-    """``set-locations --param NODE.PARAM=V1,V2``: the comparison is a sweep over those values
-    at the subject's accuracy (``mindgrasp experiment sweep``, same records and report)."""
-    from mindgrasp_experiments.commands import sweep
-
-    subject = getattr(args, 'subject', 'virtual')
-    if subject in ('noise', 'oracle', 'autonomous'):
-        return fail(command, f'--param with several values compares them as a sweep, which '
-                             f'varies a pursuing subject; --subject {subject} takes one value '
-                             'per --param (run the command once per value).')
-    print(f'{command}: several values of --param: comparing them as a sweep at accuracy '
-          f'{args.accuracy:g}.', file=sys.stderr)
-    return sweep.main(argparse.Namespace(**{**vars(args), 'accuracy': str(args.accuracy),
-                                            'subject': subject, 'seeds': None}))
-
-
 def experiment_from(args: argparse.Namespace, protocol: str,
                     params: dict[str, Any] | None = None) -> Experiment:
     """The :class:`~mindgrasp_experiments.experiment.Experiment` the options describe."""
@@ -217,8 +159,14 @@ def experiment_from(args: argparse.Namespace, protocol: str,
                       stall_timeout_s=args.stall_timeout, ray=args.ray)
 
 
-def run_experiment(args: argparse.Namespace, protocol: str, command: str) -> int:
-    """Run the protocol with ``args``; write the run directory; print the figures."""
+def run_experiment(args: argparse.Namespace, protocol: str, command: str, *,
+                   compare: Callable[[argparse.Namespace, str], int] | None = None) -> int:
+    """Run the protocol with ``args``; write the run directory; print the figures.
+
+    ``compare(args, command)`` runs a ``--param`` given several values (the sweep verb's
+    :func:`~mindgrasp_experiments.commands.experiment_sweep.compare`); without it several values are
+    refused.
+    """
     from tqdm import tqdm
 
     from mindgrasp_experiments import ExperimentError
@@ -232,7 +180,9 @@ def run_experiment(args: argparse.Namespace, protocol: str, command: str) -> int
     except ExperimentError as exc:
         return fail(command, str(exc))
     if any(len(values) > 1 for _node, _name, values in params):
-        return compare_by_sweep(args, command)
+        if compare is None:
+            return fail(command, '--param takes one value per parameter here.')
+        return compare(args, command)
     experiment = experiment_from(args, protocol, {f'{node}.{name}': values[0]
                                                   for node, name, values in params})
     bars: list[tqdm] = []     # made once the graph is checked: an error stays one line

@@ -5,7 +5,7 @@ nodes to compose, as ``mindgrasp launch`` would start them, with the lock-step t
 class declares (:class:`~mindgrasp_ros.node_traits.NodeTraits`): LSL runs on wall time, so the
 virtual amplifier publishes ``/eeg/raw`` itself (``output:=ros``) and the LSL acquisition node is
 left out. :func:`run_trial` runs one trial as a fresh graph of the one graph host
-(:class:`~mindgrasp_ros.graph_host.GraphRunner` under the ``Lockstep`` scheduler), each node
+(:class:`~mindgrasp_ros.graph.host.GraphRunner` under the ``Lockstep`` scheduler), each node
 given :func:`trial_parameters` (the trial manager, the node whose traits say so, told to run
 just that trial; every parameter a node's traits name as seeded set to a seed derived from
 ``(seed, trial)``), advances the clock in steps of ``step_s`` until the trial manager is done,
@@ -31,7 +31,7 @@ from mindgrasp_launch.lockstep import (
     lockstep_components as _lockstep_components,
 )
 from mindgrasp_launch.lockstep import run_lockstep, set_log_level
-from mindgrasp_ros.node_spec import NodeSpec
+from mindgrasp_ros.graph.spec import NodeSpec
 from mindgrasp_ros.node_traits import NodeTraits
 
 __all__ = ['NodeSpec', 'TrialRun', 'is_trial_manager', 'lockstep_components', 'run_lockstep',
@@ -110,8 +110,8 @@ def run_trial(components: Sequence[NodeSpec], trial: int, *, seed: int,
     Exactly one component must be a trial manager (:func:`is_trial_manager`); every node gets
     :func:`trial_parameters`. A node that raises fails the trial (``failure='node_error'``).
     """
-    from mindgrasp_ros.composition import NodeCallbackError
-    from mindgrasp_ros.graph_host import GraphRunner, Lockstep
+    from mindgrasp_ros.graph import NodeCallbackError
+    from mindgrasp_ros.graph.host import GraphRunner, Lockstep
     from mindgrasp_ros.node_main import is_done
 
     traits = [c.traits for c in components]

@@ -27,7 +27,7 @@ from typing import Any
 from mindgrasp_experiments import ExperimentError
 from mindgrasp_experiments.engine import TrialRun
 from mindgrasp_experiments.records import TrialRecord
-from mindgrasp_ros.node_spec import NodeSpec
+from mindgrasp_ros.graph.spec import NodeSpec
 
 __all__ = ['Experiment', 'Results']
 
@@ -83,7 +83,7 @@ class Experiment:
 
     def launch_arguments(self, subject_args: Mapping[str, str]) -> dict[str, str]:
         """The experiment profile's launch arguments, given the subject's
-        (:func:`~mindgrasp_experiments.cli.subject_launch_args`)."""
+        (:func:`~mindgrasp_experiments.subject_launch.subject_launch_args`)."""
         args = {**subject_args, 'protocol': self.protocol, 'seed': str(self.seed), 'trials': '1'}
         for name in ('accuracy', 'realism', 'robot'):
             if getattr(self, name) is not None:
@@ -128,9 +128,9 @@ class Experiment:
         """
         from mindgrasp_common.safe_files import DeferredWriter
         from mindgrasp_eeg import EEGError
-        from mindgrasp_experiments.cli import subject_launch_args
         from mindgrasp_experiments.records import write_records
         from mindgrasp_experiments.report import write_run
+        from mindgrasp_experiments.subject_launch import subject_launch_args
         from mindgrasp_experiments.summary import calibration_accuracy_of, summarise
         from mindgrasp_experiments.workers import run_trials
         from mindgrasp_launch import LaunchError

@@ -36,7 +36,7 @@ from mindgrasp_experiments import ExperimentError
 from mindgrasp_experiments.records import TrialRecord
 from mindgrasp_experiments.report import finite
 from mindgrasp_experiments.summary import counted, summarise
-from mindgrasp_ros.node_spec import NodeSpec
+from mindgrasp_ros.graph.spec import NodeSpec
 
 __all__ = ['SUMMARY_KEYS', 'Param', 'apply_params', 'check_params', 'combinations',
            'parse_accuracies', 'parse_param', 'parse_seeds', 'parse_subjects', 'point_figures',

@@ -18,7 +18,7 @@ from collections.abc import Iterator, Sequence
 
 from mindgrasp_experiments import ExperimentError
 from mindgrasp_experiments.engine import TrialRun, run_trial
-from mindgrasp_ros.node_spec import NodeSpec
+from mindgrasp_ros.graph.spec import NodeSpec
 
 __all__ = ['check_ray_address', 'run_trials']
 

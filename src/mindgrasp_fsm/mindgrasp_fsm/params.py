@@ -24,7 +24,7 @@ from mindgrasp_common.robot import (
     HOME_POSE,
     URDF_URI,
 )
-from mindgrasp_common.robot_description import GRASP_CHECKS, load_robot
+from mindgrasp_common.robot_description import GRASP_CHECKS, load_robot, robot_choices
 from mindgrasp_fsm.command_interface import COMMAND_INTERFACES, check_command_interface
 from mindgrasp_fsm.errors import FsmError
 from mindgrasp_ros.params import param
@@ -51,10 +51,9 @@ class FsmParams:
 
     # --- general (read-only: the robot model and timer are built at start) ---------------------
     autonomous: bool = param(False, 'no BCI: search left, approach and grasp on vision alone')
-    robot: str = param('', "the arm: mindgrasp_arm, xarm6 or a robot description YAML path; its "
-                       'URDF, TCP and camera links, joints, home pose, limits and velocity '
-                       "limits replace the eight parameters below (and grasp_check); '' = "
-                       'those as given')
+    robot: str = param('', f'the arm: {robot_choices()}; its URDF, TCP and camera links, '
+                       'joints, home pose, limits and velocity limits replace the eight '
+                       "parameters below (and grasp_check); '' = those as given")
     urdf_file: str = param(URDF_URI, 'URDF for forward / inverse kinematics: a path or a '
                            'package:// URI')
     tool_link: str = param('tcp', 'URDF link of the grasp point between the fingertips')

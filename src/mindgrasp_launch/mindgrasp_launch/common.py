@@ -224,15 +224,15 @@ def robot_argument(default: str = 'mindgrasp_arm', description: str = '') -> Any
     one line naming the problem and the fix, before any process starts (checked by
     :func:`~mindgrasp_common.robot_description.load_robot`, which the nodes use too); an empty
     ``default`` accepts an empty value (the profile then means "the recorded run's robot")."""
-    from mindgrasp_common.robot_description import load_robot, robot_names
+    from mindgrasp_common.robot_description import load_robot, robot_choices
 
     def check(text: str) -> object:
         return None if not text.strip() and not default else load_robot(text.strip())
 
     return la.checked_argument(
         'robot', check=check, default_value=default,
-        description=description or f'the arm: {", ".join(robot_names())} or the path of a robot '
-                                   'description YAML (mindgrasp_common.robot_description)')
+        description=description or f'the arm: {robot_choices()} '
+                                   '(mindgrasp_common.robot_description)')
 
 
 def live_view_arguments() -> list[Any]:

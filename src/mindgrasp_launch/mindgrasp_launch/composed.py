@@ -1,5 +1,5 @@
 """``--composed``: the node modules of a launch run in one process under one executor
-(:mod:`mindgrasp_ros.composition`), with in-process delivery between them.
+(:mod:`mindgrasp_ros.graph`), with in-process delivery between them.
 
 A node is composed when it is a Python node module (``Node(package, executable)`` that resolves
 to ``python -m package.executable``) without command-line ``arguments`` (components get only
@@ -36,8 +36,8 @@ def compose(processes: list[ProcessSpec], commands: list[list[str]], run_dir: Pa
 
     Writes ``<run dir>/composed.yaml`` (the components and their ROS arguments).
     """
-    if not find_module('mindgrasp_ros.composition'):
-        msg = ('--composed needs mindgrasp_ros.composition, which is not installed: run without '
+    if not find_module('mindgrasp_ros.graph'):
+        msg = ('--composed needs mindgrasp_ros.graph, which is not installed: run without '
                '--composed (one process per node).')
         raise LaunchError(msg)
     components = []

@@ -21,7 +21,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 2
     with open(argv[0], encoding='utf-8') as f:
         plan = yaml.safe_load(f)
-    from mindgrasp_ros.composition import CompositionError, NodeSpec, run_composed
+    from mindgrasp_ros.graph import CompositionError, NodeSpec, run_composed
 
     components = [NodeSpec(c['label'], c['module'], ros_args=list(c['ros_args']))
                   for c in plan['components']]

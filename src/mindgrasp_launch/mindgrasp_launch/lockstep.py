@@ -9,9 +9,9 @@ publishes ``/eeg/raw`` itself (``output:=ros``) and the LSL acquisition node is 
 in a live run; it discovers the topics from the in-process graph and stamps messages with
 simulated time); without one (the experiments, which write records) the launch runs with
 ``record:=false``.
-Each node is a :class:`~mindgrasp_ros.node_spec.NodeSpec` (its resolved parameters typed, also
+Each node is a :class:`~mindgrasp_ros.graph.spec.NodeSpec` (its resolved parameters typed, also
 written to ``params_dir/<label>.yaml``). :func:`run_lockstep` runs them with the one graph host
-(:class:`~mindgrasp_ros.graph_host.GraphRunner` under the ``Lockstep`` scheduler) until a node is
+(:class:`~mindgrasp_ros.graph.host.GraphRunner` under the ``Lockstep`` scheduler) until a node is
 done. The experiments (:mod:`mindgrasp_experiments.engine`) build on these.
 """
 
@@ -25,7 +25,7 @@ from typing import Any
 
 from mindgrasp_launch import params as ros_params
 from mindgrasp_launch import rundir
-from mindgrasp_ros.node_spec import NodeSpec
+from mindgrasp_ros.graph.spec import NodeSpec
 from mindgrasp_ros.node_traits import NodeTraits, traits_of
 
 __all__ = ['check_left_out_nodes', 'launch_lockstep', 'lockstep_components', 'node_traits',
@@ -111,7 +111,8 @@ def node_traits(spec: Any) -> NodeTraits:
     """The traits the node class of a launch process declares (defaults for other programs);
     :class:`LaunchError` when its module cannot be loaded."""
     from mindgrasp_launch import LaunchError
-    from mindgrasp_ros.composition import CompositionError, load_node_class
+    from mindgrasp_ros.errors import CompositionError
+    from mindgrasp_ros.graph.loader import load_node_class
 
     if spec.module is None:
         return traits_of(object)
@@ -158,10 +159,10 @@ def run_lockstep(components: Sequence[NodeSpec], *, step_s: float = 0.02,
     """``mindgrasp launch <profile> --lockstep``: the graph host under the lock-step scheduler,
     until a node is done (``done``), ``duration_s`` simulated seconds (> 0) or Ctrl-C; then one
     line with the real-time factor. Returns the graph's exit code
-    (:meth:`~mindgrasp_ros.graph_host.GraphRunner.run`). ``runner``: a
-    :class:`~mindgrasp_ros.graph_host.GraphRunner` under a ``Lockstep`` scheduler that the
+    (:meth:`~mindgrasp_ros.graph.host.GraphRunner.run`). ``runner``: a
+    :class:`~mindgrasp_ros.graph.host.GraphRunner` under a ``Lockstep`` scheduler that the
     caller keeps, to see afterwards whether Ctrl-C ended the graph (``interrupted``)."""
-    from mindgrasp_ros.graph_host import GraphRunner, Lockstep
+    from mindgrasp_ros.graph.host import GraphRunner, Lockstep
 
     # nodes start with the clock at 0: no jump
     runner = runner if runner is not None else GraphRunner(Lockstep(step_s), log=log)
@@ -190,7 +191,7 @@ def launch_lockstep(service: Any, *, log: Any = print) -> int:
     ``service.stop_reason`` as a live launch does.
     """
     from mindgrasp_launch.run_report import write_run_report
-    from mindgrasp_ros.graph_host import GraphRunner, Lockstep
+    from mindgrasp_ros.graph.host import GraphRunner, Lockstep
 
     # argument problems are reported before anything is created
     check_left_out_nodes(service.plan().processes)

@@ -119,8 +119,10 @@ class RunFiles:
     ``summary.yaml`` rewritten as each process ends (label, pid, exit code) and when the launch
     shuts down (the reason), so that it is complete whenever the launch stops.
 
-    Args:
-        path: an existing run directory (:func:`rundir.create_run_dir`).
+    Parameters
+    ----------
+    path
+        An existing run directory (:func:`rundir.create_run_dir`).
     """
 
     def __init__(self, path: Path) -> None:

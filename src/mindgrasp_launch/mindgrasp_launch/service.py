@@ -111,7 +111,7 @@ class LaunchService:
         launch_arguments: ``['name:=value', ...]`` or a mapping.
         run_dir: the run directory (default ``runs/<UTC timestamp>_<profile>/``).
         runs_root: where default run directories go (default ``$MINDGRASP_RUNS_DIR`` or runs/).
-        composed: run the node modules in one process (``mindgrasp_ros.composition``).
+        composed: run the node modules in one process (``mindgrasp_ros.graph``).
         sigint_timeout, sigterm_timeout: s before escalating to SIGTERM, then SIGKILL.
         argv: the command line, stored in the run directory.
         graph_check: s to look for another graph's ``/sim`` or ``/fsm`` on the ROS domain

@@ -9,9 +9,11 @@ from __future__ import annotations
 import ast
 import math
 import os
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
+
+import yaml
 
 from mindgrasp_launch.errors import LaunchError
 
@@ -244,3 +246,29 @@ def is_substitution(value: object) -> bool:
     if isinstance(value, (list, tuple)):
         return any(isinstance(v, Substitution) for v in value)
     return False
+
+
+def _parse_value(text: str) -> Any:
+    """A substituted parameter value is read as YAML, as launch_ros does ('3' -> 3)."""
+    try:
+        value = yaml.safe_load(text)
+    except yaml.YAMLError:
+        return text
+    if value is None or isinstance(value, dict):
+        return text
+    if isinstance(value, list) and not all(isinstance(v, (bool, int, float, str)) for v in value):
+        return text
+    return value
+
+
+def resolve_parameter_value(context: LaunchContext, value: Any) -> Any:
+    """Resolve substitutions in a parameter value (text read as YAML, as launch_ros does)."""
+    if is_substitution(value):
+        return _parse_value(perform_substitutions(context, value))
+    if isinstance(value, Mapping):
+        return {str(k): resolve_parameter_value(context, v) for k, v in value.items()}
+    if isinstance(value, Path):
+        return str(value)
+    if isinstance(value, tuple):
+        return list(value)
+    return value

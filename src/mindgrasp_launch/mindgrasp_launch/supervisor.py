@@ -10,8 +10,8 @@ SIGINT timeout once the launch asked it to (exit code 0, or killed by that SIGIN
 that needed SIGTERM or SIGKILL, or died with another code, did not; the launch's exit code is 0
 only when every process ended cleanly.
 
-The supervisor is a caller of the graph host (:mod:`mindgrasp_ros.graph_host`): each process is
-a :class:`~mindgrasp_ros.graph_host.ProcessHandle` of the ``Processes`` scheduler, which polls
+The supervisor is a caller of the graph host (:mod:`mindgrasp_ros.graph.host`): each process is
+a :class:`~mindgrasp_ros.graph.host.ProcessHandle` of the ``Processes`` scheduler, which polls
 them; a process has ended when its ``done`` future has (:func:`~mindgrasp_ros.node_main.is_done`,
 as for every node of every graph host), and the launch stops them in the graph host's shutdown
 order (:func:`~mindgrasp_ros.node_main.end_graph`: newest first). What is the launch's own: the
@@ -40,7 +40,7 @@ from typing import IO
 
 from mindgrasp_launch.actions.execute_process import ProcessSpec
 from mindgrasp_launch.output import Printer
-from mindgrasp_ros.graph_host import GraphRunner, Processes
+from mindgrasp_ros.graph.host import GraphRunner, Processes
 from mindgrasp_ros.node_main import is_done
 
 logger = logging.getLogger('launch')

@@ -23,11 +23,15 @@ __all__ = ['RunNode', 'run_nodes']
 class RunNode:
     """One node of a run.
 
-    Attributes:
-        label: The run's label of the node (its ``params/<label>.yaml`` and log).
-        name: Fully qualified node name (``/classifier``), the section of ``params.yaml``.
-        traits: What its class declares (the defaults when its module no longer loads: an old
-            run still reads).
+    Attributes
+    ----------
+    label
+        The run's label of the node (its ``params/<label>.yaml`` and log).
+    name
+        Fully qualified node name (``/classifier``), the section of ``params.yaml``.
+    traits
+        What its class declares (the defaults when its module no longer loads: an old
+        run still reads).
     """
 
     label: str
@@ -39,7 +43,8 @@ def run_nodes(run_dir: str | Path) -> list[RunNode]:
     """The nodes ``run_dir/launch.yaml`` lists (none without the file or a readable list)."""
     import yaml
 
-    from mindgrasp_ros.composition import CompositionError, load_node_class
+    from mindgrasp_ros.errors import CompositionError
+    from mindgrasp_ros.graph.loader import load_node_class
 
     try:
         launch = yaml.safe_load((Path(run_dir) / 'launch.yaml').read_text(encoding='utf-8'))

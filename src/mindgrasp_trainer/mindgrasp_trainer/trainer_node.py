@@ -28,7 +28,7 @@ from mindgrasp_ros.interfaces.mindgrasp_msgs.srv import ResetSim
 from mindgrasp_ros.interfaces.sensor_msgs.msg import JointState
 from mindgrasp_ros.interfaces.std_msgs.msg import Float64, Float64MultiArray
 
-from mindgrasp_common.robot_description import RobotDescriptionError, load_robot
+from mindgrasp_common.robot_description import RobotDescriptionError, load_robot, robot_choices
 from mindgrasp_ros import rclpy
 from mindgrasp_ros.node_main import run_node
 from mindgrasp_ros.node_traits import NodeTraits
@@ -78,9 +78,8 @@ class TrainerParams:
     approach_joint: int = param(1, 'zero-based joint moved for both hands/feet (1: joint 2, '
                                 'shoulder)', min=0, max=63)
     robot: str = param('mindgrasp_arm', "the training robot, a second copy of the user's arm "
-                       '(the same robot:= as the simulator): a shipped robot (mindgrasp_arm, '
-                       'xarm6) or a robot description YAML path; the command has one velocity '
-                       'per arm joint')
+                       f'(the same robot:= as the simulator): {robot_choices()}; the command '
+                       'has one velocity per arm joint')
     reset_height: float = param(0.1, 'reset when the training end-effector goes below this',
                                 unit='m', min=-10.0, max=10.0)
     grasp_state: int = param(GRASP_OBJECT, '... or when /fsm/state enters this state '

@@ -4,7 +4,7 @@ Layers: ROS-free algorithms (:mod:`~mindgrasp_vision.detector` colour segmentati
 :mod:`~mindgrasp_vision.ranking` object-of-interest choice, :mod:`~mindgrasp_vision.overlay` AR
 image, :mod:`~mindgrasp_vision.shape_cnn` depth shape classifier, :mod:`~mindgrasp_vision.pipeline`
 all of them per frame), the simulator data set (:mod:`~mindgrasp_vision.dataset`), the
-``mindgrasp train vision`` command (:mod:`~mindgrasp_vision.train_cli`) and the ROS node
+``mindgrasp train vision`` command (:mod:`~mindgrasp_vision.commands.train_vision`) and the ROS node
 (:mod:`~mindgrasp_vision.vision_node`).
 
 Heavy modules (torch, the simulator) are imported only when used.

@@ -39,8 +39,8 @@ from mindgrasp_ros.topics import (
     VISION_OVERLAY,
 )
 from mindgrasp_vision._checks import VisionError
-from mindgrasp_vision.config import VisionConfig
 from mindgrasp_vision.detector import CameraModel
+from mindgrasp_vision.params import VisionConfig
 from mindgrasp_vision.ros_conversions import (
     depth_from_image,
     detection_to_msg,

@@ -32,6 +32,8 @@ from mindgrasp_launch.launch_api import (
 
 
 def generate_launch_description() -> LaunchDescription:
+    from mindgrasp_common.robot_description import robot_choices
+
     seed = LaunchConfiguration('seed')
     return LaunchDescription([
         *eeg_source_arguments(),
@@ -49,8 +51,7 @@ def generate_launch_description() -> LaunchDescription:
                                   'config/param/classifier.yaml'),
         robot_argument(description='the arm this calibration is for: no arm moves in a Graz '
                                    "session; the value is recorded with the run's launch "
-                                   'arguments (mindgrasp_arm, xarm6 or a robot description YAML '
-                                   'path)'),
+                                   f'arguments ({robot_choices()})'),
         *run_directory_actions(),  # ros2 launch: run directory, recorder, duration
         *eeg_source_nodes(config_files('eeg'), seed, 'follow'),
         GroupAction(classifier_nodes(config_files('classifier')),

@@ -60,6 +60,8 @@ from mindgrasp_launch.launch_api import (
 
 
 def generate_launch_description() -> LaunchDescription:
+    from mindgrasp_common.robot_description import robot_choices
+
     return LaunchDescription([
         DeclareLaunchArgument('eeg_stream',
                               description='LSL stream name of the amplifier (as its streaming '
@@ -85,8 +87,8 @@ def generate_launch_description() -> LaunchDescription:
                               description='command-line arguments of the camera driver'),
         command_interface_argument(),
         robot_argument(description="the driver's arm, whose description the controller reads "
-                                   '(joints, limits, URDF kinematics, TCP, camera): '
-                                   'mindgrasp_arm, xarm6 or a robot description YAML path'),
+                                   f'(joints, limits, URDF kinematics, TCP, camera): '
+                                   f'{robot_choices()}'),
         *eeg_pin_arguments(),   # eeg_source_id, eeg_host (or eeg_unpinned:=true): required
         *run_directory_actions(),  # ros2 launch: run directory, recorder, duration
         *driver_nodes('arm'),

@@ -30,6 +30,8 @@ from mindgrasp_launch.launch_api import (
 
 
 def generate_launch_description() -> LaunchDescription:
+    from mindgrasp_common.robot_description import robot_choices
+
     seed = LaunchConfiguration('seed')
     robot = {'robot': LaunchConfiguration('robot')}
     return LaunchDescription([
@@ -50,7 +52,7 @@ def generate_launch_description() -> LaunchDescription:
                                   'classifier); empty: the one in '
                                   'config/param/classifier.yaml'),
         robot_argument(description="the user's arm and the training robot, a second copy of "
-                                   'it: mindgrasp_arm, xarm6 or a robot description YAML path'),
+                                   f'it: {robot_choices()}'),
         *run_directory_actions(),  # ros2 launch: run directory, recorder, duration
         *[Node(package='mindgrasp_sim', executable='sim_node', name='sim',
                parameters=[*config_files('sim'),

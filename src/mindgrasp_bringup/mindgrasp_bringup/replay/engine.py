@@ -4,7 +4,7 @@
     result.report_path      # runs/<run>/replays/<time>/report.md
 
 Why it reproduces exactly: the chosen nodes (the classifier; the controller when asked) run in
-one process under the one graph host (:class:`~mindgrasp_ros.graph_host.GraphRunner`, ``Lockstep``
+one process under the one graph host (:class:`~mindgrasp_ros.graph.host.GraphRunner`, ``Lockstep``
 scheduler) on the bag's clock. Every
 recorded input message (the /eeg/raw chunks with their stamps and sample indices, exactly as
 recorded, never re-chunked) is published at its recorded time, and the graph runs until it is
@@ -59,16 +59,24 @@ _NOT_FED = (CLOCK.name, PARAMETER_EVENTS, '/rosout')
 class ReplayConfig:
     """What to replay and how.
 
-    Attributes:
-        run: Run directory (``runs/<run>``) or its bag folder.
-        controller: Re-run the controller too (open loop), not only the classifier.
-        model: Classifier model file; '' = the one the run used (its params.yaml).
-        params: Extra parameter overrides per node key (``{'classifier': {'min_certainty':
-            0.6}}``).
-        output: Report directory; default ``<run>/replays/<UTC time>``.
-        max_step_s: Longest clock step (s) between recorded messages, so node timers keep
-            their cadence (the controller's control loop).
-        progress: Show a tqdm progress bar on stderr.
+    Attributes
+    ----------
+    run
+        Run directory (``runs/<run>``) or its bag folder.
+    controller
+        Re-run the controller too (open loop), not only the classifier.
+    model
+        Classifier model file; '' = the one the run used (its params.yaml).
+    params
+        Extra parameter overrides per node key (``{'classifier': {'min_certainty':
+        0.6}}``).
+    output
+        Report directory; default ``<run>/replays/<UTC time>``.
+    max_step_s
+        Longest clock step (s) between recorded messages, so node timers keep
+        their cadence (the controller's control loop).
+    progress
+        Show a tqdm progress bar on stderr.
     """
 
     run: str | Path
@@ -150,12 +158,14 @@ def _stamp_ns(header: Any) -> int:
 def replay(cfg: ReplayConfig) -> ReplayResult:
     """Run the replay; the comparison report is written by :func:`.report.write_report`.
 
-    Raises:
-        BagError: the run or bag cannot be read, or has nothing to replay.
+    Raises
+    ------
+    BagError
+        The run or bag cannot be read, or has nothing to replay.
     """
     from mindgrasp_ros import rclpy
-    from mindgrasp_ros.graph_host import GraphRunner, Lockstep
-    from mindgrasp_ros.node_spec import NodeSpec
+    from mindgrasp_ros.graph.host import GraphRunner, Lockstep
+    from mindgrasp_ros.graph.spec import NodeSpec
     from mindgrasp_ros.node_traits import traits_of
     from mindgrasp_ros.runtime.arguments import load_params_file
 

@@ -10,8 +10,6 @@ from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-import yaml
-
 from mindgrasp_launch import params as ros_params
 from mindgrasp_launch.actions.execute_process import (
     ExecuteProcess,
@@ -25,6 +23,7 @@ from mindgrasp_launch.substitutions import (
     Substitution,
     is_substitution,
     perform_substitutions,
+    resolve_parameter_value,
 )
 
 if TYPE_CHECKING:
@@ -124,32 +123,6 @@ def resolve_program(package: str | None, executable: str) -> tuple[list[str], st
     problem = (f"the executable '{executable}' was found neither on PATH nor as a Python "
                f"module: install it, give its full path, or fix the launch argument naming it.")
     return [executable], None, problem
-
-
-def _parse_value(text: str) -> Any:
-    """A substituted parameter value is read as YAML, as launch_ros does ('3' -> 3)."""
-    try:
-        value = yaml.safe_load(text)
-    except yaml.YAMLError:
-        return text
-    if value is None or isinstance(value, dict):
-        return text
-    if isinstance(value, list) and not all(isinstance(v, (bool, int, float, str)) for v in value):
-        return text
-    return value
-
-
-def resolve_parameter_value(context: LaunchContext, value: Any) -> Any:
-    """Resolve substitutions in a parameter value (text read as YAML, as launch_ros does)."""
-    if is_substitution(value):
-        return _parse_value(perform_substitutions(context, value))
-    if isinstance(value, Mapping):
-        return {str(k): resolve_parameter_value(context, v) for k, v in value.items()}
-    if isinstance(value, Path):
-        return str(value)
-    if isinstance(value, tuple):
-        return list(value)
-    return value
 
 
 class Node(ExecuteProcess):

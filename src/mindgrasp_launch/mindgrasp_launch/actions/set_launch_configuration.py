@@ -47,7 +47,7 @@ class SetParameter(Action):
         self.value = value
 
     def execute(self, context: LaunchContext) -> None:
-        from mindgrasp_launch.actions.node import resolve_parameter_value
+        from mindgrasp_launch.substitutions import resolve_parameter_value
 
         context.global_parameters[self.name] = resolve_parameter_value(context, self.value)
 

@@ -29,7 +29,7 @@ EPILOG = """examples:
 
 def _options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--composed', action='store_true',
-                        help='run the node modules in one process (mindgrasp_ros composition)')
+                        help='run the node modules in one process (mindgrasp_ros.graph)')
     parser.add_argument('--lockstep', action='store_true',
                         help='compose the nodes in one process on simulated time, stepped as '
                              'fast as the CPU allows (deterministic for a seed; LSL nodes are '

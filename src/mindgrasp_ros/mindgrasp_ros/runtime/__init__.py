@@ -8,9 +8,7 @@ submodules mirror ``rclpy.node``, ``rclpy.qos``, ``rclpy.executors``, ``rclpy.pa
 
 from __future__ import annotations
 
-import contextlib
 import threading
-from collections.abc import Iterator
 from typing import Any
 
 from mindgrasp_ros.process import handle_stop_signals
@@ -24,57 +22,35 @@ from mindgrasp_ros.runtime import (
     qos,
     task,
     time,
+    utilities,
 )
 from mindgrasp_ros.runtime.context import Context
+from mindgrasp_ros.runtime.utilities import get_default_context, ok
 
 __all__ = [
-    'callback_groups', 'clock', 'create_node', 'default_context', 'duration', 'exceptions',
+    'callback_groups', 'clock', 'create_node', 'duration', 'exceptions',
     'executors', 'get_default_context', 'init', 'logging', 'node', 'ok', 'parameter', 'qos',
     'shutdown', 'spin', 'spin_once', 'spin_until_future_complete', 'task', 'time',
     'try_shutdown', 'utilities',
 ]
 
-_default_context = Context()
 _global_executor: Any = None
 _executor_lock = threading.Lock()
-
-
-def get_default_context() -> Context:
-    return _default_context
-
-
-@contextlib.contextmanager
-def default_context(ctx: Context) -> Iterator[None]:
-    """Make ``ctx`` the default context inside the block: nodes constructed there without a
-    ``context`` argument join it (a lock-step graph builds node classes that call
-    ``super().__init__(name)`` only). Not in rclpy, where a composable node gets its context
-    from the container."""
-    global _default_context
-    previous = _default_context
-    _default_context = ctx
-    try:
-        yield
-    finally:
-        _default_context = previous
 
 
 def init(*, args: list[str] | None = None, context: Context | None = None,
          domain_id: int | None = None, signal_handler_options: object = None) -> None:
     """Initialise the context: parse ``--ros-args`` of ``args`` (default ``sys.argv``) and join
     the DDS domain (``ROS_DOMAIN_ID`` unless ``domain_id`` is given)."""
-    ctx = context or _default_context
+    ctx = context or get_default_context()
     ctx.init(args, domain_id=domain_id)
     handle_stop_signals()      # as rclpy: whatever the process inherited
 
 
-def ok(*, context: Context | None = None) -> bool:
-    return (context or _default_context).ok()
-
-
 def shutdown(*, context: Context | None = None, uninstall_handlers: bool | None = None) -> None:
     global _global_executor
-    ctx = context or _default_context
-    if ctx is _default_context:
+    ctx = context or get_default_context()
+    if ctx is get_default_context():
         with _executor_lock:
             if _global_executor is not None:
                 _global_executor.shutdown()
@@ -83,7 +59,7 @@ def shutdown(*, context: Context | None = None, uninstall_handlers: bool | None 
 
 
 def try_shutdown(*, context: Context | None = None) -> None:
-    ctx = context or _default_context
+    ctx = context or get_default_context()
     if ctx.ok():
         shutdown(context=ctx)
 
@@ -137,10 +113,9 @@ def spin_until_future_complete(node: Any, future: Any, executor: Any = None,
 def __getattr__(name: str) -> Any:
     import importlib
 
-    if name in ('node', 'executors', 'utilities', 'rate', 'graph', 'entities', 'names',
-                'arguments', 'publisher', 'subscription'):
-        target = {'publisher': 'entities', 'subscription': 'entities'}.get(name, name)
-        module = importlib.import_module(f'{__name__}.{target}')
+    if name in ('node', 'executors', 'rate', 'names', 'arguments', 'publisher', 'subscription',
+                'timer', 'service', 'client', 'guard_condition'):
+        module = importlib.import_module(f'{__name__}.{name}')
         globals()[name] = module
         return module
     raise AttributeError(f'module {__name__!r} has no attribute {name!r}')

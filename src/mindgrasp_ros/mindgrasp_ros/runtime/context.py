@@ -1,7 +1,7 @@
 """``rclpy.context.Context``: one per process normally; owns the DDS participant.
 
 A context made with ``transport='intra'`` has no DDS at all: its nodes talk only in-process. The
-lock-step runner of :mod:`mindgrasp_ros.composition` uses that for deterministic batch runs.
+lock-step runner of :mod:`mindgrasp_ros.graph` uses that for deterministic batch runs.
 """
 
 from __future__ import annotations
@@ -19,11 +19,12 @@ from mindgrasp_ros.runtime.logging import get_logger, set_logger_level
 from mindgrasp_ros.runtime.qos import QoSProfile
 
 if TYPE_CHECKING:
-    from mindgrasp_ros.runtime.dds import DdsParticipant, DdsWriter
-    from mindgrasp_ros.runtime.entities import Publisher, Subscription, _Delivery
-    from mindgrasp_ros.runtime.graph import GraphCache
+    from mindgrasp_ros.runtime.dds.discovery import GraphCache
+    from mindgrasp_ros.runtime.dds.participant import DdsParticipant, DdsWriter
     from mindgrasp_ros.runtime.intra_graph import IntraGraph
     from mindgrasp_ros.runtime.node import Node
+    from mindgrasp_ros.runtime.publisher import Delivery, Publisher
+    from mindgrasp_ros.runtime.subscription import Subscription
 
 __all__ = ['Context']
 
@@ -77,7 +78,7 @@ class IntraProcess:
             return False
         return sub.qos_profile.is_compatible_with(pub.qos_profile)
 
-    def deliver(self, pub: Publisher, delivery: _Delivery) -> None:
+    def deliver(self, pub: Publisher, delivery: Delivery) -> None:
         subs = self._subs.get(pub.topic_name)
         if not subs:
             return
@@ -136,7 +137,7 @@ class Context:
                 raise RCLError(msg)
             self.transport = transport
             if transport == 'dds':
-                from mindgrasp_ros.runtime.dds import DdsParticipant
+                from mindgrasp_ros.runtime.dds.participant import DdsParticipant
 
                 self.dds = DdsParticipant(domain_id)
                 self.domain_id = self.dds.domain_id
@@ -246,7 +247,7 @@ class Context:
 
                     self._graph = IntraGraph(self)
                 else:
-                    from mindgrasp_ros.runtime.graph import GraphCache
+                    from mindgrasp_ros.runtime.dds.discovery import GraphCache
 
                     self._graph = GraphCache(self.require_dds('Graph introspection'))
             return self._graph

@@ -1,40 +1,32 @@
 """``rclpy.executors``: run the callbacks of nodes.
 
-Each executor owns a DDS WaitSet (ReadConditions of its nodes' readers plus a GuardCondition for
-in-process deliveries, timers and shutdown) and blocks on it with the GIL released. Waits are
-capped at 100 ms so that Ctrl-C (KeyboardInterrupt) is handled promptly, as Python signal
-handlers only run between bytecodes. The wait names the ReadConditions that fired (each is
-attached with its own key), and only those readers are taken from: a take from an empty reader
-costs ~5 us, and a node with a dozen readers (its parameter services count) woke ~150 times a
-second into ~15 of them for each message.
+Each executor owns a DDS wait set (:class:`~mindgrasp_ros.runtime.dds.waitset.DdsWaitSet`:
+ReadConditions of its nodes' readers plus a guard condition for in-process deliveries, timers and
+shutdown) and blocks on it with the GIL released. Waits are capped at 100 ms so that Ctrl-C
+(KeyboardInterrupt) is handled promptly, as Python signal handlers only run between bytecodes.
+The wait names the readers that fired, and only those are taken from.
 """
 
 from __future__ import annotations
 
 import concurrent.futures
-import itertools
 import os
 import threading
 import time
 from collections.abc import Callable
 from typing import Any
 
-from cyclonedds.core import (
-    DDSException,
-    InstanceState,
-    ReadCondition,
-    SampleState,
-    ViewState,
-    WaitSet,
-)
-from cyclonedds.core import GuardCondition as DdsGuardCondition
-from cyclonedds.internal import dds_c_t
-
 from mindgrasp_ros.errors import CompositionError, NodeCallbackError
+from mindgrasp_ros.runtime.client import Client
 from mindgrasp_ros.runtime.context import Context
-from mindgrasp_ros.runtime.entities import Client, GuardCondition, Service, Subscription, Timer
+from mindgrasp_ros.runtime.dds.waitset import DdsWaitSet
 from mindgrasp_ros.runtime.exceptions import RCLError
+from mindgrasp_ros.runtime.guard_condition import GuardCondition
+from mindgrasp_ros.runtime.service import Service
+from mindgrasp_ros.runtime.subscription import Subscription
 from mindgrasp_ros.runtime.task import Future
+from mindgrasp_ros.runtime.timer import Timer
+from mindgrasp_ros.runtime.utilities import get_default_context
 
 __all__ = [
     'Executor',
@@ -47,7 +39,6 @@ __all__ = [
 ]
 
 _MAX_WAIT_S = 0.1
-_ANY = SampleState.Any | ViewState.Any | InstanceState.Any
 
 
 class ExternalShutdownException(RCLError):
@@ -69,8 +60,6 @@ class Executor:
     """Base executor: collects ready work from its nodes and runs it."""
 
     def __init__(self, *, context: Context | None = None) -> None:
-        from mindgrasp_ros.runtime import get_default_context
-
         self._context = context or get_default_context()
         self._nodes: list[Any] = []
         self._lock = threading.RLock()
@@ -78,19 +67,13 @@ class Executor:
         self._generation = -1
         self._cond = threading.Condition()
         self._woken = False
-        self._waitset: WaitSet | None = None
-        self._guard: DdsGuardCondition | None = None
-        self._conditions: dict[int, tuple[Any, ReadCondition]] = {}
-        self._reader_of_key: dict[int, int] = {}    # WaitSet attach key -> id(reader)
-        self._keys = itertools.count(1)
+        self._waitset: DdsWaitSet | None = None
         self._ready: set[int] | None = None         # ids of readers the last wait saw fire
         self._pending: list[Work] = []
         self._waiting = False
         dds = self._context.dds
         if dds is not None:
-            self._waitset = WaitSet(dds.participant)
-            self._guard = DdsGuardCondition(dds.participant)
-            self._waitset.attach(self._guard)
+            self._waitset = DdsWaitSet(dds)
 
     @property
     def context(self) -> Context:
@@ -137,11 +120,8 @@ class Executor:
         with self._cond:
             self._woken = True
             self._cond.notify_all()
-        if self._guard is not None:
-            try:
-                self._guard.set(True)
-            except Exception:
-                pass
+        if self._waitset is not None:
+            self._waitset.trigger()
 
     def shutdown(self, timeout_sec: float | None = None) -> bool:
         self._is_shutdown = True
@@ -155,15 +135,8 @@ class Executor:
         return True
 
     def _release_waitset(self) -> None:
-        if self._waitset is None or self._context.dds is None:
-            return
-        for _entity, cond in self._conditions.values():
-            try:
-                self._waitset.detach(cond)
-                cond.__del__()
-            except Exception:
-                pass
-        self._conditions.clear()
+        if self._waitset is not None and self._context.dds is not None:
+            self._waitset.release()
 
     # ------------------------------------------------------------------ waiting
     def _sync_conditions(self) -> bool:
@@ -176,30 +149,10 @@ class Executor:
         wanted: dict[int, Any] = {}
         for node in self._nodes:
             for entity in (*node.subscriptions, *node.services, *node.clients):
-                reader = getattr(entity, '_reader', None)
+                reader = entity.dds_reader
                 if reader is not None and not entity.polled:
                     wanted[id(reader)] = reader
-        for key in list(self._conditions):
-            if key not in wanted:
-                _reader, cond = self._conditions.pop(key)
-                self._reader_of_key = {k: r for k, r in self._reader_of_key.items() if r != key}
-                try:
-                    self._waitset.detach(cond)
-                    cond.__del__()
-                except Exception:
-                    pass
-        for key, reader in wanted.items():
-            if key not in self._conditions:
-                cond = ReadCondition(reader.reader, _ANY)
-                # attached with a key of ours (WaitSet.attach passes its own), so that a wait
-                # names the conditions that fired; WaitSet.detach still finds it in `attached`
-                attach_key = next(self._keys)
-                ret = self._waitset._waitset_attach(self._waitset._ref, cond._ref, attach_key)
-                if ret < 0:
-                    raise DDSException(ret, 'Occurred while attaching a ReadCondition')
-                self._waitset.attached.append((cond, None))
-                self._reader_of_key[attach_key] = key
-                self._conditions[key] = (reader, cond)
+        self._waitset.watch(wanted)
         return True
 
     def _timeout_for_timers(self, timeout_sec: float | None) -> float | None:
@@ -220,14 +173,7 @@ class Executor:
         ReadCondition fired (None when it cannot tell: every reader is then taken from)."""
         if self._waitset is None or self._context.dds is None:
             return None
-        n = len(self._conditions) + 2
-        keys = (dds_c_t.attach * n)()
-        count = self._waitset._waitset_wait(self._waitset._ref, keys, n, timeout_ns)
-        if count < 0:
-            raise DDSException(count, f'Occurred while waiting in {self._waitset!r}')
-        if count > n:
-            return None
-        return {self._reader_of_key[k] for k in keys[:count] if k in self._reader_of_key}
+        return self._waitset.wait(timeout_ns)
 
     def _wait(self, timeout_sec: float | None) -> None:
         self._ready = None
@@ -247,8 +193,7 @@ class Executor:
     def _wait_blocking(self, timeout: float) -> None:
         if self._waitset is not None and self._context.dds is not None:
             self._ready = self._triggered(int(timeout * 1e9))
-            if self._guard is not None and self._guard.read():
-                self._guard.set(False)
+            self._waitset.clear_trigger()
             with self._cond:
                 self._woken = False
         else:
@@ -436,8 +381,9 @@ class MultiThreadedExecutor(Executor):
 
 class LockstepExecutor(Executor):
     """Runs ready callbacks until none is left, in the calling thread and a fixed order, for a
-    DDS-less context on a clock that only its owner advances (lock-step: :class:`~mindgrasp_ros.
-    composition.LockstepRunner` steps the clock, then calls :meth:`spin_until_quiescent`).
+    DDS-less context on a clock that only its owner advances (lock-step:
+    :class:`~mindgrasp_ros.graph.lockstep.LockstepRunner` steps the clock, then calls
+    :meth:`spin_until_quiescent`).
 
     It never waits: nothing arrives from outside the process, and time moves only between
     steps. Readiness comes from the entities' own API, as rclpy's executors take it from the

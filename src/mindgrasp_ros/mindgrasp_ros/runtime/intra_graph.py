@@ -1,10 +1,10 @@
 """Graph introspection of a DDS-less (``transport='intra'``) context.
 
-A lock-step run (:class:`mindgrasp_ros.composition.LockstepRunner`) has no DDS participant, so
+A lock-step run (:class:`mindgrasp_ros.graph.lockstep.LockstepRunner`) has no DDS participant, so
 there is no discovery to ask; its whole graph is the nodes of the one context. This answers the
-same queries as :class:`mindgrasp_ros.runtime.graph.GraphCache` from those nodes' publishers,
-subscriptions, services and clients (their type names and QoS as created), so a node that
-discovers topics (the bag recorder) works the same in lock-step as on DDS.
+same queries as :class:`mindgrasp_ros.runtime.dds.discovery.GraphCache` from those nodes'
+publishers, subscriptions, services and clients (their type names and QoS as created), so a node
+that discovers topics (the bag recorder) works the same in lock-step as on DDS.
 """
 
 from __future__ import annotations

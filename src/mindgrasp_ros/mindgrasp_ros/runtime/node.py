@@ -12,17 +12,10 @@ from mindgrasp_ros.runtime.callback_groups import (
     CallbackGroup,
     MutuallyExclusiveCallbackGroup,
 )
+from mindgrasp_ros.runtime.client import Client
 from mindgrasp_ros.runtime.clock import Clock, ROSClock
 from mindgrasp_ros.runtime.context import Context
-from mindgrasp_ros.runtime.entities import (
-    Client,
-    Entity,
-    GuardCondition,
-    Publisher,
-    Service,
-    Subscription,
-    Timer,
-)
+from mindgrasp_ros.runtime.entity import Entity
 from mindgrasp_ros.runtime.exceptions import (
     InvalidParameterTypeException,
     InvalidParameterValueException,
@@ -31,6 +24,7 @@ from mindgrasp_ros.runtime.exceptions import (
     ParameterNotDeclaredException,
     ParameterUninitializedException,
 )
+from mindgrasp_ros.runtime.guard_condition import GuardCondition
 from mindgrasp_ros.runtime.names import (
     apply_remaps,
     expand_topic_name,
@@ -38,6 +32,7 @@ from mindgrasp_ros.runtime.names import (
     validate_node_name,
 )
 from mindgrasp_ros.runtime.parameter import Parameter, parameter_value_to_python
+from mindgrasp_ros.runtime.publisher import Publisher
 from mindgrasp_ros.runtime.qos import (
     QoSProfile,
     as_profile,
@@ -46,6 +41,10 @@ from mindgrasp_ros.runtime.qos import (
     qos_profile_rosout_default,
     qos_profile_services_default,
 )
+from mindgrasp_ros.runtime.service import Service
+from mindgrasp_ros.runtime.subscription import Subscription
+from mindgrasp_ros.runtime.timer import Timer
+from mindgrasp_ros.runtime.utilities import get_default_context
 from mindgrasp_ros.typesupport import get_message_class, get_service_class, normalize_type_name
 
 if TYPE_CHECKING:
@@ -70,7 +69,6 @@ class Node:
                  parameter_overrides: list[Parameter] | None = None,
                  allow_undeclared_parameters: bool = False,
                  automatically_declare_parameters_from_overrides: bool = False) -> None:
-        from mindgrasp_ros.runtime import get_default_context
         from mindgrasp_ros.runtime.arguments import RosArguments, parse_ros_args
 
         self.context = context or get_default_context()
@@ -85,14 +83,6 @@ class Node:
         if cli_args:
             args.extend(parse_ros_args(['--ros-args', *cli_args]
                                        if '--ros-args' not in cli_args else cli_args))
-        from mindgrasp_ros.composition import (
-            pending_component_arguments,
-            pending_component_parameters,
-        )
-
-        component_args = pending_component_arguments()
-        if component_args:  # a node loaded as a component gets its own --ros-args
-            args.extend(parse_ros_args(component_args))
         self._args = args
         validate_node_name(node_name)
         self._name = validate_node_name(args.node_name_override(node_name) or node_name)
@@ -118,10 +108,8 @@ class Node:
         self._set_callbacks: list[Callable] = []
         self._allow_undeclared = allow_undeclared_parameters
         self._overrides: dict[str, Any] = dict(args.parameters_for(self._name, self._namespace))
-        for p in parameter_overrides or []:
+        for p in parameter_overrides or []:   # typed values win over the arguments' (rclpy)
             self._overrides[p.name] = p.value
-        # a component's typed parameters (NodeSpec.parameters) win, as its -p would
-        self._overrides.update(pending_component_parameters())
 
         self.context.add_node(self)
         self._clock = ROSClock()

@@ -26,7 +26,7 @@ from mindgrasp_bringup.session import (
     load_plan,
 )
 from mindgrasp_common.cli_checks import non_negative_int, positive_int, probability
-from mindgrasp_common.robot_description import RobotDescriptionError, load_robot
+from mindgrasp_common.robot_description import RobotDescriptionError, load_robot, robot_choices
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -50,8 +50,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help='seed of every phase (0)')
     parser.add_argument('--robot', default=None, metavar='NAME|YAML',
                         help='the arm of the Trainer and test phases (the user\'s arm and the '
-                             'training robot, a second copy of it): mindgrasp_arm (default), '
-                             'xarm6 or a robot description YAML path')
+                             'training robot, a second copy of it; default mindgrasp_arm): '
+                             f'{robot_choices()}')
     if getattr(parser, 'prog', '').endswith('calibrate'):
         parser.set_defaults(plan='calibrate')
         parser.add_argument('--virtual-accuracy', type=probability, required=True, metavar='A',

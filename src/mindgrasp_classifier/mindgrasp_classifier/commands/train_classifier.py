@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from mindgrasp_classifier._cli_common import (
+from mindgrasp_classifier.commands._common import (
     add_data_arguments,
     format_cv_report,
     load_from_args,

@@ -22,6 +22,7 @@ from mindgrasp_experiments.cli import (
     run_experiment,
     subject_type,
 )
+from mindgrasp_experiments.commands import experiment_sweep
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -44,4 +45,4 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
-    return run_experiment(args, 'set_locations', 'set-locations')
+    return run_experiment(args, 'set_locations', 'set-locations', compare=experiment_sweep.compare)

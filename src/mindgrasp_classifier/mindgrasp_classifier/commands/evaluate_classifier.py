@@ -7,7 +7,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from mindgrasp_classifier._cli_common import (
+from mindgrasp_classifier.commands._common import (
     add_data_arguments,
     format_report,
     load_from_args,

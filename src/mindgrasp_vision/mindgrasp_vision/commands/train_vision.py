@@ -29,7 +29,7 @@ import numpy as np
 from mindgrasp_common.cli_checks import non_negative_int, positive_float, positive_int, probability
 from mindgrasp_common.resources import resource_path
 from mindgrasp_vision._checks import VisionError
-from mindgrasp_vision.config import DEFAULT_SHAPE_MODEL
+from mindgrasp_vision.params import DEFAULT_SHAPE_MODEL
 
 __all__ = ['add_arguments', 'main', 'split_indices']
 

@@ -11,9 +11,8 @@ from __future__ import annotations
 import argparse
 import sys
 
+from mindgrasp_eeg import EEGError
 from mindgrasp_ros.topics import EEG_RAW
-
-from . import EEGError
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -28,7 +27,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def main(args: argparse.Namespace) -> int:
     """Export; 0 on success, 1 with a message on bad input."""
-    from .export import default_output, read_session, write_recording
+    from mindgrasp_eeg.export import default_output, read_session, write_recording
 
     try:
         recording = read_session(args.path, args.eeg_topic)   # the bag is read once

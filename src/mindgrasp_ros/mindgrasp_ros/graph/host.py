@@ -1,7 +1,7 @@
-"""One graph host: a graph's nodes (:class:`~mindgrasp_ros.node_spec.NodeSpec`) run by one runner
-under an interchangeable scheduler.
+"""One graph host: a graph's nodes (:class:`~mindgrasp_ros.graph.spec.NodeSpec`) run by one
+runner under an interchangeable scheduler.
 
-    from mindgrasp_ros.graph_host import GraphRunner, InProcess, Lockstep, Processes
+    from mindgrasp_ros.graph import GraphRunner, InProcess, Lockstep, Processes
 
     code = GraphRunner(Lockstep(step_s=0.02)).run(specs, duration_s=60.0)   # simulated time
     code = GraphRunner(InProcess()).run(specs)                              # one process
@@ -15,9 +15,11 @@ the nodes are destroyed newest first) and its exit code is
 :func:`~mindgrasp_ros.node_main.graph_exit_code` (1 when a node failed, raised in a callback or
 ended with a non-zero code, with one ``[node] ERROR: ...`` line each, else 0).
 
-The ``--composed`` container (``run_composed``), ``mindgrasp launch --lockstep``
+The ``--composed`` container (:func:`run_composed`), ``mindgrasp launch --lockstep``
 (``run_lockstep``), the experiment engine (``run_trial``) and replay call this runner; the
-scheduler and what they wait for are all that differs between them.
+scheduler and what they wait for are all that differs between them. A scheduler that builds a
+node in its own process passes the spec's arguments to the node class as rclpy's ``Node`` takes
+them (``cli_args``, ``parameter_overrides``): the same under our runtime and the real rclpy.
 """
 
 from __future__ import annotations
@@ -30,10 +32,12 @@ from collections.abc import Callable, Iterable, Sequence
 from pathlib import Path
 from typing import Any, Protocol
 
-from mindgrasp_ros.errors import NodeCallbackError
-from mindgrasp_ros.node_spec import NodeSpec
+from mindgrasp_ros.errors import CompositionError, NodeCallbackError
+from mindgrasp_ros.graph.loader import check_composable, load_node_class
+from mindgrasp_ros.graph.spec import NodeSpec
 
-__all__ = ['GraphRunner', 'InProcess', 'Lockstep', 'ProcessHandle', 'Processes', 'Scheduler']
+__all__ = ['GraphRunner', 'InProcess', 'Lockstep', 'ProcessHandle', 'Processes', 'Scheduler',
+           'run_composed']
 
 
 class Scheduler(Protocol):
@@ -128,11 +132,11 @@ class GraphRunner:
 
 class Lockstep:
     """Every node in this process, DDS-less, on a simulated clock advanced ``step_s`` at a time
-    (:class:`~mindgrasp_ros.composition.LockstepRunner`): the same seed gives the same messages
+    (:class:`~mindgrasp_ros.graph.lockstep.LockstepRunner`): the same seed gives the same messages
     in the same order whatever the machine's load."""
 
     def __init__(self, step_s: float = 0.02, *, start_time_ns: int = 0) -> None:
-        from mindgrasp_ros.composition import LockstepRunner
+        from mindgrasp_ros.graph.lockstep import LockstepRunner
 
         self.step_s = step_s
         self.runner = LockstepRunner(start_time_ns=start_time_ns)
@@ -167,11 +171,11 @@ class InProcess:
         self._t0 = time.monotonic()
 
     def add(self, spec: NodeSpec) -> Any:
-        from mindgrasp_ros.composition import component_arguments
+        from mindgrasp_ros import rclpy
 
         node_class = spec.node_class()
-        with component_arguments(spec.ros_arguments(), spec.parameters):
-            node = node_class()
+        check_composable(node_class, ('cli_args', 'parameter_overrides'))
+        node = node_class(**spec.node_arguments(rclpy.parameter.Parameter))
         self.executor.add_node(node)
         return node
 
@@ -288,15 +292,23 @@ class Processes:
         end_graph(None, nodes)
 
 
+def run_composed(specs: Sequence[NodeSpec], *, num_threads: int | None = None,
+                 duration_s: float = 0.0) -> int:
+    """Every node of ``specs`` in this process under one MultiThreadedExecutor
+    (:class:`InProcess`), until a node ends, ``duration_s`` (> 0) or Ctrl-C, as a launch ends
+    when one of its processes ends. Returns the graph's exit code
+    (:func:`~mindgrasp_ros.node_main.graph_exit_code`: 1 when a node failed)."""
+    return GraphRunner(InProcess(num_threads)).run(specs, duration_s=duration_s)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
-    """``python -m mindgrasp_ros.graph_host pkg.mod:Class [--ros-args ...]``: one node class
+    """``python -m mindgrasp_ros.graph.host pkg.mod:Class [--ros-args ...]``: one node class
     under :func:`~mindgrasp_ros.node_main.run_node` (a module's own ``main()`` otherwise)."""
-    from mindgrasp_ros.composition import CompositionError, load_node_class
     from mindgrasp_ros.node_main import EXIT_REFUSED, run_node
 
     argv = list(sys.argv[1:] if argv is None else argv)
     if not argv:
-        print('usage: python -m mindgrasp_ros.graph_host pkg.mod[:Class] [--ros-args ...]',
+        print('usage: python -m mindgrasp_ros.graph.host pkg.mod[:Class] [--ros-args ...]',
               file=sys.stderr)
         return EXIT_REFUSED
     try:

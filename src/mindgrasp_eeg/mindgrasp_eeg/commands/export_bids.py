@@ -16,8 +16,7 @@ import argparse
 import sys
 
 from mindgrasp_common.cli_checks import positive_float
-
-from . import EEGError
+from mindgrasp_eeg import EEGError
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -43,7 +42,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def main(args: argparse.Namespace) -> int:
     """Export; 0 on success, 1 with one line on bad input."""
-    from .bids import export_bids
+    from mindgrasp_eeg.bids import export_bids
 
     try:
         files = export_bids(args.paths, args.root, args.subject, args.session,

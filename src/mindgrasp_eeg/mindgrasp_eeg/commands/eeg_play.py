@@ -13,8 +13,7 @@ import argparse
 import sys
 
 from mindgrasp_common.cli_checks import non_negative_float, positive_float
-
-from . import EEGError
+from mindgrasp_eeg import EEGError
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -43,7 +42,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def main(args: argparse.Namespace) -> int:
     """Run the player; returns 0, or 1 with a message on bad input."""
-    from .player import DatasetPlayer, concatenate, expand_sources, load_recording
+    from mindgrasp_eeg.player import DatasetPlayer, concatenate, expand_sources, load_recording
 
     try:
         recording = concatenate([load_recording(f) for f in expand_sources(args.files)])

@@ -24,7 +24,7 @@ from cyclonedds.builtin_types import DcpsEndpoint
 from cyclonedds.core import InstanceState, Policy, Qos, ReadCondition, SampleState, ViewState
 from cyclonedds.util import duration
 
-from mindgrasp_ros.runtime.dds import (
+from mindgrasp_ros.runtime.dds.participant import (
     DdsParticipant,
     ros_topic_name_from_dds,
     ros_type_name_from_dds,

@@ -56,8 +56,9 @@ def main(args: argparse.Namespace) -> int:
 
     from mindgrasp_eeg import EEGError
     from mindgrasp_experiments import ExperimentError
-    from mindgrasp_experiments.cli import experiment_from, subject_launch_args
+    from mindgrasp_experiments.cli import experiment_from
     from mindgrasp_experiments.fitted_subject import is_fitted
+    from mindgrasp_experiments.subject_launch import subject_launch_args
     from mindgrasp_experiments.subjects import is_replay
     from mindgrasp_experiments.sweep import (
         check_params,
@@ -192,3 +193,17 @@ def main(args: argparse.Namespace) -> int:
 def _pct(rate: float | None) -> str:
     """A rate of the sweep document (None: not defined) in per cent."""
     return 'n/a' if rate is None else f'{100 * rate:.1f} %'
+
+
+def compare(args: argparse.Namespace, command: str) -> int:
+    """``set-locations --param NODE.PARAM=V1,V2``: the comparison is a sweep over those values
+    at the subject's accuracy (``mindgrasp experiment sweep``, same records and report)."""
+    subject = getattr(args, 'subject', 'virtual')
+    if subject in ('noise', 'oracle', 'autonomous'):
+        return fail(command, f'--param with several values compares them as a sweep, which '
+                             f'varies a pursuing subject; --subject {subject} takes one value '
+                             'per --param (run the command once per value).')
+    print(f'{command}: several values of --param: comparing them as a sweep at accuracy '
+          f'{args.accuracy:g}.', file=sys.stderr)
+    return main(argparse.Namespace(**{**vars(args), 'accuracy': str(args.accuracy),
+                                      'subject': subject, 'seeds': None}))

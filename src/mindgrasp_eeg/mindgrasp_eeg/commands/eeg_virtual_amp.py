@@ -21,8 +21,7 @@ import sys
 import time
 
 from mindgrasp_common.cli_checks import non_negative_float, non_negative_int, probability
-
-from . import EEGError
+from mindgrasp_eeg import EEGError
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -66,11 +65,11 @@ def run_without_ros(args: argparse.Namespace) -> int:
     """Stream with an internal Graz-like cue schedule; cues as LSL markers."""
     import numpy as np
 
-    from .lsl import EEGOutlet, MarkerOutlet
-    from .montage import NAUTILUS_32, NO_CLASS, class_name
-    from .subject import VirtualSubject
-    from .synthetic import SyntheticEEG
-    from .virtual_amp import VirtualAmplifier
+    from mindgrasp_eeg.lsl import EEGOutlet, MarkerOutlet
+    from mindgrasp_eeg.montage import NAUTILUS_32, NO_CLASS, class_name
+    from mindgrasp_eeg.subject import VirtualSubject
+    from mindgrasp_eeg.synthetic import SyntheticEEG
+    from mindgrasp_eeg.virtual_amp import VirtualAmplifier
 
     mode = 'follow' if args.cues else 'noise'
     subject = VirtualSubject(mode, accuracy=args.accuracy, reaction_delay=args.reaction_delay,
@@ -116,7 +115,7 @@ def main(args: argparse.Namespace) -> int:
                       'out --no-ros or the ROS arguments.', file=sys.stderr)
                 return 2
             return run_without_ros(args)
-        from .virtual_amp_node import main as node_main
+        from mindgrasp_eeg.virtual_amp_node import main as node_main
 
         return node_main(['virtual_amp', *_ros_argv(args)])
     except EEGError as exc:

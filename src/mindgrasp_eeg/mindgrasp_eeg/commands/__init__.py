@@ -1,0 +1,1 @@
+"""Verbs of the mindgrasp command (entry points 'mindgrasp.verb'), one module each."""
