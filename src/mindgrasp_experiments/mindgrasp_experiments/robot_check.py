@@ -197,7 +197,7 @@ def reachability(robot: RobotDescription, out_dir: Path | None = None,
     q = np.array(robot.home_pose)
     rows = []
     for r in np.arange(REACH[0], REACH[1] + 1e-9, 0.05):
-        for a in np.radians(np.arange(-170, 171, 10)):
+        for a in np.radians(np.arange(-170, 171, 20)):
             x, y = r * math.cos(a), r * math.sin(a)
             ok = fsm.policy.reachable(np.array([x, y, 0.025]), shape, q) == ''
             rows.append((x, y, float(ok)))
