@@ -34,7 +34,8 @@ SINGLE_XARM6 = {
 
 
 def test_shipped_robots():
-    assert robot_names() == ['mindgrasp_arm', 'panda', 'xarm6']
+    assert robot_names() == ['iiwa_franka_hand', 'iiwa_mindgrasp_hand', 'iiwa_xarm_gripper',
+                             'mindgrasp_arm', 'panda', 'xarm6']
     arm = load_robot()
     assert arm.arm_joints == robot.ARM_JOINTS and arm.home_pose == robot.HOME_POSE
     assert arm.gripper.kind == 'multi_finger' and arm.tcp_link == 'tcp'
@@ -127,7 +128,7 @@ def test_a_gripper_without_limits(tmp_path):
 
 
 @pytest.mark.parametrize(('spec', 'message'), [
-    ('ur5', r"No robot is named 'ur5'; use one of \['mindgrasp_arm', 'panda', 'xarm6'\], a pair"),
+    ('ur5', r"No robot is named 'ur5'; use one of \['iiwa_franka_hand', .*'xarm6'\], a pair"),
     ('ur5+franka_hand', r"No arm is named 'ur5'; use one of \["),
     ('panda+claw', r"No hand is named 'claw'; use one of \["),
     ('missing/arm.yaml', "The robot description 'missing/arm.yaml' does not exist"),

@@ -85,6 +85,10 @@ def main(args: argparse.Namespace) -> int:
     for f in findings:
         _say(f)
     print(f'    first camera image: {out / "camera.png"}')
+    if not all(f.ok for f in findings):
+        print(f'{robot.name}: {sum(not f.ok for f in findings)} check(s) to fix (FIX lines '
+              'above); the reachability map and the grasps wait until they pass')
+        return 1
     reach, _ = reachability(robot, out)
     findings.append(Finding(reach >= 0.5, f'grasp poses for {reach * 100:.0f} % of the object '
                                           'positions 0.2-0.7 m from the base' + (
