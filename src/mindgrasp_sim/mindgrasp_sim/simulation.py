@@ -336,10 +336,14 @@ class Simulation:
         self._finger_links = {j: n for j, n in zip(self._finger_idx, self.finger_names,
                                                    strict=True)}
         # the wrist camera leaves out the links it cannot see (TinyRenderer only; the GUI and
-        # an OpenGL renderer draw the whole arm): each link's visual shapes' colours (rgba)
-        self._cull_enabled = not self.gui and self._renderer == pb.ER_TINY_RENDERER
+        # an OpenGL renderer draw the whole arm), when the robot has meshes to leave out (the
+        # shipped arm's few primitives cost less than the test): each link's visual shapes'
+        # colours (rgba)
+        visuals = p.getVisualShapeData(self._robots['user'].body)
+        self._cull_enabled = (not self.gui and self._renderer == pb.ER_TINY_RENDERER
+                              and any(v[2] == pb.GEOM_MESH for v in visuals))
         self._visual_colours: dict[int, list[tuple[float, ...]]] = {}
-        for v in p.getVisualShapeData(self._robots['user'].body):
+        for v in visuals:
             self._visual_colours.setdefault(v[1], []).append(tuple(v[7]))
         self._visual_links = list(self._visual_colours)
         tan_y = math.tan(math.radians(self.camera.fov_deg) / 2.0)
