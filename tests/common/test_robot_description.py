@@ -128,7 +128,7 @@ def test_a_gripper_without_limits(tmp_path):
 
 
 @pytest.mark.parametrize(('spec', 'message'), [
-    ('ur5', r"No robot is named 'ur5'; use one of \['iiwa_franka_hand', .*'xarm6'\], a pair"),
+    ('ur5', r"No robot is named 'ur5'; use one of \['iiwa_franka_hand', .*'xarm6'\] or the path"),
     ('ur5+franka_hand', r"No arm is named 'ur5'; use one of \["),
     ('panda+claw', r"No hand is named 'claw'; use one of \["),
     ('missing/arm.yaml', "The robot description 'missing/arm.yaml' does not exist"),

@@ -367,9 +367,9 @@ def _find(spec: str | Path, folder: str = '', base: Path | None = None) -> Path:
         msg = (f'No {what} is named {text!r}; use one of {known} or the path of a {what} YAML '
                f'file.')
     else:
-        msg = (f'No robot is named {text!r}; use one of {known}, a pair ARM+HAND of the arms '
-               f'{arm_names()} and hands {hand_names()}, or the path of a robot YAML file '
-               '(robot:=path/to/robot.yaml).')
+        # (a pair ARM+HAND of arm_names() and hand_names() works too: load_robot)
+        msg = (f'No robot is named {text!r}; use one of {known} or the path of a robot YAML '
+               'file (robot:=path/to/robot.yaml).')
     raise RobotDescriptionError(msg)
 
 
