@@ -20,7 +20,7 @@ pytestmark = pytest.mark.slow
 
 def _check(*args: str, cwd: Path) -> subprocess.CompletedProcess:
     return subprocess.run([sys.executable, '-m', 'mindgrasp_cli', 'robot', 'check', *args],
-                          capture_output=True, text=True, timeout=900, cwd=cwd, check=False)
+                          capture_output=True, text=True, timeout=1400, cwd=cwd, check=False)
 
 
 def _robot(tmp_path: Path, edit) -> Path:
@@ -73,6 +73,7 @@ def test_a_broken_description_is_named_in_one_line(tmp_path, edit, fault):
     assert re.fullmatch(fault + ".*", fixes[0]), fixes[0]
 
 
+@pytest.mark.timeout(1500)     # a lock-step trial, the map and the checks: minutes when loaded
 def test_grasps_in_lockstep(tmp_path):
     run = _check('mindgrasp_arm', '--grasps', '1', '--realism', 'none', '--out',
                  str(tmp_path / 'out'), cwd=tmp_path)
