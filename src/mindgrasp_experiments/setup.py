@@ -43,6 +43,7 @@ setup(
              'mindgrasp_experiments.commands.experiment_random_locations'),
             'experiment report = mindgrasp_experiments.commands.experiment_report',
             'experiment sweep = mindgrasp_experiments.commands.experiment_sweep',
+            'robot check = mindgrasp_experiments.commands.robot_check',
         ],
     },
 )

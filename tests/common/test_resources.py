@@ -131,18 +131,21 @@ def test_installed_config_wins_without_ros(tmp_path, monkeypatch):
 
 
 def test_robot_descriptions_are_config_files_with_their_urdfs():
-    """robot:=NAME finds the descriptions in config/robots/, and each one's URDF (the shipped
-    arm's beside it in config/robots/urdf/, the others' in pybullet_data) with its licence."""
+    """robot:=NAME finds the descriptions in config/robots/, their arms and hands in arms/ and
+    hands/, and each part's URDF (in config/robots/urdf/ or pybullet_data) with its licence."""
     from mindgrasp_common.robot_description import load_robot, robot_names
 
-    assert robot_names() == ['mindgrasp_arm', 'panda', 'xarm6']
+    assert robot_names() == ['iiwa_franka_hand', 'iiwa_mindgrasp_hand', 'iiwa_xarm_gripper',
+                             'mindgrasp_arm', 'panda', 'xarm6']
     for name in robot_names():
         robot = load_robot(name)
         assert robot.path == REPO / 'config' / 'robots' / f'{name}.yaml'
         assert robot.urdf.is_file()
         assert robot.licence
-    shipped_urdf = REPO / 'config' / 'robots' / 'urdf' / 'mindgrasp_arm.urdf'
-    assert load_robot('mindgrasp_arm').urdf == shipped_urdf
+        for part, folder in ((robot.arm, 'arms'), (robot.hand, 'hands')):
+            assert part.path.parent == REPO / 'config' / 'robots' / folder and part.licence
+            assert part.urdf.parent == REPO / 'config' / 'robots' / 'urdf' \
+                or 'pybullet_data' in part.urdf.parts
 
 
 def test_missing_config_file_names_where_it_looked():

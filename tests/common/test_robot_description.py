@@ -3,34 +3,59 @@ their URDFs, and every bad description gives one line naming the problem and the
 
 from __future__ import annotations
 
+import copy
+import math
 from pathlib import Path
 
 import pytest
 import yaml
 
 from mindgrasp_common import robot
+from mindgrasp_common.resources import resolve_path
 from mindgrasp_common.robot_description import RobotDescriptionError, load_robot, robot_names
+
+#: the xArm6 in the single-URDF format (arm and hand in one URDF), as it shipped before the
+#: arm + hand split: the format stays valid for a lab's combined URDF
+SINGLE_XARM6 = {
+    'name': 'xarm6', 'urdf': 'package://pybullet_data/xarm/xarm6_with_gripper.urdf',
+    'licence': 'URDF and meshes by UFactory (BSD-3-Clause)',
+    'arm': {'joints': ['joint1', 'joint2', 'joint3', 'joint4', 'joint5', 'joint6'],
+            'home': [0.0, -0.86, -1.04, 0.0, 1.53, 0.0],
+            'max_velocity': [1.0, 1.0, 1.3, 1.3, 1.6, 1.6]},
+    'gripper': {'kind': 'parallel_jaw',
+                'joints': ['drive_joint', 'left_finger_joint', 'left_inner_knuckle_joint',
+                           'right_outer_knuckle_joint', 'right_finger_joint',
+                           'right_inner_knuckle_joint'],
+                'open': 0.0, 'closed': 0.85, 'grasp_check': 'width', 'self_collision': False},
+    'tcp': {'link': 'xarm_gripper_base_link', 'xyz': [0.0, 0.0, 0.152]},
+    'camera': {'link': 'xarm_gripper_base_link', 'xyz': [0.07, 0.0, 0.02],
+               'rpy': [0.0, 0.0, 1.5707963267948966]},
+}
 
 
 def test_shipped_robots():
-    assert robot_names() == ['mindgrasp_arm', 'panda', 'xarm6']
+    assert robot_names() == ['iiwa_franka_hand', 'iiwa_mindgrasp_hand', 'iiwa_xarm_gripper',
+                             'mindgrasp_arm', 'panda', 'xarm6']
     arm = load_robot()
     assert arm.arm_joints == robot.ARM_JOINTS and arm.home_pose == robot.HOME_POSE
     assert arm.gripper.kind == 'multi_finger' and arm.tcp_link == 'tcp'
+    assert (arm.arm.name, arm.hand.name, arm.hand_root) == ('mindgrasp_arm', 'mindgrasp_hand',
+                                                            'palm')
     xarm = load_robot('xarm6')
-    assert xarm.urdf.name == 'xarm6_with_gripper.urdf' and xarm.urdf.is_file()
+    assert xarm.urdf.suffix == '.urdf' and xarm.urdf.is_file()
+    assert (xarm.arm.name, xarm.hand.name, xarm.mount.link) == ('xarm6', 'xarm_gripper', 'link6')
     assert xarm.gripper.kind == 'parallel_jaw' and len(xarm.gripper.joints) == 6
     assert xarm.camera.link == 'xarm_gripper_base_link' and xarm.camera.xyz != (0.0, 0.0, 0.0)
     assert xarm.lower[1] == pytest.approx(-2.059) and xarm.max_velocity[0] == 1.0
     assert 'BSD-3-Clause' in xarm.licence
     assert load_robot(xarm.path) is xarm     # a path works as well as a name
     panda = load_robot('panda')
-    assert len(panda.arm_joints) == 7 and panda.urdf.name == 'panda.urdf'
+    assert len(panda.arm_joints) == 7 and panda.mount.rpy[2] == pytest.approx(-math.pi / 4)
     # the hand's two prismatic fingers: the second a URDF mimic of the first
     assert panda.gripper.joints == ('panda_finger_joint1', 'panda_finger_joint2')
     assert panda.gripper.mimic == (('panda_finger_joint2', 'panda_finger_joint1', 1.0, 0.0),)
     assert panda.gripper.open == (0.04, 0.04) and panda.gripper.closed == (0.0, 0.0)
-    assert 'Apache-2.0' in panda.licence and (panda.urdf.parent / 'LICENSE.txt').is_file()
+    assert 'Apache-2.0' in panda.licence
 
 
 def test_the_shipped_arm_constants_are_the_description():
@@ -41,12 +66,12 @@ def test_the_shipped_arm_constants_are_the_description():
     assert robot.ARM_EFFORT == (60.0, 80.0, 40.0, 30.0, 12.0, 6.0)
     assert (robot.FINGER_LOWER_LIMIT, robot.FINGER_UPPER_LIMIT) == (-0.6, 1.3)
     assert (robot.FINGER_OPEN, robot.FINGER_CLOSED) == (-0.55, 1.25)
-    assert robot.URDF_URI == 'package://mindgrasp_sim/urdf/mindgrasp_arm.urdf'
+    assert Path(robot.URDF_URI).is_file()      # the joined arm + hand URDF
 
 
 def _variant(tmp_path: Path, edit) -> Path:
-    """A copy of the xArm6 description with ``edit(data)`` applied."""
-    data = yaml.safe_load(load_robot('xarm6').path.read_text(encoding='utf-8'))
+    """A copy of the single-URDF xArm6 description with ``edit(data)`` applied."""
+    data = copy.deepcopy(SINGLE_XARM6)
     edit(data)
     path = tmp_path / 'my_arm.yaml'
     path.write_text(yaml.safe_dump(data), encoding='utf-8')
@@ -60,7 +85,7 @@ def _set(section: str | None, key: str, value):
 
 
 def _no_limit_urdf(tmp_path: Path):
-    urdf = load_robot('xarm6').urdf.read_text(encoding='utf-8').replace(
+    urdf = resolve_path(SINGLE_XARM6['urdf'], 'mindgrasp_sim').read_text(encoding='utf-8').replace(
         '<limit effort="50" lower="0" upper="0.85" velocity="2"/>\n    <mimic', '<mimic')
     (tmp_path / 'no_limits.urdf').write_text(urdf, encoding='utf-8')
     return _set(None, 'urdf', 'no_limits.urdf')
@@ -103,7 +128,9 @@ def test_a_gripper_without_limits(tmp_path):
 
 
 @pytest.mark.parametrize(('spec', 'message'), [
-    ('ur5', r"No robot is named 'ur5'; use one of \['mindgrasp_arm', 'panda', 'xarm6'\]"),
+    ('ur5', r"No robot is named 'ur5'; use one of \['iiwa_franka_hand', .*'xarm6'\] or the path"),
+    ('ur5+franka_hand', r"No arm is named 'ur5'; use one of \["),
+    ('panda+claw', r"No hand is named 'claw'; use one of \["),
     ('missing/arm.yaml', "The robot description 'missing/arm.yaml' does not exist"),
 ])
 def test_unknown_robots(spec, message):

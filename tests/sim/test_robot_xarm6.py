@@ -101,5 +101,5 @@ def test_unknown_robot_exits_with_one_line_naming_the_fix(spawn_node):
     proc = spawn_node('mindgrasp_sim.sim_node', '--ros-args', '-p', 'robot:=ur5')
     assert proc.wait(60) == 2
     out = proc.output()
-    assert "No robot is named 'ur5'; use one of ['mindgrasp_arm', 'panda', 'xarm6']" in out
+    assert "No robot is named 'ur5'; use one of ['iiwa_franka_hand'," in out
     assert 'Traceback' not in out

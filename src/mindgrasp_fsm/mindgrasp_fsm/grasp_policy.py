@@ -268,6 +268,20 @@ class GraspPolicy:
                 return ''
         return f'no inverse-kinematics solution above the object at ({x:.2f}, {y:.2f}) m'
 
+    def reachable(self, position: np.ndarray, shape: str, q: np.ndarray) -> str:
+        """Whether an object of ``shape`` at ``position`` (3,) m has a pre-grasp and a grasp
+        pose from joints ``q`` (n,) rad, as the approach plans them: '' or why not (the
+        reachability map of ``mindgrasp robot check``). Leaves the policy's plan unchanged."""
+        saved = (self.object_position, self.object_height, self.shape, self._q_target,
+                 self._tilt, self._yaw)
+        self.object_position, self.object_height = np.asarray(position, dtype=float), None
+        self.shape = shape
+        try:
+            return self._plan_pregrasp(np.asarray(q, dtype=float))
+        finally:
+            (self.object_position, self.object_height, self.shape, self._q_target, self._tilt,
+             self._yaw) = saved
+
     def _leans(self, yaw: float) -> list[tuple[float, float]]:
         """(tool lean rad, yaw rad) to try for the pre-grasp, in order: vertical, then leaning
         in steps of about 0.15 rad up to ``max_approach_tilt``, at ``yaw``, then the same at

@@ -59,6 +59,9 @@ from mindgrasp_sim.scene import ObjectSpec, SceneSpec, load_scene
 #: PD motor position gain (pybullet's per-step error fraction): stiff, so gravity sag < 1 mrad
 ARM_POSITION_GAIN = 0.8
 _GOVERNOR_TOLERANCE = 1.05
+#: growth (m) of a link's collision bounding box before the wrist camera leaves the link out
+#: of a frame for lying outside its view (visual shapes may stick out of collision shapes)
+CULL_MARGIN = 0.05
 GROUND_RGBA = (0.78, 0.77, 0.74, 1.0)
 TRAINER_RGBA = (0.1, 0.85, 0.1, 0.35)
 ROBOTS = ('user', 'trainer')
@@ -332,6 +335,19 @@ class Simulation:
         self._finger_velocity = [i[11] for i in finfo]
         self._finger_links = {j: n for j, n in zip(self._finger_idx, self.finger_names,
                                                    strict=True)}
+        # the wrist camera leaves out the links it cannot see (TinyRenderer only; the GUI and
+        # an OpenGL renderer draw the whole arm), when the robot has meshes to leave out (the
+        # shipped arm's few primitives cost less than the test): each link's visual shapes'
+        # colours (rgba)
+        visuals = p.getVisualShapeData(self._robots['user'].body)
+        self._cull_enabled = (not self.gui and self._renderer == pb.ER_TINY_RENDERER
+                              and any(v[2] == pb.GEOM_MESH for v in visuals))
+        self._visual_colours: dict[int, list[tuple[float, ...]]] = {}
+        for v in visuals:
+            self._visual_colours.setdefault(v[1], []).append(tuple(v[7]))
+        self._visual_links = list(self._visual_colours)
+        tan_y = math.tan(math.radians(self.camera.fov_deg) / 2.0)
+        self._cull_tan = (tan_y * self.camera.width / self.camera.height, tan_y)
         self._objects: list[tuple[ObjectSpec, int]] = []
         self._step_count = 0
         self._proj = None
@@ -877,9 +893,11 @@ class Simulation:
         if self._proj is None:
             self._proj = p.computeProjectionMatrixFOV(c.fov_deg, c.width / c.height, c.near, c.far)
         hidden = self._hide_other_robots(robot)
+        culled = self._cull_links(robot, pos, rot)
         _, _, rgba, depth_buf, _ = p.getCameraImage(
             c.width, c.height, view, self._proj, renderer=self._renderer, shadow=0,
             flags=pb.ER_NO_SEGMENTATION_MASK, **_LIGHT)
+        self._uncull(robot, culled)
         self._unhide(hidden)
         rgba = np.array(rgba, dtype=np.uint8, copy=True).reshape(c.height, c.width, 4)
         d = np.asarray(depth_buf, dtype=np.float32).reshape(c.height, c.width)
@@ -891,6 +909,39 @@ class Simulation:
             depth = self.realism.depth_image(depth, rgb)
             rgb = self.realism.colour_image(rgb)
         return rgb, depth
+
+    def _cull_links(self, robot: str, pos: np.ndarray, rot: np.ndarray) -> list[int]:
+        """Make the links of ``robot`` that lie outside the camera's view invisible for one
+        frame (alpha 0: TinyRenderer then skips their triangles) and return them.
+
+        A wrist camera never sees most of its own arm, yet TinyRenderer transforms and clips
+        every triangle of it: the xArm6's and the Panda's meshes cost 20-30 ms a frame. A link
+        is left out when its bounding box (the collision shapes', grown by
+        :data:`CULL_MARGIN` for visual shapes that stick out) lies wholly beyond one side of
+        the view frustum, so the image is the same. pos (3,) m, rot (3, 3): the camera's
+        optical frame in the world.
+        """
+        if not self._cull_enabled or robot != 'user':
+            return []
+        body = self._robots[robot].body
+        p = self._p
+        links = self._visual_links
+        boxes = np.array([p.getAABB(body, link) for link in links])          # (L, 2, 3) m
+        boxes[:, 0] -= CULL_MARGIN
+        boxes[:, 1] += CULL_MARGIN
+        corners = boxes[:, _BOX_CORNERS, _XYZ]                                # (L, 8, 3)
+        seen = _boxes_in_view((corners - pos) @ rot, self.camera.near, self._cull_tan)
+        culled = [link for link, s in zip(links, seen, strict=True) if not s]
+        for link in culled:
+            p.changeVisualShape(body, link, rgbaColor=[1.0, 1.0, 1.0, 0.0])
+        return culled
+
+    def _uncull(self, robot: str, culled: list[int]) -> None:
+        """Give the links :meth:`_cull_links` hid their colours back (each visual shape's)."""
+        body = self._robots[robot].body
+        for link in culled:
+            for k, colour in enumerate(self._visual_colours[link]):
+                self._p.changeVisualShape(body, link, shapeIndex=k, rgbaColor=colour)
 
     def _draw_ground(self, rgba: np.ndarray, depth: np.ndarray, empty: np.ndarray,
                      pos: np.ndarray, rot: np.ndarray) -> None:
@@ -1108,6 +1159,36 @@ class Simulation:
 
     def __exit__(self, *exc: object) -> None:
         self.close()
+
+
+#: the 8 corners of a box (lower, upper) as indices into its (2, 3) bounds, and the 12 edges
+#: between corners numbered by bits (x: 4, y: 2, z: 1)
+_BOX_CORNERS = np.array([[(i >> 2) & 1, (i >> 1) & 1, i & 1] for i in range(8)])
+_XYZ = np.arange(3)
+_BOX_EDGES = np.array([(i, i | bit) for i in range(8) for bit in (1, 2, 4) if not i & bit])
+
+
+def _boxes_in_view(cam: np.ndarray, near: float, tan: tuple[float, float]) -> np.ndarray:
+    """Whether each box, corners ``cam`` (L, 8, 3) m in a camera's optical frame (z forward),
+    may show in its image: the part of the box beyond the near plane ``near`` m, projected,
+    meets the image's rectangle of half-widths ``tan`` (x, y). Conservative (the projection's
+    bounding rectangle stands for the projection). Returns (L,) bool."""
+    z = cam[..., 2]
+    ahead = z > near                                                       # (L, 8)
+    a, b = cam[:, _BOX_EDGES[:, 0]], cam[:, _BOX_EDGES[:, 1]]              # (L, 12, 3)
+    cross = ahead[:, _BOX_EDGES[:, 0]] != ahead[:, _BOX_EDGES[:, 1]]       # (L, 12)
+    dz = b[..., 2] - a[..., 2]
+    t = np.where(cross, (near - a[..., 2]) / np.where(cross, dz, 1.0), 0.0)
+    pts = np.concatenate([cam, a + t[..., None] * (b - a)], axis=1)        # (L, 20, 3)
+    valid = np.concatenate([ahead, cross], axis=1)
+    zs = np.where(valid, pts[..., 2], 1.0)
+    u, v = pts[..., 0] / zs, pts[..., 1] / zs
+    inf = np.inf
+    return (ahead.any(axis=1)
+            & (np.where(valid, u, inf).min(axis=1) <= tan[0])
+            & (np.where(valid, u, -inf).max(axis=1) >= -tan[0])
+            & (np.where(valid, v, inf).min(axis=1) <= tan[1])
+            & (np.where(valid, v, -inf).max(axis=1) >= -tan[1]))
 
 
 def _in_link(pos: np.ndarray, orn: np.ndarray, frame: LinkFrame) -> tuple[np.ndarray, np.ndarray]:

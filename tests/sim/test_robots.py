@@ -1,0 +1,154 @@
+"""Arms and hands as separate descriptions joined by a mount (mindgrasp_common.robot_description):
+the shipped pairs give PyBullet the same bodies as the single URDFs they were cut from (so their
+records stay the same), any arm takes any hand, and a bad pair names its fault in one line."""
+
+from __future__ import annotations
+
+import itertools
+from pathlib import Path
+
+import numpy as np
+import pybullet_data
+import pytest
+import yaml
+
+from mindgrasp_common.resources import resource_path
+from mindgrasp_common.robot_description import (
+    RobotDescriptionError,
+    arm_names,
+    hand_names,
+    load_robot,
+)
+from mindgrasp_sim.pybullet_quiet import pb
+from mindgrasp_sim.robot_model import FILES
+from mindgrasp_sim.simulation import CameraConfig, Simulation
+
+#: the single URDFs the shipped pairs were cut from
+ORIGINALS = {
+    'mindgrasp_arm': resource_path('mindgrasp_sim', 'urdf', 'mindgrasp_arm.urdf'),
+    'xarm6': Path(pybullet_data.getDataPath()) / 'xarm' / 'xarm6_with_gripper.urdf',
+    'panda': Path(pybullet_data.getDataPath()) / 'franka_panda' / 'panda.urdf',
+}
+
+
+def _body(urdf: Path) -> tuple:
+    """What PyBullet makes of a URDF: joint infos, dynamics, visual and collision shapes."""
+    c = pb.connect(pb.DIRECT)
+    try:
+        flags = (pb.URDF_USE_INERTIA_FROM_FILE | pb.URDF_USE_SELF_COLLISION
+                 | pb.URDF_USE_SELF_COLLISION_EXCLUDE_PARENT)
+        b = pb.loadURDF(str(urdf), useFixedBase=True, flags=flags, physicsClientId=c)
+        n = pb.getNumJoints(b, physicsClientId=c)
+        return ([pb.getJointInfo(b, j, physicsClientId=c)[:17] for j in range(n)],
+                [pb.getDynamicsInfo(b, j, physicsClientId=c) for j in range(-1, n)],
+                [v[1:8] for v in pb.getVisualShapeData(b, physicsClientId=c)],
+                [pb.getCollisionShapeData(b, j, physicsClientId=c) for j in range(-1, n)])
+    finally:
+        pb.disconnect(c)
+
+
+@pytest.mark.parametrize('name', sorted(ORIGINALS))
+def test_a_shipped_pair_is_the_body_it_was_cut_from(name):
+    """Same links in the same order, same joints, masses, inertias, collision shapes, and the
+    same visual shapes but for the xArm6's decimated visual meshes (same links, frames, colours,
+    other files)."""
+    robot = load_robot(name)
+    assert robot.arm is not None and robot.hand is not None
+    joined, original = _body(robot.urdf), _body(ORIGINALS[name])
+    for what, a, b in zip(('joints', 'dynamics', 'visuals', 'collisions'), joined, original,
+                          strict=True):
+        if what == 'visuals' and name == 'xarm6':
+            # (link, geometry type, scale, file, frame position, frame orientation, colour)
+            a, b = [[v[:3] + v[4:] for v in vs] for vs in (a, b)]
+        assert a == b, f'{name}: the joined URDF differs in its {what}'
+
+
+@pytest.mark.parametrize('name', sorted(ORIGINALS))
+def test_the_wrist_camera_sees_the_same_with_links_left_out(name):
+    """The links the camera leaves out of a frame (outside its view) change no pixel."""
+    rng = np.random.default_rng(0)
+    with Simulation('set_locations', seed=0, robot=name, camera=CameraConfig(64, 64)) as sim:
+        for _ in range(8):
+            sim.set_joint_positions(sim.home_pose + rng.normal(0.0, 0.4, sim.n_joints))
+            culled = sim.render_camera(exact=True)
+            sim._cull_enabled = False
+            full = sim.render_camera(exact=True)
+            sim._cull_enabled = True
+            for a, b in zip(culled, full, strict=True):
+                np.testing.assert_array_equal(a, b)
+
+
+def test_the_shipped_arm_files_are_the_generated_ones():
+    for file, build in FILES.items():
+        committed = resource_path('mindgrasp_sim', 'urdf', file).read_text(encoding='utf-8')
+        assert committed == build(), f'regenerate {file}: python -m mindgrasp_sim.robot_model ' \
+                                     '--write config/robots/urdf'
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(('arm', 'hand'), list(itertools.product(arm_names(), hand_names())))
+def test_any_arm_takes_any_hand(arm, hand):
+    """Every shipped arm with every shipped hand loads, holds still, closes its hand and renders
+    its wrist camera."""
+    robot = load_robot(f'{arm}+{hand}')
+    assert robot.arm_joints == robot.arm.joints and robot.gripper == robot.hand.gripper
+    with Simulation('set_locations', seed=0, robot=robot, camera=CameraConfig(32, 32)) as sim:
+        sim.set_gripper(1.0)
+        sim.step(240)
+        np.testing.assert_allclose(sim.joint_positions(), robot.home_pose, atol=0.02)
+        closure = (sim.finger_positions() - np.array(robot.gripper.open)) / (
+            np.array(robot.gripper.closed) - np.array(robot.gripper.open))
+        # 1 s: the fingers' velocity limits let them close most of the way (0.8 of the
+        # shipped hand's closure, the others' full)
+        assert np.all(closure > 0.6), f'{arm}+{hand}: the hand did not close ({closure})'
+        rgb, depth = sim.render_camera()
+        assert rgb.shape == (32, 32, 3) and np.isfinite(depth).all()
+
+
+def _pair(tmp_path: Path, hand_edit=None, **robot) -> Path:
+    """A robot YAML joining the shipped xArm6 with a copy of the xArm gripper's description
+    (``hand_edit(data)`` applied), with ``robot`` keys added."""
+    hand = yaml.safe_load(resource_path('mindgrasp_sim', 'robots', 'hands',
+                                        'xarm_gripper.yaml').read_text(encoding='utf-8'))
+    hand['urdf'] = str(resource_path('mindgrasp_sim', 'urdf', 'xarm_gripper.urdf'))
+    if hand_edit:
+        hand_edit(hand)
+    (tmp_path / 'hand.yaml').write_text(yaml.safe_dump(hand), encoding='utf-8')
+    path = tmp_path / 'robot.yaml'
+    path.write_text(yaml.safe_dump({'name': 'mine', 'arm': 'xarm6', 'hand': 'hand.yaml',
+                                    **robot}), encoding='utf-8')
+    return path
+
+
+def test_a_pair_of_ones_own_files(tmp_path):
+    robot = load_robot(_pair(tmp_path, mount={'joint': 'my_mount', 'xyz': [0, 0, 0.01]}))
+    assert robot.name == 'mine' and robot.hand.path == tmp_path / 'hand.yaml'
+    text = robot.urdf.read_text(encoding='utf-8')
+    assert '<joint name="my_mount" type="fixed">' in text and 'package://' not in text
+
+
+@pytest.mark.parametrize(('hand_edit', 'robot', 'message'), [
+    (lambda h: h.update(joints=['drive_joint', 'left_finger']), {},
+     r"Hand description '.*hand.yaml': the gripper joints name the joint 'left_finger', which "
+     'the URDF xarm_gripper.urdf lacks; use one of its joints'),
+    (None, {'arm': 'ur5'}, "No arm is named 'ur5'; use one of"),
+    (None, {'mount': {'link': 'link9'}}, "the mount link 'link9' is not a link of the URDF "
+                                         'xarm6_arm.urdf'),
+    (None, {'home': [0.0] * 7}, r'arm: home must be 6 finite numbers'),
+    (lambda h: h['tcp'].update(link='tool0'), {}, "the tcp link 'tool0' is not a link of the "
+                                                  'URDF xarm_gripper.urdf'),
+])
+def test_a_bad_pair_names_its_fault_in_one_line(tmp_path, hand_edit, robot, message):
+    with pytest.raises(RobotDescriptionError, match=message) as err:
+        load_robot(_pair(tmp_path, hand_edit, **robot))
+    assert '\n' not in str(err.value)
+
+
+def test_a_hand_whose_names_clash_with_the_arm(tmp_path):
+    def arm_as_hand(h):       # the arm's own URDF as the hand: every name clashes
+        h.update(urdf=str(resource_path('mindgrasp_sim', 'urdf', 'xarm6_arm.urdf')),
+                 joints=['joint1'], open=0.0, closed=0.1)
+        h['tcp']['link'] = h['camera']['link'] = 'link6'
+    with pytest.raises(RobotDescriptionError, match=r"both URDFs have a link named '.*'; rename "
+                                                    r'it in one of them'):
+        load_robot(_pair(tmp_path, arm_as_hand))
