@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import multiprocessing
 import os
 import re
@@ -34,6 +35,7 @@ from pathlib import Path
 TARGET_P99_MS = 50.0
 _WARN = re.compile(r'\[(WARN|WARNING|ERROR)\]')
 _RTF = re.compile(r'real-time factor ([0-9.]+)x')
+_STAMP = re.compile(r'\[\w+\] \[([0-9.]+)\]')
 
 
 def _burn() -> None:
@@ -97,17 +99,11 @@ def log_lines(run_dir: Path) -> list[str]:
 
 def warnings_before_first_trial(run_dir: Path) -> list[str]:
     """WARN/ERROR lines of any node logged before the trial manager named the first target
-    (by the launch's combined log, whose order is the order of output)."""
-    combined = run_dir / 'logs' / 'launch.log'
-    lines = combined.read_text(encoding='utf-8', errors='replace').splitlines() \
-        if combined.exists() else log_lines(run_dir)
-    before = []
-    for line in lines:
-        if 'Trial 1: grasp the' in line:
-            return before
-        if _WARN.search(line):
-            before.append(line)
-    return before
+    (by the stamps of the node log lines, ``[LEVEL] [seconds] [node]: ...``)."""
+    stamped = [(float(m.group(1)), line) for line in log_lines(run_dir)
+               if (m := _STAMP.match(line))]
+    first = min((t for t, line in stamped if 'Trial 1: grasp the' in line), default=math.inf)
+    return [line for t, line in sorted(stamped) if t < first and _WARN.search(line)]
 
 
 def summary(run_dir: Path, load: int) -> dict:

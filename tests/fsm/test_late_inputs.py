@@ -6,6 +6,8 @@ stall after the start still latches the sensor fault; the node ticks on a predic
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 import pytest
 
@@ -124,3 +126,34 @@ def test_a_stall_after_the_start_still_latches_the_sensor_fault(fsm: GraspFsm,
     out = fsm.tick(stalled)
     assert out.stopped and out.stop_kind == StopKind.FAULT, out.reason
     assert any(e.startswith(f'{SENSOR_FAULT}: joint states are 0.50 s old') for e in out.events)
+
+
+def test_the_node_ticks_on_a_prediction_at_once_and_on_fresh_joint_states(rclpy_ctx) -> None:
+    """A decision reaches the arm when the prediction arrives, not at the next control tick;
+    a joint state makes the controller tick only once most of a control period has passed
+    (1 s here: nothing else can tick meanwhile, the node is not spun)."""
+    from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import MIPrediction
+    from mindgrasp_ros.interfaces.sensor_msgs.msg import JointState
+
+    from mindgrasp_fsm.fsm_node import FsmNode
+
+    node = FsmNode(parameter_overrides=[rclpy_ctx.parameter.Parameter('control_period',
+                                                                      value=1.0)])
+    try:
+        def joint_state() -> JointState:
+            js = JointState(name=[f'joint_{i}' for i in range(1, 7)], position=HOME,
+                            velocity=np.zeros(6))
+            js.header.stamp = node.get_clock().now().to_msg()
+            return js
+
+        assert node.ticks == 0
+        node.prediction_callback(MIPrediction(class_index=0, certainty=1.0))
+        assert node.ticks == 1                      # at once
+        node.joint_state_callback(joint_state())
+        assert node.ticks == 1                      # the controller has just ticked
+        time.sleep(0.8)
+        node.joint_state_callback(joint_state())
+        assert node.ticks == 2                      # most of a period later: a tick
+        assert node.inputs.joints is not None
+    finally:
+        node.destroy_node()

@@ -98,8 +98,11 @@ def generate_launch_description() -> LaunchDescription:
                          {'stream_name': eeg_stream, 'seed': seed,
                           'subject_mode': LaunchConfiguration('subject')}]),
         # 3 acquisition: LSL inlet -> /eeg/raw
+        # pinned to the demo's own amplifier (its source_id is the stream name, on this host)
         Node(package='mindgrasp_eeg', executable='acquisition_node', name='eeg_acquisition',
-             parameters=[*config_files('eeg', 'demo'), {'stream_name': eeg_stream}]),
+             parameters=[*config_files('eeg', 'demo'),
+                         {'stream_name': eeg_stream, 'source_id': eeg_stream,
+                          'hostname': 'local'}]),
         # the participant's screen (display:=window|fullscreen|headless)
         *display_nodes(config_files('trainer'), LaunchConfiguration('trials')),
         # 4 classifier: /eeg/raw -> /bci/prediction
