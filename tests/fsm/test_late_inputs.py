@@ -100,7 +100,8 @@ def test_a_start_with_late_first_inputs_waits_without_a_sensor_fault(fsm: GraspF
         outs.append(fsm.tick(late))
     waiting = outs[-1]
     assert waiting.stopped and waiting.stop_kind == StopKind.AWAITING_INPUT, waiting.reason
-    assert 'waiting for the joint states to stream (the latest is 0.50 s old)' in waiting.reason
+    assert 'waiting for the joint states to stream (the latest is 0.50 s old, limit 0.30 s)' \
+        in waiting.reason
     assert not any(e.startswith(SENSOR_FAULT) for e in _stopped_events(outs))
     assert all(not o.joint_velocities.any() for o in outs)
     # the inputs stream: the left hand turns joint 1 at once

@@ -12,7 +12,9 @@ in rad/s; default),
 ``/servo_node/delta_twist_cmds`` (geometry_msgs/TwistStamped, after
 ``/servo_node/switch_command_type``);
 ``/gripper_controller/commands`` (``[closure]``, 0 open .. 1 closed) and ``/fsm/state``
-(FsmState, transient local). Topic names and QoS: :mod:`mindgrasp_ros.topics`. Parameters: every
+(FsmState, transient local). The controller ticks when a prediction arrives, on a fresh joint
+state once most of ``control_period`` has passed, and on its timer when neither came for 1.5
+periods. Topic names and QoS: :mod:`mindgrasp_ros.topics`. Parameters: every
 field of :class:`mindgrasp_fsm.params.FsmParams` (``mindgrasp param describe /fsm <name>`` shows
 unit, range and whether a change applies live), plus ``duration`` (s; > 0 ends the node after
 that time, for launch tests).

@@ -411,7 +411,8 @@ class GraspFsm:
         if self._starting_up('joint states', age, p.watchdog_timeout, now) and \
                 self._fault_at is None and not refused:
             return StopKind.AWAITING_INPUT, (f'stopped: waiting for the joint states to stream '
-                                             f'(the latest is {age:.2f} s old)')
+                                             f'(the latest is {age:.2f} s old, limit '
+                                             f'{p.watchdog_timeout:.2f} s)')
         why = self._sensor_latch(inputs, now)
         if why:
             return StopKind.FAULT, why
@@ -422,7 +423,8 @@ class GraspFsm:
             age = now - pred.stamp
             if self._starting_up('MI predictions', age, p.watchdog_timeout, now):
                 return StopKind.AWAITING_INPUT, (f'stopped: waiting for the MI predictions to '
-                                                 f'stream (the latest is {age:.2f} s old)')
+                                                 f'stream (the latest is {age:.2f} s old, limit '
+                                                 f'{p.watchdog_timeout:.2f} s)')
             if age > p.watchdog_timeout:
                 self._stale_pred = True
                 self._back_at = self._fresh = None
@@ -436,7 +438,8 @@ class GraspFsm:
         age = now - inputs.vision.stamp
         if self._starting_up('camera images', age, p.camera_timeout, now):
             return StopKind.AWAITING_INPUT, (f'stopped: waiting for the camera images to stream '
-                                             f'(the latest is {age:.2f} s old); holding still')
+                                             f'(the latest is {age:.2f} s old, limit '
+                                             f'{p.camera_timeout:.2f} s); holding still')
         if age > p.camera_timeout:
             return StopKind.FAULT, (f'stopped: no camera images for {age:.2f} s (limit '
                                     f'{p.camera_timeout:.2f} s); holding still')

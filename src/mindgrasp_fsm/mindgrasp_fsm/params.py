@@ -75,8 +75,10 @@ class FsmParams:
     # no profile may step a joint from slow to fast in one tick (braking is never limited)
     max_joint_acceleration: list[float] = param([2.0] * 6, 'speed-up limit per joint for every '
                                                 'velocity command', unit='rad/s^2', live=True)
-    control_period: float = param(0.02, 'control tick (the node ticks at 1 / control_period)',
-                                  unit='s', min=0.001, max=1.0)
+    control_period: float = param(0.02, 'control tick: the node ticks on a fresh joint state '
+                                  'once 0.75 of it passed, at once on a prediction, and on its '
+                                  'timer after 1.5 of it without a tick', unit='s', min=0.001,
+                                  max=1.0)
     # the form of the arm command for the driver (mindgrasp_fsm.command_interface): the same
     # acceleration-limited joint velocities, sent as a driver of each kind takes them
     command_interface: str = param('velocity', 'arm command: velocity (ros2_control forward '
