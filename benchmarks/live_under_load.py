@@ -76,7 +76,11 @@ def outcomes(run_dir: Path) -> dict[str, int]:
 
 
 def latency(run_dir: Path) -> dict | None:
-    """``mindgrasp bag latency`` of the run (its report dict), None when it has none."""
+    """``mindgrasp bag latency`` of the run (its report dict), None when it has none: the
+    ``latency.json`` the launch wrote when it ended, else computed from the bag."""
+    saved = run_dir / 'latency.json'
+    if saved.exists():
+        return json.loads(saved.read_text(encoding='utf-8'))
     from mindgrasp_bag import BagError
     from mindgrasp_bag.latency import LatencyError, latency_report
     from mindgrasp_bag.paths import resolve_bag
@@ -141,11 +145,11 @@ def print_summary(s: dict) -> None:
     for line in s['sensor_fault_stops']:
         print(f'    {line}')
     print(f"  controller/simulator warnings: {len(s['fsm_sim_warnings'])}")
-    for line in s['fsm_sim_warnings'][:20]:
+    for line in s['fsm_sim_warnings'][:10]:
         print(f'    {line}')
     early = s['warnings_before_first_trial']
     print(f'  warnings before the first trial: {len(early)}')
-    for line in early[:20]:
+    for line in early[:10]:
         print(f'    {line}')
     la = s['load_average']
     print(f'  load average (1/5/15 min) after the run: {la[0]:.1f} / {la[1]:.1f} / {la[2]:.1f} '
@@ -183,10 +187,10 @@ def main(argv: list[str] | None = None) -> int:
             p.start()
         try:
             code = run_demo(run_dir, args.trials, args.seed, args.timeout)
-            s = summary(run_dir, args.load)
         finally:
             for p in burners:
                 p.terminate()
+        s = summary(run_dir, args.load)
         s['demo_exit_code'] = code
         if not args.keep:
             shutil.rmtree(tmp, ignore_errors=True)
