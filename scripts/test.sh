@@ -3,6 +3,9 @@
 # Extra arguments go to pytest (e.g. scripts/test.sh -m "not slow" -x; -n 0 runs in one process).
 # Two pytest-xdist workers by default (MINDGRASP_TEST_WORKERS): most tests wait on other
 # processes, so two at a time use the 2 cores.
+# MINDGRASP_TEST_LOAD=N runs N busy processes (one busy loop each) beside the suite for its
+# whole duration and stops them when it ends (also on Ctrl-C): the tests must hold on a
+# loaded machine, where timing changes and outcomes must not.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ./scripts/setup.sh
@@ -31,4 +34,24 @@ fi
 # that no other test process on this host holds (tests/conftest.py).
 export ROS_AUTOMATIC_DISCOVERY_RANGE=${ROS_AUTOMATIC_DISCOVERY_RANGE:-LOCALHOST}
 export MNE_DATASETS_EEGBCI_PATH=${MNE_DATASETS_EEGBCI_PATH:-$(cd .. && pwd)/shared/data}
-exec .venv/bin/python -m pytest -n "${MINDGRASP_TEST_WORKERS:-2}" --dist loadfile "$@"
+load=${MINDGRASP_TEST_LOAD:-0}
+if ! [[ "$load" =~ ^[0-9]+$ ]]; then
+  echo "test: MINDGRASP_TEST_LOAD is '$load'; give a number of busy processes (e.g. 2), or 0." >&2
+  exit 2
+fi
+if [ "$load" -eq 0 ]; then
+  exec .venv/bin/python -m pytest -n "${MINDGRASP_TEST_WORKERS:-2}" --dist loadfile "$@"
+fi
+burners=()
+stop_burners() { [ "${#burners[@]}" -eq 0 ] || kill "${burners[@]}" 2>/dev/null || true; }
+trap stop_burners EXIT
+trap 'exit 130' INT
+trap 'exit 143' TERM
+for _ in $(seq "$load"); do
+  ( trap - EXIT; while :; do :; done ) &
+  burners+=("$!")
+done
+echo "test: $load busy process(es) beside the suite (pids ${burners[*]}); stopped at its end"
+rc=0
+.venv/bin/python -m pytest -n "${MINDGRASP_TEST_WORKERS:-2}" --dist loadfile "$@" || rc=$?
+exit "$rc"

@@ -26,11 +26,11 @@ DEMO_NODES = {'recorder_node', 'trial_manager_node', 'sim_node', 'virtual_amp_no
 
 @pytest.mark.timeout(900)
 def test_ros2_launch_demo_grasps_on_real_rclpy(colcon_ws, tmp_path: Path) -> None:
-    """Two live trials of the red cube on real rclpy: the arm grasps it at least once and never
-    grasps anything else. Two, not one: eight rclpy processes in real time on 2 cores beside the
-    other test worker's heaviest tests fell 0.3-0.6 s behind, the approach stopped 3 mm low and
-    the fingertips stuck on the table (a no-grasp, seen in two fresh-clone runs; see issue 28's
-    note). A lost trial on a starved machine is safe; a wrong grasp is not."""
+    """Two live trials of the red cube on real rclpy: the arm grasps it in both. Eight rclpy
+    processes in real time on 2 cores beside the other test worker's heaviest tests fall
+    0.3-0.6 s behind; the descent bounds its speed by the age of the joint states (issue 39),
+    so a loaded machine changes the timing, never the outcome (before it, the approach stopped
+    3 mm low and the fingertips stuck on the table in two fresh-clone runs)."""
     from mindgrasp_bag.reader import BagReader
     from mindgrasp_bag.typestore import typestore
 
@@ -62,8 +62,7 @@ def test_ros2_launch_demo_grasps_on_real_rclpy(colcon_ws, tmp_path: Path) -> Non
         records = list(csv.DictReader(f))
     assert len(records) == 2 and {r['desired'] for r in records} == {'red cube'}, records
     outcomes = [(r['grasped'], r['outcome']) for r in records]
-    assert ('red cube', 'correct_grasp') in outcomes, records
-    assert all(o in {('red cube', 'correct_grasp'), ('', 'no_grasp')} for o in outcomes), records
+    assert outcomes == [('red cube', 'correct_grasp')] * 2, records
     store = typestore()
     with BagReader(run / 'bag') as bag:
         results = [store.deserialize_cdr(data, 'mindgrasp_msgs/msg/GraspResult')

@@ -4,6 +4,8 @@ type switched by its service, and a silent driver input stopping the arm."""
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 import pytest
 
@@ -29,6 +31,15 @@ def sim(spawn_node, rclpy_ctx):
     node.destroy_node()
 
 
+def _most_warnings(since: float, hold: float = 1.0) -> int:
+    """The most "one warning per burst" lines a stream of bad commands sent since ``since``
+    (time.monotonic(), s) can have given: a burst ends only after ``hold`` s without a bad
+    command (the node's ``bad_command_hold``), so a new one needs that long of the stream's time
+    (simulated time, which never runs ahead of the wall clock). On an idle machine that is 1; a
+    loaded one may pause the stream and split it."""
+    return 1 + int((time.monotonic() - since) / hold)
+
+
 def _publish_at(node, rate: float, make) -> list[bool]:
     """Publish ``make()`` at ``rate`` Hz while the returned flag is True (while the test node
     spins)."""
@@ -51,6 +62,7 @@ def test_trajectories_with_wrong_joints_are_refused_and_good_ones_followed(sim) 
         pub.publish(JointTrajectory(joint_names=names[0], points=[point]))
 
     names[0] = ['shoulder_pan', *JOINTS[1:]]
+    bad_since = time.monotonic()
     sending = _publish_at(node, 50.0, trajectory)
     assert spin_until(node, lambda: 'Rejected /arm_controller/joint_trajectory' in proc.output(),
                       60.0), proc.output()
@@ -58,7 +70,7 @@ def test_trajectories_with_wrong_joints_are_refused_and_good_ones_followed(sim) 
     assert spin_until(node, lambda: len(joints) > n + 100, 60.0)   # 1 s of simulated time
     assert max(abs(m.velocity[0]) for m in joints[n:]) < 0.01
     line = [ln for ln in proc.output().splitlines() if 'Rejected' in ln]
-    assert len(line) == 1, line
+    assert 1 <= len(line) <= _most_warnings(bad_since), line     # per burst, not per message
     assert ("JointTrajectory joint_names ['shoulder_pan', 'joint_2'" in line[0]
             and "send joint_names ['joint_1', 'joint_2'" in line[0]), line
     # the driver's names: after bad_command_hold (1 s) of good ones, the arm follows
@@ -84,6 +96,7 @@ def test_servo_twists_move_the_arm_after_the_switch_to_twist(sim) -> None:
         msg.twist.linear.z = 0.05          # the tool straight up at 5 cm/s
         pub.publish(msg)
 
+    ignored_since = time.monotonic()
     sending = _publish_at(node, 50.0, twist)
     # MoveIt Servo starts in JOINT_JOG: twists are ignored (one line) until it is switched
     assert spin_until(node, lambda: 'Ignored /servo_node/delta_twist_cmds' in proc.output(),
@@ -102,6 +115,7 @@ def test_servo_twists_move_the_arm_after_the_switch_to_twist(sim) -> None:
 
     assert not call(7)
     assert call(ServoCommandType.Request.TWIST)
+    most_ignored = _most_warnings(ignored_since)
     # the tool rises straight up: 3 cm, while it keeps within 5 mm of its x and y
     start = np.array([poses[-1].pose.position.x, poses[-1].pose.position.y,
                       poses[-1].pose.position.z])
@@ -117,10 +131,13 @@ def test_servo_twists_move_the_arm_after_the_switch_to_twist(sim) -> None:
     assert drift < 0.005, drift
     # a twist in another frame is refused with the frame to use, and the arm holds
     frame[0] = 'camera_link'
+    refused_since = time.monotonic()
     refused = "twist frame_id 'camera_link' is not the arm base frame; send twists in 'base_link'."
     assert spin_until(node, lambda: refused in proc.output(), 60.0), proc.output()
     assert spin_until(node, lambda: np.all(np.abs(joints[-1].velocity) < 0.01), 60.0)
     sending[0] = False
     out = proc.output()
-    assert out.count('Ignored /servo_node/delta_twist_cmds') == 1, out
-    assert out.count('Rejected /servo_node/delta_twist_cmds') == 1, out
+    # one warning per burst of ignored, then of refused twists (not one per twist)
+    assert 1 <= out.count('Ignored /servo_node/delta_twist_cmds') <= most_ignored, out
+    assert 1 <= out.count('Rejected /servo_node/delta_twist_cmds') <= \
+        _most_warnings(refused_since), out

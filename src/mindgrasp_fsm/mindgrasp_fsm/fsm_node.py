@@ -12,7 +12,9 @@ in rad/s; default),
 ``/servo_node/delta_twist_cmds`` (geometry_msgs/TwistStamped, after
 ``/servo_node/switch_command_type``);
 ``/gripper_controller/commands`` (``[closure]``, 0 open .. 1 closed) and ``/fsm/state``
-(FsmState, transient local). Topic names and QoS: :mod:`mindgrasp_ros.topics`. Parameters: every
+(FsmState, transient local). The controller ticks when a prediction arrives, on a fresh joint
+state once most of ``control_period`` has passed, and on its timer when neither came for 1.5
+periods. Topic names and QoS: :mod:`mindgrasp_ros.topics`. Parameters: every
 field of :class:`mindgrasp_fsm.params.FsmParams` (``mindgrasp param describe /fsm <name>`` shows
 unit, range and whether a change applies live), plus ``duration`` (s; > 0 ends the node after
 that time, for launch tests).
@@ -65,6 +67,11 @@ from mindgrasp_ros.topics import (
 )
 
 _NUMBER = re.compile(r'\d+(\.\d+)?')
+#: a joint state makes the controller tick when this many control periods passed since its last
+#: tick (0.75: every second state of a 100 Hz driver at the 50 Hz control rate)
+_INPUT_TICK = 0.75
+#: the timer ticks only when nothing else did for this many control periods
+_TIMER_TICK = 1.5
 
 
 class FsmNode(rclpy.node.Node):
@@ -93,6 +100,7 @@ class FsmNode(rclpy.node.Node):
         self._last_state_pub = -1e9
         self.done = rclpy.task.Future()
         self.ticks = 0
+        self._last_tick = -1e9      # s, node clock: when the controller last ticked
 
         self.arm = ArmCommandOutput(self, self.params, self.fsm.kinematics)
         self.gripper_pub = self.create_publisher(Float64MultiArray, GRIPPER_COMMANDS.name,
@@ -109,7 +117,7 @@ class FsmNode(rclpy.node.Node):
         self.create_subscription(UInt8MultiArray, GRIPPER_CONTACTS.name, self.contacts_callback,
                                  GRIPPER_CONTACTS.qos)
         self.create_subscription(CameraInfo, COLOR_INFO.name, self.info_callback, COLOR_INFO.qos)
-        self.create_timer(self.params.control_period, self.control_callback)
+        self.create_timer(self.params.control_period, self.timer_callback)
         declare_duration(self)
         # a second /fsm or commander of the arm (another graph on this domain): refused before
         # the first command
@@ -140,6 +148,7 @@ class FsmNode(rclpy.node.Node):
         self.inputs.prediction = Prediction(
             int(msg.class_index), float(msg.certainty), self._stamp_or_now(msg.header),
             probabilities=probabilities if probabilities.size else None, classes=classes)
+        self.control_callback()          # a decision reaches the arm at once, not at a tick
 
     def detections_callback(self, msg: DetectionArray) -> None:
         if msg.image_width == 0 or msg.image_height == 0:
@@ -167,6 +176,10 @@ class FsmNode(rclpy.node.Node):
             v = vel[idx] if vel.size else np.zeros(len(idx))
             if np.isfinite(pos[idx]).all() and np.isfinite(v).all():
                 self.inputs.joints = JointStateIn(pos[idx], v, self._stamp_or_now(msg.header))
+                # tick on the fresh state once a control period is nearly over (a 100 Hz
+                # driver: every second state): the command starts from where the arm is
+                if self._now() - self._last_tick >= _INPUT_TICK * self.params.control_period:
+                    self.control_callback()
                 return
             fault = 'joint states contain NaN or infinite values; check the arm driver'
         self.inputs.joint_fault = (self._now(), fault)
@@ -199,8 +212,17 @@ class FsmNode(rclpy.node.Node):
             return
         self.inputs.camera = CameraModel.from_k(int(msg.width), int(msg.height), k)
 
+    def timer_callback(self) -> None:
+        """The fallback tick: when no joint state or prediction made the controller tick for
+        :data:`_TIMER_TICK` control periods (a silent driver, a stalled EEG), it ticks here, so
+        the watchdog still stops the arm."""
+        if self._now() - self._last_tick >= _TIMER_TICK * self.params.control_period:
+            self.control_callback()
+
     def control_callback(self) -> None:
+        """One controller tick: on a prediction, on a fresh joint state, or on the timer."""
         now = self._now()
+        self._last_tick = now
         self.inputs.time = now
         out = self.fsm.tick(self.inputs)
         self.ticks += 1

@@ -84,6 +84,8 @@ from mindgrasp_fsm.types import (
 
 #: how the events of a sensor-fault latch begin (the node logs them as warnings)
 SENSOR_FAULT = 'sensor fault'
+#: the inputs whose age the watchdog judges (names in its messages)
+_INPUT_STREAMS = ('joint states', 'MI predictions', 'camera images')
 _CLASS_WORDS = {0: 'left hand', 1: 'right hand', 2: 'both hands', 3: 'both feet', REST: 'rest'}
 
 
@@ -206,6 +208,12 @@ class GraspFsm:
         self._back_at: float | None = None
         self._fresh: tuple[int, float] | None = None
         self._loss = 'prediction loss'
+        # start-up: an input "streams" once it was fresh for sensor_clean_time without a break,
+        # or once the arm moved; before that an old message is a sender still starting up (the
+        # nodes come up in any order, a loaded machine delays the first messages): the arm
+        # waits for it, no fault latches (name -> fresh since, s)
+        self._fresh_since: dict[str, float] = {}
+        self._streaming: set[str] = set()
         # sensor-fault latch: time (s) of the latest joint-state fault seen (None: not latched)
         self._fault_at: float | None = None
         self._fault_why = ''
@@ -297,6 +305,10 @@ class GraspFsm:
         if self.state == State.RETURN_TO_START:
             accel = np.minimum(accel, p.return_acceleration)
         v = self._limiter.limit(v, self._dt, accel)
+        self.policy.sent(self._now, v)     # where the commands put the arm (grasp policy)
+        if v.any():
+            # the arm moves: from now on an old input is a fault (latched), never a late start
+            self._streaming.update(_INPUT_STREAMS)
         return FsmOutput(
             joint_velocities=v, gripper=self._gripper, state=self.state,
             previous_state=self.previous_state, locked=self._lock_until is not None,
@@ -347,6 +359,8 @@ class GraspFsm:
         t = self._clock
         assert inputs.joints is not None
         q = np.asarray(inputs.joints.position, dtype=float)
+        # the motion of states 4-6 is bounded by how old the joint states are (grasp policy)
+        self.policy.observe(now, inputs.joints.stamp, inputs.joints.velocity)
 
         self._observe(inputs.vision, t)
 
@@ -391,6 +405,14 @@ class GraspFsm:
         p = self.params
         if inputs.joints is None:
             return StopKind.AWAITING_INPUT, 'stopped: no joint states received yet'
+        age = now - inputs.joints.stamp
+        refused = inputs.joint_fault is not None and \
+            now - inputs.joint_fault[0] < p.sensor_clean_time
+        if self._starting_up('joint states', age, p.watchdog_timeout, now) and \
+                self._fault_at is None and not refused:
+            return StopKind.AWAITING_INPUT, (f'stopped: waiting for the joint states to stream '
+                                             f'(the latest is {age:.2f} s old, limit '
+                                             f'{p.watchdog_timeout:.2f} s)')
         why = self._sensor_latch(inputs, now)
         if why:
             return StopKind.FAULT, why
@@ -399,6 +421,10 @@ class GraspFsm:
             if pred is None:
                 return StopKind.AWAITING_INPUT, 'stopped: no MI prediction received yet'
             age = now - pred.stamp
+            if self._starting_up('MI predictions', age, p.watchdog_timeout, now):
+                return StopKind.AWAITING_INPUT, (f'stopped: waiting for the MI predictions to '
+                                                 f'stream (the latest is {age:.2f} s old, limit '
+                                                 f'{p.watchdog_timeout:.2f} s)')
             if age > p.watchdog_timeout:
                 self._stale_pred = True
                 self._back_at = self._fresh = None
@@ -410,10 +436,31 @@ class GraspFsm:
             return (StopKind.AWAITING_INPUT,
                     'stopped: no camera images received yet; holding still')
         age = now - inputs.vision.stamp
+        if self._starting_up('camera images', age, p.camera_timeout, now):
+            return StopKind.AWAITING_INPUT, (f'stopped: waiting for the camera images to stream '
+                                             f'(the latest is {age:.2f} s old, limit '
+                                             f'{p.camera_timeout:.2f} s); holding still')
         if age > p.camera_timeout:
             return StopKind.FAULT, (f'stopped: no camera images for {age:.2f} s (limit '
                                     f'{p.camera_timeout:.2f} s); holding still')
         return StopKind.NONE, ''
+
+    def _starting_up(self, name: str, age: float, limit: float, now: float) -> bool:
+        """True while input ``name``, whose latest message is ``age`` s old at ``now`` (s), is
+        older than ``limit`` s but has not streamed yet: its sender is still starting up, and the
+        arm (which has not moved) waits for it instead of latching a fault.
+
+        An input streams once it was no older than ``limit`` for ``sensor_clean_time`` s
+        without a break, or once the arm moved; after that an old message is a fault."""
+        if name in self._streaming:
+            return False
+        if age > limit:
+            self._fresh_since.pop(name, None)
+            return True
+        since = self._fresh_since.setdefault(name, now)
+        if now - since >= self.params.sensor_clean_time:
+            self._streaming.add(name)
+        return False
 
     def _joint_fault(self, inputs: FsmInputs, now: float) -> str:
         """What is wrong with the joint states at ``now`` (s), '' when nothing."""

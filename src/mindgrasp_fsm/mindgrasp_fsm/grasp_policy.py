@@ -118,6 +118,13 @@ class GraspPolicy:
         self._retreat_reason = ''
         self._lost_since: float | None = None
         self._samples: list[tuple[float, np.ndarray, float | None]] = []   # (stamp, centre, h)
+        #: age (s) of the joint states this tick's motion is computed from; the controller sets
+        #: it every tick (:meth:`observe`)
+        self.input_age = 0.0
+        self._input_time = (0.0, 0.0)    # (now, joint-state stamp), s of the inputs' clock
+        self._seen_velocity = self._zeros()  # their measured velocity (n,) rad/s
+        # the velocity commands sent (time s of the inputs' clock, (n,) rad/s), oldest first
+        self._sent: list[tuple[float, np.ndarray]] = []
 
     # ------------------------------------------------------------------ helpers
     @property
@@ -128,10 +135,71 @@ class GraspPolicy:
     def _zeros(self) -> np.ndarray:
         return np.zeros(len(self.params.joint_names))
 
+    def observe(self, now: float, stamp: float, velocity: np.ndarray | None = None) -> None:
+        """This tick's time ``now`` and the ``stamp`` of the joint states it sees (s, the
+        inputs' clock), and their measured ``velocity`` (n,) rad/s: how old they are, and where
+        the commands sent since then have taken the arm."""
+        self._input_time = (float(now), float(stamp))
+        self.input_age = max(float(now) - float(stamp), 0.0)
+        self._seen_velocity = self._zeros() if velocity is None else \
+            np.asarray(velocity, dtype=float)
+
+    def sent(self, now: float, velocities: np.ndarray) -> None:
+        """The joint velocities (n,) rad/s the controller sent at ``now`` (s): a velocity driver
+        runs each until the next (or its ``driver_command_timeout``). Kept for 2 s."""
+        self._sent.append((float(now), np.array(velocities, dtype=float)))
+        while len(self._sent) > 1 and self._sent[1][0] < now - 2.0:
+            self._sent.pop(0)
+
+    def _commands_since(self, stamp: float, now: float) -> list[tuple[float, np.ndarray]]:
+        """The joint velocities (n,) rad/s in force from ``stamp`` to ``now`` (s), as
+        (duration s, velocities) pieces: each command sent runs until the next one or the
+        driver's ``driver_command_timeout``, then zero."""
+        timeout = self.params.driver_command_timeout
+        pieces, cursor, zeros = [], stamp, self._zeros()
+        for i, (t, v) in enumerate(self._sent):
+            nxt = self._sent[i + 1][0] if i + 1 < len(self._sent) else now
+            lo, hi = max(t, stamp), min(nxt, now)
+            if hi <= lo:
+                continue
+            if lo > cursor:
+                pieces.append((lo - cursor, zeros))
+            off = min(max(t + timeout, lo), hi)
+            pieces += [(off - lo, v), (hi - off, zeros)]
+            cursor = hi
+        if now > cursor:
+            pieces.append((now - cursor, zeros))
+        return [(d, v) for d, v in pieces if d > 0]
+
+    def _arm_now(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Where the arm is now and how fast it moves, ((n,) rad, (n,) rad/s): the joint states
+        seen (``q``, measured ``input_age`` s ago, and their velocity) carried forward by the
+        commands sent since, through the arm's first-order response (``driver_velocity_lag``).
+        A command the driver missed leaves the arm behind this: never nearer to a goal."""
+        now, stamp = self._input_time
+        tau = self.params.driver_velocity_lag
+        q, vel = np.array(q, dtype=float), self._seen_velocity
+        if vel.shape != q.shape:
+            vel = self._zeros()
+        for d, u in self._commands_since(stamp, now):
+            if tau > 0:
+                decay = math.exp(-d / tau)
+                q = q + u * d + (vel - u) * tau * (1.0 - decay)
+                vel = u + (vel - u) * decay
+            else:
+                q, vel = q + u * d, u
+        return q, vel
+
     def _track(self, q: np.ndarray, q_target: np.ndarray) -> tuple[np.ndarray, bool]:
-        """Proportional joint-space tracking, scaled so the velocity direction is kept."""
+        """Proportional joint-space tracking, scaled so the velocity direction is kept.
+
+        The gain is at most 1 / (joint-state age + ``driver_command_timeout`` +
+        ``driver_velocity_lag``): a command that runs for that whole time ends at the target,
+        not beyond it (old joint states, late ticks)."""
         err = q_target - q
-        v = self.params.ik_gain * err
+        horizon = self.input_age + self.params.driver_command_timeout + \
+            self.params.driver_velocity_lag
+        v = min(self.params.ik_gain, 1.0 / max(horizon, 1e-6)) * err
         vmax = np.asarray(self.params.max_joint_velocity)
         scale = float(np.max(np.abs(v) / vmax))
         if scale > 1.0:
@@ -161,6 +229,7 @@ class GraspPolicy:
         if q_set is None:
             return self._zeros(), False, True
         v, reached = self._track(q, q_set)
+        v = self._bound_to_goal(q, v, p1)
         if s >= 1.0:
             close = float(np.linalg.norm(self.kinematics.tool_position(q) - p1)) < 0.004
             if reached or close:
@@ -168,6 +237,33 @@ class GraspPolicy:
         if t - t0 > duration + self.params.segment_timeout:
             return self._zeros(), False, True
         return v, False, False
+
+    def _bound_to_goal(self, q: np.ndarray, v: np.ndarray, goal: np.ndarray) -> np.ndarray:
+        """Joint velocities ``v`` (n,) rad/s scaled down so that the command cannot carry the
+        tool past ``goal`` (3,) m, the end of its segment (the table, at the end of the
+        descent), however late the next tick and however old the joint states ``q`` (n,) rad.
+
+        From where the arm is now (:meth:`_arm_now`: the joint states seen carried forward by
+        the commands sent since), a command ``u`` that the driver runs for its
+        ``driver_command_timeout`` T (no newer one: a late tick) and the arm's response lag tau
+        move the joints ``u T + v_now tau`` in all: the tool speed of ``u`` is at most
+        ``(left - tau |v_now|) / T``. Far from the goal nothing changes; over the last
+        ``cartesian_speed * T`` (3 cm) the tool slows down (time constant T, 0.25 s)."""
+        assert self.kinematics is not None
+        q_now, v_now = self._arm_now(q)
+        tool = self.kinematics.tool_position(q_now)
+        left = float(np.linalg.norm(np.asarray(goal, dtype=float) - tool))
+
+        def tool_speed(joint_velocity: np.ndarray) -> float:
+            # by a small step of the forward kinematics (no Jacobian needed from the model)
+            step = 1e-3
+            moved = self.kinematics.tool_position(q_now + joint_velocity * step) - tool
+            return float(np.linalg.norm(moved)) / step
+
+        coast = self.params.driver_velocity_lag * tool_speed(v_now)
+        limit = max(left - coast, 0.0) / max(self.params.driver_command_timeout, 1e-3)
+        speed = tool_speed(v)
+        return v * (limit / speed) if speed > limit else v
 
     def _height(self) -> float:
         """Object height (m): measured from above when available, else the shape's size."""

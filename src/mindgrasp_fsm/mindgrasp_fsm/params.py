@@ -74,8 +74,10 @@ class FsmParams:
     # no profile may step a joint from slow to fast in one tick (braking is never limited)
     max_joint_acceleration: list[float] = param([2.0] * 6, 'speed-up limit per joint for every '
                                                 'velocity command', unit='rad/s^2', live=True)
-    control_period: float = param(0.02, 'control tick (the node ticks at 1 / control_period)',
-                                  unit='s', min=0.001, max=1.0)
+    control_period: float = param(0.02, 'control tick: the node ticks on a fresh joint state '
+                                  'once 0.75 of it passed, at once on a prediction, and on its '
+                                  'timer after 1.5 of it without a tick', unit='s', min=0.001,
+                                  max=1.0)
     # the form of the arm command for the driver (mindgrasp_fsm.command_interface): the same
     # acceleration-limited joint velocities, sent as a driver of each kind takes them
     command_interface: str = param('velocity', 'arm command: velocity (ros2_control forward '
@@ -248,6 +250,20 @@ class FsmParams:
                                      unit='rad', min=0.0, max=1.2, live=True)
     segment_timeout: float = param(8.0, 'for one motion segment', unit='s', min=0.1, max=120.0,
                                    live=True)
+    # a velocity command runs on until the next one or the driver's own timeout (and the arm
+    # coasts for its lag), and the joint states it was computed from are already old: the
+    # straight moves of states 4-6 never go faster than the distance left (from where the
+    # commands sent since those states put the tool) over timeout + lag, and the joint-space
+    # moves use a gain of at most 1 / (age + timeout + lag), so a late tick or an old state
+    # cannot carry the tool past its goal (the table)
+    driver_command_timeout: float = param(0.25, "how long the arm driver runs a velocity command "
+                                          "without a newer one (the simulator's "
+                                          'command_timeout)', unit='s', min=0.0, max=10.0,
+                                          live=True)
+    driver_velocity_lag: float = param(0.05, "time constant of the arm's response to a new "
+                                       'velocity (the realism profile: 50 ms): the arm coasts '
+                                       'about this long at its old speed after a stop',
+                                       unit='s', min=0.0, max=10.0, live=True)
     # the fingertips reach 0.025 m below the grasp point and would stall on the table
     min_tcp_height: float = param(0.03, 'lowest grasp point above the table', unit='m', min=0.0,
                                   max=1.0, live=True)

@@ -221,6 +221,7 @@ class SimNode(rclpy.node.Node):
         self.create_service(LoadScene, '/sim/load_scene', self.load_scene_callback)
         self.create_service(Step, '/sim/step', self.step_callback)
         self._t0 = self._clock_s() if self.mode == 'realtime' else 0.0
+        self._clock_started = False      # realtime: the clock starts at the first callback
         self._set_t0(self._t0)
         if self.mode == 'realtime':
             self.create_timer(1.0 / float(p.joint_state_rate), self.realtime_callback)
@@ -303,7 +304,19 @@ class SimNode(rclpy.node.Node):
             self._finish()
 
     def realtime_callback(self) -> None:
-        """Catch up with the node's clock (wall, or /clock with use_sim_time)."""
+        """Catch up with the node's clock (wall, or /clock with use_sim_time).
+
+        The simulated clock starts at the first call: the time the node took to build the
+        scene, publish its first frame and start spinning (a loaded machine takes seconds) is
+        no lag, and the start says nothing about it. A lag beyond ``max_catch_up`` later on
+        (a stall) is skipped with a warning."""
+        if self.total_steps == 0 and not self._clock_started:
+            self._clock_started = True
+            start = self._clock_s()
+            for io in self.robots.values():
+                io.gate.shift(start - self._t0)     # commands that came before the start
+            self._set_t0(start)
+            return
         due = self._clock_s() - self.sim_now()
         cap = float(self.params.max_catch_up)
         if due > cap:
