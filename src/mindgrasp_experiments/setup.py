@@ -57,6 +57,7 @@ setup(
             'experiment random-locations = mindgrasp_experiments.commands.random_locations',
             'experiment report = mindgrasp_experiments.commands.report',
             'experiment sweep = mindgrasp_experiments.commands.sweep',
+            'experiment population = mindgrasp_experiments.commands.population',
         ],
     },
 )
