@@ -9,6 +9,7 @@ from __future__ import annotations
 import csv
 import json
 import os
+import secrets
 import shutil
 import signal
 import socket
@@ -259,10 +260,10 @@ def _free_port() -> int:
 def _ray_start(args: list[str], temp_dir: str, log: Path) -> subprocess.Popen:
     """``ray start --block`` in a process group of its own (its servers and workers too)."""
     ray = str(Path(sys.executable).with_name('ray'))
-    env = {**os.environ, 'RAY_USAGE_STATS_ENABLED': '0'}
+    env = dict(os.environ)
     with log.open('w') as stream:
         return subprocess.Popen(
-            [ray, 'start', '--block', '--node-ip-address', HOST, '--num-cpus', '1',
+            [ray, 'start', '--block', '--num-cpus', '1',
              '--temp-dir', temp_dir, '--disable-usage-stats',
              '--dashboard-agent-listen-port', str(_free_port()),
              '--metrics-export-port', str(_free_port()), *args],
@@ -290,8 +291,8 @@ def _stop(proc: subprocess.Popen) -> None:
 
 def _alive_nodes(address: str) -> int:
     """Alive nodes of the cluster, asked by a Ray driver in a subprocess."""
-    code = (f'import ray; ray.init(address={address!r}, _node_ip_address={HOST!r}, '
-            'log_to_driver=False, include_dashboard=False); '
+    code = (f'import ray; ray.init(address={address!r}, log_to_driver=False, '
+            'include_dashboard=False); '
             'print(sum(n["Alive"] for n in ray.nodes()))')
     result = subprocess.run([sys.executable, '-c', code], capture_output=True, text=True,
                             timeout=120, check=False)
@@ -302,11 +303,17 @@ def _alive_nodes(address: str) -> int:
 
 
 @pytest.fixture
-def ray_cluster(tmp_path: Path) -> Iterator[str]:
-    """A 2-node Ray cluster on 127.0.0.1 (head + a second node process); its address. The
-    finalizer ends the two ``ray start --block`` process groups it started (never ``ray stop``:
-    that would end other Ray instances of this machine too)."""
+def ray_cluster(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[str]:
+    """A 2-node Ray cluster on this machine (head + a second node process), reached at
+    127.0.0.1; its address. Ray 2.60 takes no loopback node address (``ray start`` turns
+    127.0.0.1 into the machine's address) and its servers listen on every interface, so the
+    cluster takes a token of this test only (``RAY_AUTH_MODE=token``): nobody else can join it
+    or run code on it. The finalizer ends the two ``ray start --block`` process groups it
+    started (never ``ray stop``: that would end other Ray instances of this machine too)."""
     pytest.importorskip('ray', reason='the optional extra cluster: pip install -e ".[cluster]"')
+    monkeypatch.setenv('RAY_AUTH_MODE', 'token')
+    monkeypatch.setenv('RAY_AUTH_TOKEN', secrets.token_hex(32))
+    monkeypatch.setenv('RAY_USAGE_STATS_ENABLED', '0')
     port = _free_port()
     address = f'{HOST}:{port}'
     # short paths: Ray's Unix sockets live in the temp dir (at most 107 characters)
