@@ -677,7 +677,8 @@ def render_report(rows: Sequence[Mapping[str, Any]], figures: Mapping[str, Any],
               '|---|---|---|---|---|---|---|---|---|---|']
     for r in rows:
         if not r.get('trials'):
-            lines.append(f"| {r['label']} | {_cell(r['group'])} | {r['status']} | - | - | - | - "
+            status = 'not run (below)' if r['status'].startswith('not run') else r['status']
+            lines.append(f"| {r['label']} | {_cell(r['group'])} | {status} | - | - | - | - "
                          '| - | - | - |')
             continue
         lines.append(
@@ -687,6 +688,10 @@ def render_report(rows: Sequence[Mapping[str, Any]], figures: Mapping[str, Any],
             f"{_cell(r['itr_bits_per_min'], 'bits')} | {_cell(r['answer_pair'])} | "
             f"{_cell(r['gate_verdict'])} | {_cell(r['predicted_correct_rate'], 'pct')} / "
             f"{_cell(r['correct_rate'], 'pct')} |")
+    not_run = [r for r in rows if str(r.get('status', '')).startswith('not run')]
+    if not_run:
+        lines += ['', 'Not run (the run went on with the next subject):', '']
+        lines += [f"- {r['label']}: {r['status'].removeprefix('not run: ')}" for r in not_run]
     subjects = {s['label']: s for s in info.get('subjects', [])}
     restricted = [(label, s) for label, s in subjects.items() if s.get('restriction')
                   or s.get('note')]
