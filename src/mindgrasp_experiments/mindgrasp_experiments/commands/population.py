@@ -29,8 +29,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Arguments of ``mindgrasp experiment population``."""
     from mindgrasp_common.cli_checks import probability
 
-    add_common_arguments(parser, trials=18)
-    parser.set_defaults(trial_timeout=240.0)
+    # 240 s: the trial timeout the replay subjects are measured with (README)
+    add_common_arguments(parser, trials=18, trial_timeout=240.0)
     parser.add_argument('--subjects', default=None, metavar='S1,S2,...',
                         help='replay subjects, comma-separated: eegmmidb:<n> or subject files '
                              '(.yaml), e.g. eegmmidb:1,eegmmidb:2')
@@ -45,11 +45,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help='set a parameter of a node for every subject (names as in the '
                              'profile\'s parameter files), e.g. fsm.confirm_threshold=3; a '
                              'population file can set some for one subject')
-    # the set-locations protocol's default timeout for replay subjects (README)
-    for action in parser._actions:
-        if action.dest == 'trial_timeout':
-            action.help = ('end a trial without a grasp after S simulated s (default 240, as '
-                           'the replay subjects are measured)')
 
 
 def main(args: argparse.Namespace) -> int:
