@@ -215,8 +215,9 @@ def test_a_population_of_2_subjects_x_2_trials(population: tuple[Path, dict]) ->
     assert _records(out) == {label: (out / 'subjects' / label / 'records.csv').read_text()
                              for label in ('eegmmidb_s001', 'eegmmidb_s002')}
     # other options for the same --out: one line, nothing run
-    result = mindgrasp('experiment', 'population', '--subjects', SUBJECTS, '--trials', '3',
-                       '--out', str(out), '--no-progress')
+    other = [('3' if RUN[i - 1] == '--trials' else a) for i, a in enumerate(RUN)]
+    result = mindgrasp('experiment', 'population', '--subjects', SUBJECTS, *other,
+                       '--out', str(out))
     assert result.returncode == 2 and 'other options (trials)' in result.stderr, result.stderr
 
 
