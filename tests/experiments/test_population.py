@@ -322,8 +322,7 @@ def ray_cluster(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[str
     temps = [tempfile.mkdtemp(prefix='mgray'), tempfile.mkdtemp(prefix='mgray')]
     procs: list[subprocess.Popen] = []
     try:
-        procs.append(_ray_start(['--head', '--port', str(port), '--include-dashboard', 'false',
-                                 '--ray-client-server-port', str(_free_port())],
+        procs.append(_ray_start(['--head', '--port', str(port), '--include-dashboard', 'false'],
                                 temps[0], tmp_path / 'head.log'))
         deadline = time.monotonic() + START_TIMEOUT
         while time.monotonic() < deadline:
