@@ -44,6 +44,7 @@ setup(
             'experiment report = mindgrasp_experiments.commands.experiment_report',
             'experiment sweep = mindgrasp_experiments.commands.experiment_sweep',
             'robot check = mindgrasp_experiments.commands.robot_check',
+            'experiment population = mindgrasp_experiments.commands.experiment_population',
         ],
     },
 )

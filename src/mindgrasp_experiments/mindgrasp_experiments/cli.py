@@ -45,7 +45,8 @@ def subject_type(text: str) -> str:
     raise argparse.ArgumentTypeError(msg)
 
 
-def add_common_arguments(parser: argparse.ArgumentParser, trials: int) -> None:
+def add_common_arguments(parser: argparse.ArgumentParser, trials: int,
+                         trial_timeout: float = 600.0) -> None:
     """Options of every ``mindgrasp experiment`` protocol (numbers checked by argparse)."""
     from mindgrasp_common.cli_checks import bounded_int, non_negative_int, positive_float
     from mindgrasp_common.robot_description import robot_choices
@@ -69,8 +70,9 @@ def add_common_arguments(parser: argparse.ArgumentParser, trials: int) -> None:
     parser.add_argument('--stall-timeout', type=positive_float, default=120.0, metavar='S',
                         help='abort a trial after S simulated s without a controller state '
                              'change (default 120)')
-    parser.add_argument('--trial-timeout', type=positive_float, default=600.0, metavar='S',
-                        help='end a trial without a grasp after S simulated s (default 600)')
+    parser.add_argument('--trial-timeout', type=positive_float, default=trial_timeout,
+                        metavar='S', help='end a trial without a grasp after S simulated s '
+                                          f'(default {trial_timeout:g})')
     parser.add_argument('--no-progress', action='store_true', help='no progress bar')
     parser.add_argument('--ray', metavar='ADDRESS', default=None,
                         help='run the trials as Ray tasks (pip install -e ".[cluster]"): auto '

@@ -7,6 +7,14 @@
 - ``time_to_grasp``: histogram of the simulated time to a successful grasp, correct and wrong
   grasps stacked apart.
 
+A population run (:mod:`~mindgrasp_experiments.population`) adds, from its per-subject table
+(:func:`write_population_plots`):
+
+- ``population_outcomes``: per subject, correct, wrong and no grasps as stacked bars (share of
+  its trials), the subject's answer pair and gate verdict under its name;
+- ``predicted_vs_measured``: each subject's correct rate as the calibration predicted it
+  against the measured one, with the identity line and the band of +/- 20 points.
+
 Interrupted trials are left out, as from the figures (:func:`~.summary.counted`).
 """
 
@@ -19,7 +27,7 @@ from pathlib import Path
 from mindgrasp_experiments.records import TrialRecord, shape_of
 from mindgrasp_experiments.summary import counted
 
-__all__ = ['write_plots']
+__all__ = ['write_plots', 'write_population_plots']
 
 _MARKERS = {'cube': 's', 'cylinder': 'o', 'sphere': '^'}
 _COLOURS = {'red': 'tab:red', 'yellow': 'gold', 'blue': 'tab:blue'}
@@ -165,3 +173,84 @@ def write_plots(records: Sequence[TrialRecord], run_dir: str | Path,
     out += _save(fig, run_dir, 'time_to_grasp')
     plt.close(fig)
     return out
+
+
+def _population_outcomes(plt, rows: Sequence[dict], out: Path) -> list[Path]:
+    """Stacked bars: each subject's correct, wrong and no grasps as shares of its trials."""
+    ran = [r for r in rows if r.get('trials')]
+    fig, ax = plt.subplots(figsize=(max(5.0, 0.6 * len(rows) + 2.0), 4.5))
+    x = list(range(len(rows)))
+    bottom = [0.0] * len(rows)
+    for outcome, key, colour in (('correct grasp', 'correct', 'tab:green'),
+                                 ('wrong grasp', 'wrong_grasp', 'tab:red'),
+                                 ('no grasp', 'no_grasp', 'lightgrey')):
+        shares = [(r.get(f'{key}_count') or 0) / r['trials'] if r.get('trials') else 0.0
+                  for r in rows]
+        total = sum(r.get(f'{key}_count') or 0 for r in ran)
+        ax.bar(x, shares, bottom=bottom, color=colour, edgecolor='k', linewidth=0.4,
+               label=f'{outcome} ({total})')
+        bottom = [b + s for b, s in zip(bottom, shares, strict=True)]
+    for i, r in enumerate(rows):
+        if not r.get('trials'):
+            ax.annotate('not run', (i, 0.02), rotation=90, ha='center', va='bottom', fontsize=7)
+    ax.axhline(0.5, color='k', lw=0.8, ls=':')
+    ax.set_xticks(x)
+    ax.set_xticklabels([f"{r['label']}\n{r.get('answer_pair') or '-'}\n"
+                        f"{r.get('gate_verdict') or '-'}" for r in rows], fontsize=7,
+                       rotation=0 if len(rows) <= 8 else 60)
+    ax.set_ylim(0, 1)
+    ax.set_ylabel('share of the subject\'s trials')
+    ax.set_xlabel('subject (answer pair, gate verdict)')
+    ax.legend(fontsize=8, loc='upper left', bbox_to_anchor=(1.01, 1.0))
+    trials = sorted({r['trials'] for r in ran})
+    ax.set_title(f"Outcomes per subject ({', '.join(map(str, trials)) or 0} trials each, "
+                 'set locations)')
+    paths = _save(fig, out, 'population_outcomes')
+    plt.close(fig)
+    return paths
+
+
+def _predicted_vs_measured(plt, rows: Sequence[dict], out: Path) -> list[Path]:
+    """Predicted against measured correct rate, identity line and the +/- 20-point band."""
+    fig, ax = plt.subplots(figsize=(5.5, 5.5))
+    ax.plot([0, 1], [0, 1], color='k', lw=1, label='identity')
+    ax.fill_between([0, 1], [-0.2, 0.8], [0.2, 1.2], color='tab:blue', alpha=0.12,
+                    label='within 20 points')
+    colours = {'ready': 'tab:green', 'needs_training': 'tab:orange', 'not_ready': 'tab:red'}
+    shown = [r for r in rows if r.get('predicted_correct_rate') is not None
+             and r.get('correct_rate') is not None]
+    for verdict in dict.fromkeys(str(r.get('gate_verdict') or '-') for r in shown):
+        rs = [r for r in shown if str(r.get('gate_verdict') or '-') == verdict]
+        ax.scatter([r['predicted_correct_rate'] for r in rs], [r['correct_rate'] for r in rs],
+                   c=colours.get(verdict, 'tab:grey'), edgecolors='k', zorder=3,
+                   label=f'gate: {verdict} ({len(rs)})')
+        for r in rs:
+            ax.annotate(r['label'], (r['predicted_correct_rate'], r['correct_rate']),
+                        textcoords='offset points', xytext=(4, 3), fontsize=6)
+    if not shown:
+        ax.text(0.5, 0.5, 'no subject has a predicted correct rate\n(the calibration wrote '
+                'no gate prediction)', ha='center', va='center', fontsize=9)
+    ax.set_xlim(0, 1)
+    ax.set_ylim(0, 1)
+    ax.set_aspect('equal')
+    ax.grid(alpha=0.3)
+    ax.set_xlabel('predicted correct rate (calibration gate)')
+    ax.set_ylabel('measured correct rate (closed loop)')
+    ax.legend(fontsize=7, loc='lower right')
+    ax.set_title(f'Predicted against measured ({len(shown)} subjects)')
+    paths = _save(fig, out, 'predicted_vs_measured')
+    plt.close(fig)
+    return paths
+
+
+def write_population_plots(rows: Sequence[dict], out: str | Path) -> list[Path]:
+    """population_outcomes and predicted_vs_measured (PNG and SVG) of a population's
+    per-subject rows (:func:`~mindgrasp_experiments.population.subject_row`); returns the
+    files written."""
+    import matplotlib
+
+    matplotlib.use('Agg')
+    import matplotlib.pyplot as plt
+
+    out = Path(out)
+    return [*_population_outcomes(plt, rows, out), *_predicted_vs_measured(plt, rows, out)]
