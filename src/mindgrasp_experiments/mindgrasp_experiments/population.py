@@ -11,8 +11,8 @@ A population is a list of replay subjects (``eegmmidb:<n>`` or subject files,
       - {subject: eegmmidb_local/eegmmidb_s006.yaml, group: unseen,
          params: {fsm.offer_delay: 2.0}}       # node parameters for this subject only
 
-Each subject is calibrated (:func:`~mindgrasp_experiments.subject_launch.subject_launch_args`, the model
-cached in ``<out>/models``) and runs the set-locations protocol as ``mindgrasp experiment
+Each subject is calibrated (:func:`~mindgrasp_experiments.subject_launch.subject_launch_args`,
+the model cached in ``<out>/models``) and runs the set-locations protocol as ``mindgrasp experiment
 set-locations --subject S`` does (one :class:`~mindgrasp_experiments.experiment.Experiment`,
 its run directory ``<out>/subjects/<label>/``, trials on ``workers`` processes or Ray). A
 subject whose run directory holds a finished run of the same options is not run again, so a
@@ -424,8 +424,8 @@ def run_population(subjects: Sequence[PopulationSubject], out: str | Path, *,
     population's ``out``, unknown ``params``).
     """
     from mindgrasp_eeg import EEGError
-    from mindgrasp_experiments.subject_launch import subject_launch_args
     from mindgrasp_experiments.experiment import Experiment
+    from mindgrasp_experiments.subject_launch import subject_launch_args
 
     out = Path(out)
     options = {'trials': trials, 'seed': seed, 'accuracy': accuracy, 'params': dict(params or {}),
