@@ -53,6 +53,7 @@ setup(
         # verbs of the mindgrasp command: 'COMMAND VERB = module' (add_arguments, main)
         'mindgrasp.verb': [
             'eeg fit-virtual = mindgrasp_experiments.fit_virtual_cli',
+            'evaluate decoding = mindgrasp_experiments.commands.evaluate_decoding',
             'experiment set-locations = mindgrasp_experiments.commands.set_locations',
             'experiment random-locations = mindgrasp_experiments.commands.random_locations',
             'experiment report = mindgrasp_experiments.commands.report',
