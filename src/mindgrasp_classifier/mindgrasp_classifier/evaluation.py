@@ -53,9 +53,9 @@ from sklearn.model_selection import StratifiedKFold
 from mindgrasp_classifier.errors import ClassifierError
 from mindgrasp_common.mi import REST
 
-__all__ = ['EVALUATIONS', 'EXTRA_COLUMNS', 'RESULT_COLUMNS', 'TASKS', 'Recentred', 'Split', 'Task', 'Trials',
-           'balanced_accuracy', 'fit_predict', 'leave_run_out', 'moabb_score', 'task',
-           'within_session', 'write_results']
+__all__ = ['EVALUATIONS', 'EXTRA_COLUMNS', 'RESULT_COLUMNS', 'TASKS', 'Recentred', 'Split',
+           'Task', 'Trials', 'balanced_accuracy', 'fit_predict', 'leave_run_out', 'moabb_score',
+           'task', 'within_session', 'write_results']
 
 #: MOABB's result columns (``moabb.evaluations.base.BaseEvaluation``), in its order
 RESULT_COLUMNS = ('score', 'time', 'samples', 'subject', 'session', 'channels', 'n_sessions',
