@@ -21,6 +21,7 @@ distances: ``MG MDM`` (the default decoder, the online MDM: 1 s windows in 0.5-2
 
 from __future__ import annotations
 
+import json
 import math
 from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor
@@ -47,6 +48,8 @@ PUBLISHED: dict[tuple[str, str], float] = {
 }
 
 
+#: changes when the rows of a subject would change: kept rows of another version are recomputed
+RESULTS_VERSION = 1
 #: step between the windows of MIndGrasp's pipelines here (s)
 WINDOW_STEP = 0.25
 #: the pipelines run unless named: MOABB's three, the decoder's MDM and the replay decoder
@@ -202,17 +205,35 @@ def evaluate_subject(subject: int, *, tasks: Sequence[str] | None = None,
     return rows
 
 
-def _subject_job(args: tuple[int, dict[str, Any]]) -> list[dict[str, Any]]:
-    subject, kwargs = args
-    return evaluate_subject(subject, **kwargs)
+def _subject_job(args: tuple[int, dict[str, Any], Path | None]) -> list[dict[str, Any]]:
+    """Rows of one subject, read from ``done`` if it holds them for the same settings, else
+    computed (and written there)."""
+    subject, kwargs, done = args
+    settings = {'version': RESULTS_VERSION, **{k: (list(v) if isinstance(v, (list, tuple))
+                                                   else v) for k, v in kwargs.items()}}
+    path = None if done is None else done / f'S{subject:03d}.json'
+    if path is not None and path.is_file():
+        doc = json.loads(path.read_text(encoding='utf-8'))
+        if doc.get('settings') == settings:
+            return doc['rows']
+    rows = evaluate_subject(subject, **kwargs)
+    if path is not None:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = path.with_suffix('.tmp')
+        tmp.write_text(json.dumps({'settings': settings, 'rows': rows}), encoding='utf-8')
+        tmp.replace(path)
+    return rows
 
 
-def evaluate(subjects: Sequence[int], *, jobs: int = 1,
+def evaluate(subjects: Sequence[int], *, jobs: int = 1, done: str | Path | None = None,
              progress: Callable[[int], None] | None = None,
              **kwargs: Any) -> list[dict[str, Any]]:
     """:func:`evaluate_subject` of each subject (``jobs`` processes), rows in subject order;
-    ``progress`` is called with the number of subjects done."""
-    todo = [(s, kwargs) for s in subjects]
+    ``progress`` is called with the number of subjects done. With ``done`` (a directory), each
+    subject's rows are kept there as they finish (``S001.json``) and reused by a rerun with
+    the same settings: an interrupted evaluation resumes."""
+    folder = None if done is None else Path(done)
+    todo = [(s, kwargs, folder) for s in subjects]
     rows: list[dict[str, Any]] = []
     if jobs <= 1 or len(todo) <= 1:
         for i, job in enumerate(todo):

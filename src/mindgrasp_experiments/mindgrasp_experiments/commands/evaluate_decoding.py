@@ -6,7 +6,9 @@ beside pyRiemann's MDM, TS+LR and CSP+LDA, for 4 classes and each binary pair.
 Writes results.csv (MOABB's columns: score, time, samples, subject, session, channels,
 n_sessions, dataset, pipeline, evaluation; then task, metric, balanced_accuracy, n_folds,
 n_trials), table.md (one table per evaluation and task, a row per subject) and decoding.png.
-Reads the runs on disk only (MNE_DATASETS_EEGBCI_PATH); nothing is downloaded.
+Each subject's rows are kept in subjects/S001.json as it finishes: the same command again
+resumes an interrupted evaluation. Reads the runs on disk only (MNE_DATASETS_EEGBCI_PATH);
+nothing is downloaded.
 """
 
 from __future__ import annotations
@@ -81,7 +83,8 @@ def main(args: argparse.Namespace) -> int:
 
     bar = tqdm(total=len(subjects), desc='subjects', file=sys.stderr, disable=None, leave=False)
     try:
-        rows = evaluate(subjects, jobs=args.jobs, tasks=tasks, pipeline_names=names,
+        rows = evaluate(subjects, jobs=args.jobs, done=Path(args.out) / 'subjects',
+                        tasks=tasks, pipeline_names=names,
                         evaluations=evaluations, runs=runs, seed=args.seed,
                         progress=lambda n: bar.update(n - bar.n))
     except ClassifierError as exc:
