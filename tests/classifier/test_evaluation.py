@@ -36,6 +36,15 @@ def separable_trials(n_runs: int = 3, per_class: int = 6, gap: float = 1.0,
                      ['a', 'b', 'c', 'd'])
 
 
+def test_eegmmidb_imagery_runs_are_labelled_as_physionet_says() -> None:
+    from mindgrasp_classifier.data import EEGMMIDB_RUNS
+
+    for run in (4, 8, 12):                       # imagined left / right fist
+        assert EEGMMIDB_RUNS[run] == {'T1': 0, 'T2': 1}, run
+    for run in (6, 10, 14):                      # imagined both fists / both feet
+        assert EEGMMIDB_RUNS[run] == {'T1': 2, 'T2': 3}, run
+
+
 def test_tasks_pool_and_name_their_classes() -> None:
     rest = ev.task('rest_imagery')
     assert rest.classes == [0, 1]

@@ -49,7 +49,7 @@ PUBLISHED: dict[tuple[str, str], float] = {
 
 
 #: changes when the rows of a subject would change: kept rows of another version are recomputed
-RESULTS_VERSION = 1
+RESULTS_VERSION = 2     # 2: EEGMMIDB run 12 labelled left/right
 #: step between the windows of MIndGrasp's pipelines here (s)
 WINDOW_STEP = 0.25
 #: the pipelines run unless named: MOABB's three, the decoder's MDM and the replay decoder
