@@ -38,6 +38,7 @@ setup(
         # verbs of the mindgrasp command: 'COMMAND VERB = module' (add_arguments, main)
         'mindgrasp.verb': [
             'eeg fit-virtual = mindgrasp_experiments.commands.eeg_fit_virtual',
+            'evaluate decoding = mindgrasp_experiments.commands.evaluate_decoding',
             'experiment set-locations = mindgrasp_experiments.commands.experiment_set_locations',
             ('experiment random-locations = '
              'mindgrasp_experiments.commands.experiment_random_locations'),

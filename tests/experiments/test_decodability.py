@@ -149,17 +149,17 @@ def test_measure_labels_rest_and_needs_both_sets(protocol) -> None:
     assert np.isnan(only_lr.score('hands_feet')) and np.isfinite(only_lr.score('left_right'))
 
 
-def test_log_euclidean_classifiers_match_pyriemann() -> None:
-    from pyriemann.classification import MDM
-    from pyriemann.datasets import make_matrices
+def test_figures_use_the_classifier_pipelines() -> None:
+    from mindgrasp_classifier.evaluation import TASKS
+    from mindgrasp_classifier.pipelines import MdmClassifier, TsLrClassifier
 
-    covs = make_matrices(60, 6, 'spd', rs=0)
-    y = np.repeat([0, 1, 2], 20)
-    covs[y == 1] *= 1.5
-    vectors = dec.log_vectors(covs)
-    ours = dec._predict('mdm', vectors[:45], y[:45], vectors[45:])
-    theirs = MDM(metric='logeuclid').fit(covs[:45], y[:45]).predict(covs[45:])
-    assert np.array_equal(ours, theirs)
+    mdm, ts_lr = (dec.make_pipeline(name) for name in dec.PIPELINES)
+    assert type(mdm) is MdmClassifier and mdm.metric == 'logeuclid'
+    assert type(ts_lr) is TsLrClassifier and ts_lr.metric == 'logeuclid'
+    assert ts_lr.class_weight == 'balanced' and ts_lr.C == 1.0
+    assert dec.FIGURES is TASKS                   # the tasks of mindgrasp evaluate decoding
+    with pytest.raises(EEGError, match="Unknown decodability pipeline 'lda'"):
+        dec.make_pipeline('lda')
 
 
 def test_real_subject_figures_are_above_chance() -> None:

@@ -27,8 +27,11 @@ from mindgrasp_ros.topics import EEG_MARKERS, EEG_RAW, TRAINER_PROMPT, VIRTUAL_S
 
 #: EEGMMIDB run -> {annotation: MIndGrasp class} (../shared/data/EEGMMIDB-README.md).
 EEGMMIDB_RUNS: dict[int, dict[str, int]] = {
-    **{r: {'T1': 0, 'T2': 1} for r in (3, 4, 7, 8, 11)},   # left / right fist
-    **{r: {'T1': 2, 'T2': 3} for r in (5, 6, 9, 10, 12, 13, 14)},  # both fists / both feet
+    # PhysioNet: runs 3, 7, 11 (executed) and 4, 8, 12 (imagined) are left / right fist;
+    # 5, 9, 13 and 6, 10, 14 both fists / both feet (run 12 was labelled hands/feet until
+    # 2026-11-28)
+    **{r: {'T1': 0, 'T2': 1} for r in (3, 4, 7, 8, 11, 12)},   # left / right fist
+    **{r: {'T1': 2, 'T2': 3} for r in (5, 6, 9, 10, 13, 14)},  # both fists / both feet
 }
 EEGMMIDB_IMAGERY_RUNS = (4, 6, 8, 10, 12, 14)
 #: EEGMMIDB's rest annotation (between every two cues, ~4.2 s), labelled :data:`REST` on request

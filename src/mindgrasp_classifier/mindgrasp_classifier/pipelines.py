@@ -16,9 +16,9 @@ from __future__ import annotations
 
 import numpy as np
 from pyriemann.classification import MDM
-from pyriemann.geometry.base import invsqrtm
+from pyriemann.geometry.base import invsqrtm, logm
 from pyriemann.geometry.geodesic import geodesic_riemann
-from pyriemann.geometry.mean import mean_riemann
+from pyriemann.geometry.mean import mean_logeuclid, mean_riemann
 from pyriemann.geometry.tangentspace import tangent_space, untangent_space
 from pyriemann.tangentspace import TangentSpace
 from sklearn.base import BaseEstimator, ClassifierMixin
@@ -73,6 +73,16 @@ def softmax(logits: np.ndarray) -> np.ndarray:
     return p / p.sum(axis=-1, keepdims=True)
 
 
+METRICS = ('riemann', 'logeuclid')
+
+
+def _check_metric(metric: str) -> str:
+    if metric not in METRICS:
+        msg = f'Unknown metric {metric!r}; choose one of {list(METRICS)}.'
+        raise ClassifierError(msg)
+    return metric
+
+
 def _check_covs(X: np.ndarray) -> np.ndarray:
     X = np.asarray(X, dtype=float)
     if X.ndim != 3 or X.shape[1] != X.shape[2]:
@@ -112,6 +122,13 @@ class _DistanceClassifier(ClassifierMixin, BaseEstimator):
 class MdmClassifier(_DistanceClassifier):
     """Minimum distance to Riemannian class means (pyRiemann ``MDM``, affine-invariant metric).
 
+    Parameters
+    ----------
+    metric : {'riemann', 'logeuclid'}
+        ``riemann`` (default: the decoder's, the only one a model file stores) or
+        ``logeuclid`` (pyRiemann ``MDM(metric='logeuclid')``: log-Euclidean means and
+        distances, for offline measurements that fit many models, e.g. decodability).
+
     Attributes
     ----------
     classes_ : ndarray, shape (n_classes,)
@@ -121,27 +138,43 @@ class MdmClassifier(_DistanceClassifier):
     name = 'mdm'
     supports_mean_update = True
 
+    def __init__(self, metric: str = 'riemann') -> None:
+        self.metric = metric
+
     def fit(self, X: np.ndarray, y: np.ndarray) -> MdmClassifier:
         """Fit class means on covariances ``X`` with labels ``y``."""
         X = _check_covs(X)
-        mdm = MDM(metric='riemann').fit(X, np.asarray(y))
+        mdm = MDM(metric=_check_metric(self.metric)).fit(X, np.asarray(y))
         self.classes_ = mdm.classes_
         self.covmeans_ = np.asarray(mdm.covmeans_, dtype=float)
         self._refresh()
         return self
 
     def _refresh(self) -> None:
-        self._means_invsqrt = invsqrtm(self.covmeans_)
+        if self.metric == 'logeuclid':
+            self._means_log = logm(self.covmeans_)
+        else:
+            self._means_invsqrt = invsqrtm(self.covmeans_)
 
     def _features(self, X: np.ndarray) -> np.ndarray:
         return X
 
     def distances(self, X: np.ndarray) -> np.ndarray:
-        """Riemannian distance to each class mean, shape (n_matrices, n_classes)."""
-        return riemann_distances(self._features(_check_covs(X)), self._means_invsqrt)
+        """Distance to each class mean in the classifier's metric, shape (n_matrices,
+        n_classes) (log-Euclidean: ``|| log(C) - log(M_k) ||_F``, pyRiemann
+        ``distance_logeuclid``)."""
+        X = self._features(_check_covs(X))
+        if self.metric == 'logeuclid':
+            diff = logm(X)[:, None] - self._means_log[None]
+            return np.sqrt(np.sum(diff ** 2, axis=(-2, -1)))
+        return riemann_distances(X, self._means_invsqrt)
 
     def update_mean(self, class_position: int, cov: np.ndarray, rate: float) -> None:
         """Move one class mean along the geodesic towards ``cov`` by ``rate`` (0..1)."""
+        if self.metric != 'riemann':
+            msg = (f'Mean updates move along affine-invariant geodesics; this MDM uses the '
+                   f'{self.metric!r} metric. Use MdmClassifier() (metric riemann) online.')
+            raise ClassifierError(msg)
         target = self._features(_check_covs(cov[None]))[0]
         self.covmeans_[class_position] = geodesic_riemann(
             self.covmeans_[class_position], target, rate)
@@ -175,6 +208,9 @@ class FgMdmClassifier(MdmClassifier):
     """
 
     name = 'fgmdm'
+
+    def __init__(self) -> None:
+        self.metric = 'riemann'     # the filter and the means are affine-invariant
 
     def fit(self, X: np.ndarray, y: np.ndarray) -> FgMdmClassifier:
         """Fit the geodesic filter and the class means."""
@@ -230,28 +266,44 @@ class TsLrClassifier(_DistanceClassifier):
         probabilities carry no prior from how many epochs of each class the calibration had
         (EEGMMIDB has two to four times as many rest epochs as epochs of one imagery class);
         MDM has no prior either. ``None``: scikit-learn's unweighted fit.
+    metric : {'riemann', 'logeuclid'}
+        Mean and tangent space: ``riemann`` (default, the only one a model file stores) or
+        ``logeuclid`` (pyRiemann's log-Euclidean ones, for offline measurements).
+    reference : {'mean', 'identity'}
+        Tangent point: the training matrices' mean in ``metric`` (default) or the identity,
+        for matrices already re-centred on their mean (decodability re-centres each recording).
     """
 
     name = 'ts_lr'
     supports_mean_update = False
 
-    def __init__(self, C: float = 1.0, class_weight: str | None = 'balanced') -> None:
+    def __init__(self, C: float = 1.0, class_weight: str | None = 'balanced',
+                 metric: str = 'riemann', reference: str = 'mean') -> None:
         self.C = C
         self.class_weight = class_weight
+        self.metric = metric
+        self.reference = reference
 
     def fit(self, X: np.ndarray, y: np.ndarray) -> TsLrClassifier:
         """Fit the reference point and the logistic regression."""
         X = _check_covs(X)
-        self.reference_ = mean_riemann(X)
+        metric = _check_metric(self.metric)
+        if self.reference == 'identity':
+            self.reference_ = np.eye(X.shape[-1])
+        elif self.reference == 'mean':
+            self.reference_ = mean_riemann(X) if metric == 'riemann' else mean_logeuclid(X)
+        else:
+            msg = f"Unknown reference {self.reference!r}; choose 'mean' or 'identity'."
+            raise ClassifierError(msg)
         lr = LogisticRegression(C=self.C, max_iter=2000, class_weight=self.class_weight)
-        lr.fit(tangent_space(X, self.reference_, metric='riemann'), np.asarray(y))
+        lr.fit(tangent_space(X, self.reference_, metric=metric), np.asarray(y))
         self.classes_ = lr.classes_
         self.coef_ = np.atleast_2d(lr.coef_).astype(float)
         self.intercept_ = np.atleast_1d(lr.intercept_).astype(float)
         return self
 
     def _log_proba(self, X: np.ndarray) -> np.ndarray:
-        z = tangent_space(_check_covs(X), self.reference_, metric='riemann') @ self.coef_.T
+        z = tangent_space(_check_covs(X), self.reference_, metric=self.metric) @ self.coef_.T
         z = z + self.intercept_
         if z.shape[1] == 1:  # binary: scikit-learn's single decision function
             z = np.hstack([np.zeros_like(z), z])
