@@ -19,7 +19,7 @@ from mindgrasp_testing import root_setup
 SRC = Path(__file__).resolve().parents[2] / 'src'
 #: what ``mindgrasp --help`` listed before the commands became entry points, in name order
 COMMANDS = ['bag', 'eeg', 'evaluate', 'experiment', 'export', 'interface', 'launch', 'node',
-            'param', 'replay', 'run', 'service', 'session', 'topic', 'train', 'trainer']
+            'param', 'replay', 'robot', 'run', 'service', 'session', 'topic', 'train', 'trainer']
 
 
 def _declared() -> dict[str, dict[str, list[str]]]:
