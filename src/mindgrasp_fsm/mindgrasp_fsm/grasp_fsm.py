@@ -64,6 +64,8 @@ import math
 
 import numpy as np
 
+from mindgrasp_common.answer_pair import DEFAULT_PAIR, AnswerPair, answer_pair, model_decision
+from mindgrasp_common.errors import CommonError
 from mindgrasp_common.mi import REST
 from mindgrasp_fsm.acceleration import AccelerationLimiter
 from mindgrasp_fsm.errors import FsmError
@@ -85,6 +87,75 @@ from mindgrasp_fsm.types import (
 #: how the events of a sensor-fault latch begin (the node logs them as warnings)
 SENSOR_FAULT = 'sensor fault'
 _CLASS_WORDS = {0: 'left hand', 1: 'right hand', 2: 'both hands', 3: 'both feet', REST: 'rest'}
+
+
+def _side(classes: tuple[int, ...]) -> int | list[int]:
+    """One side of an answer pair for :class:`Evidence`: its class, or the set."""
+    return int(classes[0]) if len(classes) == 1 else list(classes)
+
+
+def _word(classes: tuple[int, ...]) -> str:
+    """'both-hands', 'rest', 'imagery' ...: what the evidence of one side of the pair is for."""
+    return _CLASS_WORDS[classes[0]].replace(' ', '-') if len(classes) == 1 else 'imagery'
+
+
+def readiness_problem(params: FsmParams) -> str | None:
+    """Why ``params.classifier_model`` may not drive the arm when ``require_ready_model`` is set
+    (one sentence naming the override), or None: its calibration gate
+    (:mod:`mindgrasp_classifier.gate`) called the person ready, or no readiness is required."""
+    import json
+
+    from mindgrasp_common.resources import ResourceNotFoundError, resolve_path
+
+    if not params.require_ready_model or params.autonomous:
+        return None
+    override = 'override with require_ready_model:=false (a bench test, or at your own risk)'
+    if not params.classifier_model:
+        return f'no classifier model to check (classifier_model is empty); {override}.'
+    try:
+        path = resolve_path(params.classifier_model, 'mindgrasp_classifier', ('.json',))
+        if path.suffix != '.json':
+            path = path.with_name(path.name + '.json')
+        gate = json.loads(path.read_text()).get('gate') or {}
+    except (OSError, ValueError, AttributeError, ResourceNotFoundError) as exc:
+        return f'cannot read the gate of {params.classifier_model} ({exc}); {override}.'
+    verdict = gate.get('verdict') if isinstance(gate, dict) else None
+    if verdict == 'ready':
+        return None
+    if not verdict:
+        return (f'the model {params.classifier_model} has no calibration gate verdict (calibrate '
+                f'with mindgrasp session calibrate); {override}.')
+    return (f"the model {params.classifier_model} is not ready ({verdict}: "
+            f"{gate.get('reason', '')}); {override}.")
+
+
+def resolve_answer(params: FsmParams) -> tuple[AnswerPair, dict[str, float] | None]:
+    """The answer pair in force and the model's decision thresholds (nat s; None: none).
+
+    ``answer_pair: auto`` takes the pair of ``classifier_model`` (the person's, chosen at
+    calibration), :data:`~mindgrasp_common.answer_pair.DEFAULT_PAIR` without one; a name
+    overrides it (a named side order as in the model when the model chose that pair).
+
+    Raises
+    ------
+    FsmError
+        An unknown pair name, or a classifier model that cannot be read.
+    """
+    chosen, thresholds = None, None
+    try:
+        if params.classifier_model:
+            chosen, thresholds = model_decision(params.classifier_model)
+        if params.answer_pair == 'auto':
+            pair = chosen or answer_pair(DEFAULT_PAIR)
+        elif chosen is not None and chosen.name == params.answer_pair:
+            pair = chosen
+        else:
+            pair = answer_pair(params.answer_pair)
+            thresholds = None       # the model's thresholds belong to its own pair
+    except CommonError as exc:
+        msg = f'The scan answer pair: {exc}'
+        raise FsmError(msg) from None
+    return pair, thresholds
 
 
 def clamp_to_limits(q: np.ndarray, v: np.ndarray, params: FsmParams) -> np.ndarray:
@@ -151,6 +222,8 @@ class GraspFsm:
         # gains' and the search tilts' convention), -1 when the arm's joint turns the other way
         self.tilt_sign = tilt_direction(kinematics, self.params.home_position, self.tilt_joint)
         self.policy = GraspPolicy(self.params, kinematics)
+        #: the scan paradigm's answer pair in force and the model's decision thresholds (nat s)
+        self.answer, self._model_thresholds = resolve_answer(self.params)
         self.reset()
 
     @classmethod
@@ -220,21 +293,30 @@ class GraspFsm:
         # this scan, and the ends of the joint-1 range reached since the first of them
         self._passed: list[float] = []
         self._limits_reached: set[float] = set()
-        self._confirm = Evidence(MiClass.BOTH_HANDS, [MiClass.BOTH_FEET],
-                                 threshold=self.params.confirm_threshold,
-                                 clip=self.params.evidence_clip,
-                                 reject_threshold=self.params.pass_threshold)
+        yes, no = _side(self.answer.yes), _side(self.answer.no)
+        th = self.decision_thresholds()
+        self._confirm = Evidence(yes, list(self.answer.no), threshold=th['confirm'],
+                                 clip=self.params.evidence_clip, reject_threshold=th['pass'])
         # cancel and go-on are the two answers of one test during the approach
-        self._cancel = Evidence(MiClass.BOTH_FEET, [MiClass.BOTH_HANDS],
-                                threshold=self.params.cancel_threshold,
-                                clip=self.params.evidence_clip,
-                                reject_threshold=self.params.affirm_threshold)
+        self._cancel = Evidence(no, list(self.answer.yes), threshold=th['cancel'],
+                                clip=self.params.evidence_clip, reject_threshold=th['affirm'])
         self._affirmed = False
         self._attempt = 0
         self._outcome = ''
         self._gripper = GripperCommand(self.params.gripper_open_position, 0.0)
         self._events: list[str] = []
         self.policy = GraspPolicy(self.params, self.kinematics)
+
+    def decision_thresholds(self) -> dict[str, float]:
+        """The scan decisions' thresholds in force (nat s): ``confirm``, ``pass``, ``affirm``,
+        ``cancel``; the classifier model's (per person) when it has them and
+        ``model_thresholds`` is set, else the parameters."""
+        p = self.params
+        th = {'confirm': p.confirm_threshold, 'pass': p.pass_threshold,
+              'affirm': p.affirm_threshold, 'cancel': p.cancel_threshold}
+        if p.model_thresholds and self._model_thresholds:
+            th.update({k: v for k, v in self._model_thresholds.items() if k in th})
+        return th
 
     def force_state(self, state: State | int, reason: str = 'set by the caller',
                     center_next: State | int | None = None, attempt: int = 0) -> None:
@@ -361,15 +443,18 @@ class GraspFsm:
             self._enter(new, reason)
 
         if self._cancellable():
-            self._cancel.threshold, self._cancel.clip = p.cancel_threshold, p.evidence_clip
-            self._cancel.reject_threshold = p.affirm_threshold
+            th = self.decision_thresholds()
+            self._cancel.threshold, self._cancel.clip = th['cancel'], p.evidence_clip
+            self._cancel.reject_threshold = th['affirm']
             if self._cancel.update(inputs.prediction):
                 self._cancel_approach(q, f'cancelled the approach to the {self._ooi_label} '
-                                      f'(both-feet evidence {self._cancel.value:.2f} nat s)')
+                                      f'({_word(self.answer.no)} evidence '
+                                      f'{self._cancel.value:.2f} nat s)')
                 return self._output(np.zeros(self.n_joints), phase='cancelled')
             if self._cancel.rejected and not self._affirmed:
                 self._affirmed = True
-                self._events.append(f'go on with the {self._ooi_label} (both-hands evidence '
+                self._events.append(f'go on with the {self._ooi_label} '
+                                    f'({_word(self.answer.yes)} evidence '
                                     f'{-self._cancel.value:.2f} nat s)')
 
         handler = {
@@ -703,22 +788,24 @@ class GraspFsm:
             self._offer_since = t
             self._confirm.reset(self._now + p.offer_delay)
             self._events.append(f'offering the {ooi.label}')
-        self._confirm.threshold, self._confirm.clip = p.confirm_threshold, p.evidence_clip
-        self._confirm.reject_threshold = p.pass_threshold
+        th = self.decision_thresholds()
+        self._confirm.threshold, self._confirm.clip = th['confirm'], p.evidence_clip
+        self._confirm.reject_threshold = th['pass']
         if self._confirm.update(inputs.prediction):
             self._committed = True
             self._affirmed = False
             self._offer_since = None
             # the go-on decision counts windows after those of the confirmation only
             self._cancel.reset(self._now + p.offer_delay)
-            self._goto(self._center_next, f'confirmed the {ooi.label} (both-hands evidence '
-                       f'{self._confirm.value:.2f} nat s)')
+            self._goto(self._center_next, f'confirmed the {ooi.label} '
+                       f'({_word(self.answer.yes)} evidence {self._confirm.value:.2f} nat s)')
             return np.zeros(self.n_joints), 'confirmed'
         declined = self._confirm.rejected
         if declined or t - self._offer_since > p.offer_timeout:
             self._offer_since = None
             self._remember_passed(q)
-            why = (f'declined (both-feet evidence {-self._confirm.value:.2f} nat s)' if declined
+            why = (f'declined ({_word(self.answer.no)} evidence {-self._confirm.value:.2f} '
+                   'nat s)' if declined
                    else f'not confirmed in {p.offer_timeout:.1f} s')
             self._goto(State.OBJECT_SEARCH, f'passed the {ooi.label}: {why}')
             return np.zeros(self.n_joints), 'passed'
