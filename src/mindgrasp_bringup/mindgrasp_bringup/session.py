@@ -634,7 +634,8 @@ class Session:
         if 'band' in config:
             config['band'] = tuple(config['band'])
         try:
-            entries = calibrate_answer(recordings, TrainingConfig(**config))
+            entries = calibrate_answer(recordings, TrainingConfig(**config),
+                                       temperature=model.temperature)
         except ClassifierError as err:
             return {'gate': {'verdict': 'needs_training', 'reason': str(err)}}
         model.answer_pair = entries['answer_pair']

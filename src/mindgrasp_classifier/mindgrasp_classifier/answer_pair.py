@@ -10,9 +10,9 @@ window on a decoder that was trained on it:
    (:func:`~mindgrasp_classifier.training.stream_recording`, the classifier node's re-centering,
    :func:`~mindgrasp_classifier.pseudo_online.node_adaptation`) of a model trained on the
    other recordings (leave-run-out). A run whose classes no other run has (EEGMMIDB: each run
-   holds one pair of classes; a single recording) is held out by halves instead: each half streamed through a model
-   trained on the other recordings and the run's other half. Every window lying wholly inside a
-   labelled epoch keeps its probabilities.
+   holds one pair of classes; a single recording) is held out by halves instead: each half
+   streamed through a model trained on the other recordings and the run's other half. Every
+   window lying wholly inside a labelled epoch keeps its probabilities.
 2. **Decisions** (:func:`simulate_pair`). For each candidate pair the class a person would
    imagine for "yes" and for "no" gives episodes: held-out windows of that class, epochs of one
    held-out stretch in a seeded random order (as the replay subject stitches them), fed as
@@ -68,6 +68,8 @@ PREFER_DEFAULT = 0.03
 #: initial approach before the go-on is awaited, the final approach + grasp + lift after it, and
 #: the return to the start after a cancel
 MOTION_S = {'next_offer': 5.0, 'approach': 6.0, 'grasp': 12.0, 'return': 8.0}
+#: fewest trials per class a fold model is trained on
+FOLD_MIN_TRIALS = 3
 #: objects the set-locations scene offers in one sweep
 N_OBJECTS = 9
 
@@ -156,7 +158,7 @@ def _halves(rec: Recording) -> tuple[Recording, Recording]:
 
 
 def heldout_streams(recordings: Sequence[Recording], cfg: Any, *, tmin: float | None = None,
-                    tmax: float | None = None,
+                    tmax: float | None = None, temperature: float | None = None,
                     log: Callable[[str], None] | None = None) -> list[FoldStream]:
     """Stream every calibration recording through a decoder trained without it (see the module
     docstring, step 1).
@@ -170,13 +172,17 @@ def heldout_streams(recordings: Sequence[Recording], cfg: Any, *, tmin: float | 
         classes its training data have).
     tmin, tmax : float, optional
         Labelled stretch of an event without an annotation (default ``cfg.tmin``/``tmax``).
+    temperature : float, optional
+        Probability calibration of the fold models: the person's model's (fitted on its own
+        held-out predictions), which spares each fold its inner cross-validation; None: each
+        fold model is cross-validated and calibrated on its own training runs.
 
     Returns
     -------
     streams : list of FoldStream
     """
-    from mindgrasp_classifier.pseudo_online import label_segments, node_adaptation, window_labels
     from mindgrasp_classifier.preprocessing import window_samples
+    from mindgrasp_classifier.pseudo_online import label_segments, node_adaptation, window_labels
     from mindgrasp_classifier.training import stream_recording, train
 
     if not recordings:
@@ -200,13 +206,17 @@ def heldout_streams(recordings: Sequence[Recording], cfg: Any, *, tmin: float | 
     for name, train_recs, test in folds:
         present = set(np.concatenate([r.events[:, 1] for r in train_recs]).tolist())
         classes = sorted(present if wanted is None else present & wanted)
-        fold_cfg = dataclasses.replace(cfg, classes=classes)
+        # a run held out by halves leaves half its trials to train on
+        fold_cfg = dataclasses.replace(cfg, classes=classes,
+                                       min_trials=min(cfg.min_trials, FOLD_MIN_TRIALS))
         try:
-            model, _ = train(train_recs, fold_cfg)
+            model, _ = train(train_recs, fold_cfg, cross_validate=temperature is None)
         except ClassifierError as exc:
             if log:
                 log(f'answer pair: fold {name} skipped ({exc})')
             continue
+        if temperature is not None:
+            model.temperature = float(temperature)
         ends, dist = stream_recording(model, test, node_adaptation())
         segs = label_segments(test, tmin, tmax)
         labels = window_labels(ends, window_samples(model.rate, model.window), segs)
@@ -338,10 +348,10 @@ class _Decisions:
 
 def _decide(paths: dict[str, list[np.ndarray]], th: dict[str, float], step: float,
             timing: dict[str, float]) -> _Decisions:
-    off = int(round((timing['offer_timeout'] - timing['offer_delay']) / step))
-    go = int(round((MOTION_S['approach'] + timing['offer_timeout'] - timing['offer_delay'])
-                   / step))
-    grasp = int(round(MOTION_S['grasp'] / step))
+    off = round((timing['offer_timeout'] - timing['offer_delay']) / step)
+    go = round((MOTION_S['approach'] + timing['offer_timeout'] - timing['offer_delay'])
+                   / step)
+    grasp = round(MOTION_S['grasp'] / step)
 
     def offer(path: np.ndarray) -> tuple[int, float]:
         o, k = _first(path, th['confirm'], th['pass'], off)
@@ -429,9 +439,9 @@ def simulate_pair(streams: Sequence[FoldStream], pair: AnswerPair, *,
         res.reason = 'no held-out windows of both answers'
         return res
     step = usable[0].step
-    n_off = int(math.ceil((timing['offer_timeout'] - timing['offer_delay']) / step))
-    n_app = int(math.ceil((MOTION_S['approach'] + MOTION_S['grasp'] + timing['offer_timeout'])
-                          / step))
+    n_off = math.ceil((timing['offer_timeout'] - timing['offer_delay']) / step)
+    n_app = math.ceil((MOTION_S['approach'] + MOTION_S['grasp'] + timing['offer_timeout'])
+                          / step)
     yes_c, no_c = pair.yes[0], pair.no[0]
     yes_for = list(pair.yes) if len(pair.yes) > 1 else pair.yes[0]
     no_for = list(pair.no) if len(pair.no) > 1 else pair.no[0]

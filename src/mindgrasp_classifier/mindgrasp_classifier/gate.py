@@ -72,6 +72,7 @@ def calibrate_answer(recordings: Sequence[Any], cfg: Any, *,
                      play_classes: set[int] | None = None,
                      target_wrong_rate: float = TARGET_WRONG_RATE,
                      streams: Sequence[FoldStream] | None = None, seed: int = 0,
+                     temperature: float | None = None,
                      log: Callable[[str], None] | None = None) -> dict[str, Any]:
     """Choose the answer pair, its thresholds and the gate verdict for one person.
 
@@ -87,6 +88,9 @@ def calibrate_answer(recordings: Sequence[Any], cfg: Any, *,
         Rate of wrong offer decisions the thresholds aim at.
     streams : sequence of FoldStream, optional
         Held-out streams already computed (:func:`heldout_streams`).
+    temperature : float, optional
+        The person's model's probability calibration, used by the fold models
+        (:func:`heldout_streams`).
 
     Returns
     -------
@@ -96,7 +100,7 @@ def calibrate_answer(recordings: Sequence[Any], cfg: Any, *,
         the model file's entries.
     """
     if streams is None:
-        streams = heldout_streams(recordings, cfg, log=log)
+        streams = heldout_streams(recordings, cfg, temperature=temperature, log=log)
     best, results = choose_pair(streams, play_classes=play_classes,
                                 target_wrong_rate=target_wrong_rate, seed=seed, log=log)
     return answer_entries(best, results, target_wrong_rate, play_classes)

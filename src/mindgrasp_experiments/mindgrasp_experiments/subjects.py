@@ -115,7 +115,7 @@ def replay_model(subject: str | SubjectFiles, directory: str | Path, *,
     from mindgrasp_classifier.gate import calibrate_answer
 
     entries = calibrate_answer(labelled, cfg, play_classes=set(player.classes),
-                               target_wrong_rate=rate)
+                               target_wrong_rate=rate, temperature=model.temperature)
     model.answer_pair = entries['answer_pair']
     model.decision_thresholds = entries['decision_thresholds']
     model.gate = entries['gate']
