@@ -28,9 +28,12 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 if TYPE_CHECKING:
-    from mindgrasp_eeg.subject_file import SubjectFiles
+    from collections.abc import Sequence
 
-__all__ = ['SUBJECTS', 'is_replay', 'noise_model', 'replay_model']
+    from mindgrasp_common.types import Recording
+    from mindgrasp_eeg.subject_file import ReplayFile, SubjectFiles
+
+__all__ = ['SUBJECTS', 'is_replay', 'labelled_recordings', 'noise_model', 'replay_model']
 
 SUBJECTS = ('noise', 'virtual', 'oracle', 'autonomous')
 
@@ -73,9 +76,9 @@ def replay_model(subject: str | SubjectFiles, directory: str | Path, *,
     from mindgrasp_classifier.answer_pair import TARGET_WRONG_RATE
     from mindgrasp_classifier.errors import ClassifierError
     from mindgrasp_classifier.training import TrainingConfig, train
-    from mindgrasp_common.mi import DECODER_CLASS_NAMES, REST
+    from mindgrasp_common.mi import DECODER_CLASS_NAMES
     from mindgrasp_eeg import EEGError
-    from mindgrasp_eeg.replay_eeg import ReplayEEG, segments
+    from mindgrasp_eeg.replay_eeg import ReplayEEG
     from mindgrasp_eeg.subject_file import check_layout, replay_subject
 
     files = replay_subject(subject) if isinstance(subject, str) else subject
@@ -88,13 +91,7 @@ def replay_model(subject: str | SubjectFiles, directory: str | Path, *,
     calibration, play = files.recordings('calibration'), files.recordings('play')
     check_layout([*calibration, *play], files.source)
     player = ReplayEEG.from_subject(files, recordings=play)   # enough epochs to play?
-    # cues: the onsets of the class epochs and of the rest epochs (class REST: the decoder says
-    # "nothing meant" instead of guessing an imagery class); training windows lie in each
-    # epoch's [tmin, tmax] (REPLAY_TRAINING)
-    labelled = []
-    for f, rec in zip(files.calibration, calibration, strict=True):
-        events = [(k0, REST if cls is None else cls) for k0, _k1, cls in segments(rec, f.events)]
-        labelled.append(replace(rec, events=np.array(events, dtype=int).reshape(-1, 2)))
+    labelled = labelled_recordings(files.calibration, calibration)
     cfg = TrainingConfig(**REPLAY_TRAINING,
                          channels=files.channels if isinstance(files.channels, str)
                          else list(files.channels))
@@ -124,6 +121,21 @@ def replay_model(subject: str | SubjectFiles, directory: str | Path, *,
         f'{[f.entry for f in files.calibration]}')
     json_path.parent.mkdir(parents=True, exist_ok=True)
     return Path(model.save(json_path.with_suffix('')))
+
+
+def labelled_recordings(files: Sequence[ReplayFile], recordings: Sequence[Recording]
+                        ) -> list[Recording]:
+    """``recordings`` (of the replay ``files``) with their cues: the onsets of the class epochs
+    and of the rest epochs (class REST: the decoder says "nothing meant" instead of guessing an
+    imagery class); training windows lie in each epoch's [tmin, tmax] (REPLAY_TRAINING)."""
+    from mindgrasp_common.mi import REST
+    from mindgrasp_eeg.replay_eeg import segments
+
+    labelled = []
+    for f, rec in zip(files, recordings, strict=True):
+        events = [(k0, REST if cls is None else cls) for k0, _k1, cls in segments(rec, f.events)]
+        labelled.append(replace(rec, events=np.array(events, dtype=int).reshape(-1, 2)))
+    return labelled
 
 
 def noise_model(path: str | Path, *, trials_per_class: int = 20, seed: int = 100,
