@@ -86,3 +86,36 @@ def test_the_verdicts_and_what_to_train() -> None:
     assert gate_verdict(0.9, 0.1, 0.9, 'hands_feet', ['both_hands'], ['both_feet'])[0] == \
         'needs_training'                              # too many wrong grasps predicted
     assert gate_verdict(0.0, 0.0, 0.52, 'mi_rest', ['left_hand'], ['rest'])[0] == 'not_ready'
+
+
+def test_the_choice_keeps_the_default_only_when_something_predicts_a_grasp() -> None:
+    from mindgrasp_classifier.answer_pair import PairResult, select
+    from mindgrasp_common.answer_pair import answer_pair
+
+    def result(name: str, correct: float, accuracy: float) -> PairResult:
+        return PairResult(answer_pair(name), heldout_accuracy=accuracy, decision_time_s=5.0,
+                          predicted={'correct_rate': correct})
+
+    # S003 (measured): every pair predicts no correct grasp; left / right separates best
+    assert select([result('hands_feet', 0.0, 0.46), result('left_right', 0.0, 0.61),
+                   result('mi_rest', 0.0, 0.51)]).pair.name == 'left_right'
+    assert select([result('hands_feet', 0.98, 0.81),
+                   result('left_right', 1.0, 0.86)]).pair.name == 'hands_feet'
+    assert select([result('hands_feet', 0.86, 0.81),
+                   result('left_right', 1.0, 0.86)]).pair.name == 'left_right'     # S002
+
+
+def test_two_subjects_get_different_pairs(eegbci_path: str, tmp_path) -> None:
+    """The replay subjects' own calibration (replay_model): S001 (calibrated on runs 4, 6)
+    answers with both hands / both feet, S002 (runs 4, 6, 8, 10) with left / right hand."""
+    import json
+
+    from mindgrasp_experiments.subjects import replay_model
+
+    chosen = {}
+    for subject in (1, 2):
+        model = json.loads(replay_model(f'eegmmidb:{subject}', tmp_path).read_text())
+        chosen[subject] = model['answer_pair']['name']
+        assert model['gate']['verdict'] in ('ready', 'needs_training', 'not_ready')
+        assert set(model['decision_thresholds']) == {'confirm', 'pass', 'affirm', 'cancel'}
+    assert chosen == {1: 'hands_feet', 2: 'left_right'}

@@ -29,8 +29,9 @@ window on a decoder that was trained on it:
    arm's own times between decisions (:data:`MOTION_S`, measured with the oracle subject) and
    the trial timeout. Monte Carlo over trials gives the expected correct, wrong and no-grasp
    rates and the time per decision.
-4. **The choice**: the pair with the highest predicted correct rate (``hands_feet`` kept
-   when within :data:`PREFER_DEFAULT` of the best), among the pairs the subject's play data can
+4. **The choice** (:func:`select`): the pair with the highest predicted correct rate
+   (``hands_feet`` kept when within :data:`PREFER_DEFAULT` of the best; when no pair predicts a
+   correct grasp, the best held-out separability), among the pairs the subject's play data can
    express when that is known. The gate (:mod:`mindgrasp_classifier.gate`) then says whether
    the person is ready.
 """
@@ -51,7 +52,7 @@ from mindgrasp_common.answer_pair import DEFAULT_PAIR, NAMED_PAIRS, AnswerPair, 
 from mindgrasp_common.mi import DECODER_CLASS_NAMES, REST
 
 __all__ = ['DEFAULT_THRESHOLDS', 'MOTION_S', 'TARGET_WRONG_RATE', 'FoldStream', 'PairResult',
-           'candidate_pairs', 'choose_pair', 'heldout_streams', 'predict_trials',
+           'candidate_pairs', 'choose_pair', 'heldout_streams', 'predict_trials', 'select',
            'simulate_pair']
 
 #: the controller's default decision thresholds (nat s), scaled per person
@@ -488,6 +489,24 @@ def default_timing() -> dict[str, float]:
             'trial_timeout': 600.0, 'clip': p.evidence_clip}
 
 
+def select(results: Sequence[PairResult]) -> PairResult:
+    """The chosen pair: the highest predicted correct rate, then held-out accuracy, then the
+    fastest decision; the default pair is kept when it predicts within :data:`PREFER_DEFAULT`
+    of the best, never when no pair predicts a correct grasp (then separability decides)."""
+    def key(r: PairResult) -> tuple[float, float, float]:
+        c = r.predicted.get('correct_rate', math.nan)
+        return (c if math.isfinite(c) else -1.0,
+                r.heldout_accuracy if math.isfinite(r.heldout_accuracy) else -1.0,
+                -(r.decision_time_s if math.isfinite(r.decision_time_s) else 1e9))
+
+    best = max(results, key=key)
+    default = next((r for r in results if r.pair.name == DEFAULT_PAIR), None)
+    if default is not None and key(best)[0] > 0 and \
+            key(default)[0] >= key(best)[0] - PREFER_DEFAULT:
+        best = default
+    return best
+
+
 def choose_pair(streams: Sequence[FoldStream], *, play_classes: set[int] | None = None,
                 target_wrong_rate: float = TARGET_WRONG_RATE,
                 timing: dict[str, float] | None = None, seed: int = 0,
@@ -504,17 +523,7 @@ def choose_pair(streams: Sequence[FoldStream], *, play_classes: set[int] | None 
                'calibrate on runs with the classes the person will use.')
         raise ClassifierError(msg)
 
-    def key(r: PairResult) -> tuple[float, float, float]:
-        c = r.predicted.get('correct_rate', math.nan)
-        return (c if math.isfinite(c) else -1.0,
-                r.heldout_accuracy if math.isfinite(r.heldout_accuracy) else -1.0,
-                -(r.decision_time_s if math.isfinite(r.decision_time_s) else 1e9))
-
-    best = max(results, key=key)
-    default = next((r for r in results if r.pair.name == DEFAULT_PAIR), None)
-    if default is not None and key(default)[0] >= key(best)[0] - PREFER_DEFAULT and \
-            key(default)[0] >= 0:
-        best = default
+    best = select(results)
     if log:
         for r in results:
             c = r.predicted.get('correct_rate', math.nan)
