@@ -12,9 +12,10 @@ import pytest
 
 from mindgrasp_common.mi import REST
 from mindgrasp_eeg.subject import VirtualSubject, scan_class
+from mindgrasp_fsm.answer import readiness_problem
 from mindgrasp_fsm.errors import FsmError
 from mindgrasp_fsm.evidence import Evidence, log_ratio
-from mindgrasp_fsm.grasp_fsm import GraspFsm, readiness_problem
+from mindgrasp_fsm.grasp_fsm import GraspFsm
 from mindgrasp_fsm.params import FsmParams
 from mindgrasp_fsm.types import MiClass, State
 

@@ -31,10 +31,11 @@ from mindgrasp_common.errors import CommonError
 from mindgrasp_common.mi import decoder_class_index
 from mindgrasp_common.robot import DEFAULT_ROBOT
 from mindgrasp_common.robot_description import load_robot
+from mindgrasp_fsm.answer import readiness_problem
 from mindgrasp_fsm.arm_output import ArmCommandOutput
 from mindgrasp_fsm.conversions import gripper_from_fingers, vision_frame_from_msg
 from mindgrasp_fsm.errors import FsmError
-from mindgrasp_fsm.grasp_fsm import SENSOR_FAULT, GraspFsm, readiness_problem
+from mindgrasp_fsm.grasp_fsm import SENSOR_FAULT, GraspFsm
 from mindgrasp_fsm.params import FsmParams
 from mindgrasp_fsm.types import (
     STATE_NAMES,
