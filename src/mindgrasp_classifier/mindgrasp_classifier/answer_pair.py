@@ -433,11 +433,16 @@ def simulate_pair(streams: Sequence[FoldStream], pair: AnswerPair, *,
     """Held-out accuracy, per-person thresholds and predicted trial figures of one pair."""
     timing = {**default_timing(), **(timing or {})}
     rng = np.random.default_rng(seed)
-    res = PairResult(pair, heldout_accuracy=_pair_accuracy(streams, pair))
+    # only stretches that hold both answers: two classes never recorded in one run (EEGMMIDB:
+    # a hand of runs 4/8/12 against both feet of runs 6/10/14) are told apart by the run, not
+    # by the imagery (shuffled labels then look separable), so such a pair is not evaluated
     usable = [s for s in streams if set(pair.yes) & set(s.classes) and
-              set(pair.no) & set(s.classes)]
+              set(pair.no) & set(s.classes) and np.any(s.labels == pair.yes[0]) and
+              np.any(s.labels == pair.no[0])]
+    res = PairResult(pair, heldout_accuracy=_pair_accuracy(usable, pair))
     if not usable or not math.isfinite(res.heldout_accuracy):
-        res.reason = 'no held-out windows of both answers'
+        res.reason = ('no held-out stretch holds both answers (never recorded in one run: '
+                      'confounded with the run)')
         return res
     step = usable[0].step
     n_off = math.ceil((timing['offer_timeout'] - timing['offer_delay']) / step)
