@@ -29,6 +29,7 @@ def test_the_controller_reads_the_drivers_arm(rclpy_ctx, tmp_path) -> None:
         'launch', 'hardware', 'eeg_stream:=NoAmp', 'eeg_source_id:=amp-1', 'eeg_host:=local',
         'arm_driver:=mindgrasp_sim.sim_node',
         'arm_driver_args:=--ros-args -p robot:=xarm6', MODEL, 'robot:=xarm6', 'record:=false',
+        'require_ready_model:=false',
         '--run-dir', str(run_dir)], dict(os.environ), tmp_path / 'launch.log')
     node = rclpy_ctx.create_node('hardware_probe')
     reasons: list[str] = []

@@ -206,6 +206,12 @@ def test_calibrate_runs_in_lockstep_end_to_end(tmp_path):
     assert f"expected calibration error {unseen['ece_before']:.3f} -> " in res.stdout
     assert 'on windows it was not fitted on' in res.stdout
     assert 'the temperature minimises the log loss' in res.stdout
+    # the person's answer pair, thresholds and the calibration gate (issue 38), in the model
+    assert result['gate']['verdict'] in ('ready', 'needs_training', 'not_ready')
+    assert final.answer_pair == result['answer_pair'] and final.gate == result['gate']
+    assert set(final.decision_thresholds) == {'confirm', 'pass', 'affirm', 'cancel'}
+    assert f"Calibration gate: {result['gate']['verdict']}" in res.stdout
+    assert '## Your answers' in (tmp_path / 'subjects' / 'V1' / 's1' / 'report.md').read_text()
     folder = tmp_path / 'subjects' / 'V1' / 's1'
     for run in ('01_graz', '02_heldout'):
         with BagReader(folder / run / 'bag') as reader:

@@ -623,11 +623,47 @@ class Session:
                        'fitted_on': str(entry['run_dir']),
                        'unseen': unseen if half > 0 else None}
         model.provenance['heldout_temperature'] = temperature
+        gate = self._answer_gate(log, model)
         calibrated = Path(model.save(self.dir / 'models' / f'calibrated_on_{phase}'))
         return {'heldout_accuracy': float(report['accuracy']),
                 'heldout_trials': int(report['n_trials']),
                 'model_path': str(calibrated.relative_to(self.dir)),
-                'trained_model_path': model_path, 'temperature': temperature}
+                'trained_model_path': model_path, 'temperature': temperature, **gate}
+
+    def _answer_gate(self, log: dict[str, Any], model: Any) -> dict[str, Any]:
+        """Choose the person's answer pair and thresholds and give the calibration gate's
+        verdict (:func:`mindgrasp_classifier.gate.calibrate_answer`) from every recorded Graz
+        and Trainer run of the session, each held out in turn; written into ``model``.
+        Returns ``answer_pair``, ``decision_thresholds`` and ``gate`` (empty when fewer than
+        two runs were recorded)."""
+        import dataclasses
+
+        from mindgrasp_classifier.data import load_inputs
+        from mindgrasp_classifier.errors import ClassifierError
+        from mindgrasp_classifier.gate import calibrate_answer
+        from mindgrasp_classifier.training import TrainingConfig
+
+        recordings = []
+        for e in log['phases']:
+            if e.get('kind') in ('graz', 'trainer') and e.get('run_dir'):
+                try:
+                    recordings += load_inputs(bags=[str(self.dir / e['run_dir'])])
+                except ClassifierError:
+                    continue
+        names = {f.name for f in dataclasses.fields(TrainingConfig)}
+        config = {k: v for k, v in (model.provenance.get('config') or {}).items()
+                  if k in names}
+        if 'band' in config:
+            config['band'] = tuple(config['band'])
+        try:
+            entries = calibrate_answer(recordings, TrainingConfig(**config),
+                                       temperature=model.temperature)
+        except ClassifierError as err:
+            return {'gate': {'verdict': 'needs_training', 'reason': str(err)}}
+        model.answer_pair = entries['answer_pair']
+        model.decision_thresholds = entries['decision_thresholds']
+        model.gate = entries['gate']
+        return entries
 
     def write_report(self, log: dict[str, Any]) -> str:
         """report.yaml and report.md; returns the Markdown."""

@@ -93,6 +93,16 @@ class MiModel:
         Training data, settings and cross-validation results.
     versions : dict
         Library versions at training time.
+    answer_pair : dict or None
+        The person's scan answer pair ``{name, yes: [class names], no: [class names]}``
+        (:mod:`mindgrasp_classifier.answer_pair`); None: not chosen (the controller answers
+        ``hands_feet``).
+    decision_thresholds : dict or None
+        The person's scan decision thresholds ``{confirm, pass, affirm, cancel}`` (nat s).
+    gate : dict or None
+        The calibration gate (:mod:`mindgrasp_classifier.gate`): ``verdict`` (ready,
+        needs_training, not_ready), ``reason``, ``predicted`` (correct_rate, wrong_rate,
+        decision_time_s), ``target_wrong_rate``, ``pairs``.
     """
 
     classes: list[int]
@@ -109,6 +119,9 @@ class MiModel:
     temperature: float = 1.0
     provenance: dict[str, Any] = field(default_factory=dict)
     versions: dict[str, str] = field(default_factory=library_versions)
+    answer_pair: dict[str, Any] | None = None
+    decision_thresholds: dict[str, float] | None = None
+    gate: dict[str, Any] | None = None
 
     @property
     def class_names(self) -> list[str]:
@@ -164,6 +177,9 @@ class MiModel:
                             'temperature': float(self.temperature)},
             'provenance': self.provenance,
             'versions': self.versions,
+            **{k: v for k, v in (('answer_pair', self.answer_pair),
+                                 ('decision_thresholds', self.decision_thresholds),
+                                 ('gate', self.gate)) if v is not None},
         }
 
     def save(self, path: str | Path) -> Path:
@@ -242,7 +258,10 @@ class MiModel:
                 estimator=str(meta['covariance']['estimator']),
                 temperature=float(meta.get('calibration', {}).get('temperature', 1.0)),
                 provenance=dict(meta.get('provenance', {})),
-                versions=dict(meta.get('versions', {})))
+                versions=dict(meta.get('versions', {})),
+                answer_pair=_optional_dict(meta, 'answer_pair'),
+                decision_thresholds=_optional_dict(meta, 'decision_thresholds'),
+                gate=_optional_dict(meta, 'gate'))
         except ClassifierError:
             raise
         except (KeyError, TypeError, ValueError, IndexError) as exc:
@@ -316,6 +335,16 @@ def model_paths(path: str | Path) -> tuple[Path, Path]:
     if p.suffix in ('.json', '.npz'):
         p = p.with_suffix('')
     return p.with_name(p.name + '.json'), p.with_name(p.name + '.npz')
+
+
+def _optional_dict(meta: dict[str, Any], key: str) -> dict[str, Any] | None:
+    value = meta.get(key)
+    if value is None:
+        return None
+    if not isinstance(value, dict):
+        msg = f'{key!r} of a model must be a mapping, got {type(value).__name__}'
+        raise TypeError(msg)
+    return dict(value)
 
 
 def _json_default(obj: Any) -> Any:

@@ -38,6 +38,7 @@ import shutil
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import yaml
@@ -129,6 +130,29 @@ def _protocol(run_dir: Path) -> str:
     return str(_yaml(run_dir / 'launch.yaml').get('profile') or run_dir.name)
 
 
+def _answer_pair(run_dir: Path) -> Any:
+    """The answer pair (:class:`mindgrasp_common.answer_pair.AnswerPair`) the run's scan
+    controller used (its ``params/fsm.yaml``: ``answer_pair``, ``classifier_model``), None for a
+    run without one."""
+    from mindgrasp_common.answer_pair import DEFAULT_PAIR, answer_pair, model_decision
+    from mindgrasp_common.errors import CommonError
+
+    for section in _yaml(run_dir / 'params' / 'fsm.yaml').values():
+        p = (section or {}).get('ros__parameters', {})
+        if p.get('autonomous') or p.get('paradigm', 'scan') != 'scan':
+            return None
+        try:
+            chosen = model_decision(p['classifier_model'])[0] if p.get('classifier_model') \
+                else None
+            name = str(p.get('answer_pair', 'auto'))
+            if name == 'auto' or (chosen is not None and chosen.name == name):
+                return chosen or answer_pair(DEFAULT_PAIR)
+            return answer_pair(name)
+        except CommonError:
+            return None
+    return None
+
+
 def export_bids(paths: list[str | Path], root: str | Path, subject: str,
                 session: str | None = None, *, line_freq: float = 50.0,
                 reference: str | None = None, manufacturer: str | None = None,
@@ -187,6 +211,11 @@ def export_bids(paths: list[str | Path], root: str | Path, subject: str,
             'Manufacturer': manufacturer or amp.get('manufacturer') or 'n/a'}
         if model or amp.get('model'):
             fields['ManufacturersModelName'] = model or amp['model']
+        pair = _answer_pair(run.run_dir)
+        if pair is not None:        # the scan paradigm's yes / no imagery of this person
+            fields['AnswerPair'] = pair.name
+            fields['Instructions'] = (f'The arm offers each object in turn; {pair.describe()} '
+                                      '(no also cancels an approach).')
         mne_bids.update_sidecar_json(sidecar, fields, verbose='error')
         source = root / 'sourcedata' / f'sub-{subject}' / (f'ses-{session}' if session else '') \
             / f'{run.task}_run-{counts[run.task]}'

@@ -106,7 +106,10 @@ class ReplayEEG:
         self.sample_rate = float(sample_rate)
         self.channel_names = list(channel_names)
         where = f' {source}' if source else ''
-        for cls in (None, 0, 1, 2, 3):
+        # an imagery class the recordings lack (EEGMMIDB S006-S012 play only run 12: left and
+        # right hand) is one this subject cannot express: imagining it streams rest
+        present = [c for c in (0, 1, 2, 3) if epochs.get(c)]
+        for cls in (None, *(present if len(present) >= 2 else (0, 1, 2, 3))):
             have = len(epochs.get(cls, ()))
             if have < min_epochs:
                 name = 'rest' if cls is None else f'class {cls}'
@@ -115,7 +118,9 @@ class ReplayEEG:
                        '(and their annotations in the event map).')
                 raise EEGError(msg)
         self.epochs = {cls: [np.asarray(e, dtype=float) for e in eps]
-                       for cls, eps in epochs.items()}
+                       for cls, eps in epochs.items() if len(eps)}
+        #: the imagery classes the recordings hold (the others stream rest)
+        self.classes = set(present)
         self._rng = np.random.default_rng(seed)
         self._queue: dict[int | None, list[int]] = {}
         self._class: object = 'unset'
@@ -148,6 +153,8 @@ class ReplayEEG:
         return len(self.channel_names)
 
     def _next_epoch(self, mi_class: int | None) -> np.ndarray:
+        if mi_class not in self.epochs:
+            mi_class = None             # a class the play data cannot express: rest
         queue = self._queue.get(mi_class)
         if not queue:
             queue = list(self._rng.permutation(len(self.epochs[mi_class])))

@@ -113,7 +113,8 @@ def pursue_class(target: SceneObject | None, base_yaw: float, fsm_state: int,
 
 def scan_class(target: SceneObject | None, base_yaw: float, fsm_state: int, *,
                offered: bool = False, heading_tolerance: float = 0.3,
-               stopped: bool = False) -> int | None:
+               stopped: bool = False, yes: int | None = BOTH_HANDS,
+               no: int | None = BOTH_FEET) -> int | None:
     """What a person instructed in the ``scan`` paradigm imagines (pure function).
 
     The arm turns from object to object by itself and offers each one it has centred
@@ -137,21 +138,25 @@ def scan_class(target: SceneObject | None, base_yaw: float, fsm_state: int, *,
         locations are 0.7 rad apart).
     stopped : bool
         ``FsmState.stopped``: after a prediction loss the controller waits for a fresh command;
-        the person imagines both hands ("go on") until it moves again.
+        the person imagines the "yes" class ("go on") until it moves again.
+    yes, no : int or None
+        The person's answer pair (:mod:`mindgrasp_common.answer_pair`, ``FsmState.yes_classes``
+        / ``no_classes``): the class imagined for yes and for no (None: rest). Default both
+        hands / both feet.
 
     Returns
     -------
     int or None
-        2 both hands (yes / go on), 3 both feet (no / cancel), None (rest).
+        ``yes`` (yes / go on), ``no`` (no / cancel), None (rest).
     """
     if target is None:
         return None
     if stopped:
-        return BOTH_HANDS
+        return BOTH_HANDS if yes is None else yes
     facing = abs(wrap_angle(math.atan2(target.y, target.x) - base_yaw)) <= heading_tolerance
     if (fsm_state in (State.OBJECT_SEARCH, State.CENTER_OBJECT) and offered) or \
             fsm_state in (State.INITIAL_APPROACH, State.FINAL_APPROACH):
-        return BOTH_HANDS if facing else BOTH_FEET
+        return yes if facing else no
     return None
 
 
@@ -209,6 +214,8 @@ class VirtualSubject:
         self.base_yaw, self.fsm_state, self.object_of_interest = 0.0, 0, ''
         self.fsm_stopped = False
         self.paradigm, self.offered = 'paper', False
+        self.yes_class: int | None = BOTH_HANDS     # scan: the answer pair in force
+        self.no_class: int | None = BOTH_FEET
         #: (time, asked class or None, imagined class or None) for every decision taken
         self.decisions: list[tuple[float, int | None, int | None]] = []
 
@@ -245,20 +252,26 @@ class VirtualSubject:
         self.base_yaw = float(yaw)
 
     def set_fsm(self, state: int, object_of_interest: str = '', stopped: bool = False,
-                paradigm: str = '', offered: bool = False) -> None:
+                paradigm: str = '', offered: bool = False, yes_classes: Sequence[int] = (),
+                no_classes: Sequence[int] = ()) -> None:
         """Controller state (``/fsm/state``): its number, object of interest, stop flag, the
-        paradigm it runs (``''``: a controller that does not say is taken as ``paper``) and
-        whether it offers its object of interest (scan)."""
+        paradigm it runs (``''``: a controller that does not say is taken as ``paper``),
+        whether it offers its object of interest (scan) and its answer pair (scan: the first
+        yes and no class is what the subject imagines, rest (4) is no imagery; empty: a
+        controller that does not say leaves it: both hands / both feet until one does)."""
         self.fsm_state, self.object_of_interest = int(state), object_of_interest
         self.fsm_stopped = bool(stopped)
         self.paradigm, self.offered = paradigm or 'paper', bool(offered)
+        if len(yes_classes) and len(no_classes):
+            self.yes_class = None if int(yes_classes[0]) > BOTH_FEET else int(yes_classes[0])
+            self.no_class = None if int(no_classes[0]) > BOTH_FEET else int(no_classes[0])
 
     def competent_class(self) -> int | None:
         """What a competent user would imagine now (pursue mode inputs, no errors)."""
         target = find_target(self.objects, self.target_id, self.target_colour, self.target_shape)
         if self.paradigm == 'scan':
             return scan_class(target, self.base_yaw, self.fsm_state, offered=self.offered,
-                              stopped=self.fsm_stopped)
+                              stopped=self.fsm_stopped, yes=self.yes_class, no=self.no_class)
         return pursue_class(target, self.base_yaw, self.fsm_state, self.object_of_interest,
                             heading_tolerance=self.heading_tolerance, stopped=self.fsm_stopped)
 

@@ -64,9 +64,13 @@ EEGMMIDB_EVENTS: dict[int, dict[str, int | None]] = {
     **{r: {'T0': None, 'T1': 0, 'T2': 1} for r in (4, 8, 12)},    # left fist, right fist
     **{r: {'T0': None, 'T1': 2, 'T2': 3} for r in (6, 10, 14)},   # both fists, both feet
 }
-#: runs the classifier is calibrated on / runs played in the loop (disjoint)
+#: runs the classifier is calibrated on / runs played in the loop (disjoint) of a subject with
+#: the imagery runs 4, 6, 8, 10 (S001 here); :func:`eegmmidb_runs` chooses them per subject
 EEGMMIDB_CALIBRATION_RUNS = (4, 6)
 EEGMMIDB_PLAY_RUNS = (8, 10)
+#: EEGMMIDB's imagery runs: left/right fist, both fists/feet
+EEGMMIDB_LR_RUNS = (4, 8, 12)
+EEGMMIDB_HF_RUNS = (6, 10, 14)
 #: the names an event map may use: our classes, and rest
 EVENT_NAMES = (*CLASS_NAMES, 'rest')
 SUBJECT_SUFFIXES = ('.yaml', '.yml')
@@ -217,15 +221,56 @@ def replay_subject(text: str) -> SubjectFiles:
     return eegmmidb_subject(parse_replay_source(text))
 
 
+def eegmmidb_local_runs(number: int) -> tuple[int, ...] | None:
+    """The imagery runs of EEGMMIDB subject ``number`` present in ``MNE_DATASETS_EEGBCI_PATH``
+    (MNE's folder layout); None when that folder is not set or holds none of them (MNE may
+    then download all six)."""
+    import os
+
+    root = os.environ.get('MNE_DATASETS_EEGBCI_PATH')
+    if not root:
+        return None
+    folder = Path(root) / 'MNE-eegbci-data' / 'files' / 'eegmmidb' / '1.0.0' / f'S{number:03d}'
+    runs = tuple(r for r in sorted((*EEGMMIDB_LR_RUNS, *EEGMMIDB_HF_RUNS))
+                 if (folder / f'S{number:03d}R{r:02d}.edf').is_file())
+    return runs or None
+
+
+def eegmmidb_runs(present: Sequence[int] | None) -> tuple[tuple[int, ...], tuple[int, ...]]:
+    """(calibration runs, play runs) of an EEGMMIDB subject with the imagery runs ``present``
+    (None: all six).
+
+    The play runs are the last left/right run and the last hands/feet run, each only when the
+    subject has another run of its kind left to calibrate on; every other imagery run
+    calibrates. Runs 4, 6, 8, 10 (S001 here) give calibration 4, 6 and play 8, 10; all six
+    give 4, 6, 8, 10 and 12, 14; runs 4, 6, 8, 12 (S006-S012 here) give 4, 6, 8 and 12 only,
+    so such a subject's play data hold no both hands / both feet epochs.
+    """
+    runs = tuple(sorted(present)) if present else (*EEGMMIDB_LR_RUNS, *EEGMMIDB_HF_RUNS)
+    play = []
+    for kind in (EEGMMIDB_LR_RUNS, EEGMMIDB_HF_RUNS):
+        have = [r for r in runs if r in kind]
+        if len(have) >= 2:
+            play.append(have[-1])
+    calibration = tuple(r for r in sorted(runs) if r not in play)
+    return calibration, tuple(sorted(play))
+
+
 def eegmmidb_subject(number: int) -> SubjectFiles:
-    """The built-in description of EEGMMIDB subject ``number`` (files through MNE's loader)."""
+    """The built-in description of EEGMMIDB subject ``number`` (files through MNE's loader;
+    runs by :func:`eegmmidb_runs` of the runs at hand)."""
     def files(runs: Sequence[int]) -> tuple[ReplayFile, ...]:
         return tuple(ReplayFile(_eegbci_paths(f'eegbci:{number}:{r}')[0], EEGMMIDB_EVENTS[r],
                                 f'eegbci:{number}:{r}') for r in runs)
 
+    calibration, play = eegmmidb_runs(eegmmidb_local_runs(number))
+    if not play:
+        msg = (f'eegmmidb:{number}: the imagery runs at hand ({list(calibration)}) leave none to '
+               'play (a subject needs two runs of one kind: 4/8/12 or 6/10/14); give a subject '
+               'file instead.')
+        raise EEGError(msg)
     return SubjectFiles(name=f'eegmmidb_s{number:03d}', source=f'eegmmidb:{number}',
-                        calibration=files(EEGMMIDB_CALIBRATION_RUNS),
-                        play=files(EEGMMIDB_PLAY_RUNS))
+                        calibration=files(calibration), play=files(play))
 
 
 def _eegbci_paths(reference: str) -> list[Path]:

@@ -155,7 +155,8 @@ class VirtualAmpNode(rclpy.node.Node):
     def fsm_callback(self, msg: FsmState) -> None:
         """Controller state and its object of interest."""
         self.subject.set_fsm(int(msg.state), msg.object_of_interest, msg.stopped,
-                             paradigm=msg.paradigm, offered=msg.offered)
+                             paradigm=msg.paradigm, offered=msg.offered,
+                             yes_classes=list(msg.yes_classes), no_classes=list(msg.no_classes))
 
     def push_callback(self) -> None:
         """Generate and push every sample due by now; report imagery changes."""

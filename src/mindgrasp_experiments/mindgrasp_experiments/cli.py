@@ -235,6 +235,11 @@ def run_experiment(args: argparse.Namespace, protocol: str, command: str, *,
     if s['online_windows'] or math.isfinite(s['calibration_accuracy']):
         print(f"  decoder online accuracy {_pct(s['online_accuracy'])} of "
               f"{s['online_windows']} windows (calibration {_pct(s['calibration_accuracy'])})")
+    if s.get('answer_pair'):
+        gate = (f"; calibration gate {s['gate_verdict']}, predicted "
+                f"{_pct(s['predicted_correct_rate'])} correct, "
+                f"{_pct(s['predicted_wrong_rate'])} wrong" if s.get('gate_verdict') else '')
+        print(f"  answer pair {s['answer_pair']}{gate}")
     print(f"  simulated {info['sim_s']:.0f} s in {info['wall_s']:.0f} s wall: real-time factor "
           f"{info['real_time_factor']:.1f}, {info['cpu_s_per_sim_s']:.3f} CPU s per simulated s")
     print(f"  report: {out / 'report.md'}")

@@ -143,6 +143,12 @@ class Experiment:
         except (LaunchError, EEGError) as exc:
             raise ExperimentError(str(exc)) from None
         components = self.components(out, subject_args, log)
+        gate = _model_gate(subject_args.get('model', ''))
+        if gate and gate.get('verdict') != 'ready':
+            # experiments run anyway (the report puts the prediction beside the outcome)
+            warn(f"the calibration gate did not call this subject ready "
+                 f"({gate.get('verdict')}: {gate.get('reason', '')}); running anyway, recorded "
+                 'in summary.json.')
         if on_start is not None:
             on_start()
         runs: list[TrialRun] = []
@@ -199,6 +205,23 @@ class Experiment:
         doc = written.get('doc') or {'summary': summarise(records, calibration)}
         return Results(run_dir=out, records=records, runs=runs, summary=doc['summary'],
                        info=info, interrupted=interrupted, unwritten=bool(files.pending))
+
+
+def _model_gate(model: str) -> dict:
+    """The calibration gate of a classifier model (its JSON ``gate``; {} without one)."""
+    import json
+
+    from mindgrasp_common.resources import ResourceNotFoundError, resolve_path
+
+    if not model:
+        return {}
+    try:
+        path = resolve_path(model, 'mindgrasp_classifier', ('.json',))
+        path = path if path.suffix == '.json' else path.with_name(path.name + '.json')
+        gate = json.loads(path.read_text(encoding='utf-8')).get('gate')
+    except (OSError, ValueError, AttributeError, ResourceNotFoundError):
+        return {}
+    return gate if isinstance(gate, dict) else {}
 
 
 @dataclasses.dataclass

@@ -99,7 +99,8 @@ class OracleSubjectNode(rclpy.node.Node):
 
     def fsm_callback(self, msg: FsmState) -> None:
         self.subject.set_fsm(int(msg.state), msg.object_of_interest, msg.stopped,
-                             paradigm=msg.paradigm, offered=msg.offered)
+                             paradigm=msg.paradigm, offered=msg.offered,
+                             yes_classes=list(msg.yes_classes), no_classes=list(msg.no_classes))
 
     def predict_callback(self) -> None:
         now = self.now_s()

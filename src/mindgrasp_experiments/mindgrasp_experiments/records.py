@@ -91,6 +91,7 @@ class TrialRecord:
     mean_certainty: float = math.nan
     failure: str = ''                # one of FAILURES
     reason: str = ''                 # how the trial ended, in words
+    answer_pair: str = ''            # scan: the person's answer pair (hands_feet, left_right, ...)
 
     def __post_init__(self) -> None:
         if not self.outcome:

@@ -17,7 +17,12 @@ from typing import Any
 
 from mindgrasp_common.safe_files import write_atomic
 from mindgrasp_experiments.records import TrialRecord, read_records, write_records
-from mindgrasp_experiments.summary import PAPER, calibration_accuracy_of, summarise
+from mindgrasp_experiments.summary import (
+    PAPER,
+    answer_summary,
+    calibration_accuracy_of,
+    summarise,
+)
 
 __all__ = ['finite', 'rebuild', 'render_report', 'write_run']
 
@@ -61,6 +66,36 @@ def _itr_text(summary: Mapping[str, Any]) -> str:
     bits = summary.get('itr_bits_per_selection')
     each = f', {bits:.2f} bits each' if bits is not None and math.isfinite(bits) else ''
     return f"{itr:.2f} bits/min ({summary.get('selections', 0)} selections{each})"
+
+
+def _answer_lines(summary: Mapping[str, Any]) -> list[str]:
+    """The person's answer pair and the calibration gate's prediction beside the measured
+    figures (nothing for a run without a scan answer pair)."""
+    pair = summary.get('answer_pair') or ''
+    if not pair:
+        return []
+    from mindgrasp_common.answer_pair import answer_pair
+    from mindgrasp_common.errors import CommonError
+
+    try:
+        said = '; '.join(answer_pair(p).describe() for p in pair.split(','))
+    except CommonError:
+        said = ''
+    lines = [f'Answer pair **{pair}**' + (f' ({said})' if said else '') + '.']
+    verdict = summary.get('gate_verdict') or ''
+    if verdict:
+        lines += ['', f"Calibration gate: **{verdict}** ({summary.get('gate_reason', '')}).", '',
+                  '| predicted at calibration | predicted | measured |', '|---|---|---|',
+                  f"| correct grasp | {_pct(summary.get('predicted_correct_rate'))} | "
+                  f"{_pct(summary.get('correct_and_successful_rate'))} |",
+                  f"| wrong grasp | {_pct(summary.get('predicted_wrong_rate'))} | "
+                  f"{_pct(summary.get('wrong_grasp_rate'))} |",
+                  f"| time per decision (offer) | {_s(summary.get('predicted_decision_time_s'))}"
+                  ' | |']
+        if verdict != 'ready':
+            lines += ['', f'Warning: the calibration gate did not call this person ready '
+                          f'({verdict}); the figures show what the loop gave anyway.']
+    return [*lines, '']
 
 
 def render_report(summary: Mapping[str, Any], run: Mapping[str, Any]) -> str:
@@ -113,6 +148,7 @@ def render_report(summary: Mapping[str, Any], run: Mapping[str, Any]) -> str:
     lines += ['', f"Decoder per decision (the most frequent class over one held intent): "
               f"{_pct(summary.get('online_decision_accuracy'))} of "
               f"{summary.get('online_decisions') or 0}; mean certainty {certainty_text}.", '']
+    lines += _answer_lines(summary)
     failures = summary.get('failures') or {}
     if failures:
         lines += ['Trials without a successful end, by kind: ' + ', '.join(
@@ -169,6 +205,7 @@ def write_run(run_dir: str | Path, records: Sequence[TrialRecord],
     if calibration_accuracy is None:
         calibration_accuracy = calibration_accuracy_of(run_dir)
     summary = summarise(records, calibration_accuracy)
+    summary.update(answer_summary(run_dir, records))
     doc = {'summary': summary, 'run': run, 'paper': PAPER.get(run.get('protocol', ''), {})}
     text = json.dumps(finite(doc), indent=2) + '\n'
     write_atomic(run_dir / 'summary.json', lambda tmp: tmp.write_text(text, encoding='utf-8'))

@@ -28,9 +28,12 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 if TYPE_CHECKING:
-    from mindgrasp_eeg.subject_file import SubjectFiles
+    from collections.abc import Sequence
 
-__all__ = ['SUBJECTS', 'is_replay', 'noise_model', 'replay_model']
+    from mindgrasp_common.types import Recording
+    from mindgrasp_eeg.subject_file import ReplayFile, SubjectFiles
+
+__all__ = ['SUBJECTS', 'is_replay', 'labelled_recordings', 'noise_model', 'replay_model']
 
 SUBJECTS = ('noise', 'virtual', 'oracle', 'autonomous')
 
@@ -41,7 +44,7 @@ SUBJECTS = ('noise', 'virtual', 'oracle', 'autonomous')
 #: 1 s windows); ``REPLAY_TAG`` names the cached model file, so a change here calibrates anew
 REPLAY_TRAINING = {'pipeline': 'ts_lr', 'classes': [0, 1, 2, 3, 4], 'window': 2.0,
                    'tmin': 0.5, 'tmax': 4.0}
-REPLAY_TAG = 'tslr_rest_w2'
+REPLAY_TAG = 'tslr_rest_w2_pair1'
 
 
 def is_replay(subject: str) -> bool:
@@ -51,7 +54,8 @@ def is_replay(subject: str) -> bool:
     return is_replay_source(subject)
 
 
-def replay_model(subject: str | SubjectFiles, directory: str | Path) -> Path:
+def replay_model(subject: str | SubjectFiles, directory: str | Path, *,
+                 target_wrong_rate: float | None = None) -> Path:
     """Calibrate (once) the decoder (:data:`REPLAY_TRAINING`) of a replay subject
     (``eegmmidb:<n>``, a subject file's path or its
     :class:`~mindgrasp_eeg.subject_file.SubjectFiles`) on its calibration recordings, never the
@@ -63,29 +67,31 @@ def replay_model(subject: str | SubjectFiles, directory: str | Path) -> Path:
     only for the same calibration. The whole subject is checked first (both sets loadable, one
     channel layout and rate, enough epochs of every class and of rest to play), so its problems
     surface here as one :class:`~mindgrasp_eeg.EEGError` line, before any node starts.
+
+    The model also gets the person's answer pair, decision thresholds (to ``target_wrong_rate``,
+    default :data:`mindgrasp_classifier.answer_pair.TARGET_WRONG_RATE`) and calibration gate
+    (:func:`mindgrasp_classifier.gate.calibrate_answer`), from the calibration recordings held
+    out run by run; the pairs are restricted to the classes the play recordings hold.
     """
+    from mindgrasp_classifier.answer_pair import TARGET_WRONG_RATE
     from mindgrasp_classifier.errors import ClassifierError
     from mindgrasp_classifier.training import TrainingConfig, train
-    from mindgrasp_common.mi import DECODER_CLASS_NAMES, REST
+    from mindgrasp_common.mi import DECODER_CLASS_NAMES
     from mindgrasp_eeg import EEGError
-    from mindgrasp_eeg.replay_eeg import ReplayEEG, segments
+    from mindgrasp_eeg.replay_eeg import ReplayEEG
     from mindgrasp_eeg.subject_file import check_layout, replay_subject
 
     files = replay_subject(subject) if isinstance(subject, str) else subject
+    rate = TARGET_WRONG_RATE if target_wrong_rate is None else float(target_wrong_rate)
+    tag = REPLAY_TAG if rate == TARGET_WRONG_RATE else f'{REPLAY_TAG}_w{rate:g}'
     json_path = (Path(directory) /
-                 f'{files.name}_classifier_{files.calibration_digest()[:12]}_{REPLAY_TAG}.json')
+                 f'{files.name}_classifier_{files.calibration_digest()[:12]}_{tag}.json')
     if json_path.exists():
         return json_path
     calibration, play = files.recordings('calibration'), files.recordings('play')
     check_layout([*calibration, *play], files.source)
-    ReplayEEG.from_subject(files, recordings=play)          # enough epochs to play?
-    # cues: the onsets of the class epochs and of the rest epochs (class REST: the decoder says
-    # "nothing meant" instead of guessing an imagery class); training windows lie in each
-    # epoch's [tmin, tmax] (REPLAY_TRAINING)
-    labelled = []
-    for f, rec in zip(files.calibration, calibration, strict=True):
-        events = [(k0, REST if cls is None else cls) for k0, _k1, cls in segments(rec, f.events)]
-        labelled.append(replace(rec, events=np.array(events, dtype=int).reshape(-1, 2)))
+    player = ReplayEEG.from_subject(files, recordings=play)   # enough epochs to play?
+    labelled = labelled_recordings(files.calibration, calibration)
     cfg = TrainingConfig(**REPLAY_TRAINING,
                          channels=files.channels if isinstance(files.channels, str)
                          else list(files.channels))
@@ -103,11 +109,33 @@ def replay_model(subject: str | SubjectFiles, directory: str | Path) -> Path:
         msg = (f'Cannot calibrate the replay subject {files.source}: {exc} (in a subject file: '
                'the channels: key).')
         raise EEGError(msg) from None
+    from mindgrasp_classifier.gate import calibrate_answer
+
+    entries = calibrate_answer(labelled, cfg, play_classes=set(player.classes),
+                               target_wrong_rate=rate, temperature=model.temperature)
+    model.answer_pair = entries['answer_pair']
+    model.decision_thresholds = entries['decision_thresholds']
+    model.gate = entries['gate']
     model.provenance['generator'] = (
         f'mindgrasp_experiments.subjects.replay_model({files.source}): calibration '
         f'{[f.entry for f in files.calibration]}')
     json_path.parent.mkdir(parents=True, exist_ok=True)
     return Path(model.save(json_path.with_suffix('')))
+
+
+def labelled_recordings(files: Sequence[ReplayFile], recordings: Sequence[Recording]
+                        ) -> list[Recording]:
+    """``recordings`` (of the replay ``files``) with their cues: the onsets of the class epochs
+    and of the rest epochs (class REST: the decoder says "nothing meant" instead of guessing an
+    imagery class); training windows lie in each epoch's [tmin, tmax] (REPLAY_TRAINING)."""
+    from mindgrasp_common.mi import REST
+    from mindgrasp_eeg.replay_eeg import segments
+
+    labelled = []
+    for f, rec in zip(files, recordings, strict=True):
+        events = [(k0, REST if cls is None else cls) for k0, _k1, cls in segments(rec, f.events)]
+        labelled.append(replace(rec, events=np.array(events, dtype=int).reshape(-1, 2)))
+    return labelled
 
 
 def noise_model(path: str | Path, *, trials_per_class: int = 20, seed: int = 100,

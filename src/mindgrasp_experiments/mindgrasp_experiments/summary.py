@@ -123,6 +123,57 @@ def calibration_accuracy_of(run_dir: str | Path) -> float | None:
     return model_calibration_accuracy(model_path)
 
 
+#: the flat summary keys of the answer pair and the calibration gate (answer_summary)
+ANSWER_KEYS = ('answer_pair', 'gate_verdict', 'gate_reason', 'predicted_correct_rate',
+               'predicted_wrong_rate', 'predicted_decision_time_s')
+
+
+def answer_summary(run_dir: str | Path, records: Sequence[TrialRecord] = ()) -> dict:
+    """The run's answer pair and its calibration gate, as flat summary keys
+    (:data:`ANSWER_KEYS`): the pair the records name (the controller's, from ``/fsm/state``),
+    else the one ``<run_dir>/params/fsm.yaml`` would resolve; the gate's verdict and predicted
+    figures from the classifier model the fsm was given (``classifier_model``). Missing figures
+    are NaN / ''; nothing for a run without a scan controller."""
+    import json
+
+    import yaml
+
+    from mindgrasp_common.resources import ResourceNotFoundError, resolve_path
+
+    out: dict = {k: '' for k in ANSWER_KEYS[:3]}
+    out.update({k: math.nan for k in ANSWER_KEYS[3:]})
+    pairs = sorted({r.answer_pair for r in records if r.answer_pair})
+    out['answer_pair'] = ','.join(pairs)
+    try:
+        doc = yaml.safe_load((Path(run_dir) / 'params' / 'fsm.yaml').read_text(encoding='utf-8'))
+        params = next(iter(doc.values()))['ros__parameters']
+    except (OSError, yaml.YAMLError, AttributeError, KeyError, TypeError, StopIteration):
+        return out
+    model = str(params.get('classifier_model') or '')
+    meta: dict = {}
+    if model:
+        try:
+            path = resolve_path(model, 'mindgrasp_classifier', ('.json',))
+            if path.suffix != '.json':
+                path = path.with_name(path.name + '.json')
+            meta = json.loads(path.read_text(encoding='utf-8'))
+        except (OSError, ValueError, ResourceNotFoundError):
+            meta = {}
+    if not out['answer_pair']:
+        chosen = str(params.get('answer_pair', 'auto'))
+        if chosen == 'auto':
+            chosen = (meta.get('answer_pair') or {}).get('name', 'hands_feet')
+        out['answer_pair'] = chosen if params.get('paradigm', 'scan') == 'scan' else ''
+    gate = meta.get('gate') if isinstance(meta.get('gate'), dict) else {}
+    predicted = gate.get('predicted') or {}
+    out['gate_verdict'] = str(gate.get('verdict', ''))
+    out['gate_reason'] = str(gate.get('reason', ''))
+    for key in ('correct_rate', 'wrong_rate', 'decision_time_s'):
+        value = predicted.get(key)
+        out[f'predicted_{key}'] = float(value) if isinstance(value, (int, float)) else math.nan
+    return out
+
+
 def summarise(records: Sequence[TrialRecord], calibration_accuracy: float | None = None) -> dict:
     """Every figure of a set of trials (interrupted ones left out, counted apart):
 

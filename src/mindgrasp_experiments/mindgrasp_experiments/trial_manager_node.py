@@ -194,6 +194,8 @@ class TrialManagerNode(rclpy.node.Node):
         if self.phase == 'trial':
             self.tracker.on_state(int(msg.state), msg.object_of_interest, self.now_s(),
                                   msg.reason)
+            if msg.paradigm == 'scan' and self.tracker.record is not None:
+                self.tracker.record.answer_pair = msg.answer_pair
 
     def prediction_callback(self, msg: MIPrediction) -> None:
         self._seen(BCI_PREDICTION.name)

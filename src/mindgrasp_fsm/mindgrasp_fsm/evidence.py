@@ -16,7 +16,9 @@ one the sum never falls below 0 (a CUSUM, Page 1954), so evidence against the de
 the person starts to imagine cannot delay it afterwards.
 
 When the decoder knows no ``rest`` class (a model of the four imagery classes only), "against"
-is every other class the decoder knows.
+is every other class the decoder knows. Either side may be a *set* of classes (a person's answer
+pair, :mod:`mindgrasp_common.answer_pair`: "yes" = any imagery against "no" = rest): its
+probability is the sum over the set.
 
     >>> import numpy as np
     >>> from mindgrasp_common.types import Prediction
@@ -43,23 +45,30 @@ __all__ = ['Evidence', 'log_ratio']
 _FLOOR = 1e-6     # probabilities are clipped here: a 0 from a float32 message is not certainty
 
 
-def log_ratio(probabilities: np.ndarray, classes: Sequence[int], for_class: int,
-              against: Sequence[int]) -> float | None:
-    """``log p(for_class) - log sum p(against)`` from one prediction's probabilities.
+def log_ratio(probabilities: np.ndarray, classes: Sequence[int],
+              for_class: int | Sequence[int], against: Sequence[int]) -> float | None:
+    """``log sum p(for_class) - log sum p(against)`` from one prediction's probabilities.
 
-    ``classes`` are the decoder's class indices in the order of ``probabilities``; classes of
-    ``against`` the decoder does not know are left out, and when none is known "against" is
-    every other class. None when ``for_class`` is unknown to the decoder or the probabilities
-    do not match ``classes``.
+    ``classes`` are the decoder's class indices in the order of ``probabilities``;
+    ``for_class`` is one class or a set of them (those the decoder does not know are left out);
+    classes of ``against`` the decoder does not know are left out, and when none is known
+    "against" is every other class. None when no class of ``for_class`` is known to the decoder
+    or the probabilities do not match ``classes``.
     """
     p = np.asarray(probabilities, dtype=float)
     classes = [int(c) for c in classes]
-    if p.shape != (len(classes),) or for_class not in classes or not np.isfinite(p).all():
+    group = [int(for_class)] if isinstance(for_class, (int, np.integer)) else \
+        [int(c) for c in for_class if int(c) in classes]
+    if p.shape != (len(classes),) or not group or group[0] not in classes or \
+            not np.isfinite(p).all():
         return None
-    known = [c for c in against if c in classes and c != for_class]
+    known = [c for c in against if c in classes and c not in group]
     if not known:
-        known = [c for c in classes if c != for_class]
-    p_for = max(p[classes.index(for_class)], _FLOOR)
+        known = [c for c in classes if c not in group]
+    if len(group) == 1:
+        p_for = max(p[classes.index(group[0])], _FLOOR)
+    else:
+        p_for = max(sum(p[classes.index(c)] for c in group), _FLOOR)
     p_against = max(sum(p[classes.index(c)] for c in known), _FLOOR)
     return math.log(p_for) - math.log(p_against)
 
@@ -69,8 +78,9 @@ class Evidence:
 
     Parameters
     ----------
-    for_class : int
-        Decoder class that speaks for the decision (2 both hands, 3 both feet).
+    for_class : int or sequence of int
+        Decoder class (or set of classes) that speaks for the decision (2 both hands, 3 both
+        feet; ``(0, 1, 2, 3)`` any imagery).
     against : sequence of int
         Classes that speak against it (4 rest, ...).
     threshold : float
@@ -84,10 +94,12 @@ class Evidence:
         the sum stays >= 0.
     """
 
-    def __init__(self, for_class: int, against: Sequence[int], *, threshold: float,
-                 clip: float = 2.0, max_gap: float = 0.25,
+    def __init__(self, for_class: int | Sequence[int], against: Sequence[int], *,
+                 threshold: float, clip: float = 2.0, max_gap: float = 0.25,
                  reject_threshold: float | None = None) -> None:
-        self.for_class, self.against = int(for_class), [int(c) for c in against]
+        self.for_class: int | list[int] = int(for_class) if isinstance(
+            for_class, (int, np.integer)) else [int(c) for c in for_class]
+        self.against = [int(c) for c in against]
         self.threshold, self.clip, self.max_gap = float(threshold), float(clip), float(max_gap)
         self.reject_threshold = reject_threshold
         self.reset()

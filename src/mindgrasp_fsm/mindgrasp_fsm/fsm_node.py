@@ -34,6 +34,7 @@ from mindgrasp_common.errors import CommonError
 from mindgrasp_common.mi import decoder_class_index
 from mindgrasp_common.robot import DEFAULT_ROBOT
 from mindgrasp_common.robot_description import load_robot
+from mindgrasp_fsm.answer import readiness_problem
 from mindgrasp_fsm.arm_output import ArmCommandOutput
 from mindgrasp_fsm.conversions import gripper_from_fingers, vision_frame_from_msg
 from mindgrasp_fsm.errors import FsmError
@@ -85,6 +86,10 @@ class FsmNode(rclpy.node.Node):
         super().__init__(self.node_traits.name, **kwargs)
         # one FsmParams object, shared with the controller: live changes apply at the next tick
         self.params = declare_params(self, FsmParams)
+        problem = readiness_problem(self.params)
+        if problem:
+            msg = f'The controller refuses to drive the arm: {problem}'
+            raise FsmError(msg)
         started, graph_check_wait = time.monotonic(), declare_graph_check(self)
         self.fsm = GraspFsm.from_params(self.params)
         # open and closed positions (rad) of the gripper's first (driving) joint: the others
@@ -124,6 +129,12 @@ class FsmNode(rclpy.node.Node):
         refuse_second_graph(self, FsmError, started=started, wait=graph_check_wait,
                             own_publishers={self.arm.topic: 1})
         mode = 'autonomous' if self.params.autonomous else 'BCI'
+        if not self.params.autonomous and self.params.paradigm == 'scan':
+            th = self.fsm.decision_thresholds()
+            self.get_logger().info(
+                f'Answer pair {self.fsm.answer.name} ({self.fsm.answer.describe()}); decision '
+                f"thresholds confirm {th['confirm']:.2f}, pass {th['pass']:.2f}, affirm "
+                f"{th['affirm']:.2f}, cancel {th['cancel']:.2f} nat s.")
         self.get_logger().info(f'Grasp controller ready ({mode} mode, arm commands on '
                                f'{self.arm.topic} ({self.arm.interface}), '
                                f'{1.0 / self.params.control_period:.0f} Hz, lock '
@@ -257,7 +268,9 @@ class FsmNode(rclpy.node.Node):
                        object_of_interest=out.object_of_interest, locked=bool(out.locked),
                        stopped=bool(out.stopped), reason=out.reason, paradigm=out.paradigm,
                        offered=bool(out.offered), confirm_evidence=float(out.confirm_evidence),
-                       cancel_evidence=float(out.cancel_evidence))
+                       cancel_evidence=float(out.cancel_evidence),
+                       answer_pair=self.fsm.answer.name,
+                       yes_classes=list(self.fsm.answer.yes), no_classes=list(self.fsm.answer.no))
         msg.header.stamp = self.get_clock().now().to_msg()
         self.state_pub.publish(msg)
 

@@ -66,6 +66,9 @@ import numpy as np
 
 from mindgrasp_common.mi import REST
 from mindgrasp_fsm.acceleration import AccelerationLimiter
+from mindgrasp_fsm.answer import evidence_side as _side
+from mindgrasp_fsm.answer import evidence_word as _word
+from mindgrasp_fsm.answer import resolve_answer
 from mindgrasp_fsm.errors import FsmError
 from mindgrasp_fsm.evidence import Evidence
 from mindgrasp_fsm.grasp_policy import GraspPolicy, PolicyStep, fingers_loaded
@@ -153,6 +156,8 @@ class GraspFsm:
         # gains' and the search tilts' convention), -1 when the arm's joint turns the other way
         self.tilt_sign = tilt_direction(kinematics, self.params.home_position, self.tilt_joint)
         self.policy = GraspPolicy(self.params, kinematics)
+        #: the scan paradigm's answer pair in force and the model's decision thresholds (nat s)
+        self.answer, self._model_thresholds = resolve_answer(self.params)
         self.reset()
 
     @classmethod
@@ -228,21 +233,30 @@ class GraspFsm:
         # this scan, and the ends of the joint-1 range reached since the first of them
         self._passed: list[float] = []
         self._limits_reached: set[float] = set()
-        self._confirm = Evidence(MiClass.BOTH_HANDS, [MiClass.BOTH_FEET],
-                                 threshold=self.params.confirm_threshold,
-                                 clip=self.params.evidence_clip,
-                                 reject_threshold=self.params.pass_threshold)
+        yes, no = _side(self.answer.yes), _side(self.answer.no)
+        th = self.decision_thresholds()
+        self._confirm = Evidence(yes, list(self.answer.no), threshold=th['confirm'],
+                                 clip=self.params.evidence_clip, reject_threshold=th['pass'])
         # cancel and go-on are the two answers of one test during the approach
-        self._cancel = Evidence(MiClass.BOTH_FEET, [MiClass.BOTH_HANDS],
-                                threshold=self.params.cancel_threshold,
-                                clip=self.params.evidence_clip,
-                                reject_threshold=self.params.affirm_threshold)
+        self._cancel = Evidence(no, list(self.answer.yes), threshold=th['cancel'],
+                                clip=self.params.evidence_clip, reject_threshold=th['affirm'])
         self._affirmed = False
         self._attempt = 0
         self._outcome = ''
         self._gripper = GripperCommand(self.params.gripper_open_position, 0.0)
         self._events: list[str] = []
         self.policy = GraspPolicy(self.params, self.kinematics)
+
+    def decision_thresholds(self) -> dict[str, float]:
+        """The scan decisions' thresholds in force (nat s): ``confirm``, ``pass``, ``affirm``,
+        ``cancel``; the classifier model's (per person) when it has them and
+        ``model_thresholds`` is set, else the parameters."""
+        p = self.params
+        th = {'confirm': p.confirm_threshold, 'pass': p.pass_threshold,
+              'affirm': p.affirm_threshold, 'cancel': p.cancel_threshold}
+        if p.model_thresholds and self._model_thresholds:
+            th.update({k: v for k, v in self._model_thresholds.items() if k in th})
+        return th
 
     def force_state(self, state: State | int, reason: str = 'set by the caller',
                     center_next: State | int | None = None, attempt: int = 0) -> None:
@@ -375,15 +389,18 @@ class GraspFsm:
             self._enter(new, reason)
 
         if self._cancellable():
-            self._cancel.threshold, self._cancel.clip = p.cancel_threshold, p.evidence_clip
-            self._cancel.reject_threshold = p.affirm_threshold
+            th = self.decision_thresholds()
+            self._cancel.threshold, self._cancel.clip = th['cancel'], p.evidence_clip
+            self._cancel.reject_threshold = th['affirm']
             if self._cancel.update(inputs.prediction):
                 self._cancel_approach(q, f'cancelled the approach to the {self._ooi_label} '
-                                      f'(both-feet evidence {self._cancel.value:.2f} nat s)')
+                                      f'({_word(self.answer.no)} evidence '
+                                      f'{self._cancel.value:.2f} nat s)')
                 return self._output(np.zeros(self.n_joints), phase='cancelled')
             if self._cancel.rejected and not self._affirmed:
                 self._affirmed = True
-                self._events.append(f'go on with the {self._ooi_label} (both-hands evidence '
+                self._events.append(f'go on with the {self._ooi_label} '
+                                    f'({_word(self.answer.yes)} evidence '
                                     f'{-self._cancel.value:.2f} nat s)')
 
         handler = {
@@ -750,22 +767,24 @@ class GraspFsm:
             self._offer_since = t
             self._confirm.reset(self._now + p.offer_delay)
             self._events.append(f'offering the {ooi.label}')
-        self._confirm.threshold, self._confirm.clip = p.confirm_threshold, p.evidence_clip
-        self._confirm.reject_threshold = p.pass_threshold
+        th = self.decision_thresholds()
+        self._confirm.threshold, self._confirm.clip = th['confirm'], p.evidence_clip
+        self._confirm.reject_threshold = th['pass']
         if self._confirm.update(inputs.prediction):
             self._committed = True
             self._affirmed = False
             self._offer_since = None
             # the go-on decision counts windows after those of the confirmation only
             self._cancel.reset(self._now + p.offer_delay)
-            self._goto(self._center_next, f'confirmed the {ooi.label} (both-hands evidence '
-                       f'{self._confirm.value:.2f} nat s)')
+            self._goto(self._center_next, f'confirmed the {ooi.label} '
+                       f'({_word(self.answer.yes)} evidence {self._confirm.value:.2f} nat s)')
             return np.zeros(self.n_joints), 'confirmed'
         declined = self._confirm.rejected
         if declined or t - self._offer_since > p.offer_timeout:
             self._offer_since = None
             self._remember_passed(q)
-            why = (f'declined (both-feet evidence {-self._confirm.value:.2f} nat s)' if declined
+            why = (f'declined ({_word(self.answer.no)} evidence {-self._confirm.value:.2f} '
+                   'nat s)' if declined
                    else f'not confirmed in {p.offer_timeout:.1f} s')
             self._goto(State.OBJECT_SEARCH, f'passed the {ooi.label}: {why}')
             return np.zeros(self.n_joints), 'passed'

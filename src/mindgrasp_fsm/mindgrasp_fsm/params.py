@@ -119,6 +119,20 @@ class FsmParams:
     paradigm: str = param('scan', 'BCI interaction: paper (4-class steering) or scan (the arm '
                           'offers each object, the person confirms or cancels)',
                           choices=PARADIGMS)
+    # the person's answer pair (mindgrasp_common.answer_pair): auto = the one the classifier
+    # model chose at calibration (hands_feet for a model without one); the model's decision
+    # thresholds replace the four below unless model_thresholds is false
+    answer_pair: str = param('auto', "scan: the imagery that answers yes / no: auto (the "
+                             "classifier model's choice, else hands_feet), hands_feet, "
+                             'left_right, mi_rest or <yes>_<no> (decoder class names)')
+    classifier_model: str = param('', 'scan: classifier model (.json) whose answer pair and '
+                                  "decision thresholds auto takes ('': none, hands_feet and the "
+                                  'thresholds below)')
+    model_thresholds: bool = param(True, "scan: use the classifier model's per-person decision "
+                                   'thresholds (when it has them) instead of the four below')
+    require_ready_model: bool = param(False, 'refuse to start unless classifier_model was '
+                                      "called ready by its calibration gate (the hardware "
+                                      'profile sets it; false overrides)')
     confirm_threshold: float = param(3.0, 'scan: evidence for both hands against both feet '
                                      'that commits to the offered object', unit='nat s',
                                      min=0.01, max=100.0, live=True)
@@ -457,6 +471,14 @@ class FsmParams:
             msg = (f"'resume_after_stale' is {self.resume_after_stale!r}; use one of "
                    f"{', '.join(RESUME_MODES)}.")
             raise FsmError(msg)
+        if self.answer_pair != 'auto':
+            from mindgrasp_common.answer_pair import answer_pair
+            from mindgrasp_common.errors import CommonError
+
+            try:
+                answer_pair(self.answer_pair)
+            except CommonError as exc:
+                raise FsmError(f"The parameter 'answer_pair': {exc}") from None
         if self.grasp_retries < 0:
             msg = f"'grasp_retries' must be >= 0, got {self.grasp_retries}."
             raise FsmError(msg)

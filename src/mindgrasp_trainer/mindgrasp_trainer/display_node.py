@@ -202,7 +202,9 @@ class DisplayNode(rclpy.node.Node):
     def fsm_callback(self, msg: FsmState) -> None:
         self.state.fsm_state_name = str(msg.state_name) or str(int(msg.state))
         self.state.instruction = controller_instruction(msg.paradigm, int(msg.state),
-                                                        bool(msg.offered))
+                                                        bool(msg.offered),
+                                                        list(msg.yes_classes),
+                                                        list(msg.no_classes))
         self.state.evidence = float(max(msg.confirm_evidence, msg.cancel_evidence))
 
     def target_callback(self, msg: TaskTarget) -> None:

@@ -17,6 +17,7 @@ files when headless, so tests read the same pixels a participant sees.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import cv2
@@ -41,24 +42,40 @@ INSTRUCTION_COLOUR = (255, 220, 80)
 PARADIGM_LABEL = {'graz': 'Graz-BCI', 'trainer': 'MIndGrasp Trainer', 'test': 'Test'}
 
 
-def controller_instruction(paradigm: str, state: int, offered: bool = False) -> str:
+def controller_instruction(paradigm: str, state: int, offered: bool = False,
+                           yes_classes: Sequence[int] = (), no_classes: Sequence[int] = ()
+                           ) -> str:
     """What the participant is asked to imagine now, from ``/fsm/state`` ('' = nothing to say).
 
-    ``scan`` (mindgrasp_fsm.grasp_fsm): the arm offers objects; both hands answer yes, both feet
-    no, and both feet cancel an approach. ``paper``: the four-class steering. Two lines (a
-    heading and the classes), separated by a newline.
+    ``scan`` (mindgrasp_fsm.grasp_fsm): the arm offers objects; the person's answer pair
+    (``FsmState.yes_classes`` / ``no_classes``, :mod:`mindgrasp_common.answer_pair`; none
+    given: both hands / both feet) answers yes and no, and "no" cancels an approach.
+    ``paper``: the four-class steering. Two lines (a heading and the classes), separated by a
+    newline.
     """
     if paradigm == 'scan':
+        yes, no = _answer_words(yes_classes, 'both hands'), _answer_words(no_classes, 'both feet')
         if offered:
-            return 'Offered: want it?\nboth hands = yes, both feet = no'
+            return f'Offered: want it?\n{yes} = yes, {no} = no'
         if state in (3, 4):
-            return 'Approaching\nboth hands = go on, both feet = cancel'
+            return f'Approaching\n{yes} = go on, {no} = cancel'
         if state in (1, 2):
             return 'Searching\nrest'
         return 'Rest'
     if paradigm == 'paper' and state in (1, 2, 3):
         return 'Left/right hand: turn\nboth hands: select/approach, feet: back'
     return ''
+
+
+def _answer_words(classes: Sequence[int], default: str) -> str:
+    """How the display names one side of the answer pair: 'both hands', 'left hand', 'rest',
+    'any movement' (the imagery classes)."""
+    words = {0: 'left hand', 1: 'right hand', 2: 'both hands', 3: 'both feet', 4: 'rest'}
+    if not len(classes):
+        return default
+    if len(classes) > 1:
+        return 'any movement'
+    return words.get(int(classes[0]), default)
 
 
 @dataclass

@@ -95,6 +95,27 @@ def _calibrate_result(session: Session, args: argparse.Namespace, t0: float) -> 
           f"error {unseen['ece_before']:.3f} -> {unseen['ece_after']:.3f}; the temperature "
           'minimises the log loss, the binned calibration error may still rise), model '
           f"{session.dir / held['model_path']}, {wall:.0f} s.")
+    gate = held.get('gate') or {}
+    if gate:
+        from mindgrasp_common.answer_pair import AnswerPair
+
+        pred = gate.get('predicted') or {}
+        said = (AnswerPair.from_dict(held['answer_pair']).describe()
+                if held.get('answer_pair') else '')
+        print(f"Answer pair {(held.get('answer_pair') or {}).get('name', '-')} ({said}); "
+              f"predicted {_pct(pred.get('correct_rate'))} correct, "
+              f"{_pct(pred.get('wrong_rate'))} wrong grasps, "
+              f"{_secs(pred.get('decision_time_s'))} per decision.")
+        print(f"Calibration gate: {gate.get('verdict', '-')}: {gate.get('reason', '')}")
+        report = session.dir / 'report.md'
+        if report.exists():      # the session report tells the person how to answer
+            with report.open('a', encoding='utf-8') as f:
+                f.write(f"\n## Your answers\n\nAnswer pair **"
+                        f"{(held.get('answer_pair') or {}).get('name', '-')}**: {said}.\n\n"
+                        f"Calibration gate: **{gate.get('verdict', '-')}** "
+                        f"({gate.get('reason', '')}); predicted {_pct(pred.get('correct_rate'))} "
+                        f"correct and {_pct(pred.get('wrong_rate'))} wrong grasps, "
+                        f"{_secs(pred.get('decision_time_s'))} per decision.\n")
     if args.json:
         print(json.dumps({'cv_accuracy': cv, 'heldout_accuracy': held['heldout_accuracy'],
                           'virtual_accuracy': args.virtual_accuracy,
@@ -103,9 +124,20 @@ def _calibrate_result(session: Session, args: argparse.Namespace, t0: float) -> 
                           'trained_model_path': str((session.dir / held['trained_model_path'])
                                                     .resolve()),
                           'temperature': temp,
+                          'answer_pair': held.get('answer_pair'),
+                          'decision_thresholds': held.get('decision_thresholds'),
+                          'gate': held.get('gate'),
                           'session_dir': str(session.dir.resolve()),
                           'wall_time_s': round(wall, 1)}))
     return 0
+
+
+def _pct(x: float | None) -> str:
+    return 'n/a' if x is None else f'{100 * x:.0f} %'
+
+
+def _secs(x: float | None) -> str:
+    return 'n/a' if x is None else f'{x:.1f} s'
 
 
 def main(args: argparse.Namespace) -> int:

@@ -131,6 +131,8 @@ def generate_launch_description() -> LaunchDescription:
              parameters=config_files('vision', 'experiment')),
         fsm_node(config_files('fsm', 'experiment'),
                  {'autonomous': EqualsSubstitution(subject, 'autonomous'),
-                  'robot': LaunchConfiguration('robot')}),
+                  'robot': LaunchConfiguration('robot'),
+                  # the person's answer pair and decision thresholds (fsm answer_pair: auto)
+                  'classifier_model': model}),
     ])
 

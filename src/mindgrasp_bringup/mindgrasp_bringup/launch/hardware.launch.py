@@ -80,6 +80,11 @@ def generate_launch_description() -> LaunchDescription:
                                   'train classifier); for a bench test without a person, name '
                                   'the simulated head\'s on purpose: model:=package://'
                                   'mindgrasp_classifier/models/default_classifier.json'),
+        DeclareLaunchArgument('require_ready_model', default_value='true',
+                              choices=['true', 'false'],
+                              description="refuse to drive the arm unless the model's "
+                                          'calibration gate called the person ready (false: '
+                                          'a bench test, or at your own risk)'),
         DeclareLaunchArgument('camera_driver', default_value='',
                               description='camera driver started like arm_driver (empty: the '
                                           'arm driver or another system publishes the camera)'),
@@ -101,5 +106,10 @@ def generate_launch_description() -> LaunchDescription:
         *classifier_nodes(config_files('classifier', 'hardware')),
         Node(package='mindgrasp_vision', executable='vision_node', name='vision',
              parameters=config_files('vision', 'hardware')),
-        fsm_node(config_files('fsm', 'hardware'), {'robot': LaunchConfiguration('robot')}),
+        # the person's answer pair and thresholds come from the model; a model whose
+        # calibration gate did not say ready is refused (require_ready_model, profile file)
+        fsm_node(config_files('fsm', 'hardware'),
+                 {'robot': LaunchConfiguration('robot'),
+                  'classifier_model': LaunchConfiguration('model'),
+                  'require_ready_model': LaunchConfiguration('require_ready_model')}),
     ])
