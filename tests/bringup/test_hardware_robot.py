@@ -41,7 +41,7 @@ def test_the_controller_reads_the_drivers_arm(rclpy_ctx, tmp_path) -> None:
     finally:
         code = launch.stop(timeout=30)
         node.destroy_node()
-    assert code == 0, launch.output()
+    assert code == 130, launch.output()         # stopped by SIGINT: an interrupted run
     assert "with the robot 'xarm6'" in (run_dir / 'logs' / 'arm_driver.log').read_text()
 
 

@@ -67,7 +67,7 @@ def joint_table(robot: RobotDescription) -> list[str]:
 
 def _hand_links(sim) -> dict[int, str]:
     """PyBullet link index -> name of the links of the hand (the hand root and below)."""
-    p, body = sim._p, sim._robots['user'].body
+    p, body = sim.client, sim.body()
     names = {j: p.getJointInfo(body, j)[12].decode() for j in range(p.getNumJoints(body))}
     parent = {j: p.getJointInfo(body, j)[16] for j in names}
     root = next((j for j, n in names.items() if n == sim.robot.hand_root), None)
@@ -86,7 +86,7 @@ def tcp_findings(sim) -> list[Finding]:
     hand open): not inside any link, and approached by the fingertips as the hand closes."""
     from mindgrasp_sim.pybullet_quiet import pb
 
-    p, body = sim._p, sim._robots['user'].body
+    p, body = sim.client, sim.body()
     tcp, _ = sim.ee_pose()
     probe = p.createMultiBody(0, p.createCollisionShape(pb.GEOM_SPHERE, radius=0.002), -1,
                               tcp.tolist())
@@ -106,18 +106,18 @@ def tcp_findings(sim) -> list[Finding]:
 
     def spread() -> float:
         # mean distance of the moving finger links' closest points to the TCP
-        moving = {sim._finger_idx[k] for k in range(len(sim._finger_idx))}
+        moving = set(sim.finger_joint_indices)
         d = [min((c[8] for c in p.getClosestPoints(probe, body, 0.5, linkIndexB=j)),
                  default=math.nan) for j in moving]
         return float(np.nanmean(d)) if d else math.nan
 
     open_spread = spread()
     g = sim.robot.gripper
-    for j, q in zip(sim._finger_idx, g.closed, strict=True):
+    for j, q in zip(sim.finger_joint_indices, g.closed, strict=True):
         p.resetJointState(body, j, q)
     p.performCollisionDetection()
     closed_spread = spread()
-    for j, q in zip(sim._finger_idx, g.open, strict=True):
+    for j, q in zip(sim.finger_joint_indices, g.open, strict=True):
         p.resetJointState(body, j, q)
     p.performCollisionDetection()
     if math.isfinite(open_spread) and math.isfinite(closed_spread) \

@@ -153,18 +153,18 @@ def home_like(robot: str, reference: str = 'xarm6', iterations: int = 200) -> li
                                               pb.getQuaternionFromEuler(frame.rpy))
         link_pos, link_orn = pb.multiplyTransforms(cam_pos.tolist(), cam_orn.tolist(),
                                                    inv_pos, inv_orn)
-        kin, body = sim._kin, sim._kin_body
+        kin, body = sim.kinematic_twin
         mid = np.array(target.home_pose)         # the arm's own home: seed and rest pose
         q = mid.copy()
         movable = [j for j in range(kin.getNumJoints(body))
                    if kin.getJointInfo(body, j)[2] != pb.JOINT_FIXED]
         lower = [kin.getJointInfo(body, j)[8] for j in movable]
         upper = [kin.getJointInfo(body, j)[9] for j in movable]
-        arm = [movable.index(j) for j in sim._arm_idx]
+        arm = [movable.index(j) for j in sim.arm_joint_indices]
         for _ in range(iterations):
-            sim._kin_set(q)
+            sim.set_twin_joints(q)
             sol = kin.calculateInverseKinematics(
-                body, sim._cam_idx, link_pos, link_orn, lowerLimits=lower,
+                body, sim.camera_link_index, link_pos, link_orn, lowerLimits=lower,
                 upperLimits=upper, jointRanges=[u - lo for u, lo in zip(upper, lower, strict=True)],
                 restPoses=[float(mid[arm.index(i)]) if i in arm else 0.0
                            for i in range(len(movable))], maxNumIterations=100)

@@ -567,6 +567,42 @@ class Simulation:
         """Names of the simulated arms: ``('user',)`` or ``('user', 'trainer')``."""
         return tuple(self._robots)
 
+    # read-only handles for tools that inspect the robot itself (``mindgrasp robot check``,
+    # ``robot_import home``): the world's pybullet client, the arm's body, the finger joints
+    # and the kinematic twin
+    @property
+    def client(self):
+        """The world's pybullet client (``pybullet_utils.bullet_client``)."""
+        return self._p
+
+    def body(self, robot: str = 'user') -> int:
+        """PyBullet body id of ``robot``'s arm in :attr:`client`."""
+        return self._robot(robot).body
+
+    @property
+    def finger_joint_indices(self) -> list[int]:
+        """PyBullet joint indices of the hand's finger joints, in the robot YAML's order."""
+        return list(self._finger_idx)
+
+    @property
+    def kinematic_twin(self) -> tuple[object, int]:
+        """``(client, body)`` of the kinematic twin used for IK / FK (never stepped)."""
+        return self._kin, self._kin_body
+
+    @property
+    def arm_joint_indices(self) -> list[int]:
+        """PyBullet joint indices of the arm's joints, in the robot YAML's order."""
+        return list(self._arm_idx)
+
+    @property
+    def camera_link_index(self) -> int:
+        """PyBullet link index of the wrist camera's link."""
+        return self._cam_idx
+
+    def set_twin_joints(self, q: np.ndarray) -> None:
+        """Put the kinematic twin's arm at ``q`` (rad, one per arm joint)."""
+        self._kin_set(q)
+
     @property
     def layout_seed(self) -> int:
         """Seed of the current object layout (random scenes)."""
