@@ -23,6 +23,7 @@ PROG = 'mindgrasp evaluate decoding'
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Arguments of ``mindgrasp evaluate decoding``."""
     from mindgrasp_classifier.evaluation import EVALUATIONS, TASKS
+    from mindgrasp_common.cli_checks import bounded_int, non_negative_int
 
     parser.add_argument('--subjects', required=True,
                         help='EEGMMIDB subjects, e.g. 1-4,6-12 (their imagery runs on disk)')
@@ -39,9 +40,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--runs', default=None,
                         help='imagery runs to use, e.g. 4,6,8 (default: 4,6,8,10,12,14, those '
                              'on disk)')
-    parser.add_argument('--seed', type=int, default=42,
+    parser.add_argument('--seed', type=non_negative_int, default=42,
                         help='seed of the within-session folds (default 42)')
-    parser.add_argument('--jobs', type=int, default=1, help='subjects in parallel (default 1)')
+    parser.add_argument('--jobs', type=bounded_int(1, 256), default=1,
+                        help='subjects in parallel, 1-256 (default 1)')
     parser.add_argument('--out', required=True, help='output directory')
 
 
