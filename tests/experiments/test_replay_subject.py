@@ -43,6 +43,12 @@ def test_the_model_is_calibrated_on_the_calibration_set_and_cached_by_its_digest
     assert provenance['sources'] == [str(tmp_path / 'cal.xdf')]      # never the played file
     assert provenance['trials_per_class'] == {'left_hand': 5, 'right_hand': 5, 'both_hands': 5,
                                               'both_feet': 5, 'rest': 20}
+    # one calibration run of 5 trials per class trains a model but cannot be held out: the gate
+    # says so and keeps the default pair, instead of refusing the calibration
+    gate = json.loads(model.read_text())['gate']
+    assert gate['verdict'] == 'needs_training'
+    assert gate['reason'].startswith('the calibration is too small to predict the closed loop')
+    assert json.loads(model.read_text())['answer_pair']['name'] == 'hands_feet'
     mtime = model.stat().st_mtime_ns
     assert replay_model(str(subject), tmp_path / 'out') == model            # cached
     assert model.stat().st_mtime_ns == mtime

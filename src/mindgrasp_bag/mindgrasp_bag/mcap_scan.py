@@ -35,6 +35,7 @@ from collections import defaultdict
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import BinaryIO
 
 from mcap.exceptions import EndOfFile, McapError
 from mcap.reader import make_reader
@@ -165,8 +166,8 @@ def _channel_info(channel: Channel, schemas: dict[int, Schema]) -> ChannelInfo:
 
 
 @contextlib.contextmanager
-def _mapped(path: Path) -> Iterator[tuple[bytes | mmap.mmap, int]]:
-    """The file's bytes (memory-mapped: nothing is read until used) and its size."""
+def _mapped(path: Path) -> Iterator[tuple[BinaryIO, bytes | mmap.mmap, int]]:
+    """The open file, its bytes (memory-mapped: nothing is read until used) and its size."""
     try:
         f = path.open('rb')
     except OSError as exc:
@@ -177,7 +178,7 @@ def _mapped(path: Path) -> Iterator[tuple[bytes | mmap.mmap, int]]:
         _check_magic(path, f.read(8))
         buf = mmap.mmap(f.fileno(), size, access=mmap.ACCESS_READ)
         try:
-            yield buf, size
+            yield f, buf, size
         finally:
             buf.close()
 
@@ -441,38 +442,27 @@ def read_mcap_contents(path: Path, *, scan: bool = False) -> McapContents:
     """
     path = Path(path)
     contents = McapContents(path)
-    try:
-        f = path.open('rb')
-    except OSError as exc:
-        msg = f'Cannot open {path}: {exc.strerror}; check the path and its permissions.'
-        raise BagError(msg) from None
-    with f:
-        size = path.stat().st_size
-        _check_magic(path, f.read(8))
-        buf = mmap.mmap(f.fileno(), size, access=mmap.ACCESS_READ)
-        try:
-            summary = _summary(path, f, buf, size) if _is_finished(f, size) else None
-            if summary is not None and summary.chunk_indexes:
-                contents.chunk_indexes = sorted(
-                    summary.chunk_indexes,
-                    key=lambda c: (c.message_start_time, c.chunk_start_offset))
-                contents.indexed = True
-            if not scan and summary is not None and summary.statistics is not None:
-                stats: Statistics = summary.statistics
-                contents.channels = {cid: _channel_info(ch, summary.schemas)
-                                     for cid, ch in summary.channels.items()}
-                contents.channel_counts = dict(stats.channel_message_counts)
-                contents.message_count = stats.message_count
-                if stats.message_count:
-                    contents.start_ns = stats.message_start_time
-                    contents.end_ns = stats.message_end_time
-                contents.compression = next(
-                    (c.compression for c in summary.chunk_indexes if c.compression), '')
-                contents.footer = True
-                return contents
-            _scan_contents(path, buf, size, contents)
-        finally:
-            buf.close()
+    with _mapped(path) as (f, buf, size):
+        summary = _summary(path, f, buf, size) if _is_finished(f, size) else None
+        if summary is not None and summary.chunk_indexes:
+            contents.chunk_indexes = sorted(
+                summary.chunk_indexes,
+                key=lambda c: (c.message_start_time, c.chunk_start_offset))
+            contents.indexed = True
+        if not scan and summary is not None and summary.statistics is not None:
+            stats: Statistics = summary.statistics
+            contents.channels = {cid: _channel_info(ch, summary.schemas)
+                                 for cid, ch in summary.channels.items()}
+            contents.channel_counts = dict(stats.channel_message_counts)
+            contents.message_count = stats.message_count
+            if stats.message_count:
+                contents.start_ns = stats.message_start_time
+                contents.end_ns = stats.message_end_time
+            contents.compression = next(
+                (c.compression for c in summary.chunk_indexes if c.compression), '')
+            contents.footer = True
+            return contents
+        _scan_contents(path, buf, size, contents)
     return contents
 
 
@@ -522,7 +512,7 @@ def iter_scanned_messages(path: Path, contents: McapContents | None = None,
     """
     path = Path(path)
     contents = contents if contents is not None else McapContents(path)
-    with _mapped(path) as (buf, size):
+    with _mapped(path) as (_f, buf, size):
         schemas: dict[int, Schema] = {}
         channels: dict[int, ChannelInfo] = {}
         for record in _records(path, buf, size, contents):
@@ -571,7 +561,7 @@ def iter_indexed_messages(contents: McapContents, *, channel_ids: set[int] | Non
                    or not channel_ids.isdisjoint(c.message_index_offsets))]
     channels = contents.channels
     name = contents.path.name
-    with _mapped(contents.path) as (buf, size):
+    with _mapped(contents.path) as (_f, buf, size):
 
         def load(index: ChunkIndex) -> list[tuple[int, int, int, Message]]:
             offset = index.chunk_start_offset
@@ -656,7 +646,7 @@ def recover_mcap(path: Path, out: Path | None = None) -> tuple[int, McapContents
     counted = [0]
 
     def rewrite(tmp: Path) -> None:
-        with _mapped(path) as (buf, size), tmp.open('wb') as dest:
+        with _mapped(path) as (_f, buf, size), tmp.open('wb') as dest:
             compression = _first_compression(buf, size)
             writer = McapWriter(dest, compression={'zstd': CompressionType.ZSTD,
                                                    'lz4': CompressionType.LZ4}.get(

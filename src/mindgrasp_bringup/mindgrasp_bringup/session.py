@@ -634,8 +634,8 @@ class Session:
         """Choose the person's answer pair and thresholds and give the calibration gate's
         verdict (:func:`mindgrasp_classifier.gate.calibrate_answer`) from every recorded Graz
         and Trainer run of the session, each held out in turn; written into ``model``.
-        Returns ``answer_pair``, ``decision_thresholds`` and ``gate`` (empty when fewer than
-        two runs were recorded)."""
+        Returns ``answer_pair``, ``decision_thresholds`` and ``gate`` (``needs_training`` with
+        the default pair when the runs are too few to hold any out)."""
         import dataclasses
 
         from mindgrasp_classifier.data import load_inputs
@@ -655,11 +655,8 @@ class Session:
                   if k in names}
         if 'band' in config:
             config['band'] = tuple(config['band'])
-        try:
-            entries = calibrate_answer(recordings, TrainingConfig(**config),
-                                       temperature=model.temperature)
-        except ClassifierError as err:
-            return {'gate': {'verdict': 'needs_training', 'reason': str(err)}}
+        entries = calibrate_answer(recordings, TrainingConfig(**config),
+                                   temperature=model.temperature)
         model.answer_pair = entries['answer_pair']
         model.decision_thresholds = entries['decision_thresholds']
         model.gate = entries['gate']

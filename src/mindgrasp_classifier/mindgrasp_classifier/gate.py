@@ -34,10 +34,11 @@ from mindgrasp_classifier.answer_pair import (
     choose_pair,
     heldout_streams,
 )
+from mindgrasp_classifier.errors import ClassifierError
 from mindgrasp_common.answer_pair import DEFAULT_PAIR, answer_pair
 
 __all__ = ['DECODES', 'READY_CORRECT', 'READY_WRONG', 'VERDICTS', 'calibrate_answer',
-           'gate_verdict']
+           'gate_verdict', 'unassessed_entries']
 
 VERDICTS = ('ready', 'needs_training', 'not_ready')
 #: predicted correct rate (per trial) from which a person is ready
@@ -100,7 +101,14 @@ def calibrate_answer(recordings: Sequence[Any], cfg: Any, *,
         the model file's entries.
     """
     if streams is None:
-        streams = heldout_streams(recordings, cfg, temperature=temperature, log=log)
+        try:
+            streams = heldout_streams(recordings, cfg, temperature=temperature, log=log)
+        except ClassifierError as exc:
+            # too little calibration to hold any of it out: the model is usable, its person
+            # unassessed; the default pair and thresholds, and a verdict that says what to record
+            return unassessed_entries(f'the calibration is too small to predict the closed loop '
+                                      f'({exc}); record more runs and calibrate again',
+                                      target_wrong_rate)
     best, results = choose_pair(streams, play_classes=play_classes,
                                 target_wrong_rate=target_wrong_rate, seed=seed, log=log)
     return answer_entries(best, results, target_wrong_rate, play_classes)
@@ -143,6 +151,18 @@ def _defaults() -> dict[str, float]:
     from mindgrasp_classifier.answer_pair import DEFAULT_THRESHOLDS
 
     return DEFAULT_THRESHOLDS
+
+
+def unassessed_entries(reason: str, target_wrong_rate: float = TARGET_WRONG_RATE
+                       ) -> dict[str, Any]:
+    """Entries of a model whose calibration could not be held out (``needs_training``, with
+    ``reason``): the default pair and thresholds, no prediction."""
+    return {'answer_pair': answer_pair(DEFAULT_PAIR).to_dict(),
+            'decision_thresholds': {k: float(v) for k, v in _defaults().items()},
+            'gate': {'verdict': 'needs_training', 'reason': reason,
+                     'predicted': {'correct_rate': None, 'wrong_rate': None,
+                                   'decision_time_s': None, 'trial_time_s': None},
+                     'target_wrong_rate': float(target_wrong_rate), 'pairs': []}}
 
 
 def default_entries() -> dict[str, Any]:

@@ -1,10 +1,11 @@
 """Export the EEG of a recorded session (rosbag2) to a file MNE reads: FIF or EDF (ROS-free).
 
-The bag is read with ``rosbags``' rosbag2 ``Reader`` and the project's typestore (which registers
-``mindgrasp_msgs`` from its ``.msg`` files). Samples are placed by ``EEGChunk.first_sample_index``,
-so the exported time axis is the amplifier's: sample ``i`` lies ``i / sample_rate`` seconds after
-the first one, whose ROS stamp becomes the file's measurement date. Samples the acquisition never
-received (drops, a lost stream) are written as zeros and covered by a ``BAD_gap`` annotation.
+The bag is read with :class:`mindgrasp_bag.reader.BagReader` and the project's typestore (which
+registers ``mindgrasp_msgs`` from its ``.msg`` files). Samples are placed by
+``EEGChunk.first_sample_index``, so the exported time axis is the amplifier's: sample ``i`` lies
+``i / sample_rate`` seconds after the first one, whose ROS stamp becomes the file's measurement
+date. Samples the acquisition never received (drops, a lost stream) are written as zeros and
+covered by a ``BAD_gap`` annotation.
 
 Annotations (onset in seconds from the first sample, from the message header stamps):
 

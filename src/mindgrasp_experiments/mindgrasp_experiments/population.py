@@ -387,7 +387,11 @@ def _check_config(out: Path, config: Mapping[str, Any]) -> None:
         msg = (f'--out {out} exists and holds other files than a population run; choose a new '
                '--out or remove it (a run never overwrites recorded data).')
         raise ExperimentError(msg)
-    out.mkdir(parents=True, exist_ok=True)
+    if not out.absolute().parent.is_dir():
+        msg = (f'--out {out}: the folder {out.absolute().parent} does not exist; give a run '
+               'directory in an existing folder (only the run directory itself is created).')
+        raise ExperimentError(msg)
+    out.mkdir(exist_ok=True)
     path.write_text(json.dumps(config, indent=2) + '\n', encoding='utf-8')
 
 

@@ -85,6 +85,7 @@ def main(args: argparse.Namespace) -> int:
     if out is None:
         from mindgrasp_launch.rundir import default_runs_root, utc_stamp
 
+        default_runs_root().mkdir(parents=True, exist_ok=True)
         out = default_runs_root() / f'{utc_stamp()}_population'
     bar = tqdm(total=len(subjects) * args.trials, unit='trial', disable=args.no_progress,
                file=sys.stderr, desc=COMMAND, dynamic_ncols=True)

@@ -91,6 +91,7 @@ def main(args: argparse.Namespace) -> int:
         out = create_run_dir('sweep', args.out, option='--out')
     except LaunchError as exc:
         return fail(COMMAND, str(exc))
+    (out / 'points').mkdir(exist_ok=True)     # each point's run directory is created in it
     for subject in subjects:
         if subject != 'virtual' and not is_replay(subject) and not is_fitted(subject):
             return fail(COMMAND, f'--subject {subject}: a sweep varies the accuracy of a '
