@@ -70,8 +70,9 @@ def check_domain_free(node_names: Iterable[str | None], wait: float) -> None:
         return
     seen = _graph_nodes(wait, wanted)
     if seen:
-        domain = os.environ.get('ROS_DOMAIN_ID', '') or '0'
-        free = int(domain) + 1 if domain.isdigit() and int(domain) < 232 else 1
+        from mindgrasp_ros.graph_check import domain_and_free
+
+        domain, free = domain_and_free()
         msg = (f"another graph runs on ROS_DOMAIN_ID={domain} (its {', '.join(sorted(seen))} "
                'answered): a second one on the same domain would cross its commands, so nothing '
                f'was started. Launch on another domain (e.g. ROS_DOMAIN_ID={free} mindgrasp '

@@ -27,7 +27,7 @@ import time
 from collections.abc import Mapping
 from typing import Any
 
-__all__ = ['DEFAULT_WAIT', 'declare_graph_check', 'refuse_second_graph']
+__all__ = ['DEFAULT_WAIT', 'declare_graph_check', 'domain_and_free', 'refuse_second_graph']
 
 #: discovery period (s): on one host, Cyclone DDS discovers a running graph within a few hundred
 #: milliseconds, also on a loaded machine
@@ -45,6 +45,13 @@ def declare_graph_check(node: Any, default: float = DEFAULT_WAIT) -> float:
         additional_constraints='read-only: restart the node to change it', read_only=True,
         floating_point_range=[FloatingPointRange(from_value=0.0, to_value=60.0)])
     return float(node.declare_parameter('graph_check_wait', float(default), desc).value)
+
+
+def domain_and_free() -> tuple[str, int]:
+    """This process's ROS domain (``ROS_DOMAIN_ID``, '0' when unset) and another one to suggest
+    in the one-line refusals."""
+    domain = os.environ.get('ROS_DOMAIN_ID', '') or '0'
+    return domain, int(domain) + 1 if domain.isdigit() and int(domain) < 232 else 1
 
 
 def _hosted_in_process(node: Any) -> bool:
@@ -86,8 +93,7 @@ def refuse_second_graph(node: Any, error: type[Exception], *, started: float,
             found.append(f'another node {full}')
         found += [f'{n} more publisher(s) on {topic}' for topic, n in extra.items() if n > 0]
         if found:
-            domain = os.environ.get('ROS_DOMAIN_ID', '') or '0'
-            free = int(domain) + 1 if domain.isdigit() and int(domain) < 232 else 1
+            domain, free = domain_and_free()
             msg = (f'Another ROS graph runs on ROS_DOMAIN_ID={domain} ({", ".join(found)}): two '
                    'graphs on one domain cross their commands, so this one does not start. '
                    f'Start it on another domain (e.g. ROS_DOMAIN_ID={free}) or stop the other '

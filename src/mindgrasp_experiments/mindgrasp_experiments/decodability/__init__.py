@@ -1,18 +1,9 @@
 """How decodable a subject's motor imagery is: the same figures for real and virtual subjects.
 
 A subject's *decodability figures* are offline accuracies of classifiers calibrated on one set of
-recordings and tested on another (another run or session), for five questions, the tasks of
-:data:`mindgrasp_classifier.evaluation.TASKS`:
-
-====================  =============================  ======
-figure                classes                        chance
-====================  =============================  ======
-``four_class``        left, right, both hands, feet  0.25
-``left_right``        left vs right hand             0.5
-``hands_feet``        both hands vs both feet        0.5
-``rest_imagery``      rest vs any imagery            0.5
-``rest_both_hands``   rest vs both hands             0.5
-====================  =============================  ======
+recordings and tested on another (another run or session), for five questions: the tasks of
+:data:`mindgrasp_classifier.evaluation.TASKS` (four classes, left vs right hand, both hands vs
+both feet, rest vs any imagery, rest vs both hands).
 
 The package is built as the field builds such measurements (MOABB: paradigm, evaluation,
 pipelines):
