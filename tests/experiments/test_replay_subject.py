@@ -90,6 +90,7 @@ def run_one_trial(subject: str, out: Path) -> list[str]:
     assert subject in (out / 'params' / 'virtual_amp.yaml').read_text()     # eeg_source
     (record,) = read_records(out)
     assert record.decoder_windows > 0 and 0.0 <= record.online_accuracy <= 1.0
+    assert record.subject == subject          # the person, not the virtual subject replaying
     (model,) = out.glob('*_classifier_*.json')
     return [Path(p).name for p in json.loads(model.read_text())['provenance']['sources']]
 

@@ -101,6 +101,9 @@ class Experiment:
                                     run_dir / 'params', overlay=self.launch, log=log)
         timeouts = {'stall_timeout': float(self.stall_timeout_s),
                     'trial_timeout': float(self.trial_timeout_s)}
+        if subject_args.get('subject', self.subject) != self.subject:
+            # a replay or fitted subject runs as the virtual one: the records name the person
+            timeouts['subject'] = str(self.subject)
         comps = [c.with_parameters(timeouts) if is_trial_manager(c) else c for c in comps]
         from mindgrasp_experiments.fitted_subject import head_params
 
