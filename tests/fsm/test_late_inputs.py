@@ -158,3 +158,47 @@ def test_the_node_ticks_on_a_prediction_at_once_and_on_fresh_joint_states(rclpy_
         assert node.inputs.joints is not None
     finally:
         node.destroy_node()
+
+
+def test_a_tick_after_a_stall_of_the_controller_holds_and_judges_its_inputs_next(
+        rclpy_ctx) -> None:
+    """A busy machine stalls the controller's process: the joint states that arrived meanwhile
+    wait behind the first callback, so that tick holds the arm instead of latching a sensor fault
+    on their age; the next tick judges them (fresh: no fault). A driver that is really silent
+    still latches the fault at the tick after."""
+    from mindgrasp_ros.interfaces.sensor_msgs.msg import JointState
+
+    from mindgrasp_fsm.fsm_node import FsmNode
+
+    node = FsmNode()
+    try:
+        def joint_state() -> None:
+            js = JointState(name=[f'joint_{i}' for i in range(1, 7)], position=HOME,
+                            velocity=np.zeros(6))
+            js.header.stamp = node.get_clock().now().to_msg()
+            node.joint_state_callback(js)
+
+        end = time.monotonic() + 1.5 * node.params.sensor_clean_time
+        while time.monotonic() < end:           # the joint states stream (a clean start)
+            joint_state()
+            node.timer_callback()
+            time.sleep(0.02)
+        assert node.fsm._fault_why == ''
+        ticks, stalls = node.ticks, node.own_stalls
+        time.sleep(2 * node.params.watchdog_timeout)     # this process stalls
+        node.timer_callback()                   # first callback after it: the states are queued
+        assert (node.ticks, node.own_stalls) == (ticks, stalls + 1)
+        assert node.fsm._fault_why == ''
+        deadline = time.monotonic() + 30
+        while node.ticks == ticks and time.monotonic() < deadline:
+            joint_state()                       # the queued (fresh) states, then a tick
+            node.timer_callback()
+            time.sleep(0.02)
+        assert node.ticks > ticks and node.fsm._fault_why == ''
+        deadline = time.monotonic() + 30
+        while not node.fsm._fault_why and time.monotonic() < deadline:
+            node.timer_callback()               # the timer ticks on, no state arrives
+            time.sleep(0.02)
+        assert node.fsm._fault_why.startswith('joint states are'), 'a silent driver latches'
+    finally:
+        node.destroy_node()

@@ -73,6 +73,8 @@ _NUMBER = re.compile(r'\d+(\.\d+)?')
 _INPUT_TICK = 0.75
 #: the timer ticks only when nothing else did for this many control periods
 _TIMER_TICK = 1.5
+#: a gap between ticks beyond this share of the watchdog timeout is a stall of this process
+_OWN_STALL = 0.5
 
 
 class FsmNode(rclpy.node.Node):
@@ -106,6 +108,7 @@ class FsmNode(rclpy.node.Node):
         self.done = rclpy.task.Future()
         self.ticks = 0
         self._last_tick = -1e9      # s, node clock: when the controller last ticked
+        self.own_stalls = 0         # ticks held because this process itself had stalled
 
         self.arm = ArmCommandOutput(self, self.params, self.fsm.kinematics)
         self.gripper_pub = self.create_publisher(Float64MultiArray, GRIPPER_COMMANDS.name,
@@ -231,8 +234,22 @@ class FsmNode(rclpy.node.Node):
             self.control_callback()
 
     def control_callback(self) -> None:
-        """One controller tick: on a prediction, on a fresh joint state, or on the timer."""
+        """One controller tick: on a prediction, on a fresh joint state, or on the timer.
+
+        A tick that comes :data:`_OWN_STALL` watchdog timeouts after the previous one (and two
+        timer periods) follows a stall of this process (a busy machine): the inputs that arrived
+        meanwhile still wait behind this callback, so their age says nothing yet. It holds the
+        arm and judges at the next tick, instead of latching a sensor fault that only a fresh
+        decision releases."""
         now = self._now()
+        stall = max(_OWN_STALL * self.params.watchdog_timeout,
+                    2 * _TIMER_TICK * self.params.control_period)
+        if self.ticks and now - self._last_tick > stall:
+            self._last_tick = now
+            self.own_stalls += 1
+            joints = self.inputs.joints
+            self.arm.stop(None if joints is None else joints.position)
+            return
         self._last_tick = now
         self.inputs.time = now
         out = self.fsm.tick(self.inputs)
@@ -279,7 +296,9 @@ class FsmNode(rclpy.node.Node):
         if rclpy.ok():
             joints = self.inputs.joints
             self.arm.stop(None if joints is None else joints.position)
-        self.get_logger().info(f'Controller ran {self.ticks} ticks.')
+        stalls = (f', {self.own_stalls} held after a stall of this process'
+                  if self.own_stalls else '')
+        self.get_logger().info(f'Controller ran {self.ticks} ticks{stalls}.')
         super().destroy_node()
 
 

@@ -61,8 +61,10 @@ class SimParams:
                                   'height', unit='m', min=0.0, max=10.0)
     frame_id: str = param('world', 'frame of /ee_pose and /sim/objects (the arm base is at its '
                           'origin)')
-    max_catch_up: float = param(0.25, 'realtime: lag beyond this is skipped, not raced through',
-                                unit='s', min=0.0, max=60.0)
+    max_catch_up: float = param(0.1, 'realtime: lag beyond this is skipped, not raced through '
+                                '(the joint states are never older than this plus a stall; a '
+                                'skip beyond 0.25 s, a stall, is warned)', unit='s', min=0.0,
+                                max=60.0)
     tf_publish_frequency: float = param(20.0, 'most /tf messages per second, as '
                                         "robot_state_publisher's publish_frequency", unit='Hz',
                                         min=0.1, max=10000.0)
