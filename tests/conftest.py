@@ -50,6 +50,27 @@ if SHARED_DATA.is_dir():
 
 
 @pytest.fixture(autouse=True)
+def _exclusive_or_shared(request: pytest.FixtureRequest,
+                         tmp_path_factory: pytest.TempPathFactory) -> Iterator[None]:
+    """A test marked ``exclusive`` (a live real-time run whose outcome is its point) runs while
+    no other test of this suite runs: it takes an exclusive lock on a file of the suite run's
+    temporary folder (shared by the xdist workers), every other test a shared one. It waits for
+    the other worker's current test to end, however long, as ``flock`` does; the other worker
+    waits for it in turn."""
+    import fcntl
+
+    base = tmp_path_factory.getbasetemp()
+    folder = base.parent if os.environ.get('PYTEST_XDIST_WORKER') else base
+    exclusive = request.node.get_closest_marker('exclusive') is not None
+    with (folder / 'mindgrasp-exclusive.lock').open('a') as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX if exclusive else fcntl.LOCK_SH)
+        try:
+            yield
+        finally:
+            fcntl.flock(lock, fcntl.LOCK_UN)
+
+
+@pytest.fixture(autouse=True)
 def _process_log_level() -> Iterator[None]:
     """Each test starts at the process's default log level and leaves it there: a lock-step run
     sets the level of every node logger in its process (``set_log_level``, as ``--log-level``),

@@ -24,13 +24,15 @@ DEMO_NODES = {'recorder_node', 'trial_manager_node', 'sim_node', 'virtual_amp_no
               'acquisition_node', 'classifier_node', 'vision_node', 'fsm_node'}
 
 
-@pytest.mark.timeout(900)
+@pytest.mark.exclusive
+@pytest.mark.timeout(1800)   # waits for the other worker's current test, then ~4 min
 def test_ros2_launch_demo_grasps_on_real_rclpy(colcon_ws, tmp_path: Path) -> None:
-    """Two live trials of the red cube on real rclpy: the arm grasps it in both. Eight rclpy
-    processes in real time on 2 cores beside the other test worker's heaviest tests fall
-    0.3-0.6 s behind; the descent bounds its speed by the age of the joint states (issue 39),
-    so a loaded machine changes the timing, never the outcome (before it, the approach stopped
-    3 mm low and the fingertips stuck on the table in two fresh-clone runs)."""
+    """Two live trials of the red cube on real rclpy: the arm grasps it in both. The
+    descent bounds its speed by the age of the joint states (issue 39), so a late state cannot
+    carry the fingertips into the table. The eight rclpy processes need about 1.5 of the 2
+    cores: beside the other test worker's heaviest tests (load 5-10) the simulator stalled for
+    0.3 s every few seconds, each stall latched the controller's sensor fault, and neither trial
+    finished in two fresh-clone runs; so this test runs alone (``exclusive``)."""
     from mindgrasp_bag.reader import BagReader
     from mindgrasp_bag.typestore import typestore
 
