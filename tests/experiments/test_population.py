@@ -221,11 +221,19 @@ def test_a_population_of_2_subjects_x_2_trials(population: tuple[Path, dict]) ->
     assert result.returncode == 2 and 'other options (trials)' in result.stderr, result.stderr
 
 
+def _with_models_of(population: tuple[Path, dict], out: Path) -> Path:
+    """``out`` holding the calibrated models of the ``population`` run (found by their digest:
+    the same calibration is not made again; what a test checks is how the trials run)."""
+    out.mkdir()
+    shutil.copytree(population[0] / 'models', out / 'models')
+    return out
+
+
 @pytest.mark.slow
 @pytest.mark.timeout(7200)
 def test_a_killed_population_continues_with_the_same_records(
         population: tuple[Path, dict], tmp_path: Path) -> None:
-    out = tmp_path / 'run'
+    out = _with_models_of(population, tmp_path / 'run')
     command = [sys.executable, '-m', 'mindgrasp_cli', 'experiment', 'population', '--subjects',
                SUBJECTS, *RUN, '--workers', '1', '--out', str(out)]
     first = out / 'subjects' / 'eegmmidb_s001' / 'summary.json'
@@ -350,7 +358,7 @@ def ray_cluster(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[str
 @pytest.mark.timeout(7200)
 def test_a_population_on_a_two_node_ray_cluster_gives_the_local_records(
         population: tuple[Path, dict], ray_cluster: str, tmp_path: Path) -> None:
-    out = tmp_path / 'run'
+    out = _with_models_of(population, tmp_path / 'run')
     doc = last_json(mindgrasp('experiment', 'population', '--subjects', SUBJECTS, *RUN,
                               '--ray', ray_cluster, '--out', str(out), '--json',
                               timeout=RUN_TIMEOUT))

@@ -383,7 +383,8 @@ def _check_config(out: Path, config: Mapping[str, Any]) -> None:
                    'same options to continue it, or a new --out.')
             raise ExperimentError(msg)
         return
-    if out.exists() and any(p.name not in ('logs',) for p in out.iterdir()):
+    # models/: calibrations made before (by digest, e.g. copied from another run) are reused
+    if out.exists() and any(p.name not in ('logs', 'models') for p in out.iterdir()):
         msg = (f'--out {out} exists and holds other files than a population run; choose a new '
                '--out or remove it (a run never overwrites recorded data).')
         raise ExperimentError(msg)
