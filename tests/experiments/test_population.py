@@ -161,6 +161,32 @@ def test_a_choice_the_play_data_cannot_express_is_replaced(tmp_path: Path) -> No
     assert pair is None and 'names no answer pair' in note
 
 
+def test_the_gate_keeps_a_subject_who_is_not_ready_from_the_arm(tmp_path: Path) -> None:
+    """--gate ready (the default): a subject the calibration gate does not call ready gets a
+    row with the verdict, reason and prediction and no trials, as the hardware launch refuses
+    its model; a ready one drives the arm."""
+    from mindgrasp_experiments.population import _gate_row
+
+    model = tmp_path / 'model.json'
+    model.write_text(json.dumps({
+        'answer_pair': {'name': 'mi_rest', 'yes': ['left_hand'], 'no': ['rest']},
+        'gate': {'verdict': 'not_ready', 'reason': 'no answer pair decodes',
+                 'predicted': {'correct_rate': 0.13, 'wrong_rate': 0.87,
+                               'decision_time_s': 9.6}}}))
+    row = _gate_row(_subject(), model)
+    assert row is not None and row['trials'] is None
+    assert row['status'].startswith('not run: the calibration gate says not_ready (no answer '
+                                    'pair decodes)')
+    assert (row['gate_verdict'], row['answer_pair'], row['predicted_correct_rate']) == \
+        ('not_ready', 'mi_rest', 0.13)
+    figures = population_figures([row])
+    assert figures['subjects_run'] == 0 and figures['subjects_kept_from_the_arm'] == 1
+    model.write_text(json.dumps({'gate': {'verdict': 'ready'}}))
+    assert _gate_row(_subject(), model) is None
+    model.write_text('{}')          # a model without a verdict is not ready either
+    assert _gate_row(_subject(), model)['gate_verdict'] == 'unassessed'
+
+
 def test_bad_arguments_are_one_line() -> None:
     for args, message in ((('--subjects', 'virtual'), 'a population runs replay subjects'),
                           ((), 'give the subjects'),

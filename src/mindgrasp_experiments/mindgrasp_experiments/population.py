@@ -60,6 +60,8 @@ NAMED_PAIRS: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
     'hands_feet': (('both_hands',), ('both_feet',)),
     'left_right': (('left_hand',), ('right_hand',)),
 }
+#: --gate: who drives the arm: subjects the calibration gate calls ready (as on hardware), or all
+GATES = ('ready', 'any')
 #: the gate's predictions and the answer pair, as the calibration writes them into summary.json
 CONTRACT_KEYS = ('answer_pair', 'gate_verdict', 'predicted_correct_rate', 'predicted_wrong_rate',
                  'predicted_decision_time_s')
@@ -316,6 +318,29 @@ def subject_row(subject: PopulationSubject, doc: Mapping[str, Any] | None,
     return row
 
 
+def _gate_row(subject: PopulationSubject, model_json: str | Path) -> dict[str, Any] | None:
+    """The row of a subject whose calibration gate does not say ready (its verdict, reason and
+    prediction, no trials), or None when it may drive the arm."""
+    try:
+        doc = json.loads(Path(model_json).read_text(encoding='utf-8'))
+    except (OSError, ValueError):
+        doc = {}
+    gate = doc.get('gate') if isinstance(doc, dict) and isinstance(doc.get('gate'), dict) else {}
+    verdict = str(gate.get('verdict') or 'unassessed')
+    if verdict == 'ready':
+        return None
+    predicted = gate.get('predicted') if isinstance(gate.get('predicted'), dict) else {}
+    pair = doc.get('answer_pair') if isinstance(doc.get('answer_pair'), dict) else {}
+    summary = {'answer_pair': pair.get('name'), 'gate_verdict': verdict,
+               'gate_reason': gate.get('reason'),
+               'predicted_correct_rate': predicted.get('correct_rate'),
+               'predicted_wrong_rate': predicted.get('wrong_rate'),
+               'predicted_decision_time_s': predicted.get('decision_time_s')}
+    status = (f"not run: the calibration gate says {verdict} ({gate.get('reason', '')}); it "
+              'does not drive the arm, as on hardware (--gate any runs it)')
+    return subject_row(subject, {'summary': summary}, status=status)
+
+
 def restricted_pair(subject: PopulationSubject, model_json: str | Path) -> tuple[str | None, str]:
     """The answer pair to run ``subject`` with when the calibrated model's choice is one its
     play data cannot express, and a note for the report.
@@ -417,8 +442,14 @@ def run_population(subjects: Sequence[PopulationSubject], out: str | Path, *,
                    command: str = '', log: Callable[[str], None] = print,
                    warn: Callable[[str], None] = print,
                    on_subject: Callable[[PopulationSubject, str], None] | None = None,
-                   on_trial: Callable[[], None] | None = None) -> PopulationResults:
+                   on_trial: Callable[[], None] | None = None,
+                   gate: str = 'ready') -> PopulationResults:
     """Calibrate each subject and run its closed loop, in order; write the population.
+
+    ``gate='ready'`` (default) runs the closed loop only for subjects whose calibration gate
+    says ready, as ``mindgrasp launch hardware`` lets only them drive a real arm; the others get
+    a row with their verdict, prediction and reason. ``gate='any'`` runs every subject (to
+    measure what the gate keeps from the arm).
 
     Subjects with a finished run in ``out`` of the same options are read, not run again
     (``on_subject(subject, 'resumed')``); one cut off half-way is run again from its first
@@ -435,7 +466,11 @@ def run_population(subjects: Sequence[PopulationSubject], out: str | Path, *,
     out = Path(out)
     options = {'trials': trials, 'seed': seed, 'accuracy': accuracy, 'params': dict(params or {}),
                'robot': robot, 'realism': realism, 'launch': launch, 'step_s': step_s,
-               'trial_timeout_s': trial_timeout_s, 'stall_timeout_s': stall_timeout_s}
+               'trial_timeout_s': trial_timeout_s, 'stall_timeout_s': stall_timeout_s,
+               'gate': gate}
+    if gate not in GATES:
+        msg = f'--gate is {gate!r}; use one of {", ".join(GATES)}.'
+        raise ExperimentError(msg)
     _check_config(out, {**options, 'subjects': [s.config() for s in subjects]})
     (out / 'subjects').mkdir(exist_ok=True)
     rows: list[dict[str, Any]] = []
@@ -462,6 +497,13 @@ def run_population(subjects: Sequence[PopulationSubject], out: str | Path, *,
                 on_subject(subject, 'failed')
             warn(f'{subject.label}: not run: {exc}')
             rows.append(subject_row(subject, None, status=f'not run: {exc}'))
+            continue
+        gated = _gate_row(subject, subject_args.get('model', '')) if gate == 'ready' else None
+        if gated is not None:
+            if on_subject is not None:
+                on_subject(subject, 'gated')
+            warn(f"{subject.label}: {gated['status']}")
+            rows.append(gated)
             continue
         pair, note = restricted_pair(subject, subject_args.get('model', ''))
         notes[subject.label] = note
@@ -542,6 +584,8 @@ def population_figures(rows: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
     rates = [r.get('correct_rate') for r in ran]
     out: dict[str, Any] = {
         'subjects': len(rows), 'subjects_run': len(ran), 'trials': total,
+        'subjects_kept_from_the_arm': sum('calibration gate says' in str(r.get('status', ''))
+                                          for r in rows),
         'correct_rate': _quartiles(rates),
         'wrong_grasp_rate': _quartiles([r.get('wrong_grasp_rate') for r in ran]),
         'no_grasp_rate': _quartiles([r.get('no_grasp_rate') for r in ran]),
@@ -644,7 +688,8 @@ def _figures_lines(fig: Mapping[str, Any]) -> list[str]:
         + (f' (Wilson 95 % {_cell(ci[0], "pct")} - {_cell(ci[1], "pct")})'
            if ci[0] is not None else ''))
     return [
-        f"- subjects run: {fig['subjects_run']} of {fig['subjects']}, {fig['trials']} trials",
+        f"- subjects run: {fig['subjects_run']} of {fig['subjects']}, {fig['trials']} trials "
+        f"({fig.get('subjects_kept_from_the_arm', 0)} kept from the arm by the calibration gate)",
         f"- correct grasp per subject: median {q('correct_rate', 'pct')}",
         f"- wrong grasp per subject: median {q('wrong_grasp_rate', 'pct')}; at most "
         f"{_cell(fig.get('max_wrong_grasps_per_subject'))} in one subject",

@@ -41,6 +41,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--accuracy', type=probability, default=1.0,
                         help='probability that each subject imagines the right class (the EEG '
                              'is the subject\'s own; default 1.0)')
+    parser.add_argument('--gate', choices=('ready', 'any'), default='ready',
+                        help='who drives the arm: ready (default) runs the closed loop only for '
+                             'subjects whose calibration gate says ready, as the hardware launch '
+                             'does; any runs every subject')
     parser.add_argument('--param', action='append', default=[], metavar='NODE.PARAM=V',
                         help='set a parameter of a node for every subject (names as in the '
                              'profile\'s parameter files), e.g. fsm.confirm_threshold=3; a '
@@ -92,7 +96,7 @@ def main(args: argparse.Namespace) -> int:
 
     def on_subject(subject, status: str) -> None:
         bar.set_description(f'{COMMAND} {subject.label} ({status})')
-        if status in ('resumed', 'failed'):
+        if status in ('resumed', 'failed', 'gated'):
             bar.update(args.trials)
 
     def warn(line: str) -> None:
@@ -107,7 +111,7 @@ def main(args: argparse.Namespace) -> int:
             trial_timeout_s=args.trial_timeout, stall_timeout_s=args.stall_timeout,
             command=' '.join(['mindgrasp', 'experiment', COMMAND, *sys.argv[3:]]),
             log=log.append if args.json else lambda line: bar.write(line, file=sys.stderr),
-            warn=warn, on_subject=on_subject, on_trial=lambda: bar.update(1))
+            warn=warn, on_subject=on_subject, on_trial=lambda: bar.update(1), gate=args.gate)
     except ExperimentError as exc:
         bar.close()
         return fail(COMMAND, str(exc))
