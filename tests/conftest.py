@@ -49,20 +49,20 @@ if SHARED_DATA.is_dir():
     os.environ.setdefault('MNE_DATASETS_EEGBCI_PATH', str(SHARED_DATA))
 
 
-@pytest.fixture(autouse=True)
-def _exclusive_or_shared(request: pytest.FixtureRequest,
-                         tmp_path_factory: pytest.TempPathFactory) -> Iterator[None]:
+@pytest.hookimpl(hookwrapper=True, tryfirst=True)
+def pytest_runtest_protocol(item: pytest.Item, nextitem: pytest.Item | None) -> Iterator[None]:
     """A test marked ``exclusive`` (a live real-time run whose outcome is its point) runs while
-    no other test of this suite runs: it takes an exclusive lock on a file of the suite run's
-    temporary folder (shared by the xdist workers), every other test a shared one. It waits for
-    the other worker's current test to end, however long, as ``flock`` does; the other worker
-    waits for it in turn."""
+    no other test of this suite runs: around each test's whole protocol (its fixtures of any
+    scope set up, run and torn down) it takes an exclusive lock on a file of this suite run
+    (shared by the xdist workers), every other test a shared one. Outermost (tryfirst), so the
+    wait for the other worker's current test is not counted in any test's timeout."""
     import fcntl
+    import tempfile
 
-    base = tmp_path_factory.getbasetemp()
-    folder = base.parent if os.environ.get('PYTEST_XDIST_WORKER') else base
-    exclusive = request.node.get_closest_marker('exclusive') is not None
-    with (folder / 'mindgrasp-exclusive.lock').open('a') as lock:
+    run = os.environ.get('PYTEST_XDIST_TESTRUNUID') or f'pid{os.getpid()}'
+    path = Path(tempfile.gettempdir()) / f'mindgrasp-exclusive-{run}.lock'
+    exclusive = item.get_closest_marker('exclusive') is not None
+    with path.open('a') as lock:
         fcntl.flock(lock, fcntl.LOCK_EX if exclusive else fcntl.LOCK_SH)
         try:
             yield
