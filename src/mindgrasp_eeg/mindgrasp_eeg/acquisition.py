@@ -265,7 +265,17 @@ class EEGAcquisition:
                                                       clocksync=self._clocksync_for(info))
                         return
                     if time.monotonic() >= deadline:
-                        outcome['error'] = not_found_error(finder.pred, timeout)
+                        # one last look (1 s): a stream that appears as the wait ends is taken,
+                        # not listed as "visible" in the error
+                        try:
+                            info = resolve_stream(*self.selector, timeout=1.0,
+                                                  hostname=self.hostname, list_visible=False)
+                        except EEGError:
+                            outcome['error'] = not_found_error(finder.pred, timeout)
+                            return
+                        outcome['found'] = open_inlet(info, max_buflen=self.max_buflen,
+                                                      dejitter=self.dejitter,
+                                                      clocksync=self._clocksync_for(info))
                         return
                     self._stop.wait(0.1)
             except EEGError as exc:

@@ -53,9 +53,12 @@ def virtual_amp_pin() -> tuple[dict[str, str], dict[str, str]]:
     resolved) and this host. LSL streams are visible across the machine and the lab's
     network, so a second demo (another ROS domain, another rig) with the same stream name can
     no longer feed this one's classifier (issue 42). Lock-step runs have no LSL stream: their
-    records do not depend on it."""
+    records do not depend on it. The acquisition waits up to 120 s for that amplifier (not the
+    30 s of a stream started by hand): it starts beside it, and a real ``ros2 launch`` demo on a
+    loaded 2-core machine took over 30 s to bring it up."""
     source_id = _run_source_id()
-    return {'source_id': source_id}, {'source_id': source_id, 'hostname': 'local'}
+    return {'source_id': source_id}, {'source_id': source_id, 'hostname': 'local',
+                                      'resolve_timeout': 120.0}
 
 
 #: the launch configuration that keeps a launch's source id once made
