@@ -105,6 +105,8 @@ def test_the_choice_keeps_the_default_only_when_something_predicts_a_grasp() -> 
                    result('left_right', 1.0, 0.86)]).pair.name == 'left_right'     # S002
 
 
+@pytest.mark.timeout(1800)   # two real-EEG calibrations with the held-out pair choice (191 s in
+#                              CI, over 300 s beside a second suite)
 def test_two_subjects_get_different_pairs(eegbci_path: str, tmp_path) -> None:
     """The replay subjects' own calibration (replay_model): S001 (calibrated on runs 4, 6)
     answers with both hands / both feet, S002 (runs 4, 6, 8, 10), whose both hands / both feet
