@@ -37,13 +37,24 @@ def s001(eegbci_path: str) -> list:
 
 
 def test_pairs_follow_the_decoders_and_the_play_datas_classes() -> None:
-    names = [p.name for p in candidate_pairs([0, 1, 2, 3, REST])]
+    names = [p.name for p in candidate_pairs([0, 1, 2, 3, REST], rest_pairs=True)]
     assert names[:3] == ['hands_feet', 'left_right', 'mi_rest'] and 'both_hands_rest' in names
     # S006-S012 play only run 12 (left / right hand): hands and feet cannot answer
-    names = [p.name for p in candidate_pairs([0, 1, 2, 3, REST], play_classes={0, 1})]
+    names = [p.name for p in candidate_pairs([0, 1, 2, 3, REST], play_classes={0, 1},
+                                             rest_pairs=True)]
     assert names[:2] == ['left_right', 'mi_rest'] and not any('both' in n for n in names)
-    mi_rest = candidate_pairs([0, 1, 2, 3, REST], play_classes={0, 1})[1]
+    mi_rest = candidate_pairs([0, 1, 2, 3, REST], play_classes={0, 1}, rest_pairs=True)[1]
     assert mi_rest.yes[:2] == (0, 1) and mi_rest.no == (REST,)
+
+
+def test_pairs_with_rest_are_not_chosen_automatically() -> None:
+    """Imagery against rest predicted far better than it played (wrong grasps), so the
+    automatic choice only weighs pairs of two imagery classes."""
+    names = [p.name for p in candidate_pairs([0, 1, 2, 3, REST])]
+    assert names[:2] == ['hands_feet', 'left_right'] and len(names) == 10
+    assert not any('rest' in n for n in names)
+    names = [p.name for p in candidate_pairs([0, 1, 2, 3, REST], play_classes={0, 1})]
+    assert names == ['left_right']
 
 
 def test_s001_is_ready_with_hands_and_feet(s001: list) -> None:
@@ -111,7 +122,8 @@ def test_two_subjects_get_different_pairs(eegbci_path: str, tmp_path) -> None:
     """The replay subjects' own calibration (replay_model): S001 (calibrated on runs 4, 6)
     answers with both hands / both feet, S002 (runs 4, 6, 8, 10), whose both hands / both feet
     decode worst, with another pair (left / right hand with thresholds allowed below the
-    defaults; imagery / rest since they never go below them)."""
+    defaults; since they never go below them imagery / rest, which is no longer chosen
+    automatically)."""
     import json
 
     from mindgrasp_experiments.subjects import replay_model
@@ -122,4 +134,4 @@ def test_two_subjects_get_different_pairs(eegbci_path: str, tmp_path) -> None:
         chosen[subject] = model['answer_pair']['name']
         assert model['gate']['verdict'] in ('ready', 'needs_training', 'not_ready')
         assert set(model['decision_thresholds']) == {'confirm', 'pass', 'affirm', 'cancel'}
-    assert chosen[1] == 'hands_feet' and chosen[2] in ('left_right', 'mi_rest'), chosen
+    assert chosen[1] == 'hands_feet' and chosen[2] != 'hands_feet', chosen

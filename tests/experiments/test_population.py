@@ -59,7 +59,7 @@ def test_the_local_population_file_lists_the_11_subjects_with_their_runs() -> No
     # run 12 holds left and right fist only: the pairs it can express are said
     assert s6.restricted and s6.play_classes == ('left_hand', 'right_hand')
     assert s6.restriction() == ('play data holds left_hand, right_hand and rest only: answer '
-                                'pairs restricted to left_right, mi_rest')
+                                'pairs restricted to left_right')
 
 
 def test_expressible_pairs_follow_the_contract_names() -> None:

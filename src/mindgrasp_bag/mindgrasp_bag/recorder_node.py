@@ -119,20 +119,25 @@ class RecorderNode(rclpy.node.Node):
         self.recorder = Recorder(writer, max_queue_bytes=p.max_queue_mb << 20,
                                  on_error=self._on_error)
         self.recorder.start()
-        self._topic_subscriptions: dict[str, Any] = {}
-        self._requested: dict[str, dict[str, Any]] = {}     # topic -> QoS subscribed with
-        self._matched: set[str] = set()                     # topics that matched a publisher
-        self._unpublished: set[str] = set()                 # seen with subscribers only
-        self._refused: set[str] = set()
-        self._types: dict[str, str] = {}
-        self.param_watch = (ParameterWatch(self, ParameterChangeLog(p.parameter_changes))
-                            if p.parameter_changes else None)
-        self.get_logger().info(f'Recording to {writer.path} (MCAP, compression '
-                               f'{writer.compression}).')
-        self.create_timer(p.discovery_period, self.discover_callback)
-        self.create_timer(1.0, self.report_callback)
-        end_after(self, p.duration)
-        self.discover_callback()
+        try:
+            self._topic_subscriptions: dict[str, Any] = {}
+            self._requested: dict[str, dict[str, Any]] = {}     # topic -> QoS subscribed with
+            self._matched: set[str] = set()                     # topics that matched a publisher
+            self._unpublished: set[str] = set()                 # seen with subscribers only
+            self._refused: set[str] = set()
+            self._types: dict[str, str] = {}
+            self.param_watch = (ParameterWatch(self, ParameterChangeLog(p.parameter_changes))
+                                if p.parameter_changes else None)
+            self.get_logger().info(f'Recording to {writer.path} (MCAP, compression '
+                                   f'{writer.compression}).')
+            self.create_timer(p.discovery_period, self.discover_callback)
+            self.create_timer(1.0, self.report_callback)
+            end_after(self, p.duration)
+            self.discover_callback()
+        except BaseException:
+            # cut short (Ctrl-C while the graph starts, a bad topic): the bag is closed all the same
+            self.recorder.stop()
+            raise
 
     def _wanted(self, topic: str) -> bool:
         if topic in self.topics or (topic == PARAMETER_EVENTS and self.param_watch):

@@ -32,7 +32,7 @@ window on a decoder that was trained on it:
 4. **The choice** (:func:`select`): the pair with the highest predicted correct rate
    (``hands_feet`` kept when within :data:`PREFER_DEFAULT` of the best; when no pair predicts a
    correct grasp, the best held-out separability), among the pairs the subject's play data can
-   express when that is known. The gate (:mod:`mindgrasp_classifier.gate`) then says whether
+   express when that is known, and of two imagery classes (:data:`REST_PAIRS_CHOSEN`). The gate (:mod:`mindgrasp_classifier.gate`) then says whether
    the person is ready.
 """
 
@@ -51,7 +51,7 @@ from mindgrasp_classifier.errors import ClassifierError
 from mindgrasp_common.answer_pair import DEFAULT_PAIR, NAMED_PAIRS, AnswerPair, answer_pair
 from mindgrasp_common.mi import DECODER_CLASS_NAMES, REST
 
-__all__ = ['DEFAULT_THRESHOLDS', 'MOTION_S', 'TARGET_WRONG_RATE', 'FoldStream', 'PairResult',
+__all__ = ['DEFAULT_THRESHOLDS', 'MOTION_S', 'REST_PAIRS_CHOSEN', 'TARGET_WRONG_RATE', 'FoldStream', 'PairResult',
            'candidate_pairs', 'choose_pair', 'heldout_streams', 'predict_trials', 'select',
            'simulate_pair']
 
@@ -71,6 +71,12 @@ PREFER_DEFAULT = 0.03
 #: initial approach before the go-on is awaited, the final approach + grasp + lift after it, and
 #: the return to the start after a cancel
 MOTION_S = {'next_offer': 5.0, 'approach': 6.0, 'grasp': 12.0, 'return': 8.0}
+#: pairs with rest on one side (``mi_rest``, ``both_hands_rest``, ...) are not chosen
+#: automatically: their held-out predictions were far too optimistic for the closed loop
+#: (EEGMMIDB replay, 18 trials each: S002 predicted 99.5 % correct / 0 % wrong, played 5 correct,
+#: 4 wrong; S003 2 correct, 5 wrong of 9). They stay available by name (the controller's
+#: ``answer_pair`` parameter) and are chosen from with ``rest_pairs=True``.
+REST_PAIRS_CHOSEN = False
 #: fewest trials per class a fold model is trained on
 FOLD_MIN_TRIALS = 3
 #: objects the set-locations scene offers in one sweep
@@ -240,13 +246,14 @@ def heldout_streams(recordings: Sequence[Recording], cfg: Any, *, tmin: float | 
 
 
 # ------------------------------------------------------------------------------ decisions
-def candidate_pairs(classes: Sequence[int], play_classes: set[int] | None = None
-                    ) -> list[AnswerPair]:
+def candidate_pairs(classes: Sequence[int], play_classes: set[int] | None = None, *,
+                    rest_pairs: bool = REST_PAIRS_CHOSEN) -> list[AnswerPair]:
     """Every pair the decoder's ``classes`` allow: the named ones, then each other (yes imagery
     class, no class); with ``play_classes`` (classes the subject's play data hold, rest always
     there) only pairs whose imagined classes are among them. ``mi_rest``'s yes side lists the
-    imagery classes the decoder knows, the play data's first."""
-    known = set(classes)
+    imagery classes the decoder knows, the play data's first. Pairs with rest on a side only
+    with ``rest_pairs`` (:data:`REST_PAIRS_CHOSEN`)."""
+    known = set(classes) if rest_pairs else set(classes) - {REST}
     can = set(known) if play_classes is None else (set(play_classes) | {REST}) & known
     out: list[AnswerPair] = []
     for name, (yes, no) in NAMED_PAIRS.items():
@@ -515,6 +522,7 @@ def select(results: Sequence[PairResult]) -> PairResult:
 
 
 def choose_pair(streams: Sequence[FoldStream], *, play_classes: set[int] | None = None,
+                rest_pairs: bool = REST_PAIRS_CHOSEN,
                 target_wrong_rate: float = TARGET_WRONG_RATE,
                 timing: dict[str, float] | None = None, seed: int = 0,
                 log: Callable[[str], None] | None = None) -> tuple[PairResult, list[PairResult]]:
@@ -524,7 +532,7 @@ def choose_pair(streams: Sequence[FoldStream], *, play_classes: set[int] | None 
     classes = sorted(set().union(*(set(s.classes) for s in streams)))
     results = [simulate_pair(streams, p, target_wrong_rate=target_wrong_rate,
                              clip=timing['clip'], timing=timing, seed=seed)
-               for p in candidate_pairs(classes, play_classes)]
+               for p in candidate_pairs(classes, play_classes, rest_pairs=rest_pairs)]
     if not results:
         msg = ('No answer pair is possible: the decoder and the play data share no two classes; '
                'calibrate on runs with the classes the person will use.')

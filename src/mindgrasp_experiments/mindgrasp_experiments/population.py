@@ -119,7 +119,10 @@ class PopulationSubject:
         """One sentence on what the play data can express, ``''`` when it holds every class."""
         if not self.restricted:
             return ''
-        pairs = expressible_pairs(self.play_classes, rest=self.play_rest)
+        from mindgrasp_classifier.answer_pair import REST_PAIRS_CHOSEN
+
+        # the pairs the automatic choice may take (imagery / rest is not among them)
+        pairs = expressible_pairs(self.play_classes, rest=self.play_rest and REST_PAIRS_CHOSEN)
         return (f"play data holds {', '.join(self.play_classes) or 'no imagery class'}"
                 f"{' and rest' if self.play_rest else ''} only: answer pairs restricted to "
                 f"{', '.join(pairs) or 'none'}")

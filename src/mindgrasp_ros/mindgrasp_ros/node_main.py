@@ -62,7 +62,7 @@ from typing import Any
 
 from mindgrasp_ros import rclpy
 from mindgrasp_ros.params import refuse_undeclared_overrides
-from mindgrasp_ros.process import exit_if_main_program, stop_requested
+from mindgrasp_ros.process import exit_if_main_program, is_main_program, stop_requested
 
 __all__ = ['EXIT_FAILED', 'EXIT_OK', 'EXIT_REFUSED', 'NodeFailure', 'declare_duration',
            'end_after', 'end_graph', 'error_text', 'exit_code', 'fail', 'failure_text',
@@ -270,6 +270,9 @@ def run_node(node_class: Callable[[], Any], args: list[str] | None = None, *,
         exit_if_main_program(EXIT_OK, getattr(node_class, '__module__', ''))
         return EXIT_OK
     label = getattr(node_class, '__name__', 'node')
+    if stop_requested.is_set() and is_main_program(getattr(node_class, '__module__', '')):
+        # Ctrl-C while the program was still importing (mindgrasp_ros.start): a stop, nothing ran
+        exit_if_main_program(EXIT_OK, getattr(node_class, '__module__', ''))
     try:
         rclpy.init(args=argv)
     except _argument_errors() as exc:

@@ -10,6 +10,8 @@ import sys
 import time
 from pathlib import Path
 
+from mindgrasp_ros.start import python_module_argv
+
 __all__ = ['NodeProcess']
 
 
@@ -26,9 +28,10 @@ class NodeProcess:
         self.module = module
         self.log_path = log
         self._log = log.open('wb')
-        target = [module] if module.endswith('.py') else ['-m', module]
+        program = [sys.executable, module] if module.endswith('.py') else \
+            python_module_argv(module)
         self.proc = subprocess.Popen(
-            [sys.executable, '-u', *target, *args], stdout=self._log,
+            [program[0], '-u', *program[1:], *args], stdout=self._log,
             stderr=subprocess.STDOUT, env=env, start_new_session=True)
 
     def output(self) -> str:

@@ -22,9 +22,10 @@ import threading
 import traceback
 from collections.abc import Callable
 from pathlib import Path
+from types import FrameType
 
-__all__ = ['exit_if_main_program', 'exit_process', 'handle_stop_signals', 'is_main_program',
-           'run_program']
+__all__ = ['exit_if_main_program', 'exit_process', 'handle_stop_signals',
+           'interrupt_unless_importing', 'is_main_program', 'run_program']
 
 
 #: set by SIGINT and SIGTERM (handle_stop_signals). A node's spin loop also checks it: the signal's
@@ -37,6 +38,18 @@ stop_requested = threading.Event()
 def _interrupt(signum: int, frame: object) -> None:
     stop_requested.set()
     signal.default_int_handler(signal.SIGINT, frame)
+
+
+def interrupt_unless_importing(signum: int, frame: FrameType | None) -> None:
+    """A stop signal while a node program starts (:mod:`mindgrasp_ros.start`): set
+    :data:`stop_requested`, and raise KeyboardInterrupt unless an import is in progress (raised
+    inside a C extension's initialisation it becomes ``ImportError: initialization failed``)."""
+    stop_requested.set()
+    while frame is not None:
+        if frame.f_code.co_filename.startswith('<frozen importlib'):
+            return     # acted on once the imports are done (run_node checks stop_requested)
+        frame = frame.f_back
+    raise KeyboardInterrupt
 
 
 def handle_stop_signals() -> None:
@@ -53,9 +66,9 @@ def handle_stop_signals() -> None:
     if threading.current_thread() is not threading.main_thread():
         return
     if signal.getsignal(signal.SIGINT) in (signal.SIG_IGN, signal.SIG_DFL, None,
-                                           signal.default_int_handler):
+                                           signal.default_int_handler, interrupt_unless_importing):
         signal.signal(signal.SIGINT, _interrupt)
-    if signal.getsignal(signal.SIGTERM) in (signal.SIG_DFL, None):
+    if signal.getsignal(signal.SIGTERM) in (signal.SIG_DFL, None, interrupt_unless_importing):
         signal.signal(signal.SIGTERM, _interrupt)
 
 

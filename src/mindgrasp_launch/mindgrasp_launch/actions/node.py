@@ -5,7 +5,6 @@ from __future__ import annotations
 import importlib.util
 import os
 import shutil
-import sys
 from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -25,6 +24,7 @@ from mindgrasp_launch.substitutions import (
     perform_substitutions,
     resolve_parameter_value,
 )
+from mindgrasp_ros.start import python_module_argv
 
 if TYPE_CHECKING:
     from mindgrasp_launch.context import LaunchContext
@@ -87,7 +87,7 @@ def resolve_program(package: str | None, executable: str) -> tuple[list[str], st
     if package:
         module = node_module(package, executable)
         if module is not None:
-            return [sys.executable, '-m', module], module, None
+            return python_module_argv(module), module, None
         found = ament_executable(package, executable) or shutil.which(executable)
         if found:
             return [found], None, None
@@ -95,7 +95,7 @@ def resolve_program(package: str | None, executable: str) -> tuple[list[str], st
         problem = (f"the node module '{module}' does not exist (yet), so 'python -m {module}' "
                    f"cannot start: write or install it, check package= and executable=, or "
                    f"leave the node out.")
-        return [sys.executable, '-m', module], module, problem
+        return python_module_argv(module), module, problem
     path = Path(executable).expanduser()
     if os.sep in executable and path.is_file():
         if not os.access(path, os.X_OK):
@@ -106,12 +106,12 @@ def resolve_program(package: str | None, executable: str) -> tuple[list[str], st
     if found:
         return [found], None, None
     if '.' in executable and '/' not in executable and find_module(executable):
-        return [sys.executable, '-m', executable], executable, None
+        return python_module_argv(executable), executable, None
     pkg, sep, exe = executable.partition('/')
     if sep and pkg and exe and '/' not in exe:  # 'package/executable', as `ros2 run` takes it
         module = node_module(pkg, exe)
         if module is not None:
-            return [sys.executable, '-m', module], module, None
+            return python_module_argv(module), module, None
         module = f'{pkg}.{exe}'
         ros2 = shutil.which('ros2')
         if ros2:

@@ -107,9 +107,9 @@ class LockstepRunner:
                                                  for name, value in params.items()]}
         check_composable(node_class, NODE_KEYWORDS)
         node = node_class(*args, **kwargs, context=self.context, **node_args)
+        self.nodes.append(node)    # first: a Ctrl-C from here on still destroys it (closes its bag)
         self._publish_clock()
         self.executor.add_node(node)
-        self.nodes.append(node)
         self.spin_until_quiescent()
         return node
 

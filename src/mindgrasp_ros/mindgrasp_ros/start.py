@@ -1,0 +1,50 @@
+"""Start a node module as the program: ``python -m mindgrasp_ros.start MODULE [ARGS...]``.
+
+The launcher and :class:`~mindgrasp_ros.node_process.NodeProcess` start Python nodes this way
+instead of ``python -m MODULE``. The difference is Ctrl-C while the node is still importing:
+a launch that ends early (a 2-trial trainer session on a busy machine) sends SIGINT to a node
+that may still be importing torch or pyRiemann. Python's KeyboardInterrupt inside a C extension's
+initialisation becomes ``ImportError: initialization failed`` (matplotlib's ``ft2font``, measured
+in CI), the node exits 1 and the launch reports a failure although nothing had started.
+
+Here, until the node's own signal handling takes over (:func:`~mindgrasp_ros.process.
+handle_stop_signals`, called by ``rclpy.init``), SIGINT and SIGTERM set
+:data:`~mindgrasp_ros.process.stop_requested`; they raise KeyboardInterrupt only when no import is
+in progress. A node asked to stop before it started then ends with 0 as soon as its imports are
+done (:func:`~mindgrasp_ros.node_main.run_node` checks the flag first), as a stop.
+"""
+
+from __future__ import annotations
+
+import runpy
+import signal
+import sys
+
+from mindgrasp_ros.process import exit_process, interrupt_unless_importing
+
+__all__ = ['python_module_argv']
+
+
+def python_module_argv(module: str) -> list[str]:
+    """The command line that runs the Python module ``module`` as a node program."""
+    return [sys.executable, '-m', 'mindgrasp_ros.start', module]
+
+
+def main() -> None:
+    """Run ``sys.argv[1]`` as ``__main__`` with the rest of the command line as its arguments."""
+    if len(sys.argv) < 2:
+        print('usage: python -m mindgrasp_ros.start MODULE [ARGS...]', file=sys.stderr)
+        exit_process(2)
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(signum, interrupt_unless_importing)
+    module = sys.argv[1]
+    del sys.argv[1]    # the module sees its own argv, as under ``python -m MODULE``
+    try:
+        runpy.run_module(module, run_name='__main__', alter_sys=True)
+    except KeyboardInterrupt:   # stopped between two imports of the module, before its main()
+        exit_process(0)
+    exit_process(0)
+
+
+if __name__ == '__main__':
+    main()

@@ -1,0 +1,72 @@
+"""``python -m mindgrasp_ros.start MODULE``: a node stopped while it still imports ends with 0.
+
+A launch that ends early sends SIGINT to nodes that may still be importing torch or pyRiemann;
+a KeyboardInterrupt inside a C extension's initialisation became ``ImportError: initialization
+failed`` and exit 1 (CI). Here the node module's import waits, inside the import, until the stop
+was requested, so the signal arrives during an import every time.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import textwrap
+import time
+from pathlib import Path
+
+from mindgrasp_ros.node_process import NodeProcess
+
+DEPENDENCY = '''
+import time
+from pathlib import Path
+
+from mindgrasp_ros.process import stop_requested
+
+Path(__file__).with_name('importing').touch()
+deadline = time.monotonic() + 300.0
+while not stop_requested.is_set() and time.monotonic() < deadline:   # the test's SIGINT
+    time.sleep(0.01)
+'''
+
+NODE = '''
+import slow_dependency  # noqa: F401  (waits in its import until the stop was requested)
+from mindgrasp_ros import rclpy
+from mindgrasp_ros.node_main import run_node
+
+
+class Never(rclpy.node.Node):
+    def __init__(self) -> None:
+        print('constructed', flush=True)
+        super().__init__('never')
+
+
+def main() -> int:
+    return run_node(Never, [])
+
+
+if __name__ == '__main__':
+    from mindgrasp_ros.process import run_program
+
+    run_program(main)
+'''
+
+
+def test_a_node_stopped_while_importing_ends_with_0_and_never_starts(tmp_path: Path) -> None:
+    (tmp_path / 'slow_dependency.py').write_text(textwrap.dedent(DEPENDENCY))
+    (tmp_path / 'slow_node.py').write_text(textwrap.dedent(NODE))
+    env = {**os.environ, 'PYTHONPATH': os.pathsep.join(
+        [str(tmp_path), os.environ.get('PYTHONPATH', '')])}
+    proc = NodeProcess('slow_node', [], env, tmp_path / 'node.log')
+    try:
+        deadline = time.monotonic() + 300.0
+        while not (tmp_path / 'importing').exists():
+            assert proc.poll() is None, proc.output()
+            assert time.monotonic() < deadline, proc.output()
+            time.sleep(0.05)
+        proc.proc.send_signal(signal.SIGINT)
+        code = proc.wait(300.0)
+    finally:
+        proc.stop()
+    out = proc.output()
+    assert code == 0, out
+    assert 'constructed' not in out and 'Traceback' not in out, out
