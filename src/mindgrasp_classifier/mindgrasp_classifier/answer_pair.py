@@ -32,7 +32,8 @@ window on a decoder that was trained on it:
 4. **The choice** (:func:`select`): the pair with the highest predicted correct rate
    (``hands_feet`` kept when within :data:`PREFER_DEFAULT` of the best; when no pair predicts a
    correct grasp, the best held-out separability), among the pairs the subject's play data can
-   express when that is known, and of two imagery classes (:data:`REST_PAIRS_CHOSEN`). The gate (:mod:`mindgrasp_classifier.gate`) then says whether
+   express when that is known, and of two imagery classes (:data:`REST_PAIRS_CHOSEN`). The gate
+   (:mod:`mindgrasp_classifier.gate`) then says whether
    the person is ready.
 """
 
@@ -51,8 +52,8 @@ from mindgrasp_classifier.errors import ClassifierError
 from mindgrasp_common.answer_pair import DEFAULT_PAIR, NAMED_PAIRS, AnswerPair, answer_pair
 from mindgrasp_common.mi import DECODER_CLASS_NAMES, REST
 
-__all__ = ['DEFAULT_THRESHOLDS', 'MOTION_S', 'REST_PAIRS_CHOSEN', 'TARGET_WRONG_RATE', 'FoldStream', 'PairResult',
-           'candidate_pairs', 'choose_pair', 'heldout_streams', 'predict_trials', 'select',
+__all__ = ['DEFAULT_THRESHOLDS', 'MOTION_S', 'REST_PAIRS_CHOSEN', 'TARGET_WRONG_RATE',
+           'FoldStream', 'PairResult', 'candidate_pairs', 'choose_pair', 'heldout_streams', 'predict_trials', 'select',
            'simulate_pair']
 
 #: the controller's default decision thresholds (nat s), scaled per person
