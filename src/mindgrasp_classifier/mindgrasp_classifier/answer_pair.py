@@ -33,8 +33,7 @@ window on a decoder that was trained on it:
    (``hands_feet`` kept when within :data:`PREFER_DEFAULT` of the best; when no pair predicts a
    correct grasp, the best held-out separability), among the pairs the subject's play data can
    express when that is known, and of two imagery classes (:data:`REST_PAIRS_CHOSEN`). The gate
-   (:mod:`mindgrasp_classifier.gate`) then says whether
-   the person is ready.
+   (:mod:`mindgrasp_classifier.gate`) then says whether the person is ready.
 """
 
 from __future__ import annotations
@@ -53,8 +52,8 @@ from mindgrasp_common.answer_pair import DEFAULT_PAIR, NAMED_PAIRS, AnswerPair, 
 from mindgrasp_common.mi import DECODER_CLASS_NAMES, REST
 
 __all__ = ['DEFAULT_THRESHOLDS', 'MOTION_S', 'REST_PAIRS_CHOSEN', 'TARGET_WRONG_RATE',
-           'FoldStream', 'PairResult', 'candidate_pairs', 'choose_pair', 'heldout_streams', 'predict_trials', 'select',
-           'simulate_pair']
+           'FoldStream', 'PairResult', 'candidate_pairs', 'choose_pair', 'heldout_streams',
+           'predict_trials', 'select', 'simulate_pair']
 
 #: the controller's default decision thresholds (nat s), scaled per person
 DEFAULT_THRESHOLDS = {'confirm': 3.0, 'pass': 3.0, 'affirm': 3.0, 'cancel': 5.0}
