@@ -114,24 +114,3 @@ def test_the_choice_keeps_the_default_only_when_something_predicts_a_grasp() -> 
                    result('left_right', 1.0, 0.86)]).pair.name == 'hands_feet'
     assert select([result('hands_feet', 0.86, 0.81),
                    result('left_right', 1.0, 0.86)]).pair.name == 'left_right'     # S002
-
-
-@pytest.mark.timeout(1800)   # two real-EEG calibrations with the held-out pair choice (191 s in
-#                              CI, over 300 s beside a second suite)
-def test_two_subjects_get_different_pairs(eegbci_path: str, tmp_path) -> None:
-    """The replay subjects' own calibration (replay_model): S001 (calibrated on runs 4, 6)
-    answers with both hands / both feet, S002 (runs 4, 6, 8, 10), whose both hands / both feet
-    decode worst, with another pair (left / right hand with thresholds allowed below the
-    defaults; since they never go below them imagery / rest, which is no longer chosen
-    automatically)."""
-    import json
-
-    from mindgrasp_experiments.subjects import replay_model
-
-    chosen = {}
-    for subject in (1, 2):
-        model = json.loads(replay_model(f'eegmmidb:{subject}', tmp_path).read_text())
-        chosen[subject] = model['answer_pair']['name']
-        assert model['gate']['verdict'] in ('ready', 'needs_training', 'not_ready')
-        assert set(model['decision_thresholds']) == {'confirm', 'pass', 'affirm', 'cancel'}
-    assert chosen[1] == 'hands_feet' and chosen[2] != 'hands_feet', chosen

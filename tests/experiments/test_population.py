@@ -247,6 +247,22 @@ def test_a_population_of_2_subjects_x_2_trials(population: tuple[Path, dict]) ->
     assert result.returncode == 2 and 'other options (trials)' in result.stderr, result.stderr
 
 
+@pytest.mark.slow
+@pytest.mark.timeout(7200)
+def test_the_two_subjects_get_different_answer_pairs(population: tuple[Path, dict]) -> None:
+    """The replay subjects' own calibration (replay_model, made once by the population run):
+    S001 (calibrated on runs 4, 6) answers with both hands / both feet, S002, whose both hands /
+    both feet decode worst, with another pair (left / right hand)."""
+    chosen = {}
+    for n in (1, 2):
+        [path] = (population[0] / 'models').glob(f'eegmmidb_s00{n}_classifier_*.json')
+        model = json.loads(path.read_text())
+        chosen[n] = model['answer_pair']['name']
+        assert model['gate']['verdict'] in ('ready', 'needs_training', 'not_ready')
+        assert set(model['decision_thresholds']) == {'confirm', 'pass', 'affirm', 'cancel'}
+    assert chosen[1] == 'hands_feet' and chosen[2] != 'hands_feet', chosen
+
+
 def _with_models_of(population: tuple[Path, dict], out: Path) -> Path:
     """``out`` holding the calibrated models of the ``population`` run (found by their digest:
     the same calibration is not made again; what a test checks is how the trials run)."""

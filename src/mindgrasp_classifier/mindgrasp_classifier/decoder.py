@@ -12,11 +12,11 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from pyriemann.geometry.mean import mean_riemann
 
 from mindgrasp_classifier.errors import ClassifierError
 from mindgrasp_classifier.model import DECODER_CLASS_NAMES, SCALE_V_TO_UV, MiModel
 from mindgrasp_classifier.pipelines import certainty as certainty_of
+from mindgrasp_classifier.pipelines import riemann_mean
 from mindgrasp_classifier.preprocessing import (
     CausalBandpass,
     channel_indices,
@@ -242,7 +242,7 @@ class MiDecoder:
 
         ``covs`` shape (n_windows, n_channels, n_channels), from :meth:`MiModel.covariances`.
         """
-        self._set_reference(mean_riemann(np.asarray(covs, dtype=float)))
+        self._set_reference(riemann_mean(covs))
         self._n_ref_updates = len(covs)
 
     # --- streaming -----------------------------------------------------------------------

@@ -192,9 +192,10 @@ class Recentred(ClassifierMixin, BaseEstimator):
     def fit(self, X: np.ndarray, y: np.ndarray) -> Recentred:
         """Fit the reference and the classifier on ``X``, shape (n, c, c)."""
         from pyriemann.geometry.base import invsqrtm
-        from pyriemann.geometry.mean import mean_riemann
 
-        self.white_ = invsqrtm(mean_riemann(X))
+        from mindgrasp_classifier.pipelines import riemann_mean
+
+        self.white_ = invsqrtm(riemann_mean(X))
         self.classifier_ = clone(self.classifier).fit(self.white_ @ X @ self.white_, y)
         self.classes_ = self.classifier_.classes_
         return self

@@ -19,7 +19,6 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from pyriemann.geometry.mean import mean_riemann
 from sklearn.metrics import confusion_matrix, recall_score
 from sklearn.model_selection import LeaveOneGroupOut, StratifiedGroupKFold
 
@@ -37,7 +36,7 @@ from mindgrasp_classifier.decoder import (
 from mindgrasp_classifier.errors import ClassifierError
 from mindgrasp_classifier.model import DECODER_CLASS_NAMES as CLASS_NAMES
 from mindgrasp_classifier.model import MiModel, library_versions
-from mindgrasp_classifier.pipelines import PIPELINES, certainty, make_classifier
+from mindgrasp_classifier.pipelines import PIPELINES, certainty, make_classifier, riemann_mean
 from mindgrasp_classifier.preprocessing import (
     select_channels,
     step_samples,
@@ -311,7 +310,7 @@ def _blank_model(cfg: TrainingConfig, rec: Recording, classes: list[int]) -> MiM
 
 
 def _fit(model: MiModel, covs: np.ndarray, labels: np.ndarray) -> None:
-    model.reference = mean_riemann(covs)
+    model.reference = riemann_mean(covs)
     model.classifier = make_classifier(model.pipeline)
     model.classifier.fit(MiModel.recenter(covs, model.reference), labels)
 
@@ -593,7 +592,7 @@ def evaluate_windows(model: MiModel, recordings: Sequence[Recording], tmin: floa
                             session_step=0.5 if recenter == 'session' else None)
         if len(win.labels) == 0:
             continue
-        ref = mean_riemann(win.session_covs[0]) if recenter == 'session' else None
+        ref = riemann_mean(win.session_covs[0]) if recenter == 'session' else None
         dists.append(decode_windows(model, win.covs, ref))
         labels.append(win.labels)
         trials.append(win.trials + len(trial_labels))
