@@ -60,8 +60,9 @@ def test_node_command_line_is_that_of_ros2_launch() -> None:
     ]))
     (spec,) = p.processes
     cmd = spec.command('/tmp/p.yaml')
-    assert cmd[:3] == [sys.executable, '-m', 'launch_fixtures.ticker']
-    assert cmd[3:] == ['--count', '2', '--ros-args', '-r', '__node:=talker', '-r',
+    # python -m MODULE through mindgrasp_ros.start (a Ctrl-C while it imports is a clean stop)
+    assert cmd[:4] == [sys.executable, '-m', 'mindgrasp_ros.start', 'launch_fixtures.ticker']
+    assert cmd[4:] == ['--count', '2', '--ros-args', '-r', '__node:=talker', '-r',
                        '__ns:=/robot', '--params-file', '/tmp/p.yaml', '--log-level', 'warn',
                        '-r', '/chatter:=/robot/chatter']
     assert spec.fully_qualified_name == '/robot/talker'

@@ -62,7 +62,12 @@ from typing import Any
 
 from mindgrasp_ros import rclpy
 from mindgrasp_ros.params import refuse_undeclared_overrides
-from mindgrasp_ros.process import exit_if_main_program, is_main_program, stop_requested
+from mindgrasp_ros.process import (
+    exit_if_main_program,
+    handle_stop_signals,
+    is_main_program,
+    stop_requested,
+)
 
 __all__ = ['EXIT_FAILED', 'EXIT_OK', 'EXIT_REFUSED', 'NodeFailure', 'declare_duration',
            'end_after', 'end_graph', 'error_text', 'exit_code', 'fail', 'failure_text',
@@ -273,6 +278,9 @@ def run_node(node_class: Callable[[], Any], args: list[str] | None = None, *,
     if stop_requested.is_set() and is_main_program(getattr(node_class, '__module__', '')):
         # Ctrl-C while the program was still importing (mindgrasp_ros.start): a stop, nothing ran
         exit_if_main_program(EXIT_OK, getattr(node_class, '__module__', ''))
+    # before rclpy.init: the real rclpy chains its own handlers to this one, so a Ctrl-C also
+    # sets stop_requested there (see the spin loop below)
+    handle_stop_signals()
     try:
         rclpy.init(args=argv)
     except _argument_errors() as exc:
@@ -305,9 +313,10 @@ def run_node(node_class: Callable[[], Any], args: list[str] | None = None, *,
                 try:
                     executor.spin_once(timeout_sec=_SIGNAL_CHECK_SEC)
                 except RuntimeError:
-                    # real rclpy: a SIGINT shut the context down between the wait and the take
-                    # ('Unable to convert call argument' from take_message): a stop, not a fault
-                    if rclpy.ok():
+                    # real rclpy: a SIGINT shut the context down between the wait and the take,
+                    # or its KeyboardInterrupt was raised inside take_message's conversion, which
+                    # pybind11 turns into 'Unable to convert call argument': a stop, not a fault
+                    if rclpy.ok() and not stop_requested.is_set():
                         raise
                     break
                 _raise_if_stop_requested()

@@ -68,7 +68,7 @@ def handle_stop_signals() -> None:
     if signal.getsignal(signal.SIGINT) in (signal.SIG_IGN, signal.SIG_DFL, None,
                                            signal.default_int_handler, interrupt_unless_importing):
         signal.signal(signal.SIGINT, _interrupt)
-    if signal.getsignal(signal.SIGTERM) in (signal.SIG_DFL, None, interrupt_unless_importing):
+    if signal.getsignal(signal.SIGTERM) in (signal.SIG_DFL, None):
         signal.signal(signal.SIGTERM, _interrupt)
 
 

@@ -8,10 +8,11 @@ initialisation becomes ``ImportError: initialization failed`` (matplotlib's ``ft
 in CI), the node exits 1 and the launch reports a failure although nothing had started.
 
 Here, until the node's own signal handling takes over (:func:`~mindgrasp_ros.process.
-handle_stop_signals`, called by ``rclpy.init``), SIGINT and SIGTERM set
-:data:`~mindgrasp_ros.process.stop_requested`; they raise KeyboardInterrupt only when no import is
-in progress. A node asked to stop before it started then ends with 0 as soon as its imports are
-done (:func:`~mindgrasp_ros.node_main.run_node` checks the flag first), as a stop.
+handle_stop_signals`, called by ``run_node``), SIGINT sets
+:data:`~mindgrasp_ros.process.stop_requested` and raises KeyboardInterrupt only when no import is
+in progress. SIGTERM keeps its default: the launcher's escalation after a SIGINT that was not
+obeyed ends the process. A node asked to stop before it started then ends with 0 as soon as its
+imports are done (:func:`~mindgrasp_ros.node_main.run_node` checks the flag first), as a stop.
 """
 
 from __future__ import annotations
@@ -35,8 +36,8 @@ def main() -> None:
     if len(sys.argv) < 2:
         print('usage: python -m mindgrasp_ros.start MODULE [ARGS...]', file=sys.stderr)
         exit_process(2)
-    for signum in (signal.SIGINT, signal.SIGTERM):
-        signal.signal(signum, interrupt_unless_importing)
+    # SIGINT only: SIGTERM keeps its default (the launcher's escalation ends the process)
+    signal.signal(signal.SIGINT, interrupt_unless_importing)
     module = sys.argv[1]
     del sys.argv[1]    # the module sees its own argv, as under ``python -m MODULE``
     try:
