@@ -135,7 +135,7 @@ class RecorderNode(rclpy.node.Node):
             end_after(self, p.duration)
             self.discover_callback()
         except BaseException:
-            # cut short (Ctrl-C while the graph starts, a bad topic): the bag is closed all the same
+            # cut short (a Ctrl-C while a lock-step graph starts): the bag is closed all the same
             self.recorder.stop()
             raise
 
