@@ -270,14 +270,15 @@ def run_node(node_class: Callable[[], Any], args: list[str] | None = None, *,
             callbacks (parameter services) then run up to ``poll_sec`` late.
     """
     argv = list(args if args is not None else sys.argv)
+    module = getattr(node_class, '__module__', '')
     if _wants_help(argv):
         print(help_text(node_class))
-        exit_if_main_program(EXIT_OK, getattr(node_class, '__module__', ''))
+        exit_if_main_program(EXIT_OK, module)
         return EXIT_OK
     label = getattr(node_class, '__name__', 'node')
-    if stop_requested.is_set() and is_main_program(getattr(node_class, '__module__', '')):
+    if stop_requested.is_set() and is_main_program(module):
         # Ctrl-C while the program was still importing (mindgrasp_ros.start): a stop, nothing ran
-        exit_if_main_program(EXIT_OK, getattr(node_class, '__module__', ''))
+        exit_if_main_program(EXIT_OK, module)
     # before rclpy.init: the real rclpy chains its own handlers to this one, so a Ctrl-C also
     # sets stop_requested there (see the spin loop below)
     handle_stop_signals()
@@ -285,7 +286,7 @@ def run_node(node_class: Callable[[], Any], args: list[str] | None = None, *,
         rclpy.init(args=argv)
     except _argument_errors() as exc:
         print(f'[{label}] ERROR: {exc}', file=sys.stderr, flush=True)
-        exit_if_main_program(EXIT_REFUSED, getattr(node_class, '__module__', ''))
+        exit_if_main_program(EXIT_REFUSED, module)
         return EXIT_REFUSED
     node = executor = None
     try:
@@ -334,7 +335,7 @@ def run_node(node_class: Callable[[], Any], args: list[str] | None = None, *,
         print(f'[{label}] ERROR: {reason}', file=sys.stderr, flush=True)
     # run as a program: end right after the cleanup (the interpreter's teardown of torch/scipy
     # took 2-5 s on a loaded machine; a node must stop within 1 s of SIGINT)
-    exit_if_main_program(code, getattr(node_class, '__module__', ''))
+    exit_if_main_program(code, module)
     return code
 
 

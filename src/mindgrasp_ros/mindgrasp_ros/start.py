@@ -17,6 +17,7 @@ imports are done (:func:`~mindgrasp_ros.node_main.run_node` checks the flag firs
 
 from __future__ import annotations
 
+import contextlib
 import runpy
 import signal
 import sys
@@ -40,10 +41,9 @@ def main() -> None:
     signal.signal(signal.SIGINT, interrupt_unless_importing)
     module = sys.argv[1]
     del sys.argv[1]    # the module sees its own argv, as under ``python -m MODULE``
-    try:
+    # a KeyboardInterrupt here: stopped between two imports of the module, before its main()
+    with contextlib.suppress(KeyboardInterrupt):
         runpy.run_module(module, run_name='__main__', alter_sys=True)
-    except KeyboardInterrupt:   # stopped between two imports of the module, before its main()
-        exit_process(0)
     exit_process(0)
 
 
