@@ -258,6 +258,25 @@ def test_5_to_6_fails_after_the_retries(params: FsmParams) -> None:
     assert all(o.state != State.FINAL_APPROACH for o in outs)
 
 
+def test_a_late_gripper_state_seen_again_is_no_stall_of_the_fingers(params: FsmParams) -> None:
+    """Ticks that see the same gripper state again (the driver's states are late on a loaded
+    machine) are no evidence that the fingers stopped: the closing goes on until states show
+    the fingers stopped, and then the grasp is judged. Judged per tick, the repeated open state
+    read as fingers stalled at 0.3 s and the grasp failed with the hand round the cube."""
+    fsm = _grasp_fsm(params)
+    q = _grasp_pose()
+    late_open = GripperState(opening=1.0, force=0.0, stamp=0.0, contact=False,
+                             fingers_in_contact=0)
+    outs, t = [], 0.0
+    while t < 0.8:
+        outs.append(fsm.tick(inputs(t, q=q, obs=None, gripper=late_open)))
+        t += 0.02
+    assert all(o.state == State.GRASP_OBJECT and o.phase == 'close' for o in outs), \
+        [(o.state, o.phase, o.reason) for o in outs if o.phase != 'close'][:1]
+    outs, _, _ = _drive(fsm, q, HOLDING, 1.2, t0=t)
+    assert any(o.phase == 'lift' for o in outs)
+
+
 def test_slip_after_lift_retries(params: FsmParams) -> None:
     fsm = _grasp_fsm(params)
     q = _grasp_pose()

@@ -121,11 +121,15 @@ def test_realtime_node_serves_the_arm_and_camera_contract(rclpy_ctx, spawn_node)
     rclpy, node = rclpy_ctx, probe.node
     assert spin_until(rclpy, node, lambda: len(probe.joints) > 150 and probe.images
                       and probe.depths and probe.infos and probe.markers, 120), proc.output()
-    # joint states: 6 arm joints at 100 Hz (header stamps 10 ms apart), home pose
+    # joint states: 6 arm joints stamped with the simulated time of a physics step, home pose.
+    # Their spacing is the machine's: 10 ms at 100 Hz on an idle one, wider where a busy one
+    # made the node catch up, which sends only the newest state (benchmarks/live_under_load.py)
     js = probe.joints[-1]
     assert list(js.name) == [f'joint_{i}' for i in range(1, 7)]
-    stamps = np.array([m.header.stamp.sec + m.header.stamp.nanosec * 1e-9 for m in probe.joints])
-    assert np.median(np.diff(stamps)) == pytest.approx(0.01, abs=0.002)
+    stamps = np.array([m.header.stamp.sec * 10**9 + m.header.stamp.nanosec
+                       for m in probe.joints], dtype=np.int64)
+    steps = np.diff(stamps) / (1e9 / 240)
+    assert (steps >= 0.99).all() and np.allclose(steps, np.round(steps), atol=0.01), steps
     np.testing.assert_allclose(probe.q(), [0, 0, 0, np.pi / 2, 1.2, 0], atol=0.003)
     # camera: 128x128 rgb8 + 32FC1 metres + camera_info; the red cube straight ahead
     img, depth, info = probe.images[-1], probe.depths[-1], probe.infos[-1]

@@ -10,18 +10,18 @@ from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import Detection as DetectionMs
 from mindgrasp_ros.interfaces.sensor_msgs.msg import Image, RegionOfInterest
 from mindgrasp_ros.interfaces.std_msgs.msg import Header
 
+from mindgrasp_ros.image_bridge import cv2_to_imgmsg
 from mindgrasp_vision import Detection, VisionError
 from mindgrasp_vision.ros_conversions import (
     depth_from_image,
     detection_to_msg,
-    image_from_rgb,
     rgb_from_image,
 )
 
 
 def test_rgb_round_trip_and_bgr():
     rgb = np.random.default_rng(0).integers(0, 255, (6, 5, 3), dtype=np.uint8)
-    msg = image_from_rgb(Image, rgb, Header(frame_id='camera'))
+    msg = cv2_to_imgmsg(rgb, 'rgb8', Header(frame_id='camera'))
     assert (msg.encoding, msg.step, msg.height, msg.width) == ('rgb8', 15, 6, 5)
     assert np.array_equal(rgb_from_image(msg), rgb)
     bgr = Image(height=6, width=5, encoding='bgr8', step=15,

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from mindgrasp_common.resources import resource_path
-from mindgrasp_vision.ros_conversions import image_from_rgb
+from mindgrasp_ros.image_bridge import cv2_to_imgmsg
 
 pytestmark = pytest.mark.slow
 
@@ -68,7 +68,7 @@ class Camera:
             self.depth.publish(image_cls(
                 header=header, height=dh, width=dw, encoding='32FC1', step=dw * 4,
                 data=np.frombuffer(depth.astype('<f4').tobytes(), np.uint8)))
-        msg = image_from_rgb(image_cls, rgb, header)
+        msg = cv2_to_imgmsg(rgb, 'rgb8', header)
         msg.encoding = encoding
         self.stamps.add((header.stamp.sec, header.stamp.nanosec))
         self.color.publish(msg)

@@ -111,6 +111,7 @@ class GraspPolicy:
         self._gripper = GripperCommand(params.gripper_open_position, 0.0)
         self._last_opening: tuple[float, float] | None = None  # (time, opening)
         self._stall_since: float | None = None
+        self._close_sent = 0.0     # inputs' clock (s) when the close command went out
         self._contact_since: float | None = None   # all fingers touching since (s)
         self._hold_since: float | None = None      # compliant hold commanded since (s)
         self._opening_at_close: float | None = None  # the first opening read while closing
@@ -498,6 +499,8 @@ class GraspPolicy:
         self._contact_since = None
         self._hold_since = None
         self._opening_at_close = None
+        # the inputs' clock when the close command goes out: older gripper states cannot show it
+        self._close_sent = self._input_time[0]
         self._gripper = GripperCommand(self.params.gripper_closed_position,
                                        self.params.shape_value(self.shape, 'close_force'))
 
@@ -557,6 +560,29 @@ class GraspPolicy:
         self._start_line(t, q, target)
         return PolicyStep(self._zeros(), self._gripper, self.phase)
 
+    def _fingers_stalled(self, gripper: GripperState) -> bool:
+        """True once the closing fingers have not moved for 0.2 s.
+
+        Judged on the gripper states' own stamps, one reading per message and only on states
+        stamped after the close command went out: a tick that sees the same (late) message
+        again, or a state from before the command, is no evidence that the fingers stopped.
+        On a loaded machine that mistake ended the closing before the fingers reached the
+        object (a live demo closed on nothing, efforts 0.01 N m, with the hand round the cube)."""
+        p = self.params
+        last = self._last_opening
+        if gripper.stamp < self._close_sent or (last is not None and gripper.stamp <= last[0]):
+            return (last is not None and self._stall_since is not None
+                    and last[0] - self._stall_since >= 0.2)
+        self._last_opening = (gripper.stamp, gripper.opening)
+        if last is None:
+            return False
+        rate = abs(gripper.opening - last[1]) / max(gripper.stamp - last[0], 1e-3)
+        if rate >= p.stall_rate:
+            self._stall_since = None
+            return False
+        self._stall_since = self._stall_since if self._stall_since is not None else gripper.stamp
+        return gripper.stamp - self._stall_since >= 0.2
+
     def grasp_step(self, t: float, q: np.ndarray, gripper: GripperState | None) -> PolicyStep:
         """One tick of the grasp; events ``grasped``, ``retry`` or ``failed``."""
         p = self.params
@@ -568,23 +594,14 @@ class GraspPolicy:
             elapsed = t - self._t0
             stalled = False
             if gripper is not None:
-                rate = 0.0
-                if self._last_opening is not None:
-                    dt = max(t - self._last_opening[0], 1e-3)
-                    rate = abs(gripper.opening - self._last_opening[1]) / dt
-                if self._last_opening is not None and rate < p.stall_rate:
-                    self._stall_since = self._stall_since if self._stall_since is not None else t
-                    stalled = t - self._stall_since >= 0.2
-                else:
-                    self._stall_since = None
-                self._last_opening = (t, gripper.opening)
+                if self._opening_at_close is None:
+                    self._opening_at_close = gripper.opening
+                stalled = self._fingers_stalled(gripper)
                 n = fingers_loaded(gripper, p.finger_contact_effort)
                 if n is None:
                     n = gripper.fingers_in_contact
                 if p.grasp_check == 'width':
                     n = None     # jaws: closing ends when they stall (on the object or shut)
-                if self._opening_at_close is None:
-                    self._opening_at_close = gripper.opening
                 if self._opening_at_close - gripper.opening < p.contact_min_travel:
                     # a load before the fingers closed is not the object's: open fingertips
                     # pressed on the table (a live arm that went a few mm low on a busy machine

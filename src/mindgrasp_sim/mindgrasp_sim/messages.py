@@ -17,6 +17,7 @@ from mindgrasp_ros.interfaces.tf2_msgs.msg import TFMessage
 from mindgrasp_ros.interfaces.visualization_msgs.msg import Marker, MarkerArray
 
 from mindgrasp_common.types import SceneObject
+from mindgrasp_ros.image_bridge import cv2_to_imgmsg
 from mindgrasp_sim.task import TaskEvent
 from mindgrasp_sim.tf_tree import Transform
 
@@ -61,20 +62,12 @@ def pose_stamped(hdr: Header, position: np.ndarray, quat_xyzw: np.ndarray) -> Po
 def image_messages(hdr: Header, rgb: np.ndarray, depth: np.ndarray) -> tuple[Image, Image]:
     """``rgb8`` colour image (rgb uint8 (H, W, 3)) and ``32FC1`` little-endian depth image
     (depth float32 (H, W), metres along the optical axis)."""
-    h, w = depth.shape
-    color = Image(header=hdr, height=h, width=w, encoding='rgb8', is_bigendian=0, step=w * 3,
-                  data=np.ascontiguousarray(rgb, dtype=np.uint8).reshape(-1))
-    depth_msg = Image(header=hdr, height=h, width=w, encoding='32FC1', is_bigendian=0,
-                      step=w * 4, data=np.ascontiguousarray(depth, dtype='<f4')
-                      .view(np.uint8).reshape(-1))
-    return color, depth_msg
+    return cv2_to_imgmsg(rgb, 'rgb8', hdr), cv2_to_imgmsg(depth, '32FC1', hdr)
 
 
 def rgb_image(hdr: Header, rgb: np.ndarray) -> Image:
     """``rgb8`` image of rgb uint8 (H, W, 3)."""
-    h, w = rgb.shape[:2]
-    return Image(header=hdr, height=h, width=w, encoding='rgb8', is_bigendian=0, step=w * 3,
-                 data=np.ascontiguousarray(rgb, dtype=np.uint8).reshape(-1))
+    return cv2_to_imgmsg(rgb, 'rgb8', hdr)
 
 
 def camera_info(hdr: Header, k: np.ndarray, width: int, height: int) -> CameraInfo:

@@ -270,10 +270,18 @@ class SimNode(rclpy.node.Node):
             self._stamp_cache = (self.total_steps, msgs.stamp(ns))
         return self._stamp_cache[1]
 
-    def advance(self, n_steps: int) -> None:
-        """Step the physics ``n_steps`` times, publishing whatever falls due."""
+    def advance(self, n_steps: int, *, newest_only: bool = False) -> None:
+        """Step the physics ``n_steps`` times, publishing whatever falls due.
+
+        ``newest_only`` (a real-time catch-up): joint states and camera frames that fall due
+        before the last step are not sent; the newest of each goes out once the steps are done.
+        A driver sends the arm's state as it is now, not a backlog, and the backlog cost a
+        starved simulator the time it was catching up with (ten joint-state sets for 0.1 s of
+        lag, each waking the controller for a state it could only judge stale)."""
         sim = self.sim
-        for _ in range(int(n_steps)):
+        n_steps = int(n_steps)
+        held = {'js': False, 'cam': False}
+        for i in range(n_steps):
             now = self.sim_now()
             for io in self.robots.values():
                 v = io.gate.current(now)
@@ -285,11 +293,18 @@ class SimNode(rclpy.node.Node):
             sim.step()
             self.total_steps += 1
             k = self.total_steps + 1e-6    # schedules are fractional step counts
+            last = not newest_only or i == n_steps - 1
             if k >= self._next['js']:
                 self._next['js'] += self.js_every
-                self.publish_states()
+                held['js'] = True
             if k >= self._next['cam']:
                 self._next['cam'] += self.cam_every
+                held['cam'] = True
+            if last and held['js']:
+                held['js'] = False
+                self.publish_states()
+            if last and held['cam']:
+                held['cam'] = False
                 self.publish_camera()
             if k >= self._next['scene']:
                 self._next['scene'] += self.scene_every
@@ -341,7 +356,7 @@ class SimNode(rclpy.node.Node):
             due = cap
         n = int(due * self.sim.physics_hz)
         if n > 0:
-            self.advance(n)
+            self.advance(n, newest_only=True)
 
     def fast_iteration(self) -> None:
         """One iteration of fast mode: the physics steps up to the next joint state."""

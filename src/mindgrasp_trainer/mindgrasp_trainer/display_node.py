@@ -54,6 +54,7 @@ from mindgrasp_ros.interfaces.std_msgs.msg import Float64
 
 from mindgrasp_ros import rclpy
 from mindgrasp_ros import topics as tp
+from mindgrasp_ros.image_bridge import cv2_to_imgmsg
 from mindgrasp_ros.node_main import end_after, run_node
 from mindgrasp_ros.node_traits import NodeTraits
 from mindgrasp_ros.params import declare_params, param
@@ -251,8 +252,7 @@ class DisplayNode(rclpy.node.Node):
         image_rate = float(self.params.image_rate)
         if self.params.headless and image_rate > 0 and now - self.last_image >= 1 / image_rate:
             self.last_image = now
-            msg = Image(height=frame.shape[0], width=frame.shape[1], encoding='rgb8',
-                        is_bigendian=0, step=frame.shape[1] * 3, data=frame.reshape(-1))
+            msg = cv2_to_imgmsg(frame, 'rgb8')
             msg.header.stamp = flip.to_msg()
             msg.header.frame_id = 'participant_display'
             self.image_pub.publish(msg)

@@ -20,6 +20,7 @@ from mindgrasp_ros.interfaces.mindgrasp_msgs.msg import MIPrediction, Prompt
 from mindgrasp_ros.interfaces.sensor_msgs.msg import Image
 
 from mindgrasp_ros import rclpy
+from mindgrasp_ros.image_bridge import cv2_to_imgmsg
 from mindgrasp_ros.node_main import run_node
 from mindgrasp_ros.node_traits import NodeTraits
 from mindgrasp_ros.params import declare_params, param
@@ -156,10 +157,7 @@ class GrazNode(rclpy.node.Node):
         prediction = self.prediction if age_ns <= p.prediction_timeout * 1e9 else None
         frame = render_display(self.sequencer.current, prediction, p.display_width,
                                p.display_height, p.feedback, p.max_certainty)
-        msg = Image(
-            height=frame.shape[0], width=frame.shape[1], encoding='rgb8',
-            is_bigendian=0, step=frame.shape[1] * 3, data=frame.reshape(-1),
-        )  # fmt: skip
+        msg = cv2_to_imgmsg(frame, 'rgb8')
         msg.header.stamp = self.get_clock().now().to_msg()
         msg.header.frame_id = 'trainer_display'
         self.display_pub.publish(msg)

@@ -14,7 +14,7 @@ from mindgrasp_ros.topics import COLOR_IMAGE, DEPTH_IMAGE
 from mindgrasp_vision._checks import VisionError
 from mindgrasp_vision.detector import Detection
 
-__all__ = ['depth_from_image', 'detection_to_msg', 'image_from_rgb', 'rgb_from_image']
+__all__ = ['depth_from_image', 'detection_to_msg', 'rgb_from_image']
 
 
 def _rows(msg: object, channels: int, itemsize: int, topic: str) -> np.ndarray:
@@ -63,13 +63,6 @@ def depth_from_image(msg: object, topic: str = DEPTH_IMAGE.name) -> np.ndarray:
     msg_ = (f"The depth image on {topic} has encoding '{msg.encoding}', expected '32FC1' "
             "(metres) or '16UC1' (millimetres); configure the depth camera accordingly.")
     raise VisionError(msg_)
-
-
-def image_from_rgb(image_cls: type, rgb: np.ndarray, header: object) -> object:
-    """An ``rgb8`` sensor_msgs/Image of ``rgb`` (shape (height, width, 3) uint8)."""
-    h, w = rgb.shape[:2]
-    return image_cls(header=header, height=h, width=w, encoding='rgb8', is_bigendian=0,
-                     step=w * 3, data=np.ascontiguousarray(rgb).reshape(-1))
 
 
 def detection_to_msg(detection_cls: type, roi_cls: type, det: Detection) -> object:

@@ -27,6 +27,7 @@ from mindgrasp_ros.interfaces.std_srvs.srv import Trigger
 
 from mindgrasp_common.errors import CommonError
 from mindgrasp_ros import rclpy
+from mindgrasp_ros.image_bridge import cv2_to_imgmsg
 from mindgrasp_ros.node_main import declare_duration, run_node
 from mindgrasp_ros.params import declare_params
 from mindgrasp_ros.topics import (
@@ -44,7 +45,6 @@ from mindgrasp_vision.params import VisionConfig
 from mindgrasp_vision.ros_conversions import (
     depth_from_image,
     detection_to_msg,
-    image_from_rgb,
     rgb_from_image,
 )
 
@@ -225,8 +225,8 @@ class VisionNode(rclpy.node.Node):
                         for d in result.detections])
         self.detections_pub.publish(out)
         if self.params.publish_overlay:
-            self.overlay_pub.publish(image_from_rgb(Image, self.pipeline.overlay(rgb, result),
-                                                    header))
+            self.overlay_pub.publish(cv2_to_imgmsg(self.pipeline.overlay(rgb, result), 'rgb8',
+                                                   header))
         return result
 
     def destroy_node(self) -> None:
