@@ -40,6 +40,9 @@ from mindgrasp_fsm.kinematics import ArmKinematics
 from mindgrasp_fsm.params import FsmParams
 from mindgrasp_fsm.types import CameraModel, GripperCommand, GripperState, VisionFrame
 
+#: closing fingers that have not moved for this long (s) have stopped on the object (or shut)
+FINGER_STALL_TIME = 0.2
+
 
 @dataclass
 class PolicyStep:
@@ -109,9 +112,8 @@ class GraspPolicy:
         self._tilt = 0.0          # rad, the tool's lean towards the base (0: vertical)
         self._refinements = 0
         self._gripper = GripperCommand(params.gripper_open_position, 0.0)
-        self._last_opening: tuple[float, float] | None = None  # (time, opening)
+        self._last_opening: tuple[float, float, float] | None = None  # (t, stamp, opening)
         self._stall_since: float | None = None
-        self._close_sent = 0.0     # inputs' clock (s) when the close command went out
         self._contact_since: float | None = None   # all fingers touching since (s)
         self._hold_since: float | None = None      # compliant hold commanded since (s)
         self._opening_at_close: float | None = None  # the first opening read while closing
@@ -499,8 +501,6 @@ class GraspPolicy:
         self._contact_since = None
         self._hold_since = None
         self._opening_at_close = None
-        # the inputs' clock when the close command goes out: older gripper states cannot show it
-        self._close_sent = self._input_time[0]
         self._gripper = GripperCommand(self.params.gripper_closed_position,
                                        self.params.shape_value(self.shape, 'close_force'))
 
@@ -560,28 +560,28 @@ class GraspPolicy:
         self._start_line(t, q, target)
         return PolicyStep(self._zeros(), self._gripper, self.phase)
 
-    def _fingers_stalled(self, gripper: GripperState) -> bool:
-        """True once the closing fingers have not moved for 0.2 s.
+    def _fingers_stalled(self, t: float, gripper: GripperState) -> bool:
+        """True once the closing fingers have not moved for ``FINGER_STALL_TIME`` (s of the active
+        clock ``t``).
 
-        Judged on the gripper states' own stamps, one reading per message and only on states
-        stamped after the close command went out: a tick that sees the same (late) message
-        again, or a state from before the command, is no evidence that the fingers stopped.
-        On a loaded machine that mistake ended the closing before the fingers reached the
-        object (a live demo closed on nothing, efforts 0.01 N m, with the hand round the cube)."""
-        p = self.params
+        A gripper state already read, and older than half that window, says nothing more about
+        the fingers: the driver is late. On a loaded machine the simulator stalled 0.3 s, the
+        controller read its last open state again and again as fingers that had stopped, and
+        the grasp failed with the hand round the cube (efforts 0.01 N m). A state read again
+        while younger counts as before (lock-step ticks do that between the simulator's
+        states), which keeps lock-step records as they were."""
         last = self._last_opening
-        if gripper.stamp < self._close_sent or (last is not None and gripper.stamp <= last[0]):
-            return (last is not None and self._stall_since is not None
-                    and last[0] - self._stall_since >= 0.2)
-        self._last_opening = (gripper.stamp, gripper.opening)
-        if last is None:
+        if last is not None and gripper.stamp <= last[1] \
+                and self._input_time[0] - gripper.stamp > FINGER_STALL_TIME / 2:
             return False
-        rate = abs(gripper.opening - last[1]) / max(gripper.stamp - last[0], 1e-3)
-        if rate >= p.stall_rate:
-            self._stall_since = None
-            return False
-        self._stall_since = self._stall_since if self._stall_since is not None else gripper.stamp
-        return gripper.stamp - self._stall_since >= 0.2
+        self._last_opening = (t, gripper.stamp, gripper.opening)
+        if last is not None:
+            rate = abs(gripper.opening - last[2]) / max(t - last[0], 1e-3)
+            if rate < self.params.stall_rate:
+                self._stall_since = self._stall_since if self._stall_since is not None else t
+                return t - self._stall_since >= FINGER_STALL_TIME
+        self._stall_since = None
+        return False
 
     def grasp_step(self, t: float, q: np.ndarray, gripper: GripperState | None) -> PolicyStep:
         """One tick of the grasp; events ``grasped``, ``retry`` or ``failed``."""
@@ -596,7 +596,7 @@ class GraspPolicy:
             if gripper is not None:
                 if self._opening_at_close is None:
                     self._opening_at_close = gripper.opening
-                stalled = self._fingers_stalled(gripper)
+                stalled = self._fingers_stalled(t, gripper)
                 n = fingers_loaded(gripper, p.finger_contact_effort)
                 if n is None:
                     n = gripper.fingers_in_contact

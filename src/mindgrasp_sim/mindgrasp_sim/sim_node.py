@@ -112,6 +112,8 @@ from mindgrasp_sim.tf_tree import TfTree, Transform
 #: realtime: a lag skipped beyond this (s) is a stall and is warned (a smaller one, beyond
 #: ``max_catch_up``, is a busy machine: the status' real_time_factor shows it)
 STALL_WARNING = 0.25
+#: realtime: a callback this many joint-state periods behind is a catch-up (newest state only)
+CATCH_UP_PERIODS = 5
 
 
 @dataclass
@@ -356,7 +358,11 @@ class SimNode(rclpy.node.Node):
             due = cap
         n = int(due * self.sim.physics_hz)
         if n > 0:
-            self.advance(n, newest_only=True)
+            # a catch-up (more than five joint-state periods behind) sends only its newest
+            # state; a punctual callback publishes each state at its own step, as a lock-step
+            # host's (one 20 ms control period a step) always does
+            catch_up = due > CATCH_UP_PERIODS / float(self.params.joint_state_rate)
+            self.advance(n, newest_only=catch_up)
 
     def fast_iteration(self) -> None:
         """One iteration of fast mode: the physics steps up to the next joint state."""
