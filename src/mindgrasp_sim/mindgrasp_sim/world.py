@@ -18,6 +18,7 @@ from mindgrasp_sim.pybullet_quiet import BulletClient, pb
 from mindgrasp_sim.realism import Realism
 from mindgrasp_sim.scene import ObjectSpec, SceneSpec, load_scene
 
+#: colours (rgba, 0..1) of the ground and of the training robot (green, semi-transparent)
 GROUND_RGBA = (0.78, 0.77, 0.74, 1.0)
 TRAINER_RGBA = (0.1, 0.85, 0.1, 0.35)
 
