@@ -50,7 +50,8 @@ def grasp_figures(trials: int, seed: int) -> None:
 
 
 def vision_figures(frames: int = 50) -> None:
-    from mindgrasp_sim.simulation import CameraConfig, Simulation
+    from mindgrasp_sim.camera import CameraConfig
+    from mindgrasp_sim.simulation import Simulation
     from mindgrasp_vision.params import VisionConfig
 
     cfg = VisionConfig()

@@ -25,7 +25,8 @@ import time
 
 import numpy as np
 
-from mindgrasp_sim.simulation import CameraConfig, Simulation
+from mindgrasp_sim.camera import CameraConfig
+from mindgrasp_sim.simulation import Simulation
 
 SETTINGS = ((128, 128, 10.0), (640, 480, 30.0))
 

@@ -27,7 +27,8 @@ from mindgrasp_vision.shape_cnn import ShapeClassifier, preprocess_depth
 
 
 def _frames(width: int, height: int) -> tuple[list[tuple[np.ndarray, np.ndarray]], np.ndarray]:
-    from mindgrasp_sim.simulation import CameraConfig, Simulation
+    from mindgrasp_sim.camera import CameraConfig
+    from mindgrasp_sim.simulation import Simulation
     from mindgrasp_vision.dataset import CameraPlacer
 
     sim = Simulation(scene='set_locations', seed=0, camera=CameraConfig(width=width,

@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from mindgrasp_sim.simulation import CameraConfig, Simulation
+from mindgrasp_sim.camera import CameraConfig
+from mindgrasp_sim.simulation import Simulation
 
 
 @pytest.fixture

@@ -19,9 +19,10 @@ from mindgrasp_common.robot_description import (
     hand_names,
     load_robot,
 )
+from mindgrasp_sim.camera import CameraConfig
 from mindgrasp_sim.pybullet_quiet import pb
 from mindgrasp_sim.robot_model import FILES
-from mindgrasp_sim.simulation import CameraConfig, Simulation
+from mindgrasp_sim.simulation import Simulation
 
 #: the single URDFs the shipped pairs were cut from
 ORIGINALS = {

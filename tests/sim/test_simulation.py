@@ -10,9 +10,10 @@ import pytest
 from sim_helpers import colour_mask
 
 from mindgrasp_common.resources import resource_path
+from mindgrasp_sim.camera import CameraConfig
 from mindgrasp_sim.errors import SimError
 from mindgrasp_sim.robot_model import ArmSpec, build_urdf
-from mindgrasp_sim.simulation import CameraConfig, Simulation, top_down_quat
+from mindgrasp_sim.simulation import Simulation, top_down_quat
 
 
 def _rot(axis: str, a: float) -> np.ndarray:

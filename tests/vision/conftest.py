@@ -11,7 +11,8 @@ from mindgrasp_vision.detector import CameraModel, ColourDetector
 @pytest.fixture(scope='session')
 def sim():
     """One 128x128 headless simulation shared by the vision tests (scenes are reloaded)."""
-    from mindgrasp_sim.simulation import CameraConfig, Simulation
+    from mindgrasp_sim.camera import CameraConfig
+    from mindgrasp_sim.simulation import Simulation
 
     s = Simulation(scene={'name': 'vision_test', 'objects': [
         {'shape': 'cube', 'colour': 'red', 'position': [0.5, 0.0]}]}, seed=0,

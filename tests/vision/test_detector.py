@@ -144,7 +144,8 @@ def test_bad_parameters():
 
 
 def test_640x480_frame_gives_the_same_objects():
-    from mindgrasp_sim.simulation import CameraConfig, Simulation
+    from mindgrasp_sim.camera import CameraConfig
+    from mindgrasp_sim.simulation import Simulation
 
     with Simulation(scene='set_locations', seed=0,
                     camera=CameraConfig(width=640, height=480)) as big:

@@ -101,11 +101,12 @@ from mindgrasp_ros.topics import (
     TRAINER_ROBOT,
 )
 from mindgrasp_sim import messages as msgs
+from mindgrasp_sim.camera import CameraConfig
 from mindgrasp_sim.command_inputs import ArmCommandInputs
 from mindgrasp_sim.control import CommandBursts, CommandGate, gripper_closure, validate_velocities
 from mindgrasp_sim.errors import SimError
 from mindgrasp_sim.params import SimParams
-from mindgrasp_sim.simulation import CameraConfig, Simulation
+from mindgrasp_sim.simulation import Simulation
 from mindgrasp_sim.task import TaskMonitor
 from mindgrasp_sim.tf_tree import TfTree, Transform
 

@@ -206,7 +206,8 @@ def collect_shape_dataset(n_images: int, seed: int = 0, config: DatasetConfig = 
     depth_filter : DepthFilter | None
         Depth clean-up before detection (default: the vision pipeline's, a 3 px median).
     """
-    from mindgrasp_sim.simulation import CameraConfig, Simulation
+    from mindgrasp_sim.camera import CameraConfig
+    from mindgrasp_sim.simulation import Simulation
 
     if n_images < 1:
         msg = f'n_images must be >= 1, got {n_images}; the paper used about 500.'
