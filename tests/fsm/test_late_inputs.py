@@ -11,8 +11,9 @@ import time
 import numpy as np
 import pytest
 
-from mindgrasp_fsm.grasp_fsm import SENSOR_FAULT, GraspFsm
+from mindgrasp_fsm.grasp_fsm import GraspFsm
 from mindgrasp_fsm.params import FsmParams
+from mindgrasp_fsm.supervisor import SENSOR_FAULT
 from mindgrasp_fsm.types import JointStateIn, MiClass, StopKind
 
 from .conftest import HOME, inputs
@@ -183,22 +184,22 @@ def test_a_tick_after_a_stall_of_the_controller_holds_and_judges_its_inputs_next
             joint_state()
             node.timer_callback()
             time.sleep(0.02)
-        assert node.fsm._fault_why == ''
+        assert node.fsm.supervisor.fault == ''
         ticks, stalls = node.ticks, node.own_stalls
         time.sleep(2 * node.params.watchdog_timeout)     # this process stalls
         node.timer_callback()                   # first callback after it: the states are queued
         assert (node.ticks, node.own_stalls) == (ticks, stalls + 1)
-        assert node.fsm._fault_why == ''
+        assert node.fsm.supervisor.fault == ''
         deadline = time.monotonic() + 30
         while node.ticks == ticks and time.monotonic() < deadline:
             joint_state()                       # the queued (fresh) states, then a tick
             node.timer_callback()
             time.sleep(0.02)
-        assert node.ticks > ticks and node.fsm._fault_why == ''
+        assert node.ticks > ticks and node.fsm.supervisor.fault == ''
         deadline = time.monotonic() + 30
-        while not node.fsm._fault_why and time.monotonic() < deadline:
+        while not node.fsm.supervisor.fault and time.monotonic() < deadline:
             node.timer_callback()               # the timer ticks on, no state arrives
             time.sleep(0.02)
-        assert node.fsm._fault_why.startswith('joint states are'), 'a silent driver latches'
+        assert node.fsm.supervisor.fault.startswith('joint states are'), 'a silent driver latches'
     finally:
         node.destroy_node()

@@ -10,9 +10,10 @@ from mindgrasp_common.mi import REST
 from mindgrasp_fsm.errors import FsmError
 from mindgrasp_fsm.params import FsmParams
 
-__all__ = ['evidence_side', 'evidence_word', 'readiness_problem', 'resolve_answer']
+__all__ = ['CLASS_WORDS', 'evidence_side', 'evidence_word', 'readiness_problem', 'resolve_answer']
 
-_CLASS_WORDS = {0: 'left hand', 1: 'right hand', 2: 'both hands', 3: 'both feet', REST: 'rest'}
+#: the decoder's classes in words (events and messages)
+CLASS_WORDS = {0: 'left hand', 1: 'right hand', 2: 'both hands', 3: 'both feet', REST: 'rest'}
 
 
 def evidence_side(classes: tuple[int, ...]) -> int | list[int]:
@@ -22,7 +23,7 @@ def evidence_side(classes: tuple[int, ...]) -> int | list[int]:
 
 def evidence_word(classes: tuple[int, ...]) -> str:
     """'both-hands', 'rest', 'imagery' ...: what the evidence of one side of the pair is for."""
-    return _CLASS_WORDS[classes[0]].replace(' ', '-') if len(classes) == 1 else 'imagery'
+    return CLASS_WORDS[classes[0]].replace(' ', '-') if len(classes) == 1 else 'imagery'
 
 
 def readiness_problem(params: FsmParams) -> str | None:

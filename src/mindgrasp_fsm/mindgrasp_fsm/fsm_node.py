@@ -38,8 +38,9 @@ from mindgrasp_fsm.answer import readiness_problem
 from mindgrasp_fsm.arm_output import ArmCommandOutput
 from mindgrasp_fsm.conversions import gripper_from_fingers, vision_frame_from_msg
 from mindgrasp_fsm.errors import FsmError
-from mindgrasp_fsm.grasp_fsm import SENSOR_FAULT, GraspFsm
+from mindgrasp_fsm.grasp_fsm import GraspFsm
 from mindgrasp_fsm.params import FsmParams
+from mindgrasp_fsm.supervisor import SENSOR_FAULT
 from mindgrasp_fsm.types import (
     STATE_NAMES,
     CameraModel,

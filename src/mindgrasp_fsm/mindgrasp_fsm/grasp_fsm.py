@@ -34,7 +34,8 @@ A sensor fault (joint states stale, with NaN/inf, or refused by the node for wro
 sizes, ``FsmInputs.joint_fault``) latches the stop: the arm holds until the joint states have been
 clean for ``sensor_clean_time`` and then, as after a prediction loss, until a fresh decision. The
 output's events say when the latch starts and when it is released (both start with
-:data:`SENSOR_FAULT`).
+:data:`~mindgrasp_fsm.supervisor.SENSOR_FAULT`); :class:`~mindgrasp_fsm.supervisor.SafetySupervisor`
+judges all of this at every tick.
 
 Two BCI paradigms (``paradigm``). ``paper``: the person steers with four classes as in the
 paper (left/right hand turn, both hands select and approach, both feet back off). ``scan``
@@ -66,14 +67,15 @@ import numpy as np
 
 from mindgrasp_common.mi import REST
 from mindgrasp_fsm.acceleration import AccelerationLimiter
+from mindgrasp_fsm.answer import CLASS_WORDS, resolve_answer
 from mindgrasp_fsm.answer import evidence_side as _side
 from mindgrasp_fsm.answer import evidence_word as _word
-from mindgrasp_fsm.answer import resolve_answer
 from mindgrasp_fsm.errors import FsmError
 from mindgrasp_fsm.evidence import Evidence
 from mindgrasp_fsm.grasp_policy import GraspPolicy, PolicyStep, fingers_loaded
 from mindgrasp_fsm.kinematics import ArmKinematics
 from mindgrasp_fsm.params import FsmParams
+from mindgrasp_fsm.supervisor import SafetySupervisor
 from mindgrasp_fsm.types import (
     FsmInputs,
     FsmOutput,
@@ -84,12 +86,6 @@ from mindgrasp_fsm.types import (
     StopKind,
     VisionFrame,
 )
-
-#: how the events of a sensor-fault latch begin (the node logs them as warnings)
-SENSOR_FAULT = 'sensor fault'
-#: the inputs whose age the watchdog judges (names in its messages)
-_INPUT_STREAMS = ('joint states', 'MI predictions', 'camera images')
-_CLASS_WORDS = {0: 'left hand', 1: 'right hand', 2: 'both hands', 3: 'both feet', REST: 'rest'}
 
 
 def clamp_to_limits(q: np.ndarray, v: np.ndarray, params: FsmParams) -> np.ndarray:
@@ -207,21 +203,8 @@ class GraspFsm:
         self._ignore_angle = self.params.search_ignore_angle
         self._gave_up_at = -math.inf
         self._both_since: float | None = None   # since when both-hands is decoded without break
-        # after a prediction loss: the stamp of the first fresh prediction (None: no loss
-        # pending), and the class held since which stamp
-        self._stale_pred = False
-        self._back_at: float | None = None
-        self._fresh: tuple[int, float] | None = None
-        self._loss = 'prediction loss'
-        # start-up: an input "streams" once it was fresh for sensor_clean_time without a break,
-        # or once the arm moved; before that an old message is a sender still starting up (the
-        # nodes come up in any order, a loaded machine delays the first messages): the arm
-        # waits for it, no fault latches (name -> fresh since, s)
-        self._fresh_since: dict[str, float] = {}
-        self._streaming: set[str] = set()
-        # sensor-fault latch: time (s) of the latest joint-state fault seen (None: not latched)
-        self._fault_at: float | None = None
-        self._fault_why = ''
+        #: what may move at each tick: input ages, start-up, sensor latch, fresh decisions
+        self.supervisor = SafetySupervisor(self.params, self.n_joints)
         self._dt = 0.0
         self._limiter = AccelerationLimiter(self.n_joints)
         self._return_lift: bool | None = None
@@ -322,7 +305,7 @@ class GraspFsm:
         self.policy.sent(self._now, v)     # where the commands put the arm (grasp policy)
         if v.any():
             # the arm moves: from now on an old input is a fault (latched), never a late start
-            self._streaming.update(_INPUT_STREAMS)
+            self.supervisor.arm_moved()
         return FsmOutput(
             joint_velocities=v, gripper=self._gripper, state=self.state,
             previous_state=self.previous_state, locked=self._lock_until is not None,
@@ -364,9 +347,8 @@ class GraspFsm:
         self._dt = p.control_period if first else min(dt, p.control_period)
 
         # --- watchdog: nothing moves on stale or broken inputs -------------------------------
-        kind, why = self._watchdog(inputs, now)
-        if not why:
-            kind, why = StopKind.FAULT, self._await_fresh_decision(inputs)
+        kind, why = self.supervisor.check(inputs, now)
+        self._events += self.supervisor.take_events()
         if why:
             return self._stop(kind, why)    # the active clock does not advance while stopped
         self._clock += dt
@@ -415,155 +397,6 @@ class GraspFsm:
         if self._lock_until is not None:   # a transition asked for a lock: stop this tick
             v = np.zeros(self.n_joints)
         return self._output(clamp_to_limits(q, v, p), phase=phase)
-
-    def _watchdog(self, inputs: FsmInputs, now: float) -> tuple[StopKind, str]:
-        """Why nothing may move at ``now`` (s), and what kind of stop that is; '' when all
-        inputs are fresh."""
-        p = self.params
-        if inputs.joints is None:
-            return StopKind.AWAITING_INPUT, 'stopped: no joint states received yet'
-        age = now - inputs.joints.stamp
-        refused = inputs.joint_fault is not None and \
-            now - inputs.joint_fault[0] < p.sensor_clean_time
-        if self._starting_up('joint states', age, p.watchdog_timeout, now) and \
-                self._fault_at is None and not refused:
-            return StopKind.AWAITING_INPUT, (f'stopped: waiting for the joint states to stream '
-                                             f'(the latest is {age:.2f} s old, limit '
-                                             f'{p.watchdog_timeout:.2f} s)')
-        why = self._sensor_latch(inputs, now)
-        if why:
-            return StopKind.FAULT, why
-        if not p.autonomous:
-            pred = inputs.prediction
-            if pred is None:
-                return StopKind.AWAITING_INPUT, 'stopped: no MI prediction received yet'
-            age = now - pred.stamp
-            if self._starting_up('MI predictions', age, p.watchdog_timeout, now):
-                return StopKind.AWAITING_INPUT, (f'stopped: waiting for the MI predictions to '
-                                                 f'stream (the latest is {age:.2f} s old, limit '
-                                                 f'{p.watchdog_timeout:.2f} s)')
-            if age > p.watchdog_timeout:
-                self._stale_pred = True
-                self._back_at = self._fresh = None
-                self._loss = 'prediction loss'
-                return StopKind.FAULT, (
-                    f'stopped: the latest MI prediction is {age:.2f} s old (limit '
-                    f'{p.watchdog_timeout:.2f} s); check the classifier and EEG stream')
-        if inputs.vision is None:
-            return (StopKind.AWAITING_INPUT,
-                    'stopped: no camera images received yet; holding still')
-        age = now - inputs.vision.stamp
-        if self._starting_up('camera images', age, p.camera_timeout, now):
-            return StopKind.AWAITING_INPUT, (f'stopped: waiting for the camera images to stream '
-                                             f'(the latest is {age:.2f} s old, limit '
-                                             f'{p.camera_timeout:.2f} s); holding still')
-        if age > p.camera_timeout:
-            return StopKind.FAULT, (f'stopped: no camera images for {age:.2f} s (limit '
-                                    f'{p.camera_timeout:.2f} s); holding still')
-        return StopKind.NONE, ''
-
-    def _starting_up(self, name: str, age: float, limit: float, now: float) -> bool:
-        """True while input ``name``, whose latest message is ``age`` s old at ``now`` (s), is
-        older than ``limit`` s but has not streamed yet: its sender is still starting up, and the
-        arm (which has not moved) waits for it instead of latching a fault.
-
-        An input streams once it was no older than ``limit`` for ``sensor_clean_time`` s
-        without a break, or once the arm moved; after that an old message is a fault."""
-        if name in self._streaming:
-            return False
-        if age > limit:
-            self._fresh_since.pop(name, None)
-            return True
-        since = self._fresh_since.setdefault(name, now)
-        if now - since >= self.params.sensor_clean_time:
-            self._streaming.add(name)
-        return False
-
-    def _joint_fault(self, inputs: FsmInputs, now: float) -> str:
-        """What is wrong with the joint states at ``now`` (s), '' when nothing."""
-        p = self.params
-        joints = inputs.joints
-        assert joints is not None
-        age = now - joints.stamp
-        if age > p.watchdog_timeout:
-            return (f'joint states are {age:.2f} s old (limit {p.watchdog_timeout:.2f} s); '
-                    'check the arm driver')
-        pos = np.asarray(joints.position, dtype=float)
-        if pos.shape != (self.n_joints,):
-            return f'joint states hold {pos.size} positions, {self.n_joints} expected'
-        if not np.isfinite(pos).all() or not np.isfinite(np.asarray(joints.velocity)).all():
-            return 'joint states contain NaN or infinite values; check the arm driver'
-        return ''
-
-    def _sensor_latch(self, inputs: FsmInputs, now: float) -> str:
-        """'' when the joint states may be used, else why the arm holds (a latched stop).
-
-        A fault now, or a faulty message received since the last one seen, (re)starts the
-        latch; it is released once nothing was wrong for ``sensor_clean_time`` s, and the arm
-        then waits for a fresh decision, by the mechanism of a prediction loss.
-        """
-        p = self.params
-        why = self._joint_fault(inputs, now)
-        fault_at = now if why else None
-        received = inputs.joint_fault
-        if received is not None and (self._fault_at is None or received[0] > self._fault_at) \
-                and now - received[0] < p.sensor_clean_time:
-            fault_at, why = (fault_at or received[0]), why or received[1]
-        if fault_at is not None:
-            if self._fault_at is None:
-                self._events.append(f'{SENSOR_FAULT}: {why}; the arm holds until the joint states'
-                                    f' are clean for {p.sensor_clean_time:.1f} s and a new '
-                                    'command is given')
-            self._fault_at, self._fault_why = fault_at, why
-        if self._fault_at is None:
-            return ''
-        clean = now - self._fault_at
-        if clean < p.sensor_clean_time:
-            return (f'stopped: {SENSOR_FAULT} ({self._fault_why}); clean for {clean:.2f} of '
-                    f'{p.sensor_clean_time:.2f} s, then a new command restarts the arm')
-        self._fault_at = None
-        self._events.append(f'{SENSOR_FAULT} released: joint states clean for {clean:.2f} s'
-                            + ('' if p.autonomous else '; waiting for a new command'))
-        # the person restarts the arm as after a prediction loss, with decisions stamped after
-        # the release only
-        self._stale_pred = True
-        self._back_at, self._fresh = now, None
-        self._loss = SENSOR_FAULT
-        return ''
-
-    def _await_fresh_decision(self, inputs: FsmInputs) -> str:
-        """'' once the controller may move after a prediction loss, else why it holds still.
-
-        A fresh decision: every prediction stamped from the first fresh one after the loss on
-        decodes the same class for ``resume_hold`` s. A prediction of another class starts the
-        count again.
-        """
-        p = self.params
-        if not self._stale_pred or p.autonomous:
-            return ''
-        if p.resume_after_stale == 'resume':
-            self._stale_pred = False
-            return ''
-        pred = inputs.prediction
-        assert pred is not None            # the watchdog passed: fresh predictions arrive
-        if self._back_at is None:
-            self._back_at = pred.stamp
-        if pred.class_index == REST:
-            self._fresh = None           # rest is no command: it cannot restart the arm
-        elif pred.stamp >= self._back_at and (self._fresh is None or
-                                              self._fresh[0] != pred.class_index):
-            self._fresh = (pred.class_index, pred.stamp)
-        held = pred.stamp - self._fresh[1] if self._fresh is not None else 0.0
-        if held >= p.resume_hold:
-            self._stale_pred = False
-            self._back_at = self._fresh = None
-            self._events.append(f'fresh decision after the {self._loss}: '
-                                f'{_CLASS_WORDS.get(pred.class_index, pred.class_index)}')
-            return ''
-        back = ('the joint states are clean again after a fault' if self._loss == SENSOR_FAULT
-                else 'the MI predictions are back after a loss')
-        return (f'stopped: {back}; waiting for a new command '
-                f'(one class for {p.resume_hold:.1f} s, resume_after_stale)')
 
     def _observe(self, vision: VisionFrame | None, t: float) -> None:
         ooi = vision.object_of_interest if vision is not None else None
@@ -667,7 +500,7 @@ class GraspFsm:
                 self._goto(State.CENTER_OBJECT, f'both-hands MI selected the {ooi.label}')
                 return v, 'selected'
             return v, 'both hands but no object in view'
-        return v, _CLASS_WORDS.get(cls, 'no class')
+        return v, CLASS_WORDS.get(cls, 'no class')
 
     def _sweep_step(self, q: np.ndarray) -> np.ndarray:
         """Autonomous search: turn left; at a joint-1 limit change the camera tilt, turn back."""
