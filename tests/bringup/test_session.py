@@ -13,7 +13,7 @@ from pathlib import Path
 import pytest
 import yaml
 
-from mindgrasp_bringup.session import SessionError, check_subject, load_plan
+from mindgrasp_bringup.session_plan import SessionError, check_subject, load_plan
 from mindgrasp_common.robot_description import robot_names
 
 
@@ -223,7 +223,7 @@ def test_calibrate_runs_in_lockstep_end_to_end(tmp_path):
 
 
 def test_calibration_plan_sets_trials_per_class_and_adds_a_heldout_run():
-    from mindgrasp_bringup.session import calibration_plan
+    from mindgrasp_bringup.session_plan import calibration_plan
 
     plan = calibration_plan(load_plan('quick'), trials_per_class=5, virtual_accuracy=0.9)
     # quick prompts two classes; its test-free phases keep their order, the held-out run last

@@ -88,7 +88,7 @@ class FittedSubject:
     def digest(self) -> str:
         """SHA-256 (hex) of what the calibrated model depends on: the head, the calibration
         settings, the plan file and :data:`FITTED_TAG`."""
-        from mindgrasp_bringup.session import PLAN_DIR
+        from mindgrasp_bringup.session_plan import PLAN_DIR
 
         plan = (PLAN_DIR / f'{PLAN}.yaml').read_text(encoding='utf-8')
         text = json.dumps({'head': self.head, 'calibration': self.calibration, 'plan': plan,
@@ -200,12 +200,8 @@ def fitted_model(subject: FittedSubject, cache: Path | None = None,
     and scores on the second. The model's provenance gets the head, the settings, the digest
     and the held-out accuracy; it is written to ``cache`` under the digest.
     """
-    from mindgrasp_bringup.session import (
-        Session,
-        SessionError,
-        calibration_plan,
-        load_plan,
-    )
+    from mindgrasp_bringup.session import Session
+    from mindgrasp_bringup.session_plan import SessionError, calibration_plan, load_plan
     from mindgrasp_classifier.errors import ClassifierError
     from mindgrasp_classifier.model import MiModel
 

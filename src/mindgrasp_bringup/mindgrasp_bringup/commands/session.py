@@ -18,8 +18,8 @@ import sys
 import time
 from pathlib import Path
 
-from mindgrasp_bringup.session import (
-    Session,
+from mindgrasp_bringup.session import Session
+from mindgrasp_bringup.session_plan import (
     SessionError,
     calibration_plan,
     check_subject,
