@@ -22,6 +22,8 @@ What it changes in Kinova's expanded URDF, and why:
 - PyBullet reads no COLLADA: each mesh (Kinova's STL export of the same geometry) is decimated to
   at most FACES triangles and written as binary STL, used for the visual and the collision shape
   (PyBullet collides with a mesh's convex hull, which the decimation keeps);
+- the carbon fibre is coloured black-grey, as the arm is (Kinova's pale blue reads as a blue
+  object to the colour detector);
 - the ``world``/``root`` links, ROS-control transmissions and Gazebo plugins are left out.
 """
 
@@ -52,6 +54,10 @@ def main(expanded: str, kinova: str, out: str) -> None:
     src, kinova_dir, out_dir = Path(expanded), Path(kinova), Path(out)
     licence = (kinova_dir / 'LICENSE').read_text(encoding='utf-8')
     root = ET.parse(str(src)).getroot()
+    for colour in root.iter('color'):
+        # Kinova's carbon fibre is black; the URDF's pale blue reads as a blue object to the
+        # colour detector when the fingers enter the wrist camera's view
+        colour.set('rgba', '0.2 0.2 0.22 1')
     for tag in ('transmission', 'gazebo'):
         for e in root.findall(tag):
             root.remove(e)
