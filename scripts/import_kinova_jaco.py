@@ -24,6 +24,7 @@ What it changes in Kinova's expanded URDF, and why:
   (PyBullet collides with a mesh's convex hull, which the decimation keeps);
 - the carbon fibre is coloured black-grey, as the arm is (Kinova's pale blue reads as a blue
   object to the colour detector);
+- the finger links weigh 80 g instead of 10 g (see FINGER_MASS);
 - the ``world``/``root`` links, ROS-control transmissions and Gazebo plugins are left out.
 """
 
@@ -38,6 +39,7 @@ from pathlib import Path
 import trimesh
 
 FACES = 1500
+FINGER_MASS = 0.08    # kg
 PREFIX = 'j2n6s300_'
 HAND = PREFIX + 'link_hand'
 SOURCE = 'Kinovarobotics/kinova-ros kinova_description/urdf/j2n6s300_standalone.xacro'
@@ -87,6 +89,16 @@ def main(expanded: str, kinova: str, out: str) -> None:
         if j.find('parent').get('link') == PREFIX + 'link_6':
             j.find('parent').set('link', HAND)
     hand_links = {HAND} | {n for n in links if 'finger' in n}
+    for name in hand_links - {HAND}:
+        # Kinova gives each finger link 10 g and 1e-7 kg m2: PyBullet's finger motors then
+        # stall on an object at 0.1 N m and the grasp check feels nothing; 80 g (inertia scaled
+        # alike) lets them squeeze with their 2 N m as the real fingers do
+        inertial = links[name].find('inertial')
+        scale = FINGER_MASS / float(inertial.find('mass').get('value'))
+        inertial.find('mass').set('value', repr(FINGER_MASS))
+        inertia = inertial.find('inertia')
+        for key, value in inertia.attrib.items():
+            inertia.set(key, repr(float(value) * scale))
     arm = ET.Element('robot', name='kinova_jaco')
     hand_robot = ET.Element('robot', name='jaco_three_finger')
     for e in root:
