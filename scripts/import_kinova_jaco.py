@@ -14,9 +14,10 @@ config/robots/meshes/jaco_three_finger/), so neither xacro nor trimesh is a runt
 What it changes in Kinova's expanded URDF, and why:
 
 - the hand (``hand_3finger`` with the ring of joint 6, and the six finger links) moves from
-  ``j2n6s300_link_6`` onto its own link ``j2n6s300_link_hand``, so the arm ends in an empty
-  flange link (which the loader replaces by any hand's root); Kinova's ``end_effector`` frame
-  becomes the hand description's TCP;
+  ``j2n6s300_link_6`` onto its own link ``j2n6s300_link_hand``, link 6 turned by pi about x
+  (z out of the hand, as other hands' roots), so the arm ends in an empty flange link (which
+  the loader replaces by any hand's root, turned back by the flange's rpy); Kinova's
+  ``end_effector`` frame becomes the hand description's TCP;
 - joints 1, 4, 5 and 6 are ``continuous``; MIndGrasp's controller needs position limits, so they
   become revolute within the xacro's own limits (+-2 pi);
 - PyBullet reads no COLLADA: each mesh (Kinova's STL export of the same geometry) is decimated to
@@ -36,7 +37,9 @@ import sys
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
+import numpy as np
 import trimesh
+from scipy.spatial.transform import Rotation
 
 FACES = 1500
 FINGER_MASS = 0.08    # kg
@@ -50,6 +53,22 @@ def _header(licence: str, what: str) -> str:
             'xacro 2.1.1 and scripts/import_kinova_jaco.py (see its docstring); do not edit.\n'
             'Copyright (c) 2017, Kinova Robotics inc. Licence of the description and meshes '
             '(BSD-3-Clause):\n\n' + licence.replace('--', '- -') + '-->\n')
+
+
+def _flip(element: ET.Element) -> None:
+    """Express the ``<origin>`` of ``element`` (a link's visual, collision or inertial, or a
+    joint) in its frame turned by pi about x."""
+    origin = element.find('origin')
+    if origin is None:
+        origin = ET.SubElement(element, 'origin')
+        element.remove(origin)
+        element.insert(0, origin)
+    xyz = np.array([float(v) for v in origin.get('xyz', '0 0 0').split()])
+    rpy = [float(v) for v in origin.get('rpy', '0 0 0').split()]
+    flip = Rotation.from_euler('x', math.pi)
+    rot = flip * Rotation.from_euler('xyz', rpy)
+    origin.set('xyz', ' '.join(f'{v:.6g}' for v in np.round(flip.apply(xyz), 9) + 0.0))
+    origin.set('rpy', ' '.join(f'{v:.10g}' for v in rot.as_euler('xyz')))
 
 
 def main(expanded: str, kinova: str, out: str) -> None:
@@ -75,19 +94,19 @@ def main(expanded: str, kinova: str, out: str) -> None:
             lim = j.find('limit')
             lim.set('lower', repr(-2 * math.pi))
             lim.set('upper', repr(2 * math.pi))
-    # the hand on its own link, fixed to the (now empty) link 6 without offset
+    # the hand on its own link, link 6 turned by pi about x: its z out of the hand, as every
+    # hand's root (Kinova's link 6 has z pointing back into the wrist), so that the hand fits
+    # any arm's flange; what hung from link 6 is turned with it
     link6 = links[PREFIX + 'link_6']
     hand = ET.Element('link', name=HAND)
     for child in list(link6):
         link6.remove(child)
+        _flip(child)
         hand.append(child)
-    fixed = ET.Element('joint', name=PREFIX + 'joint_hand', type='fixed')
-    ET.SubElement(fixed, 'parent', link=PREFIX + 'link_6')
-    ET.SubElement(fixed, 'child', link=HAND)
-    ET.SubElement(fixed, 'origin', xyz='0 0 0', rpy='0 0 0')
     for j in joints.values():
         if j.find('parent').get('link') == PREFIX + 'link_6':
             j.find('parent').set('link', HAND)
+            _flip(j)
     hand_links = {HAND} | {n for n in links if 'finger' in n}
     for name in hand_links - {HAND}:
         # Kinova gives each finger link 10 g and 1e-7 kg m2: PyBullet's finger motors then
