@@ -25,7 +25,7 @@ What it changes in Kinova's expanded URDF, and why:
   (PyBullet collides with a mesh's convex hull, which the decimation keeps);
 - the carbon fibre is coloured black-grey, as the arm is (Kinova's pale blue reads as a blue
   object to the colour detector);
-- the finger links weigh 80 g instead of 10 g (see FINGER_MASS);
+- the finger links weigh 200 g instead of 10 g (see FINGER_MASS);
 - the ``world``/``root`` links, ROS-control transmissions and Gazebo plugins are left out.
 """
 
@@ -42,7 +42,7 @@ import trimesh
 from scipy.spatial.transform import Rotation
 
 FACES = 1500
-FINGER_MASS = 0.08    # kg
+FINGER_MASS = 0.2    # kg
 PREFIX = 'j2n6s300_'
 HAND = PREFIX + 'link_hand'
 SOURCE = 'Kinovarobotics/kinova-ros kinova_description/urdf/j2n6s300_standalone.xacro'
@@ -109,9 +109,10 @@ def main(expanded: str, kinova: str, out: str) -> None:
             _flip(j)
     hand_links = {HAND} | {n for n in links if 'finger' in n}
     for name in hand_links - {HAND}:
-        # Kinova gives each finger link 10 g and 1e-7 kg m2: PyBullet's finger motors then
-        # stall on an object at 0.1 N m and the grasp check feels nothing; 80 g (inertia scaled
-        # alike) lets them squeeze with their 2 N m as the real fingers do
+        # Kinova gives each finger link 10 g and 1e-7 kg m2: PyBullet's finger motors, whose
+        # torque on a blocked finger grows with the link's inertia, then squeeze an object with
+        # 0.1 N m and the grasp check feels nothing (80 g: 0.3-0.6 N m, objects slipped after
+        # the lift); 200 g (inertia scaled alike) squeezes with 0.4-1.0 N m
         inertial = links[name].find('inertial')
         scale = FINGER_MASS / float(inertial.find('mass').get('value'))
         inertial.find('mass').set('value', repr(FINGER_MASS))
