@@ -586,8 +586,9 @@ def merge_urdf(arm: ArmDescription, hand: HandDescription, mount: LinkFrame,
 
     An empty flange link (no inertial, visual or collision: a frame, as ROS-Industrial's
     ``tool0``) that no joint hangs from is replaced by the hand's root, the mount appended to the
-    joint that carried it (its axis expressed in the turned frame): no massless link enters the simulation. The arm's elements come first,
-    the mount joint, then the hand's, in their files' order (PyBullet numbers links in that order).
+    joint that carried it (its axis expressed in the turned frame): no massless link enters the
+    simulation. The arm's elements come first, the mount joint, then the hand's, in their files'
+    order (PyBullet numbers links in that order).
     """
     where = f'Joining the arm {arm.name!r} and the hand {hand.name!r}'
     trees = []
