@@ -136,7 +136,7 @@ def test_robot_descriptions_are_config_files_with_their_urdfs():
     from mindgrasp_common.robot_description import load_robot, robot_names
 
     assert robot_names() == ['iiwa_franka_hand', 'iiwa_mindgrasp_hand', 'iiwa_xarm_gripper',
-                             'mindgrasp_arm', 'panda', 'xarm6']
+                             'jaco', 'mindgrasp_arm', 'panda', 'xarm6']
     for name in robot_names():
         robot = load_robot(name)
         assert robot.path == REPO / 'config' / 'robots' / f'{name}.yaml'

@@ -35,7 +35,7 @@ SINGLE_XARM6 = {
 
 def test_shipped_robots():
     assert robot_names() == ['iiwa_franka_hand', 'iiwa_mindgrasp_hand', 'iiwa_xarm_gripper',
-                             'mindgrasp_arm', 'panda', 'xarm6']
+                             'jaco', 'mindgrasp_arm', 'panda', 'xarm6']
     arm = load_robot()
     assert arm.arm_joints == robot.ARM_JOINTS and arm.home_pose == robot.HOME_POSE
     assert arm.gripper.kind == 'multi_finger' and arm.tcp_link == 'tcp'

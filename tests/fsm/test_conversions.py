@@ -32,3 +32,14 @@ def test_gripper_opening_is_clipped_and_missing_readings_say_unknown() -> None:
                                efforts=[0.1, 0.2])
     assert one.contact is False and one.efforts is None and one.force == pytest.approx(0.3)
     assert math.isnan(gripper_from_fingers([math.nan] * 3, 0.0).opening)
+
+
+def test_a_synergy_with_a_range_per_joint_opens_by_each_joints_own_closure():
+    """The Jaco hand's proximal joints close 0-1.3 rad, its distal ones 0-0.6: half closed is
+    0.5 of each joint's range (the first joint's range for all read it as 0.73 open)."""
+    opened, closed = (0.0,) * 4, (1.3, 0.6, 1.3, 0.6)
+    g = gripper_from_fingers([0.65, 0.3, 0.65, 0.3], 0.0, open_angle=opened,
+                             closed_angle=closed)
+    assert g.opening == pytest.approx(0.5)
+    assert gripper_from_fingers(list(closed), 0.0, open_angle=opened,
+                                closed_angle=closed).opening == 0.0

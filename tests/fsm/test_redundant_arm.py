@@ -11,7 +11,7 @@ import pytest
 from mindgrasp_common.redundancy import redundancy_step
 from mindgrasp_common.robot_description import load_robot
 from mindgrasp_fsm.errors import FsmError
-from mindgrasp_fsm.grasp_fsm import GraspFsm, tilt_direction
+from mindgrasp_fsm.grasp_fsm import GraspFsm, pan_direction, tilt_direction, wrist_tilt
 from mindgrasp_fsm.params import FsmParams
 from mindgrasp_sim.control import velocities_from_twist
 
@@ -33,6 +33,18 @@ def test_the_panda_controller_has_seven_joints(panda: GraspFsm) -> None:
         six = GraspFsm.from_params(FsmParams(robot=name))
         assert (six.tilt_joint, six.tilt_sign) == (4, 1.0)
     assert tilt_direction(None, [0.0] * 7, 5) == 1.0
+
+
+def test_the_jaco_turns_and_tilts_as_its_model_says() -> None:
+    """The Jaco's joint 1 axis points down (a positive velocity turns it right) and its
+    60-degree wrist has no pitch joint: the controller reads both from the robot model; every
+    other shipped robot keeps joint 1 as the left turn and its tilt joint alone."""
+    jaco = GraspFsm.from_params(FsmParams(robot='jaco'))
+    assert (jaco.pan_sign, jaco.wrist_tilt, jaco.tilt_joint) == (-1.0, True, 4)
+    for name in ('mindgrasp_arm', 'xarm6', 'panda', 'iiwa_franka_hand'):
+        other = GraspFsm.from_params(FsmParams(robot=name))
+        assert (other.pan_sign, other.wrist_tilt) == (1.0, False), name
+    assert pan_direction(None, [0.0] * 6) == 1.0 and not wrist_tilt(None, [0.0] * 6, 4)
 
 
 @pytest.mark.parametrize(('values', 'match'), [

@@ -153,3 +153,21 @@ def test_a_hand_whose_names_clash_with_the_arm(tmp_path):
     with pytest.raises(RobotDescriptionError, match=r"both URDFs have a link named '.*'; rename "
                                                     r'it in one of them'):
         load_robot(_pair(tmp_path, arm_as_hand))
+
+
+def test_a_turned_flange_turns_its_joint_axis_with_it():
+    """The Jaco's hand root replaces its link 6 turned by pi about x (z out of the hand): joint
+    6's axis, written in its child's frame, is turned alike, so the joint still turns the hand
+    as Kinova's description does (the camera at home where the xArm6's is)."""
+    import xml.etree.ElementTree as ET
+
+    robot = load_robot('jaco')
+    joint = next(j for j in ET.parse(str(robot.urdf)).getroot().findall('joint')
+                 if j.get('name') == 'j2n6s300_joint_6')
+    assert joint.find('child').get('link') == robot.hand_root == 'j2n6s300_link_hand'
+    assert [float(v) for v in joint.find('axis').get('xyz').split()] == [0.0, 0.0, -1.0]
+    with Simulation('set_locations', seed=0, robot=robot) as sim:
+        pos, orn = sim.camera_pose()
+    np.testing.assert_allclose(pos, [0.297, 0.0, 0.621], atol=0.005)
+    x_axis = np.array(pb.getMatrixFromQuaternion(orn)).reshape(3, 3)[:, 0]
+    np.testing.assert_allclose(x_axis, [0.0, -1.0, 0.0], atol=0.01)

@@ -586,8 +586,9 @@ def merge_urdf(arm: ArmDescription, hand: HandDescription, mount: LinkFrame,
 
     An empty flange link (no inertial, visual or collision: a frame, as ROS-Industrial's
     ``tool0``) that no joint hangs from is replaced by the hand's root, the mount appended to the
-    joint that carried it: no massless link enters the simulation. The arm's elements come first,
-    the mount joint, then the hand's, in their files' order (PyBullet numbers links in that order).
+    joint that carried it (its axis expressed in the turned frame): no massless link enters the
+    simulation. The arm's elements come first, the mount joint, then the hand's, in their files'
+    order (PyBullet numbers links in that order).
     """
     where = f'Joining the arm {arm.name!r} and the hand {hand.name!r}'
     trees = []
@@ -628,6 +629,13 @@ def merge_urdf(arm: ArmDescription, hand: HandDescription, mount: LinkFrame,
                 element.remove(origin)
             if new is not origin:
                 element.insert(0, new)
+            axis = element.find('axis')
+            if axis is not None and any(mount.rpy):
+                # the joint's axis is in its child's frame, now the hand's root, turned by the
+                # mount: the same axis in the new frame (the Jaco's flange is turned by pi)
+                a = Rotation.from_euler('xyz', mount.rpy).inv().apply(
+                    [float(v) for v in axis.get('xyz', '1 0 0').split()])
+                axis.set('xyz', ' '.join(repr(float(v)) for v in np.round(a, 12) + 0.0))
         out.append(element)
     if not replace:
         fixed = ET.SubElement(out, 'joint', name=joint, type='fixed')

@@ -51,16 +51,23 @@ def vision_frame_from_msg(msg: object, stamp: float) -> VisionFrame:
 def gripper_from_fingers(positions: Sequence[float], stamp: float,
                          contacts: Sequence[bool] | None = None,
                          efforts: Sequence[float] | None = None,
-                         open_angle: float = FINGER_OPEN, closed_angle: float = FINGER_CLOSED
+                         open_angle: float | Sequence[float] = FINGER_OPEN,
+                         closed_angle: float | Sequence[float] = FINGER_CLOSED
                          ) -> GripperState:
     """Gripper state from finger joint angles (rad), optional per-finger contact flags and
     efforts (N m). Opening: 1 open .. 0 closed (mean over fingers); contact: at least two fingers
     touch (thumb against a finger), when contact flags are given; force: sum of the absolute
-    efforts (N m), NaN without them."""
+    efforts (N m), NaN without them. ``open_angle`` and ``closed_angle``: one range for every
+    joint, or one per joint (a closure synergy whose joints move over different ranges, as the
+    Jaco hand's proximal and distal joints: the mean of the joints' own closures)."""
     # plain floats: three fingers, twice per control tick, where numpy's per-call cost dominates
     pos = [float(v) for v in positions]
-    mean = math.fsum(pos) / len(pos) if pos else math.nan
-    opening = min(max((closed_angle - mean) / (closed_angle - open_angle), 0.0), 1.0)
+    if isinstance(open_angle, (int, float)) and isinstance(closed_angle, (int, float)):
+        mean = math.fsum(pos) / len(pos) if pos else math.nan
+        opening = min(max((closed_angle - mean) / (closed_angle - open_angle), 0.0), 1.0)
+    else:
+        shut = [(c - p) / (c - o) for p, o, c in zip(pos, open_angle, closed_angle, strict=True)]
+        opening = min(max(math.fsum(shut) / len(shut), 0.0), 1.0) if shut else math.nan
     n = None if contacts is None else sum(1 for c in contacts if c)
     contact = None if n is None else n >= 2
     per_finger = None

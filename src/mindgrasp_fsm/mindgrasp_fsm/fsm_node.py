@@ -95,10 +95,14 @@ class FsmNode(rclpy.node.Node):
             raise FsmError(msg)
         started, graph_check_wait = time.monotonic(), declare_graph_check(self)
         self.fsm = GraspFsm.from_params(self.params)
-        # open and closed positions (rad) of the gripper's first (driving) joint: the others
-        # move with it over the same range (the shipped hand's fingers, the xArm's linkage)
+        # open and closed positions (rad) of the gripper's first (driving) joint when the others
+        # move with it over the same range (the shipped hand's fingers, the xArm's linkage),
+        # else each joint's own (the Jaco hand's distal joints close less than its proximal)
         gripper = load_robot(self.params.robot or DEFAULT_ROBOT).gripper
-        self._gripper_range = {'open_angle': gripper.open[0], 'closed_angle': gripper.closed[0]}
+        same = len(set(gripper.open)) == 1 and len(set(gripper.closed)) == 1
+        self._gripper_range = ({'open_angle': gripper.open[0], 'closed_angle': gripper.closed[0]}
+                               if same else {'open_angle': gripper.open,
+                                             'closed_angle': gripper.closed})
         self.inputs = FsmInputs(time=0.0)
         self._fingers: np.ndarray | None = None
         self._finger_stamp = 0.0

@@ -122,9 +122,40 @@ def tilt_direction(kinematics: ArmKinematics | None, home: list[float] | np.ndar
     dq = np.zeros(q.size)
     dq[joint] = 0.01
     # forward tilt: the optical axis's horizontal component along the direction the arm faces
-    (_, r0), (_, r1) = kinematics.camera_pose(q), kinematics.camera_pose(q + dq)
-    facing = np.array([math.cos(q[0]), math.sin(q[0])])
+    # (where the camera is, seen from the base axis: joint 1's zero need not face along x, the
+    # Jaco's faces ahead at 2.9 rad)
+    (p0, r0), (_, r1) = kinematics.camera_pose(q), kinematics.camera_pose(q + dq)
+    facing = np.asarray(p0[:2], dtype=float)
     return 1.0 if float(facing @ (r1[:2, 2] - r0[:2, 2])) <= 0.0 else -1.0
+
+
+def wrist_tilt(kinematics: ArmKinematics | None, home: list[float] | np.ndarray,
+               joint: int) -> bool:
+    """True when turning the tilt ``joint`` (0-based) alone does not tilt the camera cleanly at
+    ``home`` (n,) rad: its axis lies more than 25 deg off the camera's x axis (a wrist whose
+    axes meet at 60 deg, as the Jaco's, turns and rolls the image as much as it tilts it, and
+    soon cannot tilt it further). The controller then tilts the camera with the last three
+    joints together. False without a kinematics model with a Jacobian."""
+    if kinematics is None or not hasattr(kinematics, 'jacobian'):
+        return False
+    q = np.asarray(home, dtype=float)
+    axis = np.asarray(kinematics.jacobian(q))[3:, joint]
+    _, rot = kinematics.camera_pose(q)
+    across = abs(float(rot[:, 0] @ axis)) / max(float(np.linalg.norm(axis)), 1e-9)
+    return across < math.cos(math.radians(25.0))
+
+
+def pan_direction(kinematics: ArmKinematics | None, home: list[float] | np.ndarray) -> float:
+    """+1.0 when turning joint 1 positively from ``home`` (n,) rad turns the arm to its left
+    (counterclockwise seen from above: the convention of the search and centring gains), -1.0
+    when its axis points down (the Jaco's); +1.0 without a kinematics model."""
+    if kinematics is None:
+        return 1.0
+    q = np.asarray(home, dtype=float)
+    dq = np.zeros(q.size)
+    dq[0] = 0.01
+    (p0, _), (p1, _) = kinematics.camera_pose(q), kinematics.camera_pose(q + dq)
+    return 1.0 if float(p0[0] * p1[1] - p0[1] * p1[0]) >= 0.0 else -1.0
 
 
 class GraspFsm:
@@ -151,6 +182,10 @@ class GraspFsm:
         # +1 when a positive tilt-joint velocity tilts the camera down towards the base (the
         # gains' and the search tilts' convention), -1 when the arm's joint turns the other way
         self.tilt_sign = tilt_direction(kinematics, self.params.home_position, self.tilt_joint)
+        # +1 when a positive joint-1 velocity turns the arm left (the gains' convention), -1 when
+        # joint 1's axis points down
+        self.pan_sign = pan_direction(kinematics, self.params.home_position)
+        self.wrist_tilt = wrist_tilt(kinematics, self.params.home_position, self.tilt_joint)
         self.policy = GraspPolicy(self.params, kinematics)
         #: the scan paradigm's answer pair in force and the model's decision thresholds (nat s)
         self.answer, self._model_thresholds = resolve_answer(self.params)
@@ -417,14 +452,21 @@ class GraspFsm:
         ey = (ooi.centre_y - vision.image_height / 2.0) / vision.image_height
         return ex, ey
 
-    def _centring(self, ooi: ObjectObservation, vision: VisionFrame, gain_scale: float
-                  ) -> np.ndarray:
+    def _centring(self, ooi: ObjectObservation, vision: VisionFrame, gain_scale: float,
+                  q: np.ndarray) -> np.ndarray:
         p = self.params
         ex, ey = self._errors(ooi, vision)
         v = np.zeros(self.n_joints)
-        v[0] = p.center_sign_joint1 * p.center_gain_joint1 * gain_scale * ex
-        v[self.tilt_joint] = (self.tilt_sign * p.center_sign_joint5 * p.center_gain_joint5
-                              * gain_scale * ey)
+        v[0] = self.pan_sign * p.center_sign_joint1 * p.center_gain_joint1 * gain_scale * ex
+        tilt = p.center_sign_joint5 * p.center_gain_joint5 * gain_scale * ey
+        if self.wrist_tilt and self.kinematics is not None:
+            # the camera turned about its own x axis at the rate the tilt joint alone turns
+            # it on the other arms (-tilt rad/s), by the last three joints together
+            _, rot = self.kinematics.camera_pose(q)
+            jac = np.asarray(self.kinematics.jacobian(q))[3:, -3:]
+            v[-3:] = np.linalg.lstsq(jac, -tilt * rot[:, 0], rcond=None)[0]
+        else:
+            v[self.tilt_joint] = self.tilt_sign * tilt
         return v
 
     def _certainty(self, inputs: FsmInputs) -> tuple[int, float]:
@@ -482,9 +524,9 @@ class GraspFsm:
         elif self._both_since is None:
             self._both_since = t
         if cls == MiClass.LEFT_HAND:
-            v[0] = p.search_gain * cert
+            v[0] = self.pan_sign * p.search_gain * cert
         elif cls == MiClass.RIGHT_HAND:
-            v[0] = -p.search_gain * cert
+            v[0] = -self.pan_sign * p.search_gain * cert
         elif cls == MiClass.BOTH_HANDS:
             if ooi is not None and self._ignore_from is not None and \
                     abs(q[0] - self._ignore_from) < p.bci_reselect_angle and \
@@ -539,7 +581,7 @@ class GraspFsm:
             return np.zeros(self.n_joints), 'object not in this frame'
         assert inputs.vision is not None
         ex, ey = self._errors(ooi, inputs.vision)
-        v = self._centring(ooi, inputs.vision, 1.0)
+        v = self._centring(ooi, inputs.vision, 1.0, q)
         if self._offer_since is not None:
             return self._offer(t, q, inputs, ooi, v)
         if abs(ex) < p.center_tolerance and abs(ey) < p.center_tolerance:
@@ -626,12 +668,12 @@ class GraspFsm:
     def _bearing(self, ooi: ObjectObservation, q: np.ndarray, inputs: FsmInputs) -> float:
         """Joint-1 angle (rad) at which the arm would face ``ooi``: the current one plus the
         object's horizontal angle in the image (pinhole camera; turning towards an object right
-        of centre is ``center_sign_joint1``)."""
+        of centre is ``center_sign_joint1`` times :attr:`pan_sign`)."""
         cam = inputs.camera
         if cam is None or inputs.vision is None:
             return float(q[0])
         off = math.atan2(ooi.centre_x - inputs.vision.image_width / 2.0, cam.fx)
-        return float(q[0]) + self.params.center_sign_joint1 * off
+        return float(q[0]) + self.pan_sign * self.params.center_sign_joint1 * off
 
     def _was_passed(self, ooi: ObjectObservation, q: np.ndarray, inputs: FsmInputs) -> bool:
         bearing = self._bearing(ooi, q, inputs)
@@ -678,7 +720,8 @@ class GraspFsm:
                 self._cancel_approach(q, f'cancelled the approach to the {ooi.label}: no go-on '
                                       f'within {p.offer_timeout:.1f} s')
                 return v, 'cancelled'
-            return self._centring(ooi, inputs.vision, p.approach_center_gain), 'waiting for go-on'
+            return (self._centring(ooi, inputs.vision, p.approach_center_gain, q),
+                    'waiting for go-on')
         if ooi.pixel_fraction > p.final_approach_pixel_fraction:
             self._goto(State.FINAL_APPROACH, f'{ooi.label} fills {100 * ooi.pixel_fraction:.1f} %'
                        ' of the image')
@@ -691,19 +734,19 @@ class GraspFsm:
             return v, 'limit'
         cls, cert = self._certainty(inputs)
         if p.autonomous or self._scan or cert <= p.certainty_threshold:
-            v += self._centring(ooi, inputs.vision, p.approach_center_gain)
+            v += self._centring(ooi, inputs.vision, p.approach_center_gain, q)
             v[j] = p.approach_sign * p.default_approach_velocity
             return v, 'default approach'
         if cls == MiClass.LEFT_HAND:
-            v[0] = p.turn_gain * cert
+            v[0] = self.pan_sign * p.turn_gain * cert
             return v, 'turn left'
         if cls == MiClass.RIGHT_HAND:
-            v[0] = -p.turn_gain * cert
+            v[0] = -self.pan_sign * p.turn_gain * cert
             return v, 'turn right'
         if cls == MiClass.BOTH_FEET:
             v[j] = -p.approach_sign * p.retreat_gain * cert
             return v, 'back off'
-        v += self._centring(ooi, inputs.vision, p.approach_center_gain)
+        v += self._centring(ooi, inputs.vision, p.approach_center_gain, q)
         v[j] = p.approach_sign * p.approach_gain * cert
         return v, 'approach'
 
