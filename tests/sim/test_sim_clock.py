@@ -42,3 +42,31 @@ def test_a_stall_after_the_start_still_warns(spawn_node) -> None:
     finally:
         os.kill(proc.pid, signal.SIGCONT)
     assert proc.wait_for_output('behind its clock; skipping ahead', 60), proc.output()
+
+
+def test_a_skip_keeps_every_stamp_on_a_whole_physics_step(rclpy_ctx) -> None:
+    """A stall skipped ahead by a fraction of a step put the joint-state stamps after it off
+    the start-plus-whole-steps grid (CI: 27.226 steps between two states)."""
+    from mindgrasp_sim.sim_node import SimNode
+
+    node = SimNode()
+    clock = [1000.0]
+    node._clock_s = lambda: clock[0]     # the node's clock, stepped by hand
+
+    def stamp_ns() -> int:
+        t = node._stamp()
+        return t.sec * 10**9 + t.nanosec
+
+    try:
+        node.realtime_callback()                    # the start
+        node.realtime_callback()
+        first, cap = stamp_ns(), float(node.params.max_catch_up)
+        clock[0] += 1.2345678                       # a stall of 1.23 s
+        node.realtime_callback()
+        steps = (stamp_ns() - first) / (1e9 / node.sim.physics_hz)
+        assert steps == pytest.approx(round(steps), abs=1e-3), steps
+        # skipped to within a step of the cap behind the clock, then caught up
+        assert clock[0] - node.sim_now() < 1.0 / node.sim.physics_hz, cap
+        assert node.total_steps == pytest.approx(cap * node.sim.physics_hz, abs=1)
+    finally:
+        node.destroy_node()

@@ -351,12 +351,18 @@ class SimNode(rclpy.node.Node):
                     f'The simulation is {due:.2f} s behind its clock; skipping ahead. Lower '
                     'camera_width/height or camera_rate, or use time_mode:=fast.',
                     throttle_duration_sec=5.0)
-            self._set_t0(self._t0 + due - cap)
+            # a whole number of physics steps, so that every stamp stays the start time plus
+            # whole steps (a consumer may count steps between two states)
+            skipped = math.floor((due - cap) * self.sim.physics_hz)
+            skip = skipped * self.sim.dt
+            self._t0 += skip
+            self._t0_ns += skipped * self._dt_ns
+            self._stamp_cache = (-1, None)
             for io in self.robots.values():
                 # commands that arrived during the lag were stamped before the skip; without
                 # this they would all be stale after it, and an overloaded sim ignores its arms
-                io.gate.shift(due - cap)
-            due = cap
+                io.gate.shift(skip)
+            due -= skip
         n = int(due * self.sim.physics_hz)
         if n > 0:
             # a catch-up (more than five joint-state periods behind) sends only its newest
