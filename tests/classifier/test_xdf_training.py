@@ -94,10 +94,15 @@ def test_the_xdf_holds_the_runs_cues_at_the_bags_times(graz_run: tuple[Path, Pat
     assert len(from_bag.events) == TRIALS
     np.testing.assert_allclose(np.diff(from_xdf.events[:, 0]), np.diff(from_bag.events[:, 0]),
                                atol=2)
-    # and the same EEG: the amplifier's samples, one second after the first cue
+    # and the same EEG: the amplifier's samples one second after the first cue are in both, at
+    # most 5 samples (20 ms) apart. The two place a cue by different clocks (the marker's LSL
+    # time, the prompt's ROS stamp through the EEG's stamps), and a loaded machine put them a
+    # sample or more apart: the samples are looked for, not assumed at the same index
     start_x, start_b = from_xdf.events[0, 0], from_bag.events[0, 0]
-    np.testing.assert_allclose(from_xdf.data[start_x + 250: start_x + 260],
-                               from_bag.data[start_b + 250: start_b + 260], atol=1e-9)
+    segment = from_bag.data[start_b + 250: start_b + 260]
+    offsets = [k for k in range(-25, 26) if np.allclose(
+        from_xdf.data[start_x + 250 + k: start_x + 260 + k], segment, rtol=0, atol=1e-9)]
+    assert len(offsets) == 1 and abs(offsets[0]) <= 5, offsets
 
 
 @pytest.mark.timeout(900)

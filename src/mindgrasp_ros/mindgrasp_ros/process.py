@@ -43,13 +43,33 @@ def _interrupt(signum: int, frame: object) -> None:
 def interrupt_unless_importing(signum: int, frame: FrameType | None) -> None:
     """A stop signal while a node program starts (:mod:`mindgrasp_ros.start`): set
     :data:`stop_requested`, and raise KeyboardInterrupt unless an import is in progress (raised
-    inside a C extension's initialisation it becomes ``ImportError: initialization failed``)."""
+    inside a C extension's initialisation it becomes ``ImportError: initialization failed``).
+
+    Stopped during the program's own top-level imports, nothing has run yet: the process ends
+    at once with 0. Waiting for those imports to finish (torch and pyRiemann, 6 s on an idle
+    2-core machine, over 10 s on a loaded one) outlasted the launcher's grace after SIGINT, and
+    a node stopped before it started was reported as stopped by SIGTERM. An import inside a
+    function (the program already running) is waited for, and acted on after it."""
     stop_requested.set()
+    outermost_import = None
     while frame is not None:
         if frame.f_code.co_filename.startswith('<frozen importlib'):
-            return     # acted on once the imports are done (run_node checks stop_requested)
+            outermost_import = frame
         frame = frame.f_back
-    raise KeyboardInterrupt
+    if outermost_import is None:
+        raise KeyboardInterrupt
+    if _imports_of_the_program(outermost_import.f_back):
+        exit_process(0)
+    # acted on once the import is done (run_node checks stop_requested)
+
+
+def _imports_of_the_program(caller: FrameType | None) -> bool:
+    """True when an import was started by the program's module-level code (or by ``runpy``
+    finding that module): nothing of the program has run yet."""
+    if caller is None:
+        return True
+    name = caller.f_globals.get('__name__')
+    return name == 'runpy' or (name == '__main__' and caller.f_code.co_name == '<module>')
 
 
 def handle_stop_signals() -> None:

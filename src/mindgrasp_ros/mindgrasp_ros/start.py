@@ -10,9 +10,10 @@ in CI), the node exits 1 and the launch reports a failure although nothing had s
 Here, until the node's own signal handling takes over (:func:`~mindgrasp_ros.process.
 handle_stop_signals`, called by ``run_node``), SIGINT sets
 :data:`~mindgrasp_ros.process.stop_requested` and raises KeyboardInterrupt only when no import is
-in progress. SIGTERM keeps its default: the launcher's escalation after a SIGINT that was not
-obeyed ends the process. A node asked to stop before it started then ends with 0 as soon as its
-imports are done (:func:`~mindgrasp_ros.node_main.run_node` checks the flag first), as a stop.
+in progress. A stop during the module's own top-level imports ends the process at once with 0:
+nothing has run yet. SIGTERM keeps its default: the launcher's escalation after a SIGINT that was
+not obeyed ends the process. A stop during an import inside a function ends the node with 0 once
+that import is done (:func:`~mindgrasp_ros.node_main.run_node` checks the flag first).
 """
 
 from __future__ import annotations
