@@ -146,3 +146,26 @@ def test_not_yaml(tmp_path):
     path.write_text('- a list\n', encoding='utf-8')
     with pytest.raises(RobotDescriptionError, match='must be a YAML mapping'):
         load_robot(path)
+
+
+@pytest.mark.parametrize('name', robot_names())
+def test_the_arm_heading_is_where_the_camera_looks(name):
+    """A subject node reads the arm's heading from the first joint (ArmHeading): it is the yaw of
+    the camera's optical axis, by the URDF's forward kinematics, at home and turned either way
+    (the Jaco's first joint turns the other way round and sits at 2.93 rad at home)."""
+    import numpy as np
+
+    from mindgrasp_common.robot_description import ArmHeading
+    from mindgrasp_fsm.grasp_fsm import GraspFsm
+    from mindgrasp_fsm.params import FsmParams
+
+    heading = ArmHeading.of_robot(name)
+    kinematics = GraspFsm.from_params(FsmParams(robot=name)).kinematics
+    home = np.array(load_robot(name).home_pose)
+    assert heading.joint == load_robot(name).arm_joints[0] and heading.home == home[0]
+    for turn in (-0.6, 0.0, 0.4):
+        q = home.copy()
+        q[0] += turn
+        _, rotation = kinematics.camera_pose(q)
+        looks = math.atan2(rotation[1, 2], rotation[0, 2])
+        assert heading(q[0]) == pytest.approx(looks, abs=0.02), (turn, heading)

@@ -9,6 +9,7 @@ import pytest
 
 from mindgrasp_common.types import SceneObject
 from mindgrasp_eeg import EEGError
+from mindgrasp_eeg.montage import BOTH_FEET, BOTH_HANDS
 from mindgrasp_eeg.subject import VirtualSubject, pursue_class
 from mindgrasp_eeg.synthetic import SyntheticEEG
 
@@ -161,3 +162,34 @@ def test_bad_parameters() -> None:
         VirtualSubject('dream')
     with pytest.raises(EEGError, match=r"accuracy must be within 0\.\.1"):
         VirtualSubject('follow', accuracy=1.5)
+
+
+def test_a_subject_watching_the_jaco_reads_its_heading_from_the_robot_model():
+    """The Jaco's first joint sits at 2.93 rad at home and turns clockwise for a positive angle:
+    its raw angle as the heading made the virtual subject answer yes to the wrong objects (2 of
+    30 correct, 24 wrong). With the robot's model it says yes to the object the arm faces."""
+    from mindgrasp_eeg.subject import scan_class, subject_heading
+
+    ahead = SceneObject(2, 'red', 'cube', (0.5, 0.0, 0.0))
+    left = SceneObject(1, 'blue', 'cylinder', (0.5 * math.cos(0.7), 0.5 * math.sin(0.7), 0.0))
+    heading = subject_heading('jaco')
+    home = heading.home
+    assert heading.joint == 'j2n6s300_joint_1'
+
+    def answer(target: SceneObject, angle: float) -> int | None:
+        return scan_class(target, heading(angle), 1, offered=True)
+
+    assert answer(ahead, home) == BOTH_HANDS and answer(left, home) == BOTH_FEET
+    # turned left (counter-clockwise from above) by 0.7 rad: the Jaco's angle goes down
+    assert answer(left, home - 0.7) == BOTH_HANDS and answer(ahead, home - 0.7) == BOTH_FEET
+    # the shipped arm's angle is its heading; a joint named explicitly is the one read
+    assert subject_heading('')(0.3) == 0.3 and subject_heading('', 'joint_1').joint == 'joint_1'
+    assert subject_heading('jaco', 'other').joint == 'other'
+
+
+def test_a_subject_with_an_unknown_robot_says_so_in_one_line():
+    from mindgrasp_common.robot_description import RobotDescriptionError
+    from mindgrasp_eeg.subject import subject_heading
+
+    with pytest.raises(RobotDescriptionError, match='no_such_arm'):
+        subject_heading('no_such_arm')

@@ -54,6 +54,7 @@ __all__ = [
     'GRASP_CHECKS',
     'GRIPPER_KINDS',
     'ArmDescription',
+    'ArmHeading',
     'GripperDescription',
     'HandDescription',
     'JointLimits',
@@ -61,6 +62,7 @@ __all__ = [
     'RobotDescription',
     'RobotDescriptionError',
     'arm_names',
+    'base_turn_direction',
     'hand_names',
     'load_arm',
     'load_hand',
@@ -216,6 +218,8 @@ class _UrdfJoint:
     limits: JointLimits | None
     mimic: tuple[str, float, float] | None = None   # leader joint, multiplier, offset
     parent: str = ''
+    rpy: tuple[float, float, float] = (0.0, 0.0, 0.0)   # origin in the parent link (rad)
+    axis: tuple[float, float, float] = (1.0, 0.0, 0.0)  # in the joint's frame (URDF default)
 
 
 def _read_urdf(path: Path, where: str) -> tuple[set[str], dict[str, _UrdfJoint]]:
@@ -250,8 +254,66 @@ def _read_urdf(path: Path, where: str) -> tuple[set[str], dict[str, _UrdfJoint]]
         joints[j.get('name', '')] = _UrdfJoint(j.get('type', ''),
                                               '' if child is None else child.get('link', ''),
                                               limits, leader,
-                                              '' if parent is None else parent.get('link', ''))
+                                              '' if parent is None else parent.get('link', ''),
+                                              _triple(j.find('origin'), 'rpy', '0 0 0'),
+                                              _triple(j.find('axis'), 'xyz', '1 0 0'))
     return links, joints
+
+
+def _triple(element: ET.Element | None, key: str, default: str) -> tuple[float, float, float]:
+    """Three numbers of a URDF attribute (the default when absent or unreadable)."""
+    text = default if element is None else element.get(key, default)
+    try:
+        x, y, z = (float(v) for v in text.split())
+    except ValueError:
+        x, y, z = (float(v) for v in default.split())
+    return x, y, z
+
+
+@dataclass(frozen=True)
+class ArmHeading:
+    """Where the arm points (rad, counter-clockwise seen from above, 0 along the base's x axis)
+    from the angle of one joint, its first: ``direction * (angle - home)``.
+
+    Exact for the turn of a vertical first joint from a home pose that looks straight ahead, as
+    every shipped robot's does (``tests/common/test_robot_description.py`` checks the camera).
+    A subject that watches the arm reads its heading this way: the Jaco's first joint turns the
+    other way round and sits at 2.93 rad at home, so its angle alone is no heading.
+    """
+
+    joint: str = ''          # '' = the first joint of /joint_states
+    direction: float = 1.0   # base_turn_direction
+    home: float = 0.0        # the joint's angle at home (rad)
+
+    @classmethod
+    def of_robot(cls, robot: str | Path | RobotDescription) -> ArmHeading:
+        """The heading of ``robot`` (a :func:`load_robot` spec)."""
+        robot = load_robot(robot)
+        return cls(robot.arm_joints[0], base_turn_direction(robot), robot.home_pose[0])
+
+    def __call__(self, angle: float) -> float:
+        """Heading (rad) at the joint ``angle`` (rad)."""
+        return self.direction * (angle - self.home)
+
+
+def base_turn_direction(robot: RobotDescription) -> float:
+    """+1.0 when a positive angle of the arm's first joint turns the arm counter-clockwise seen
+    from above (its axis points up, in the base frame), -1.0 when the axis points down (the
+    Jaco's). The axis is taken through the fixed and first-joint origins from the URDF's root."""
+    _, joints = _read_urdf(robot.urdf, f'robot {robot.name!r}')
+    by_child = {j.child: j for j in joints.values()}
+    joint = joints.get(robot.arm_joints[0])
+    if joint is None:
+        msg = (f'robot {robot.name!r}: the joint {robot.arm_joints[0]!r} is not in '
+               f'{robot.urdf}; check the arm joints.')
+        raise RobotDescriptionError(msg)
+    rotation = Rotation.from_euler('xyz', joint.rpy)     # URDF rpy: fixed axes
+    link = joint.parent
+    while link in by_child:                              # up to the root (fixed joints)
+        above = by_child[link]
+        rotation = Rotation.from_euler('xyz', above.rpy) * rotation
+        link = above.parent
+    return 1.0 if float(rotation.apply(joint.axis)[2]) >= 0.0 else -1.0
 
 
 def _numbers(value: Any, n: int, what: str, where: str) -> tuple[float, ...]:

@@ -105,11 +105,14 @@ class VirtualAmpParams:
     decision_period: float = param(0.5, 'pursue: time between decisions', unit='s', min=1e-3)
     heading_tolerance: float = param(0.1, 'pursue: heading error taken as centred', unit='rad',
                                      min=0.0)
-    base_joint: str = param('', "pursue: joint giving the arm heading ('' = the first joint "
-                            'of /joint_states, the base)')
+    robot: str = param('', "pursue: the arm (robot:= of the launch): its first joint, turning "
+                       "direction and home give the heading; '' = base_joint's angle is the "
+                       'heading')
+    base_joint: str = param('', "pursue: joint giving the arm heading ('' = the robot's first "
+                            'joint, or the first joint of /joint_states)')
     base_position: list[float] = param([0.0, 0.0], 'pursue: arm base in the /sim/objects frame',
                                        unit='m')
-    heading_offset: float = param(0.0, 'pursue: arm heading at base_joint = 0', unit='rad',
+    heading_offset: float = param(0.0, 'pursue: added to the arm heading', unit='rad',
                                   min=-6.3, max=6.3)
     seed: int = param(0, 'seed of the EEG time series and the subject decisions', min=0)
     head_seed: int = param(0, 'seed of the head model (keep it for one virtual subject)', min=0)

@@ -23,12 +23,14 @@ Times are seconds on any monotonic clock the caller chooses (ROS time in the nod
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Sequence
 
 import numpy as np
 
 from mindgrasp_common.geometry import wrap_angle
+from mindgrasp_common.robot_description import ArmHeading
 from mindgrasp_common.states import State
 from mindgrasp_common.types import SceneObject
 
@@ -58,6 +60,17 @@ def same_object(seen: str, wanted: str) -> bool:
     colour, _, shape = seen.partition(' ')
     w_colour, _, w_shape = wanted.partition(' ')
     return colour == w_colour and shape in (w_shape, 'unknown', '')
+
+
+def subject_heading(robot: str, joint: str = '') -> ArmHeading:
+    """How a subject node reads the arm's heading from ``/joint_states``: from the robot's model
+    (``robot``, a :func:`~mindgrasp_common.robot_description.load_robot` spec) when given,
+    else the angle of ``joint`` ('' = the first joint listed) as it is. A ``joint`` given
+    names the joint read either way."""
+    if not robot:
+        return ArmHeading(joint)
+    heading = ArmHeading.of_robot(robot)
+    return dataclasses.replace(heading, joint=joint) if joint else heading
 
 
 def pursue_class(target: SceneObject | None, base_yaw: float, fsm_state: int,

@@ -29,13 +29,14 @@ from mindgrasp_ros.interfaces.std_msgs.msg import String
 from mindgrasp_ros.interfaces.visualization_msgs.msg import MarkerArray
 
 from mindgrasp_common.markers import objects_from_markers
+from mindgrasp_common.robot_description import RobotDescriptionError
 from mindgrasp_eeg import EEGError
 from mindgrasp_eeg.lsl import EEGOutlet, MarkerOutlet
 from mindgrasp_eeg.montage import class_name
 from mindgrasp_eeg.params import VirtualAmpParams
 from mindgrasp_eeg.replay_eeg import ReplayEEG
 from mindgrasp_eeg.ros_conversions import base_yaw_from_joint_state, ns_to_time_fields, time_to_s
-from mindgrasp_eeg.subject import VirtualSubject
+from mindgrasp_eeg.subject import VirtualSubject, subject_heading
 from mindgrasp_eeg.synthetic import SyntheticEEG
 from mindgrasp_eeg.virtual_amp import VirtualAmplifier, run_source_id
 from mindgrasp_ros import rclpy
@@ -85,6 +86,7 @@ class VirtualAmpNode(rclpy.node.Node):
             p.subject_mode, accuracy=p.accuracy, reaction_delay=p.reaction_delay,
             lapse_rate=p.lapse_rate, seed=p.seed, active_phases=p.active_phases,
             decision_period=p.decision_period, heading_tolerance=p.heading_tolerance)
+        self.heading = subject_heading(p.robot, p.base_joint)
         latched = LATCHED_QUEUE.profile()
         mode = p.subject_mode
         if mode == 'follow':
@@ -148,9 +150,9 @@ class VirtualAmpNode(rclpy.node.Node):
 
     def joints_callback(self, msg: JointState) -> None:
         """Arm heading from the base joint."""
-        yaw = base_yaw_from_joint_state(msg.name, msg.position, self.params.base_joint)
-        if yaw is not None:
-            self.subject.set_base_yaw(yaw + self.params.heading_offset)
+        angle = base_yaw_from_joint_state(msg.name, msg.position, self.heading.joint)
+        if angle is not None:
+            self.subject.set_base_yaw(self.heading(angle) + self.params.heading_offset)
 
     def fsm_callback(self, msg: FsmState) -> None:
         """Controller state and its object of interest."""
@@ -197,7 +199,7 @@ class VirtualAmpNode(rclpy.node.Node):
 
 def main(args: list[str] | None = None) -> int:
     """Run until Ctrl-C or ``duration``; exit 2 with one line on a bad parameter."""
-    return run_node(VirtualAmpNode, args, errors=(EEGError,))
+    return run_node(VirtualAmpNode, args, errors=(EEGError, RobotDescriptionError))
 
 
 if __name__ == '__main__':

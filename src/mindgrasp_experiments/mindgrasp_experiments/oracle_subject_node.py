@@ -22,9 +22,10 @@ from mindgrasp_ros.interfaces.visualization_msgs.msg import MarkerArray
 
 from mindgrasp_common.markers import objects_from_markers
 from mindgrasp_common.mi import DECODER_CLASS_NAMES, REST
+from mindgrasp_common.robot_description import RobotDescriptionError
 from mindgrasp_eeg.montage import class_name
 from mindgrasp_eeg.ros_conversions import base_yaw_from_joint_state
-from mindgrasp_eeg.subject import VirtualSubject
+from mindgrasp_eeg.subject import VirtualSubject, subject_heading
 from mindgrasp_ros import rclpy
 from mindgrasp_ros.node_main import end_after, run_node
 from mindgrasp_ros.node_traits import NodeTraits
@@ -54,6 +55,8 @@ class OracleParams:
     decision_period: float = param(0.25, 'time between decisions', unit='s', min=1e-3)
     heading_tolerance: float = param(0.1, 'heading error taken as centred', unit='rad',
                                      min=0.0)
+    robot: str = param('', "the arm (robot:= of the launch): its first joint, turning direction "
+                       "and home give the heading; '' = the first joint's angle is the heading")
     seed: int = param(0, 'seed of the subject', min=0)
     duration: float = param(0.0, 'end after this long (0 = until stopped)', unit='s', min=0.0)
 
@@ -71,6 +74,7 @@ class OracleSubjectNode(rclpy.node.Node):
                                       reaction_delay=p.reaction_delay, seed=p.seed,
                                       decision_period=p.decision_period,
                                       heading_tolerance=p.heading_tolerance)
+        self.heading = subject_heading(p.robot)
         latched = LATCHED_QUEUE.profile()
         self.create_subscription(TaskTarget, TASK_TARGET.name, self.target_callback, latched)
         self.create_subscription(MarkerArray, SIM_OBJECTS.name, self.objects_callback, latched)
@@ -93,9 +97,9 @@ class OracleSubjectNode(rclpy.node.Node):
         self.subject.set_objects(objects_from_markers(msg.markers))
 
     def joints_callback(self, msg: JointState) -> None:
-        yaw = base_yaw_from_joint_state(msg.name, msg.position)
-        if yaw is not None:
-            self.subject.set_base_yaw(yaw)
+        angle = base_yaw_from_joint_state(msg.name, msg.position, self.heading.joint)
+        if angle is not None:
+            self.subject.set_base_yaw(self.heading(angle))
 
     def fsm_callback(self, msg: FsmState) -> None:
         self.subject.set_fsm(int(msg.state), msg.object_of_interest, msg.stopped,
@@ -126,8 +130,8 @@ class OracleSubjectNode(rclpy.node.Node):
 
 
 def main(args: list[str] | None = None) -> int:
-    """Run until Ctrl-C or ``duration``."""
-    return run_node(OracleSubjectNode, args)
+    """Run until Ctrl-C or ``duration``; exit 2 with one line on a robot that does not load."""
+    return run_node(OracleSubjectNode, args, errors=(RobotDescriptionError,))
 
 
 if __name__ == '__main__':

@@ -41,8 +41,10 @@ def cv2_to_imgmsg(image: np.ndarray, encoding: str, header: object | None = None
                f'{image.shape}.')
         raise ValueError(msg)
     h, w = pixels.shape[:2]
+    data = array.array('B')
+    data.frombytes(memoryview(pixels).cast('B'))     # one copy of the pixels
     msg_ = Image(height=h, width=w, encoding=encoding, is_bigendian=0,
-                 step=w * channels * pixels.itemsize, data=array.array('B', pixels.tobytes()))
+                 step=w * channels * pixels.itemsize, data=data)
     if header is not None:
         msg_.header = header
     return msg_

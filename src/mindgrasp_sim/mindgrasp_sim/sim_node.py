@@ -283,7 +283,7 @@ class SimNode(rclpy.node.Node):
         lag, each waking the controller for a state it could only judge stale)."""
         sim = self.sim
         n_steps = int(n_steps)
-        held = {'js': False, 'cam': False}
+        js_held = cam_held = False     # fell due, not yet sent (newest_only)
         for i in range(n_steps):
             now = self.sim_now()
             for io in self.robots.values():
@@ -299,15 +299,15 @@ class SimNode(rclpy.node.Node):
             last = not newest_only or i == n_steps - 1
             if k >= self._next['js']:
                 self._next['js'] += self.js_every
-                held['js'] = True
+                js_held = True
             if k >= self._next['cam']:
                 self._next['cam'] += self.cam_every
-                held['cam'] = True
-            if last and held['js']:
-                held['js'] = False
+                cam_held = True
+            if last and js_held:
+                js_held = False
                 self.publish_states()
-            if last and held['cam']:
-                held['cam'] = False
+            if last and cam_held:
+                cam_held = False
                 self.publish_camera()
             if k >= self._next['scene']:
                 self._next['scene'] += self.scene_every

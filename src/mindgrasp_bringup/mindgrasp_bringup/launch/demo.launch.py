@@ -100,7 +100,8 @@ def generate_launch_description() -> LaunchDescription:
         Node(package='mindgrasp_eeg', executable='virtual_amp_node', name='virtual_amp',
              parameters=[*config_files('eeg', 'demo'),
                          {'stream_name': eeg_stream, 'seed': seed,
-                          'subject_mode': LaunchConfiguration('subject'), **amp_pin}]),
+                          'subject_mode': LaunchConfiguration('subject'),
+                          'robot': LaunchConfiguration('robot'), **amp_pin}]),
         # 3 acquisition: LSL inlet -> /eeg/raw, pinned to this run's amplifier (source id, host)
         Node(package='mindgrasp_eeg', executable='acquisition_node', name='eeg_acquisition',
              parameters=[*config_files('eeg', 'demo'),
