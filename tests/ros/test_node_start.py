@@ -50,9 +50,12 @@ if __name__ == '__main__':
 '''
 
 
-def test_a_node_stopped_while_importing_ends_with_0_and_never_starts(tmp_path: Path) -> None:
-    (tmp_path / 'slow_dependency.py').write_text(textwrap.dedent(DEPENDENCY))
-    (tmp_path / 'slow_node.py').write_text(textwrap.dedent(NODE))
+def _stop_while_importing(tmp_path: Path, dependency: str, node: str,
+                          wait_s: float) -> tuple[int, str]:
+    """Start ``node`` (importing ``dependency``), send SIGINT once the import began, and return
+    the exit code (within ``wait_s``) and the output."""
+    (tmp_path / 'slow_dependency.py').write_text(textwrap.dedent(dependency))
+    (tmp_path / 'slow_node.py').write_text(textwrap.dedent(node))
     env = {**os.environ, 'PYTHONPATH': os.pathsep.join(
         [str(tmp_path), os.environ.get('PYTHONPATH', '')])}
     proc = NodeProcess('slow_node', [], env, tmp_path / 'node.log')
@@ -63,10 +66,15 @@ def test_a_node_stopped_while_importing_ends_with_0_and_never_starts(tmp_path: P
             assert time.monotonic() < deadline, proc.output()
             time.sleep(0.05)
         proc.proc.send_signal(signal.SIGINT)
-        code = proc.wait(120.0)        # at once; an import done first would take 300 s
+        code = proc.wait(wait_s)
     finally:
         proc.stop()
-    out = proc.output()
+    return code, proc.output()
+
+
+def test_a_node_stopped_while_importing_ends_with_0_and_never_starts(tmp_path: Path) -> None:
+    # at once; an import done first would take 300 s
+    code, out = _stop_while_importing(tmp_path, DEPENDENCY, NODE, 120.0)
     assert code == 0, out
     assert 'constructed' not in out and 'Traceback' not in out, out
 
@@ -92,21 +100,6 @@ LAZY_NODE = NODE.replace(
 def test_a_stop_during_an_import_inside_main_is_acted_on_after_it(tmp_path: Path) -> None:
     """The program already runs (an import inside a function): the import is not broken off,
     and the node ends with 0 right after it, before it is constructed."""
-    (tmp_path / 'slow_dependency.py').write_text(textwrap.dedent(WAITING_DEPENDENCY))
-    (tmp_path / 'slow_node.py').write_text(textwrap.dedent(LAZY_NODE))
-    env = {**os.environ, 'PYTHONPATH': os.pathsep.join(
-        [str(tmp_path), os.environ.get('PYTHONPATH', '')])}
-    proc = NodeProcess('slow_node', [], env, tmp_path / 'node.log')
-    try:
-        deadline = time.monotonic() + 300.0
-        while not (tmp_path / 'importing').exists():
-            assert proc.poll() is None, proc.output()
-            assert time.monotonic() < deadline, proc.output()
-            time.sleep(0.05)
-        proc.proc.send_signal(signal.SIGINT)
-        code = proc.wait(300.0)
-    finally:
-        proc.stop()
-    out = proc.output()
+    code, out = _stop_while_importing(tmp_path, WAITING_DEPENDENCY, LAZY_NODE, 300.0)
     assert code == 0 and 'imported' in out, out
     assert 'constructed' not in out and 'Traceback' not in out, out
