@@ -145,6 +145,37 @@ def test_a_bad_pair_names_its_fault_in_one_line(tmp_path, hand_edit, robot, mess
     assert '\n' not in str(err.value)
 
 
+def test_a_hand_says_how_the_controller_holds_each_shape(tmp_path):
+    """A hand's grasp: section sets the controller's per-shape parameters with robot:= (the
+    robot YAML's own grasp: over the hand's); a name the controller lacks, or a value out of
+    its range, is refused in one line."""
+    from mindgrasp_fsm.errors import FsmError
+    from mindgrasp_fsm.params import FsmParams
+
+    def holds(h):
+        h['grasp'] = {'sphere_grasp_height_fraction': 0.45, 'cube_close_force': 35}
+    path = _pair(tmp_path, holds, grasp={'cube_close_force': 50})
+    robot = load_robot(path)
+    assert robot.hand.grasp == (('cube_close_force', 35.0), ('sphere_grasp_height_fraction',
+                                                             0.45))
+    assert dict(robot.grasp) == {'cube_close_force': 50.0, 'sphere_grasp_height_fraction': 0.45}
+    params = FsmParams(robot=str(path))
+    assert (params.sphere_grasp_height_fraction, params.cube_close_force) == (0.45, 50.0)
+    assert FsmParams().sphere_grasp_height_fraction == 0.6      # without robot:= as before
+    for grasp, message in (({'sphere_squeeze': 1.0}, "sets the grasp parameter 'sphere_squeeze', "
+                                                     'which the controller does not have'),
+                           ({'sphere_grasp_height_fraction': 2.0}, 'must be within'),
+                           ({'tool_link': 1.0}, "grasp parameter 'tool_link'")):
+        folder = tmp_path / next(iter(grasp))      # descriptions are cached by path
+        folder.mkdir()
+        with pytest.raises(FsmError, match=message) as err:
+            FsmParams(robot=str(_pair(folder, grasp=grasp)))
+        assert '\n' not in str(err.value)
+    with pytest.raises(RobotDescriptionError, match="'grasp' must map controller parameters"):
+        (tmp_path / 'words').mkdir()
+        load_robot(_pair(tmp_path / 'words', grasp={'sphere_grasp_height_fraction': 'x'}))
+
+
 def test_a_hand_whose_names_clash_with_the_arm(tmp_path):
     def arm_as_hand(h):       # the arm's own URDF as the hand: every name clashes
         h.update(urdf=str(resource_path('mindgrasp_sim', 'urdf', 'xarm6_arm.urdf')),

@@ -147,7 +147,9 @@ class ArmDescription:
 @dataclass(frozen=True)
 class HandDescription:
     """A hand (``config/robots/hands/<name>.yaml``): its gripper (joints, closure synergy, kind,
-    grasp check), ``root`` (the link it is mounted by), the ``tcp`` and the ``camera``."""
+    grasp check), ``root`` (the link it is mounted by), the ``tcp`` and the ``camera``;
+    ``grasp``: how the controller holds each shape with this hand, as (parameter, value) pairs of
+    the controller's per-shape parameters (``sphere_grasp_height_fraction``, ...)."""
 
     name: str
     path: Path
@@ -157,6 +159,7 @@ class HandDescription:
     tcp: LinkFrame
     camera: LinkFrame
     licence: str = ''
+    grasp: tuple[tuple[str, float], ...] = ()
 
 
 @dataclass(frozen=True)
@@ -189,6 +192,9 @@ class RobotDescription:
     mount: LinkFrame | None = None
     #: what loads it again: the YAML path, or ``'ARM+HAND'``
     spec: str = ''
+    #: the controller's per-shape grasp parameters for this hand (HandDescription.grasp, and the
+    #: robot YAML's own ``grasp:`` over them)
+    grasp: tuple[tuple[str, float], ...] = ()
 
     @property
     def tcp_link(self) -> str:
@@ -578,7 +584,22 @@ def _load_hand(path: Path) -> HandDescription:
         name=str(data.get('name', path.stem)), path=path, urdf=urdf, root=root, gripper=gripper,
         tcp=_frame(_section(data, 'tcp', where), 'tcp', where, links, urdf),
         camera=_frame(_section(data, 'camera', where), 'camera', where, links, urdf),
-        licence=str(data.get('licence', '')))
+        licence=str(data.get('licence', '')),
+        grasp=tuple(sorted(_grasp_part(data, where).items())))
+
+
+def _grasp_part(data: dict, where: str) -> dict[str, float]:
+    """The ``grasp:`` mapping (controller parameter -> number) of a hand or robot YAML; the
+    controller checks the names (:meth:`mindgrasp_fsm.params.FsmParams.apply_robot`)."""
+    grasp = data.get('grasp') or {}
+    ok = isinstance(grasp, dict) and all(
+        isinstance(k, str) and isinstance(v, (int, float)) and not isinstance(v, bool)
+        and math.isfinite(v) for k, v in grasp.items())
+    if not ok:
+        msg = (f"{where}: 'grasp' must map controller parameters to numbers (e.g. "
+               f'sphere_grasp_height_fraction: 0.5), got {grasp!r}.')
+        raise RobotDescriptionError(msg)
+    return {k: float(v) for k, v in grasp.items()}
 
 
 def load_arm(spec: str | Path) -> ArmDescription:
@@ -783,7 +804,8 @@ def _load_pair(data: dict, path: Path | None, where: str) -> RobotDescription:
         name=name, path=path if path is not None else hand.path, urdf_uri=str(urdf), urdf=urdf,
         arm_joints=arm.joints, home_pose=home, arm_limits=arm.limits, max_velocity=max_velocity,
         gripper=hand.gripper, tcp=tcp, camera=camera, licence=licence, hand_root=hand.root,
-        arm=arm, hand=hand, mount=mount, spec=str(path) if path is not None else name)
+        arm=arm, hand=hand, mount=mount, spec=str(path) if path is not None else name,
+        grasp=tuple(sorted({**dict(hand.grasp), **_grasp_part(data, where)}.items())))
 
 
 def _load_single(data: dict, path: Path, where: str) -> RobotDescription:
@@ -798,7 +820,8 @@ def _load_single(data: dict, path: Path, where: str) -> RobotDescription:
                             urdf=urdf, arm_joints=arm_joints, home_pose=home,
                             arm_limits=arm_limits, max_velocity=max_velocity, gripper=gripper,
                             tcp=tcp, camera=camera, licence=str(data.get('licence', '')),
-                            hand_root=_hand_root_in(gripper, urdf_joints), spec=str(path))
+                            hand_root=_hand_root_in(gripper, urdf_joints), spec=str(path),
+                            grasp=tuple(sorted(_grasp_part(data, where).items())))
 
 
 @functools.lru_cache(maxsize=16)

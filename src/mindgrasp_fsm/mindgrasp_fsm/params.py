@@ -27,7 +27,7 @@ from mindgrasp_common.robot import (
 from mindgrasp_common.robot_description import GRASP_CHECKS, load_robot, robot_choices
 from mindgrasp_fsm.command_interface import COMMAND_INTERFACES, check_command_interface
 from mindgrasp_fsm.errors import FsmError
-from mindgrasp_ros.params import param
+from mindgrasp_ros.params import ParameterError, check_value, param
 
 SHAPES = ('cube', 'cylinder', 'sphere')
 RESUME_MODES = ('require_new_command', 'resume')
@@ -53,7 +53,8 @@ class FsmParams:
     autonomous: bool = param(False, 'no BCI: search left, approach and grasp on vision alone')
     robot: str = param('', f'the arm: {robot_choices()}; its URDF, TCP and camera links, '
                        'joints, home pose, limits and velocity limits replace the eight '
-                       "parameters below (and grasp_check); '' = those as given")
+                       'parameters below (and grasp_check, and the per-shape values of its '
+                       "hand's grasp: section); '' = those as given")
     urdf_file: str = param(URDF_URI, 'URDF for forward / inverse kinematics: a path or a '
                            'package:// URI')
     tool_link: str = param('tcp', 'URDF link of the grasp point between the fingertips')
@@ -408,6 +409,23 @@ class FsmParams:
             # one limit for every joint (the default): as many entries as the arm has joints
             self.max_joint_acceleration = self.max_joint_acceleration[:1] * len(self.joint_names)
         self.grasp_check = description.gripper.grasp_check
+        for name, value in description.grasp:
+            self._set_grasp(name, value, description.name)
+
+    def _set_grasp(self, name: str, value: float, robot: str) -> None:
+        """One per-shape parameter from a robot's ``grasp:`` (its hand's way of holding)."""
+        fields = {f.name: f for f in dataclasses.fields(self)}
+        if name.split('_', 1)[0] not in SHAPES or name not in fields:
+            msg = (f"The robot {robot!r} sets the grasp parameter {name!r}, which the controller "
+                   f"does not have; use a per-shape parameter <{'|'.join(SHAPES)}>_<name> of "
+                   'config/param/fsm.yaml (e.g. sphere_grasp_height_fraction).')
+            raise FsmError(msg)
+        try:
+            check_value(type(self), name, value)
+        except ParameterError as exc:
+            msg = f"The robot {robot!r}'s grasp: section: {exc}"
+            raise FsmError(msg) from None
+        setattr(self, name, value)
 
     # ---------------------------------------------------------------------------------------
     def shape_value(self, shape: str, name: str) -> float:

@@ -39,8 +39,9 @@ from collections.abc import Callable, Iterable, Mapping
 from pathlib import Path
 from typing import Any, TypeVar
 
-__all__ = ['ParameterError', 'declare_params', 'describe', 'from_mapping', 'param',
-           'parameter_type', 'read_yaml_section', 'refuse_undeclared_overrides', 'type_code']
+__all__ = ['ParameterError', 'check_value', 'declare_params', 'describe', 'from_mapping',
+           'param', 'parameter_type', 'read_yaml_section', 'refuse_undeclared_overrides',
+           'type_code']
 
 T = TypeVar('T')
 
