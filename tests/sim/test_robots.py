@@ -162,6 +162,9 @@ def test_a_hand_says_how_the_controller_holds_each_shape(tmp_path):
     params = FsmParams(robot=str(path))
     assert (params.sphere_grasp_height_fraction, params.cube_close_force) == (0.45, 50.0)
     assert FsmParams().sphere_grasp_height_fraction == 0.6      # without robot:= as before
+    # a value given otherwise (a parameter file, -p, a live change) wins over the hand's
+    assert FsmParams(robot=str(path), sphere_grasp_height_fraction=0.7
+                     ).sphere_grasp_height_fraction == 0.7
     for grasp, message in (({'sphere_squeeze': 1.0}, "sets the grasp parameter 'sphere_squeeze', "
                                                      'which the controller does not have'),
                            ({'sphere_grasp_height_fraction': 2.0}, 'must be within'),

@@ -413,7 +413,9 @@ class FsmParams:
             self._set_grasp(name, value, description.name)
 
     def _set_grasp(self, name: str, value: float, robot: str) -> None:
-        """One per-shape parameter from a robot's ``grasp:`` (its hand's way of holding)."""
+        """One per-shape parameter from a robot's ``grasp:`` (its hand's way of holding). It
+        replaces the default only: a value given otherwise (a parameter file, -p, a live change)
+        wins over the hand's."""
         fields = {f.name: f for f in dataclasses.fields(self)}
         if name.split('_', 1)[0] not in SHAPES or name not in fields:
             msg = (f"The robot {robot!r} sets the grasp parameter {name!r}, which the controller "
@@ -425,7 +427,8 @@ class FsmParams:
         except ParameterError as exc:
             msg = f"The robot {robot!r}'s grasp: section: {exc}"
             raise FsmError(msg) from None
-        setattr(self, name, value)
+        if getattr(self, name) == fields[name].default:
+            setattr(self, name, value)
 
     # ---------------------------------------------------------------------------------------
     def shape_value(self, shape: str, name: str) -> float:
