@@ -155,7 +155,7 @@ def test_the_arm_heading_is_where_the_camera_looks(name):
     (the Jaco's first joint turns the other way round and sits at 2.93 rad at home)."""
     import numpy as np
 
-    from mindgrasp_common.robot_description import ArmHeading
+    from mindgrasp_common.arm_heading import ArmHeading
     from mindgrasp_fsm.grasp_fsm import GraspFsm
     from mindgrasp_fsm.params import FsmParams
 

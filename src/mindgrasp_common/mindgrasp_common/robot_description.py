@@ -34,27 +34,29 @@ The loader checks the description against the URDFs before anything moves; each 
 from __future__ import annotations
 
 import functools
-import hashlib
 import math
-import os
-import tempfile
-import xml.etree.ElementTree as ET
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 import yaml
-from scipy.spatial.transform import Rotation
 
-from mindgrasp_common.errors import CommonError
 from mindgrasp_common.resources import ResourceNotFoundError, resolve_path, resource_path
+from mindgrasp_common.robot_types import (
+    ArmDescription,
+    GripperDescription,
+    HandDescription,
+    JointLimits,
+    LinkFrame,
+    RobotDescription,
+    RobotDescriptionError,
+)
+from mindgrasp_common.urdf import ROBOTS_PACKAGE, UrdfJoint, merge_urdf, read_urdf, write_joined
 
+# the types (mindgrasp_common.robot_types) and merge_urdf are part of this module's interface
 __all__ = [
     'GRASP_CHECKS',
     'GRIPPER_KINDS',
     'ArmDescription',
-    'ArmHeading',
     'GripperDescription',
     'HandDescription',
     'JointLimits',
@@ -62,7 +64,6 @@ __all__ = [
     'RobotDescription',
     'RobotDescriptionError',
     'arm_names',
-    'base_turn_direction',
     'hand_names',
     'load_arm',
     'load_hand',
@@ -72,254 +73,10 @@ __all__ = [
     'robot_names',
 ]
 
-#: the package whose ``robots/`` folder holds the shipped descriptions
-ROBOTS_PACKAGE = 'mindgrasp_sim'
 GRIPPER_KINDS = ('parallel_jaw', 'multi_finger')
 #: how a closed gripper is judged to hold an object: finger effort, finger contacts, jaw width
 GRASP_CHECKS = ('effort', 'contacts', 'width')
 _MOVING = ('revolute', 'prismatic', 'continuous')
-
-
-class RobotDescriptionError(CommonError):
-    """A robot description that does not fit its URDF or MIndGrasp (the message says the fix)."""
-
-
-@dataclass(frozen=True)
-class JointLimits:
-    """URDF limits of one joint: position ``lower``/``upper`` (rad or m), ``velocity`` (rad/s or
-    m/s), ``effort`` (N m or N)."""
-
-    lower: float
-    upper: float
-    velocity: float
-    effort: float
-
-
-@dataclass(frozen=True)
-class GripperDescription:
-    """The gripper: ``joints`` driven together from ``open`` (closure 0) to ``closed`` (closure 1),
-    one position per joint (rad or m); ``kind`` in :data:`GRIPPER_KINDS`; ``grasp_check`` in
-    :data:`GRASP_CHECKS`; ``limits`` (one per joint) from the URDF; ``self_collision``: whether
-    the gripper's links (and the links they hang from) collide with each other (false for a
-    linkage whose links overlap, as an SRDF's ``disable_collisions`` says); ``mimic``: the
-    gripper joints the URDF declares as ``<mimic>`` of another gripper joint, as
-    ``(joint, leader, multiplier, offset)`` (position = multiplier * leader + offset, rad or m):
-    a simulator couples them to their leader rather than driving them on their own."""
-
-    kind: str
-    joints: tuple[str, ...]
-    open: tuple[float, ...]
-    closed: tuple[float, ...]
-    grasp_check: str
-    limits: tuple[JointLimits, ...]
-    self_collision: bool = True
-    mimic: tuple[tuple[str, str, float, float], ...] = ()
-
-
-@dataclass(frozen=True)
-class LinkFrame:
-    """A frame fixed to a URDF ``link``: offset ``xyz`` (3,) m and ``rpy`` (3,) rad in it (zeros:
-    the link's own frame). The TCP, and the eye-in-hand camera's optical frame (ROS optical
-    convention: z forward, x right, y down), mounted on a link as labs add a wrist camera."""
-
-    link: str
-    xyz: tuple[float, float, float] = (0.0, 0.0, 0.0)
-    rpy: tuple[float, float, float] = (0.0, 0.0, 0.0)
-
-
-@dataclass(frozen=True)
-class ArmDescription:
-    """An arm without its hand (``config/robots/arms/<name>.yaml``): ``joints`` (n,) base to
-    wrist, ``home`` (n,) rad, ``limits`` (n,) from the URDF, ``max_velocity`` (n,) rad/s, and
-    ``flange``: the link a hand is mounted on, with the default mount offset in it."""
-
-    name: str
-    path: Path
-    urdf: Path
-    joints: tuple[str, ...]
-    home: tuple[float, ...]
-    limits: tuple[JointLimits, ...]
-    max_velocity: tuple[float, ...]
-    flange: LinkFrame
-    licence: str = ''
-
-
-@dataclass(frozen=True)
-class HandDescription:
-    """A hand (``config/robots/hands/<name>.yaml``): its gripper (joints, closure synergy, kind,
-    grasp check), ``root`` (the link it is mounted by), the ``tcp`` and the ``camera``;
-    ``grasp``: how the controller holds each shape with this hand, as (parameter, value) pairs of
-    the controller's per-shape parameters (``sphere_grasp_height_fraction``, ...)."""
-
-    name: str
-    path: Path
-    urdf: Path
-    root: str
-    gripper: GripperDescription
-    tcp: LinkFrame
-    camera: LinkFrame
-    licence: str = ''
-    grasp: tuple[tuple[str, float], ...] = ()
-
-
-@dataclass(frozen=True)
-class RobotDescription:
-    """One robot as MIndGrasp uses it (see the module docstring).
-
-    ``arm_joints`` (n,) base to wrist, n in {6, 7}; ``home_pose`` (n,) rad; ``arm_limits`` (n,)
-    from the URDF; ``max_velocity`` (n,) rad/s the controller may command (the description's, or
-    the URDF's); ``urdf`` the resolved URDF path and ``urdf_uri`` as written in the description.
-    """
-
-    name: str
-    path: Path
-    urdf_uri: str
-    urdf: Path
-    arm_joints: tuple[str, ...]
-    home_pose: tuple[float, ...]
-    arm_limits: tuple[JointLimits, ...]
-    max_velocity: tuple[float, ...]
-    gripper: GripperDescription
-    tcp: LinkFrame
-    camera: LinkFrame
-    licence: str = ''
-    #: the link the hand hangs from the arm by (its links, and this one, are the hand's)
-    hand_root: str = ''
-    #: the arm and hand descriptions it was joined from (None: a single-URDF description)
-    arm: ArmDescription | None = None
-    hand: HandDescription | None = None
-    #: the hand's root on the arm's flange link (``link``), offset ``xyz`` m, ``rpy`` rad
-    mount: LinkFrame | None = None
-    #: what loads it again: the YAML path, or ``'ARM+HAND'``
-    spec: str = ''
-    #: the controller's per-shape grasp parameters for this hand (HandDescription.grasp, and the
-    #: robot YAML's own ``grasp:`` over them)
-    grasp: tuple[tuple[str, float], ...] = ()
-
-    @property
-    def tcp_link(self) -> str:
-        """The link the TCP is fixed to."""
-        return self.tcp.link
-
-    @property
-    def lower(self) -> tuple[float, ...]:
-        """Lower position limits of the arm joints (n,) rad."""
-        return tuple(lim.lower for lim in self.arm_limits)
-
-    @property
-    def upper(self) -> tuple[float, ...]:
-        """Upper position limits of the arm joints (n,) rad."""
-        return tuple(lim.upper for lim in self.arm_limits)
-
-    @property
-    def effort(self) -> tuple[float, ...]:
-        """Effort limits of the arm joints (n,) N m."""
-        return tuple(lim.effort for lim in self.arm_limits)
-
-
-@dataclass(frozen=True)
-class _UrdfJoint:
-    type: str
-    child: str
-    limits: JointLimits | None
-    mimic: tuple[str, float, float] | None = None   # leader joint, multiplier, offset
-    parent: str = ''
-    rpy: tuple[float, float, float] = (0.0, 0.0, 0.0)   # origin in the parent link (rad)
-    axis: tuple[float, float, float] = (1.0, 0.0, 0.0)  # in the joint's frame (URDF default)
-
-
-def _read_urdf(path: Path, where: str) -> tuple[set[str], dict[str, _UrdfJoint]]:
-    """Links and joints (name -> type, child link, limits) of the URDF at ``path``."""
-    try:
-        # ElementTree never fetches external entities; expat (>= 2.4.1) caps entity expansion
-        root = ET.parse(str(path)).getroot()
-    except (OSError, ET.ParseError) as exc:
-        msg = f'{where}: cannot read the URDF {str(path)!r} ({exc}); give a valid URDF file.'
-        raise RobotDescriptionError(msg) from None
-    links = {link.get('name', '') for link in root.findall('link')}
-    joints = {}
-    for j in root.findall('joint'):
-        lim = j.find('limit')
-        limits = None
-        if lim is not None and j.get('type') != 'continuous':
-            try:
-                limits = JointLimits(*(float(lim.get(k, 'nan')) for k in
-                                       ('lower', 'upper', 'velocity', 'effort')))
-            except ValueError:
-                limits = None
-        child = j.find('child')
-        parent = j.find('parent')
-        mimic = j.find('mimic')
-        leader = None
-        if mimic is not None:
-            try:
-                leader = (mimic.get('joint', ''), float(mimic.get('multiplier', '1')),
-                          float(mimic.get('offset', '0')))
-            except ValueError:
-                leader = None
-        joints[j.get('name', '')] = _UrdfJoint(j.get('type', ''),
-                                              '' if child is None else child.get('link', ''),
-                                              limits, leader,
-                                              '' if parent is None else parent.get('link', ''),
-                                              _triple(j.find('origin'), 'rpy', '0 0 0'),
-                                              _triple(j.find('axis'), 'xyz', '1 0 0'))
-    return links, joints
-
-
-def _triple(element: ET.Element | None, key: str, default: str) -> tuple[float, float, float]:
-    """Three numbers of a URDF attribute (the default when absent or unreadable)."""
-    text = default if element is None else element.get(key, default)
-    try:
-        x, y, z = (float(v) for v in text.split())
-    except ValueError:
-        x, y, z = (float(v) for v in default.split())
-    return x, y, z
-
-
-@dataclass(frozen=True)
-class ArmHeading:
-    """Where the arm points (rad, counter-clockwise seen from above, 0 along the base's x axis)
-    from the angle of one joint, its first: ``direction * (angle - home)``.
-
-    Exact for the turn of a vertical first joint from a home pose that looks straight ahead, as
-    every shipped robot's does (``tests/common/test_robot_description.py`` checks the camera).
-    A subject that watches the arm reads its heading this way: the Jaco's first joint turns the
-    other way round and sits at 2.93 rad at home, so its angle alone is no heading.
-    """
-
-    joint: str = ''          # '' = the first joint of /joint_states
-    direction: float = 1.0   # base_turn_direction
-    home: float = 0.0        # the joint's angle at home (rad)
-
-    @classmethod
-    def of_robot(cls, robot: str | Path | RobotDescription) -> ArmHeading:
-        """The heading of ``robot`` (a :func:`load_robot` spec)."""
-        robot = load_robot(robot)
-        return cls(robot.arm_joints[0], base_turn_direction(robot), robot.home_pose[0])
-
-    def __call__(self, angle: float) -> float:
-        """Heading (rad) at the joint ``angle`` (rad)."""
-        return self.direction * (angle - self.home)
-
-
-def base_turn_direction(robot: RobotDescription) -> float:
-    """+1.0 when a positive angle of the arm's first joint turns the arm counter-clockwise seen
-    from above (its axis points up, in the base frame), -1.0 when the axis points down (the
-    Jaco's). The axis is taken through the fixed and first-joint origins from the URDF's root."""
-    _, joints = _read_urdf(robot.urdf, f'robot {robot.name!r}')
-    by_child = {j.child: j for j in joints.values()}
-    joint = joints.get(robot.arm_joints[0])
-    if joint is None:
-        msg = (f'robot {robot.name!r}: the joint {robot.arm_joints[0]!r} is not in '
-               f'{robot.urdf}; check the arm joints.')
-        raise RobotDescriptionError(msg)
-    rotation = Rotation.from_euler('xyz', joint.rpy)     # URDF rpy: fixed axes
-    link = joint.parent
-    while link in by_child:                              # up to the root (fixed joints)
-        above = by_child[link]
-        rotation = Rotation.from_euler('xyz', above.rpy) * rotation
-        link = above.parent
-    return 1.0 if float(rotation.apply(joint.axis)[2]) >= 0.0 else -1.0
 
 
 def _numbers(value: Any, n: int, what: str, where: str) -> tuple[float, ...]:
@@ -345,7 +102,7 @@ def _section(data: dict, key: str, where: str, kind: type = dict) -> Any:
     return data[key]
 
 
-def _joints(names: Any, what: str, where: str, urdf_joints: dict[str, _UrdfJoint],
+def _joints(names: Any, what: str, where: str, urdf_joints: dict[str, UrdfJoint],
             urdf: Path) -> tuple[str, ...]:
     if not (isinstance(names, list) and names and all(isinstance(n, str) for n in names)):
         msg = f'{where}: {what} must be a list of joint names, got {names!r}.'
@@ -370,7 +127,7 @@ def _link(name: Any, what: str, where: str, links: set[str], urdf: Path) -> str:
     return name
 
 
-def _limits(joint: str, urdf_joints: dict[str, _UrdfJoint], what: str, where: str,
+def _limits(joint: str, urdf_joints: dict[str, UrdfJoint], what: str, where: str,
             urdf: Path) -> JointLimits:
     lim = urdf_joints[joint].limits
     if lim is None or not all(math.isfinite(v) for v in (lim.lower, lim.upper, lim.velocity,
@@ -471,7 +228,7 @@ def _urdf_of(data: dict, path: Path, where: str) -> tuple[str, Path]:
         raise RobotDescriptionError(f'{where}: {exc}') from None
 
 
-def _arm_part(arm: dict, where: str, urdf_joints: dict[str, _UrdfJoint], urdf: Path
+def _arm_part(arm: dict, where: str, urdf_joints: dict[str, UrdfJoint], urdf: Path
               ) -> tuple[tuple[str, ...], tuple[JointLimits, ...], tuple[float, ...],
                          tuple[float, ...]]:
     """Joints, limits, home and max_velocity of an ``arm`` section (or arm description)."""
@@ -510,7 +267,7 @@ def _max_velocity(value: Any, joints: tuple[str, ...], limits: tuple[JointLimits
     return max_velocity
 
 
-def _gripper_part(g: dict, where: str, urdf_joints: dict[str, _UrdfJoint], urdf: Path
+def _gripper_part(g: dict, where: str, urdf_joints: dict[str, UrdfJoint], urdf: Path
                   ) -> GripperDescription:
     g_joints = _joints(g.get('joints'), 'gripper joints', where, urdf_joints, urdf)
     g_limits = tuple(_limits(j, urdf_joints, 'gripper', where, urdf) for j in g_joints)
@@ -542,14 +299,14 @@ def _gripper_part(g: dict, where: str, urdf_joints: dict[str, _UrdfJoint], urdf:
                               self_collision=self_collision, mimic=mimic)
 
 
-def _root_of(links: set[str], urdf_joints: dict[str, _UrdfJoint]) -> str:
+def _root_of(links: set[str], urdf_joints: dict[str, UrdfJoint]) -> str:
     """The root link of a URDF (the link no joint has as its child)."""
     children = {j.child for j in urdf_joints.values()}
     roots = sorted(links - children)
     return roots[0] if roots else ''
 
 
-def _hand_root_in(gripper: GripperDescription, urdf_joints: dict[str, _UrdfJoint]) -> str:
+def _hand_root_in(gripper: GripperDescription, urdf_joints: dict[str, UrdfJoint]) -> str:
     """The link a single-URDF robot's hand hangs by: the link the first gripper joint turns on,
     followed up through fixed joints (the palm and what is welded to it)."""
     by_child = {j.child: j for j in urdf_joints.values()}
@@ -564,7 +321,7 @@ def _load_arm(path: Path) -> ArmDescription:
     where = f'Arm description {str(path)!r}'
     data = _read_yaml(path, where)
     _, urdf = _urdf_of(data, path, where)
-    links, urdf_joints = _read_urdf(urdf, where)
+    links, urdf_joints = read_urdf(urdf, where)
     joints, limits, home, max_velocity = _arm_part(data, where, urdf_joints, urdf)
     flange = _frame(_section(data, 'flange', where), 'flange', where, links, urdf)
     return ArmDescription(name=str(data.get('name', path.stem)), path=path, urdf=urdf,
@@ -577,7 +334,7 @@ def _load_hand(path: Path) -> HandDescription:
     where = f'Hand description {str(path)!r}'
     data = _read_yaml(path, where)
     _, urdf = _urdf_of(data, path, where)
-    links, urdf_joints = _read_urdf(urdf, where)
+    links, urdf_joints = read_urdf(urdf, where)
     gripper = _gripper_part(data, where, urdf_joints, urdf)
     root = _root_of(links, urdf_joints)
     return HandDescription(
@@ -612,155 +369,6 @@ def load_hand(spec: str | Path) -> HandDescription:
     return _load_hand(_find(spec, 'hands').resolve())
 
 
-# ------------------------------------------------------------------ joining arm and hand URDFs
-def _absolute_meshes(root: ET.Element, urdf: Path, where: str) -> None:
-    """Rewrite the mesh file names of ``root`` (a URDF read from ``urdf``) as absolute paths, so
-    the joined file can live anywhere: ``package://`` URIs through the project's resources (or
-    beside the URDF, as PyBullet looks for them), relative paths from the URDF's folder."""
-    for mesh in root.iter('mesh'):
-        name = mesh.get('filename', '')
-        found = None
-        if name.startswith('package://'):
-            with_package = name[len('package://'):]
-            try:
-                found = resolve_path(name, ROBOTS_PACKAGE)
-            except ResourceNotFoundError:
-                found = None
-            if found is None or not found.is_file():
-                # PyBullet's own rule: drop package:// and look beside the URDF and above it
-                for folder in (urdf.parent, *urdf.parent.parents[:2]):
-                    if (folder / with_package).is_file():
-                        found = folder / with_package
-                        break
-        elif name.startswith('file://'):
-            found = Path(name[len('file://'):])
-        elif name:
-            found = urdf.parent / name
-        if found is None or not found.is_file():
-            msg = (f'{where}: the mesh {name!r} of {urdf.name} does not exist; give a path '
-                   'relative to the URDF or a package:// URI the project can resolve.')
-            raise RobotDescriptionError(msg)
-        mesh.set('filename', str(found.resolve()))
-
-
-def _origin(xyz: tuple[float, ...], rpy: tuple[float, ...]) -> ET.Element:
-    return ET.Element('origin', xyz=' '.join(repr(float(v)) for v in xyz),
-                      rpy=' '.join(repr(float(v)) for v in rpy))
-
-
-def _compose(origin: ET.Element | None, xyz: tuple[float, ...], rpy: tuple[float, ...]
-             ) -> ET.Element:
-    """The origin of a joint followed by the offset (xyz m, rpy rad)."""
-    if origin is None:
-        return _origin(xyz, rpy)
-    if not any(xyz) and not any(rpy):
-        return origin
-    p0 = np.array([float(v) for v in origin.get('xyz', '0 0 0').split()])
-    r0 = Rotation.from_euler('xyz', [float(v) for v in origin.get('rpy', '0 0 0').split()])
-    r1 = Rotation.from_euler('xyz', rpy)
-    return _origin(tuple(p0 + r0.apply(xyz)), tuple((r0 * r1).as_euler('xyz')))
-
-
-def merge_urdf(arm: ArmDescription, hand: HandDescription, mount: LinkFrame,
-               joint: str = 'hand_mount', name: str = '') -> str:
-    """The URDF text of ``arm`` with ``hand`` fixed to it: the hand's root link on the link
-    ``mount.link`` (the flange), offset by ``mount.xyz`` m and ``mount.rpy`` rad, through a fixed
-    joint named ``joint``. Mesh paths become absolute.
-
-    An empty flange link (no inertial, visual or collision: a frame, as ROS-Industrial's
-    ``tool0``) that no joint hangs from is replaced by the hand's root, the mount appended to the
-    joint that carried it (its axis expressed in the turned frame): no massless link enters the
-    simulation. The arm's elements come first, the mount joint, then the hand's, in their files'
-    order (PyBullet numbers links in that order).
-    """
-    where = f'Joining the arm {arm.name!r} and the hand {hand.name!r}'
-    trees = []
-    for part in (arm, hand):
-        try:
-            root = ET.parse(str(part.urdf)).getroot()
-        except (OSError, ET.ParseError) as exc:
-            msg = f'{where}: cannot read the URDF {str(part.urdf)!r} ({exc}); give a valid URDF.'
-            raise RobotDescriptionError(msg) from None
-        _absolute_meshes(root, part.urdf, where)
-        trees.append(root)
-    arm_root, hand_root = trees
-    for tag in ('link', 'joint'):
-        clash = sorted({e.get('name') for e in arm_root.findall(tag)}
-                       & {e.get('name') for e in hand_root.findall(tag)})
-        if clash:
-            msg = (f'{where}: both URDFs have a {tag} named {clash[0]!r}; rename it in one of '
-                   'them (e.g. prefix the hand\'s names).')
-            raise RobotDescriptionError(msg)
-    flange = next(e for e in arm_root.findall('link') if e.get('name') == mount.link)
-    into = [j for j in arm_root.findall('joint')
-            if j.find('child') is not None and j.find('child').get('link') == mount.link]
-    hangs = [j for j in arm_root.findall('joint')
-             if j.find('parent') is not None and j.find('parent').get('link') == mount.link]
-    replace = len(flange) == 0 and not hangs and len(into) == 1
-    out = ET.Element('robot', name=name or f'{arm.name}+{hand.name}')
-    materials: set[str] = set()
-    for element in arm_root:
-        if element is flange and replace:
-            continue
-        if element.tag == 'material':
-            materials.add(element.get('name', ''))
-        if element is (into[0] if replace else None):
-            element.find('child').set('link', hand.root)
-            origin = element.find('origin')
-            new = _compose(origin, mount.xyz, mount.rpy)
-            if origin is not None and new is not origin:
-                element.remove(origin)
-            if new is not origin:
-                element.insert(0, new)
-            axis = element.find('axis')
-            if axis is not None and any(mount.rpy):
-                # the joint's axis is in its child's frame, now the hand's root, turned by the
-                # mount: the same axis in the new frame (the Jaco's flange is turned by pi)
-                a = Rotation.from_euler('xyz', mount.rpy).inv().apply(
-                    [float(v) for v in axis.get('xyz', '1 0 0').split()])
-                axis.set('xyz', ' '.join(repr(float(v)) for v in np.round(a, 12) + 0.0))
-        out.append(element)
-    if not replace:
-        fixed = ET.SubElement(out, 'joint', name=joint, type='fixed')
-        ET.SubElement(fixed, 'parent', link=mount.link)
-        ET.SubElement(fixed, 'child', link=hand.root)
-        fixed.append(_origin(mount.xyz, mount.rpy))
-    for element in hand_root:
-        if element.tag == 'material' and element.get('name', '') in materials:
-            continue      # a colour both files define: the arm's
-        out.append(element)
-    ET.indent(out)
-    return '<?xml version="1.0"?>\n' + ET.tostring(out, encoding='unicode') + '\n'
-
-
-def _cache_dir() -> Path:
-    base = os.environ.get('XDG_CACHE_HOME') or str(Path.home() / '.cache')
-    for folder in (Path(base) / 'mindgrasp' / 'robots',
-                   Path(tempfile.gettempdir()) / f'mindgrasp-robots-{os.getuid()}'):
-        try:
-            folder.mkdir(parents=True, exist_ok=True)
-        except OSError:
-            continue
-        if os.access(folder, os.W_OK):
-            return folder
-    msg = f'Cannot write the joined robot URDF to {base}/mindgrasp/robots nor to the temp folder.'
-    raise RobotDescriptionError(msg)
-
-
-def _write_joined(text: str, name: str) -> Path:
-    """Write a joined URDF once, named by its content (processes that join the same pair share
-    the file; the write is atomic)."""
-    digest = hashlib.sha256(text.encode()).hexdigest()[:16]
-    safe = ''.join(c if c.isalnum() or c in '-_' else '_' for c in name)
-    path = _cache_dir() / f'{safe}-{digest}.urdf'
-    if not path.is_file():
-        fd, tmp = tempfile.mkstemp(dir=path.parent, suffix='.tmp')
-        with os.fdopen(fd, 'w', encoding='utf-8') as f:
-            f.write(text)
-        os.replace(tmp, path)
-    return path
-
-
 def _load_pair(data: dict, path: Path | None, where: str) -> RobotDescription:
     base = path.parent if path is not None else None
     arm_spec, hand_spec = data.get('arm'), data.get('hand')
@@ -776,7 +384,7 @@ def _load_pair(data: dict, path: Path | None, where: str) -> RobotDescription:
     if not isinstance(m, dict):
         msg = f"{where}: 'mount' must be a mapping (link:, joint:, xyz:, rpy:), got {m!r}."
         raise RobotDescriptionError(msg)
-    arm_links, _ = _read_urdf(arm.urdf, where)
+    arm_links, _ = read_urdf(arm.urdf, where)
     mount = LinkFrame(
         link=_link(m.get('link', arm.flange.link), 'mount link', where, arm_links, arm.urdf),
         xyz=_numbers(m.get('xyz', list(arm.flange.xyz)), 3, 'mount: xyz', where),
@@ -787,9 +395,9 @@ def _load_pair(data: dict, path: Path | None, where: str) -> RobotDescription:
         raise RobotDescriptionError(msg)
     name = str(data.get('name', path.stem if path is not None else f'{arm.name}+{hand.name}'))
     text = merge_urdf(arm, hand, mount, joint, name)
-    urdf = _write_joined(text, name)
+    urdf = write_joined(text, name)
     where_hand = f'{where} (hand {hand.name!r})'
-    hand_links, _ = _read_urdf(hand.urdf, where_hand)
+    hand_links, _ = read_urdf(hand.urdf, where_hand)
     tcp = hand.tcp if 'tcp' not in data else _frame(_section(data, 'tcp', where), 'tcp', where,
                                                     hand_links, hand.urdf)
     camera = hand.camera if 'camera' not in data else _frame(
@@ -810,7 +418,7 @@ def _load_pair(data: dict, path: Path | None, where: str) -> RobotDescription:
 
 def _load_single(data: dict, path: Path, where: str) -> RobotDescription:
     uri, urdf = _urdf_of(data, path, where)
-    links, urdf_joints = _read_urdf(urdf, where)
+    links, urdf_joints = read_urdf(urdf, where)
     arm_joints, arm_limits, home, max_velocity = _arm_part(_section(data, 'arm', where), where,
                                                            urdf_joints, urdf)
     gripper = _gripper_part(_section(data, 'gripper', where), where, urdf_joints, urdf)

@@ -29,8 +29,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from mindgrasp_common.arm_heading import ArmHeading
 from mindgrasp_common.geometry import wrap_angle
-from mindgrasp_common.robot_description import ArmHeading
 from mindgrasp_common.states import State
 from mindgrasp_common.types import SceneObject
 

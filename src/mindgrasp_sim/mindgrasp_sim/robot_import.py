@@ -3,7 +3,7 @@ maintainer, its output committed under ``config/robots/``).
 
 - :func:`split_urdf` cuts a URDF that holds an arm with its hand into an arm URDF and a hand URDF
   at the fixed joint that carries the hand (the mount), keeping the elements in their order, so
-  that the description joining them again (:func:`mindgrasp_common.robot_description.merge_urdf`)
+  that the description joining them again (:func:`mindgrasp_common.urdf.merge_urdf`)
   gives PyBullet the same bodies;
 - :func:`home_like` finds a home pose that puts a new pair's wrist camera where a shipped
   robot's is at home (``python -m mindgrasp_sim.robot_import home kuka_iiwa+franka_hand``);
