@@ -44,8 +44,8 @@ PIN = ('eeg_source_id:=amp-1', 'eeg_host:=local')
 #: every node that reads the robot description, per profile (plus what each profile needs)
 ROBOT_READERS = {
     'sim': ((), ('sim',)),
-    'demo': ((), ('sim', 'fsm', 'foxglove_bridge')),
-    'experiment': ((), ('sim', 'fsm')),
+    'demo': ((), ('sim', 'fsm', 'foxglove_bridge', 'virtual_amp')),
+    'experiment': ((), ('sim', 'fsm', 'virtual_amp')),   # the oracle subject too (subject:=oracle)
     'trainer': ((), ('sim', 'fsm', 'trainer')),
     'hardware': (('eeg_stream:=amp', 'eeg_source_id:=amp-1', 'eeg_host:=local', 'arm_driver:=true',
                   'model:=package://mindgrasp_classifier/models/default_classifier.json'),
