@@ -388,9 +388,11 @@ def test_tf_tree_and_robot_description_as_robot_state_publisher(rclpy_ctx, spawn
     want = Rotation.from_quat([ee.orientation.x, ee.orientation.y, ee.orientation.z,
                                ee.orientation.w])
     assert (want.inv() * rot).magnitude() < 1e-3
-    # at most 20 Hz, as robot_state_publisher's publish_frequency (joint states at 100 Hz)
+    # at most 20 Hz, as robot_state_publisher's publish_frequency (joint states at 100 Hz): no
+    # two transforms closer than 50 ms of simulated time, less one physics step. Not their median
+    # spacing: a loaded machine loses best-effort messages and widens it (CI: 58.3 ms)
     stamps = sorted(key(m.transforms[0].header.stamp) for m in dynamic)
-    assert np.median(np.diff(stamps)) == pytest.approx(50_000_000, abs=5_000_000)
+    assert np.diff(stamps).min() >= 50_000_000 - 1e9 / 240, np.diff(stamps)
     # the fingers are in the tree too, and the camera images name a frame of it
     assert {'finger_thumb', 'finger_left', 'finger_right'} <= set(edges)
     assert probe.images[-1].header.frame_id in edges
