@@ -262,6 +262,14 @@ class SimNode(rclpy.node.Node):
         self._dt_ns = round(self.sim.dt * 1e9)
         self._stamp_cache: tuple[int, TimeMsg | None] = (-1, None)
 
+    def _skip_steps(self, n: int) -> float:
+        """Move the start time on by ``n`` whole physics steps (a stall skipped); the seconds
+        skipped."""
+        self._t0 += n * self.sim.dt
+        self._t0_ns += n * self._dt_ns
+        self._stamp_cache = (-1, None)
+        return n * self.sim.dt
+
     def sim_now(self) -> float:
         """Node time (s): start time plus simulated time since start (never goes back)."""
         return self._t0 + self.total_steps * self.sim.dt
@@ -353,11 +361,7 @@ class SimNode(rclpy.node.Node):
                     throttle_duration_sec=5.0)
             # a whole number of physics steps, so that every stamp stays the start time plus
             # whole steps (a consumer may count steps between two states)
-            skipped = math.floor((due - cap) * self.sim.physics_hz)
-            skip = skipped * self.sim.dt
-            self._t0 += skip
-            self._t0_ns += skipped * self._dt_ns
-            self._stamp_cache = (-1, None)
+            skip = self._skip_steps(math.floor((due - cap) * self.sim.physics_hz))
             for io in self.robots.values():
                 # commands that arrived during the lag were stamped before the skip; without
                 # this they would all be stale after it, and an overloaded sim ignores its arms
